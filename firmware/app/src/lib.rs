@@ -1,0 +1,2 @@
+#![no_std]
+//! Firmware application logic, independent of the HAL.

@@ -1,0 +1,2 @@
+#![no_std]
+//! Geometry layer of the laser pointing controller.

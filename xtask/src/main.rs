@@ -1,0 +1,56 @@
+//! `cargo xtask <command>`: the project's one entry point for building,
+//! testing, flashing and simulating, plus the geometry and planning tools.
+
+mod calib;
+mod kin;
+mod plan;
+mod toolchain;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser, Debug)]
+#[command(name = "xtask", about = "Laser pointing controller: project tasks")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// fmt check, clippy (host + target), all host tests, release firmware build and size budget.
+    Test,
+    /// Build the release firmware for thumbv7em-none-eabihf.
+    Build,
+    /// Build the release firmware and flash it with `probe-rs run` (streams defmt logs).
+    Flash,
+    /// Print the release firmware's size (text/data/bss) against the budget.
+    Size,
+    /// Gimbal kinematics: `kin ik`, `kin fk`, `kin grid-error`.
+    Kin(kin::KinArgs),
+    /// Error-model calibration: `calib fit --input FILE.csv`.
+    Calib(calib::CalibArgs),
+    /// Galvo jump planning: `plan jump …`, `plan compare`.
+    Plan(plan::PlanArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Test => toolchain::test().map(|()| ExitCode::SUCCESS),
+        Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
+        Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
+        Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
+        Command::Kin(args) => kin::run(args),
+        Command::Calib(args) => calib::run(args),
+        Command::Plan(args) => plan::run(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(err) => {
+            eprintln!("xtask: error: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
