@@ -219,11 +219,7 @@ pub fn size() -> Result<()> {
         .join(TARGET)
         .join("release")
         .join("firmware");
-    let elf = if elf.exists() {
-        elf
-    } else {
-        build_firmware()?
-    };
+    let elf = if elf.exists() { elf } else { build_firmware()? };
     let llvm_size = llvm_size_path()?;
     let out = Command::new(&llvm_size)
         .arg(&elf)

@@ -1,0 +1,154 @@
+//! Argument cursor over a command line's words, with typed, range-checked
+//! accessors that produce [`CommandError`]s naming what was expected.
+
+use super::error::{CommandError, word};
+
+/// The remaining words of a command line.
+#[derive(Debug, Clone)]
+pub struct Args<'a> {
+    words: core::str::SplitAsciiWhitespace<'a>,
+}
+
+impl<'a> Args<'a> {
+    /// Words of `text`, split on ASCII whitespace.
+    pub fn new(text: &'a str) -> Self {
+        Self {
+            words: text.split_ascii_whitespace(),
+        }
+    }
+
+    /// The next word, if any.
+    pub fn next_word(&mut self) -> Option<&'a str> {
+        self.words.next()
+    }
+
+    /// The next word; `what` names it in the error when missing.
+    pub fn word(&mut self, what: &'static str) -> Result<&'a str, CommandError> {
+        self.words.next().ok_or(CommandError::MissingArgument(what))
+    }
+
+    /// The next word parsed as a finite number within `[min, max]`.
+    pub fn number(&mut self, what: &'static str, min: f32, max: f32) -> Result<f32, CommandError> {
+        let text = self.word(what)?;
+        parse_number(text, what, min, max)
+    }
+
+    /// The next word parsed as an integer within `[min, max]`.
+    pub fn integer(&mut self, what: &'static str, min: i32, max: i32) -> Result<i32, CommandError> {
+        let text = self.word(what)?;
+        parse_integer(text, what, min, max)
+    }
+
+    /// Fails if words remain.
+    pub fn finish(mut self) -> Result<(), CommandError> {
+        match self.words.next() {
+            None => Ok(()),
+            Some(extra) => Err(CommandError::UnexpectedArgument(word(extra))),
+        }
+    }
+}
+
+/// Parses a finite decimal number within `[min, max]`.
+pub fn parse_number(
+    text: &str,
+    what: &'static str,
+    min: f32,
+    max: f32,
+) -> Result<f32, CommandError> {
+    let value: f32 = text.parse().map_err(|_| CommandError::InvalidArgument {
+        expected: what,
+        got: word(text),
+    })?;
+    if !value.is_finite() {
+        return Err(CommandError::InvalidArgument {
+            expected: what,
+            got: word(text),
+        });
+    }
+    if !(min..=max).contains(&value) {
+        return Err(CommandError::OutOfRange { what, min, max });
+    }
+    Ok(value)
+}
+
+/// Parses a decimal integer within `[min, max]`.
+pub fn parse_integer(
+    text: &str,
+    what: &'static str,
+    min: i32,
+    max: i32,
+) -> Result<i32, CommandError> {
+    let value: i32 = text.parse().map_err(|_| CommandError::InvalidArgument {
+        expected: what,
+        got: word(text),
+    })?;
+    if !(min..=max).contains(&value) {
+        return Err(CommandError::OutOfRange {
+            what,
+            min: min as f32,
+            max: max as f32,
+        });
+    }
+    Ok(value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_checked_for_finiteness_and_range() {
+        assert_eq!(parse_number("2.5", "x_cm", -20.0, 20.0), Ok(2.5));
+        assert_eq!(parse_number("-20", "x_cm", -20.0, 20.0), Ok(-20.0));
+        assert!(matches!(
+            parse_number("nan", "x_cm", -20.0, 20.0),
+            Err(CommandError::InvalidArgument { .. })
+        ));
+        assert!(matches!(
+            parse_number("inf", "x_cm", -20.0, 20.0),
+            Err(CommandError::InvalidArgument { .. })
+        ));
+        assert!(matches!(
+            parse_number("1e9", "x_cm", -20.0, 20.0),
+            Err(CommandError::OutOfRange { .. })
+        ));
+        assert!(matches!(
+            parse_number("2,5", "x_cm", -20.0, 20.0),
+            Err(CommandError::InvalidArgument { .. })
+        ));
+    }
+
+    #[test]
+    fn integers_reject_fractions_and_overflow() {
+        assert_eq!(parse_integer("-6", "xi", -6, 6), Ok(-6));
+        assert!(parse_integer("1.5", "xi", -6, 6).is_err());
+        assert!(parse_integer("99999999999", "xi", -6, 6).is_err());
+        assert!(matches!(
+            parse_integer("7", "xi", -6, 6),
+            Err(CommandError::OutOfRange { .. })
+        ));
+    }
+
+    #[test]
+    fn finish_rejects_extra_words() {
+        let mut args = Args::new("goto 1 2 3");
+        assert_eq!(args.word("command"), Ok("goto"));
+        assert_eq!(args.number("x", -9.0, 9.0), Ok(1.0));
+        assert_eq!(args.number("y", -9.0, 9.0), Ok(2.0));
+        assert_eq!(
+            args.finish(),
+            Err(CommandError::UnexpectedArgument(word("3")))
+        );
+        assert_eq!(
+            Args::new("goto").skip_command().number("x_cm", -1.0, 1.0),
+            Err(CommandError::MissingArgument("x_cm"))
+        );
+    }
+
+    impl<'a> Args<'a> {
+        fn skip_command(mut self) -> Self {
+            self.next_word();
+            self
+        }
+    }
+}
