@@ -33,6 +33,12 @@ pub enum Error {
     /// (e.g. the torsional resonance sampled at exactly half a period per
     /// sample).
     NotControllable,
+    /// The target state cannot be reached exactly in this many samples (fewer
+    /// samples than states, or a numerically singular reachability Gramian).
+    NotReachable {
+        /// The number of samples that was asked for.
+        samples: usize,
+    },
     /// The move needs more samples than the buffer offered for it.
     CapacityExceeded {
         /// Samples the move needs (a lower bound when `at_least`).
@@ -86,6 +92,10 @@ impl fmt::Display for Error {
             Error::NotControllable => write!(
                 f,
                 "the sampled model is not controllable with this sample period"
+            ),
+            Error::NotReachable { samples } => write!(
+                f,
+                "the target state cannot be reached exactly in {samples} samples"
             ),
             Error::CapacityExceeded { needed, capacity } => write!(
                 f,

@@ -11,7 +11,13 @@
 //! Galvo motion planning.
 
 pub mod error;
+pub mod jump;
 pub mod linalg;
+pub mod min_energy;
 pub mod model;
+pub mod optimal;
+pub mod profile;
+#[cfg(test)]
+mod test_support;
 
 pub use error::Error;

@@ -1,0 +1,591 @@
+//! Time-optimal rest-to-rest planner for the rigid model.
+//!
+//! The rigid model has the eigenvalues 0, p1, p2 (real and negative for the
+//! reference galvo: −2.9e3 and −12.7e3 1/s). For real eigenvalues the
+//! continuous-time minimum-time control under `|U| ≤ Umax` is bang-bang with
+//! at most two switches (Feldbaum): `+Umax` on `[0, t1)`, `−Umax` on
+//! `[t1, t2)`, `+Umax` on `[t2, T)` for a positive move. On the sample grid
+//! the planner keeps that structure:
+//!
+//! 1. **Continuous optimum** `(t1, t2, T)` by Newton's method on the three
+//!    landing equations `θ(T) = D, ω(T) = 0, I(T) = 0`, using the model's
+//!    closed-form step response, with continuation in the distance (start in
+//!    the jerk-limited regime where `t1 = T/4, t2 = 3T/4` is accurate and grow
+//!    the distance ×4 per stage). `T` is a lower bound for every ZOH input,
+//!    so `N ≥ ⌈T/Ts⌉`.
+//! 2. **Sampled bang-bang** for `N = ⌈T/Ts⌉ − 1, ⌈T/Ts⌉, …`: every sample is
+//!    the average of a `+,−,+` signal with switch points `s1 ≤ s2` (in
+//!    samples) — saturated except the two samples containing a switch — and
+//!    the last sample is a free value `v`. The three unknowns `(s1, s2, v)`
+//!    are solved exactly for the discrete landing equations (piecewise
+//!    linear; Newton converges in a few steps). The first `N` with
+//!    `|v| ≤ Umax` is the plan: it lands exactly and never exceeds `Umax`
+//!    by construction.
+//!
+//! When `⌈T/Ts⌉ ≤ 3` (tiny moves) the unique 3-sample (dead-beat) input is
+//! tried first.
+//!
+//! Cost: the closed-form response makes every evaluation a handful of
+//! exponentials, no matrix exponential and no buffer; a 20° move takes
+//! ~10 continuation stages of 3–5 Newton steps plus 1–2 sampled solves.
+
+use crate::error::{Error, finite};
+use crate::jump::{InputLaw, JumpPlan, MethodKind, PlanInfo};
+use crate::linalg::{Matrix, Vector, at, expm_and_integral, mat_vec, solve};
+use crate::min_energy::min_energy_at;
+use crate::model::{Discrete, ModelKind};
+
+/// Diagnostics of a time-optimal plan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OptimalInfo {
+    /// Continuous-time minimum move time `T`, s: a lower bound for any
+    /// input held constant over samples.
+    pub continuous_time_s: f64,
+    /// Continuous-time switching instants `(t1, t2)`, s.
+    pub continuous_switches_s: (f64, f64),
+    /// `⌈T/Ts⌉`: the sample-count lower bound implied by `T`.
+    pub samples_lower_bound: usize,
+    /// Sampled switch points `(s1, s2)` in samples (0 for the dead-beat case).
+    pub switch_samples: (f64, f64),
+    /// Voltage of the free last sample, V (signed for the actual move).
+    pub last_sample_v: f64,
+    /// True when the unique 3-sample input was used (tiny moves).
+    pub deadbeat: bool,
+}
+
+/// The sampled bang-bang input law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BangBang {
+    n: usize,
+    s1: f64,
+    s2: f64,
+    /// Last sample's value for the positive move, V.
+    v_last: f64,
+    u_max_v: f64,
+    sign: f64,
+}
+
+fn overlap(a: f64, b: f64, c: f64, d: f64) -> f64 {
+    (b.min(d) - a.max(c)).max(0.0)
+}
+
+impl BangBang {
+    /// Voltage of sample `k`.
+    pub(crate) fn u_v(&self, k: usize) -> f64 {
+        if k + 1 == self.n {
+            return self.sign * self.v_last;
+        }
+        if k >= self.n {
+            return 0.0;
+        }
+        let (a, b) = (k as f64, k as f64 + 1.0);
+        let end = (self.n - 1) as f64;
+        let avg = overlap(a, b, 0.0, self.s1) - overlap(a, b, self.s1, self.s2)
+            + overlap(a, b, self.s2, end);
+        self.sign * self.u_max_v * avg
+    }
+}
+
+// ---- closed-form response of the rigid model ------------------------------
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct C {
+    re: f64,
+    im: f64,
+}
+
+impl C {
+    const fn new(re: f64, im: f64) -> Self {
+        Self { re, im }
+    }
+    fn add(self, o: C) -> C {
+        C::new(self.re + o.re, self.im + o.im)
+    }
+    fn sub(self, o: C) -> C {
+        C::new(self.re - o.re, self.im - o.im)
+    }
+    fn mul(self, o: C) -> C {
+        C::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+    fn scale(self, s: f64) -> C {
+        C::new(self.re * s, self.im * s)
+    }
+    fn div(self, o: C) -> C {
+        let d = o.re * o.re + o.im * o.im;
+        C::new(
+            (self.re * o.re + self.im * o.im) / d,
+            (self.im * o.re - self.re * o.im) / d,
+        )
+    }
+    fn abs(self) -> f64 {
+        libm::hypot(self.re, self.im)
+    }
+    /// `e^z`.
+    fn exp(self) -> C {
+        let m = libm::exp(self.re);
+        C::new(m * libm::cos(self.im), m * libm::sin(self.im))
+    }
+    /// `e^z − 1`, accurate for small |z|.
+    fn exp_m1(self) -> C {
+        let s = libm::sin(0.5 * self.im);
+        C::new(
+            libm::expm1(self.re) * libm::cos(self.im) - 2.0 * s * s,
+            libm::exp(self.re) * libm::sin(self.im),
+        )
+    }
+}
+
+/// `E1(z) = (e^z − 1)/z` and `E2(z) = (e^z − 1 − z)/z²`.
+fn e12(z: C) -> (C, C) {
+    if z.abs() < 0.5 {
+        // Series: E1 = Σ z^k/(k+1)!, E2 = Σ z^k/(k+2)!; 20 terms ≪ 1e-17.
+        let mut e1 = C::new(0.0, 0.0);
+        let mut e2 = C::new(0.0, 0.0);
+        let mut zk = C::new(1.0, 0.0);
+        let mut fact1 = 1.0; // (k+1)!
+        for k in 0..20u32 {
+            let f1 = fact1;
+            let f2 = fact1 * f64::from(k + 2);
+            e1 = e1.add(zk.scale(1.0 / f1));
+            e2 = e2.add(zk.scale(1.0 / f2));
+            zk = zk.mul(z);
+            fact1 = f2;
+        }
+        (e1, e2)
+    } else {
+        let em1 = z.exp_m1();
+        let e1 = em1.div(z);
+        let e2 = em1.sub(z).div(z.mul(z));
+        (e1, e2)
+    }
+}
+
+/// Impulse response `ψ(τ) = e^{Aτ}·B` and step response `Ψ(τ) = ∫₀^τ ψ` of
+/// the rigid model. With `c = Kt/J` and the roots p1, p2 of
+/// `s² + (R/L)s + Kt²/(J·L)`, writing `Δ[f] = (f(p1) − f(p2))/(p1 − p2)`:
+/// `ψ = (c/L)·(Δ[τE1(pτ)], Δ[e^{pτ}], Δ[p·e^{pτ}]/c)`,
+/// `Ψ = (c/L)·(Δ[τ²E2(pτ)], Δ[τE1(pτ)], Δ[e^{pτ}]/c)`.
+/// Falls back to the matrix exponential when the roots nearly coincide.
+#[derive(Debug, Clone, Copy)]
+struct RigidResponse {
+    c: f64,
+    inv_l: f64,
+    p1: C,
+    p2: C,
+    a: Matrix<3, 3>,
+    b: Vector<3>,
+    closed_form: bool,
+}
+
+impl RigidResponse {
+    fn new(kt: f64, j: f64, l: f64, r: f64, a: Matrix<3, 3>, b: Vector<3>) -> Self {
+        let alpha = r / l;
+        let beta = kt * kt / (j * l);
+        let disc = alpha * alpha - 4.0 * beta;
+        let (p1, p2) = if disc >= 0.0 {
+            // Numerically stable real roots.
+            let q = -0.5 * (alpha + libm::sqrt(disc));
+            (C::new(q, 0.0), C::new(beta / q, 0.0))
+        } else {
+            let w = 0.5 * libm::sqrt(-disc);
+            (C::new(-0.5 * alpha, w), C::new(-0.5 * alpha, -w))
+        };
+        let sep = p1.sub(p2).abs();
+        let closed_form = sep > 1e-4 * p1.abs().max(p2.abs()) && sep.is_finite();
+        Self {
+            c: kt / j,
+            inv_l: 1.0 / l,
+            p1,
+            p2,
+            a,
+            b,
+            closed_form,
+        }
+    }
+
+    fn dd(&self, f: impl Fn(C) -> C) -> f64 {
+        f(self.p1).sub(f(self.p2)).div(self.p1.sub(self.p2)).re
+    }
+
+    /// `(ψ(τ), Ψ(τ))`.
+    fn response(&self, tau: f64) -> (Vector<3>, Vector<3>) {
+        if !self.closed_form {
+            let (e, phi) = expm_and_integral(&self.a, tau);
+            return (mat_vec(&e, &self.b), mat_vec(&phi, &self.b));
+        }
+        let k = self.c * self.inv_l;
+        let t1 = self.dd(|p| e12(p.scale(tau)).0.scale(tau));
+        let t2 = self.dd(|p| e12(p.scale(tau)).1.scale(tau * tau));
+        let ex = self.dd(|p| p.scale(tau).exp());
+        let pex = self.dd(|p| p.mul(p.scale(tau).exp()));
+        (
+            [k * t1, k * ex, self.inv_l * pex],
+            [k * t2, k * t1, self.inv_l * ex],
+        )
+    }
+
+    fn step_response(&self, tau: f64) -> Vector<3> {
+        if tau <= 0.0 {
+            [0.0; 3]
+        } else {
+            self.response(tau).1
+        }
+    }
+
+    fn impulse_response(&self, tau: f64) -> Vector<3> {
+        if tau < 0.0 {
+            [0.0; 3]
+        } else {
+            self.response(tau).0
+        }
+    }
+}
+
+// ---- a small damped Newton solver for three unknowns ----------------------
+
+struct Newton3 {
+    /// Residual scales (θ, ω, I).
+    scales: Vector<3>,
+    tol: f64,
+    max_iter: u32,
+}
+
+impl Newton3 {
+    fn merit(&self, r: &Vector<3>) -> f64 {
+        r.iter()
+            .zip(self.scales.iter())
+            .map(|(x, s)| {
+                let y = x / s;
+                y * y
+            })
+            .sum()
+    }
+
+    /// Solves `r(x) = 0`. `eval` returns the residual and the Jacobian
+    /// (columns = partial derivatives), `project` maps onto the feasible
+    /// domain, `nudge` moves off a singular point.
+    fn solve(
+        &self,
+        mut x: Vector<3>,
+        eval: impl Fn(&Vector<3>) -> (Vector<3>, Matrix<3, 3>),
+        project: impl Fn(Vector<3>) -> Vector<3>,
+        nudge: impl Fn(Vector<3>) -> Vector<3>,
+    ) -> Option<Vector<3>> {
+        x = project(x);
+        for _ in 0..self.max_iter {
+            let (r, jac) = eval(&x);
+            let m = self.merit(&r);
+            if !m.is_finite() {
+                return None;
+            }
+            if m <= self.tol * self.tol {
+                return Some(x);
+            }
+            let Some((dx, _)) = solve(jac, [-at(&r, 0), -at(&r, 1), -at(&r, 2)]) else {
+                x = project(nudge(x));
+                continue;
+            };
+            let mut step = 1.0;
+            let mut accepted = false;
+            for _ in 0..40 {
+                let cand = project(core::array::from_fn(|i| at(&x, i) + step * at(&dx, i)));
+                let (rc, _) = eval(&cand);
+                let mc = self.merit(&rc);
+                if mc.is_finite() && mc < m * (1.0 - 1e-4 * step) {
+                    x = cand;
+                    accepted = true;
+                    break;
+                }
+                step *= 0.5;
+            }
+            if !accepted {
+                // Stuck on a kink or bound: try moving off it once.
+                let moved = project(nudge(x));
+                if moved == x {
+                    return None;
+                }
+                x = moved;
+            }
+        }
+        None
+    }
+}
+
+/// Continuous-time optimum `(t1, t2, T)` for a positive distance `d`.
+fn continuous_optimum(
+    resp: &RigidResponse,
+    u_max: f64,
+    d: f64,
+    omega_scale: f64,
+    current_scale: f64,
+    jerk: f64,
+    tau_e: f64,
+) -> Option<Vector<3>> {
+    let solve_at = |dist: f64, guess: Vector<3>| -> Option<Vector<3>> {
+        let newton = Newton3 {
+            scales: [dist, omega_scale, current_scale],
+            tol: 1e-12,
+            max_iter: 60,
+        };
+        let eval = |x: &Vector<3>| {
+            let [t1, t2, t] = *x;
+            let (g_t, s_t) = resp.response(t);
+            let g1 = resp.impulse_response(t - t1);
+            let g2 = resp.impulse_response(t - t2);
+            let s1 = resp.step_response(t - t1);
+            let s2 = resp.step_response(t - t2);
+            let target = [dist, 0.0, 0.0];
+            let r: Vector<3> = core::array::from_fn(|i| {
+                u_max * (at(&s_t, i) - 2.0 * at(&s1, i) + 2.0 * at(&s2, i)) - at(&target, i)
+            });
+            let jac: Matrix<3, 3> = core::array::from_fn(|i| {
+                [
+                    2.0 * u_max * at(&g1, i),
+                    -2.0 * u_max * at(&g2, i),
+                    u_max * (at(&g_t, i) - 2.0 * at(&g1, i) + 2.0 * at(&g2, i)),
+                ]
+            });
+            (r, jac)
+        };
+        let project = |x: Vector<3>| -> Vector<3> {
+            let t = x[2].max(1e-12);
+            let t1 = x[0].clamp(0.0, t);
+            let t2 = x[1].clamp(t1, t);
+            [t1, t2, t]
+        };
+        let nudge = |x: Vector<3>| -> Vector<3> { [x[0] * 0.9, x[1], x[2] * 1.05] };
+        newton.solve(guess, eval, project, nudge)
+    };
+    // Jerk-limited (triple integrator) solution: D = jerk·T³/32, t1 = T/4,
+    // t2 = 3T/4; accurate while T ≪ L/R.
+    let triple = |dist: f64| -> Vector<3> {
+        let t = libm::cbrt(32.0 * dist / jerk);
+        [0.25 * t, 0.75 * t, t]
+    };
+    let d0 = jerk * (0.1 * tau_e) * (0.1 * tau_e) * (0.1 * tau_e) / 32.0;
+    if d <= d0 {
+        return solve_at(d, triple(d));
+    }
+    let mut cur_d = d0;
+    let mut cur = solve_at(d0, triple(d0))?;
+    let mut ratio = 4.0;
+    let mut failures = 0;
+    while cur_d < d {
+        let next_d = (cur_d * ratio).min(d);
+        let scale = libm::sqrt(next_d / cur_d);
+        let guess = [cur[0] * scale, cur[1] * scale, cur[2] * scale];
+        match solve_at(next_d, guess) {
+            Some(x) => {
+                cur = x;
+                cur_d = next_d;
+                ratio = 4.0;
+            }
+            None => {
+                failures += 1;
+                if failures > 12 {
+                    return None;
+                }
+                ratio = 1.0 + 0.5 * (ratio - 1.0);
+            }
+        }
+    }
+    Some(cur)
+}
+
+/// Sampled bang-bang with a free last sample at exactly `n` samples:
+/// `(s1, s2, v)` or `None` if there is no such input with `|v| ≤ Umax`.
+fn sampled_bang_bang(
+    resp: &RigidResponse,
+    ts: f64,
+    u_max: f64,
+    d: f64,
+    n: usize,
+    guess: (f64, f64),
+    scales: Vector<3>,
+) -> Option<Vector<3>> {
+    if n < 4 {
+        return None;
+    }
+    let last = (n - 1) as f64;
+    // Ψ at q samples.
+    let big_s = |q: usize| resp.step_response(q as f64 * ts);
+    // R(s): response at sample n of an averaged unit step starting at s,
+    // and its derivative −g_q.
+    let r_of = |s: f64| -> (Vector<3>, Vector<3>) {
+        let m = libm::floor(s).clamp(0.0, (n - 1) as f64);
+        let f = s - m;
+        let q = n - 1 - m as usize;
+        let (hi, lo) = (big_s(q + 1), big_s(q));
+        let r = core::array::from_fn(|i| (1.0 - f) * at(&hi, i) + f * at(&lo, i));
+        // Derivative in cell min(m, n−2).
+        let qd = if m as usize >= n - 1 { 1 } else { q };
+        let (hd, ld) = (big_s(qd + 1), big_s(qd));
+        let g = core::array::from_fn(|i| at(&hd, i) - at(&ld, i));
+        (r, g)
+    };
+    let r0 = big_s(n);
+    let g0 = big_s(1);
+    let eval = |x: &Vector<3>| {
+        let [s1, s2, v] = *x;
+        let (r1, g1) = r_of(s1);
+        let (r2, g2) = r_of(s2);
+        let target = [d, 0.0, 0.0];
+        let r: Vector<3> = core::array::from_fn(|i| {
+            u_max * (at(&r0, i) - 2.0 * at(&r1, i) + 2.0 * at(&r2, i) - at(&g0, i)) + v * at(&g0, i)
+                - at(&target, i)
+        });
+        let jac: Matrix<3, 3> = core::array::from_fn(|i| {
+            [
+                2.0 * u_max * at(&g1, i),
+                -2.0 * u_max * at(&g2, i),
+                at(&g0, i),
+            ]
+        });
+        (r, jac)
+    };
+    let project = |x: Vector<3>| -> Vector<3> {
+        let s1 = x[0].clamp(0.0, last);
+        let s2 = x[1].clamp(s1, last);
+        [s1, s2, x[2]]
+    };
+    // Singular when both switches share a sample: push the second one into
+    // the next sample.
+    let nudge = |x: Vector<3>| -> Vector<3> {
+        let s2 = (libm::floor(x[0]) + 1.0).min(last).max(x[1]);
+        if s2 > x[1] {
+            [x[0], s2, x[2]]
+        } else {
+            [(x[0] - 0.5).max(0.0), x[1], x[2]]
+        }
+    };
+    let newton = Newton3 {
+        scales,
+        tol: 1e-12,
+        max_iter: 60,
+    };
+    let g = (guess.0.clamp(0.0, last), guess.1.clamp(0.0, last));
+    let x = newton.solve([g.0, g.1, 0.0], eval, project, nudge)?;
+    if libm::fabs(x[2]) <= u_max {
+        Some(x)
+    } else {
+        None
+    }
+}
+
+/// How many sample counts above the continuous bound are tried.
+const EXTRA_SAMPLE_COUNTS: usize = 12;
+
+/// Time-optimal rest-to-rest move from `from_rad` to `to_rad` (rigid model
+/// only). See the module documentation.
+pub fn plan_time_optimal<const S: usize>(
+    disc: &Discrete<S>,
+    from_rad: f64,
+    to_rad: f64,
+    capacity: usize,
+) -> Result<JumpPlan<S>, Error> {
+    if S != 3 || disc.model().kind() != ModelKind::Rigid {
+        return Err(Error::UnsupportedModel);
+    }
+    let from_rad = finite("from_rad", from_rad)?;
+    let to_rad = finite("to_rad", to_rad)?;
+    let model = disc.model();
+    let z0 = model.rest_state(from_rad);
+    let z1 = model.rest_state(to_rad);
+    if from_rad == to_rad {
+        return Ok(JumpPlan::hold(disc, z0));
+    }
+    let delta = to_rad - from_rad;
+    let (d, sign) = (libm::fabs(delta), if delta < 0.0 { -1.0 } else { 1.0 });
+    let drive = model.drive();
+    let u_max = disc.u_max_v();
+    let ts = disc.ts_s();
+    let a3: Matrix<3, 3> = core::array::from_fn(|i| {
+        core::array::from_fn(|j| model.a().get(i).map_or(0.0, |row| at(row, j)))
+    });
+    let b3: Vector<3> = core::array::from_fn(|i| at(model.b(), i));
+    let resp = RigidResponse::new(
+        drive.kt_nm_per_a,
+        drive.j_kg_m2,
+        drive.l_h,
+        drive.r_ohm,
+        a3,
+        b3,
+    );
+    let omega_scale = u_max / drive.kt_nm_per_a;
+    let current_scale = u_max / drive.r_ohm;
+    let jerk = drive.kt_nm_per_a * u_max / (drive.j_kg_m2 * drive.l_h);
+    let tau_e = drive.l_h / drive.r_ohm;
+    let cont = continuous_optimum(&resp, u_max, d, omega_scale, current_scale, jerk, tau_e)
+        .ok_or(Error::NoConvergence)?;
+    let [t1, t2, t_c] = cont;
+    let n_lo = crate::min_energy::samples_for(t_c, ts).max(1);
+    let mut info = OptimalInfo {
+        continuous_time_s: t_c,
+        continuous_switches_s: (t1, t2),
+        samples_lower_bound: n_lo,
+        switch_samples: (0.0, 0.0),
+        last_sample_v: 0.0,
+        deadbeat: false,
+    };
+    if n_lo <= S {
+        if S > capacity {
+            return Err(Error::CapacityExceeded {
+                needed: S,
+                capacity,
+            });
+        }
+        if let Some(sol) = min_energy_at(disc, &z0, &z1, S, 2)
+            && sol.max_abs_u_v <= u_max
+        {
+            info.deadbeat = true;
+            return Ok(JumpPlan::new(
+                disc,
+                z0,
+                z1,
+                S,
+                InputLaw::MinEnergy { lambda: sol.lambda },
+                MethodKind::TimeOptimal,
+                PlanInfo::Optimal(info),
+            ));
+        }
+    }
+    let scales = [d, omega_scale, current_scale];
+    let first = n_lo.saturating_sub(1).max(S + 1);
+    for n in first..first + EXTRA_SAMPLE_COUNTS {
+        if n > capacity {
+            return Err(Error::CapacityExceeded {
+                needed: n,
+                capacity,
+            });
+        }
+        let guess = (t1 / ts, t2 / ts);
+        if let Some([s1, s2, v]) = sampled_bang_bang(&resp, ts, u_max, d, n, guess, scales) {
+            info.switch_samples = (s1, s2);
+            info.last_sample_v = sign * v;
+            let law = BangBang {
+                n,
+                s1,
+                s2,
+                v_last: v,
+                u_max_v: u_max,
+                sign,
+            };
+            return Ok(JumpPlan::new(
+                disc,
+                z0,
+                z1,
+                n,
+                InputLaw::BangBang(law),
+                MethodKind::TimeOptimal,
+                PlanInfo::Optimal(info),
+            ));
+        }
+    }
+    Err(Error::NoConvergence)
+}
+
+#[cfg(test)]
+mod tests;
