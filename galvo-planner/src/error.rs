@@ -62,6 +62,8 @@ pub enum Error {
     NoConvergence,
     /// The stepper's move queue or sample ring has no room for this move.
     QueueFull,
+    /// A plan made for a different sampled model than the stepper's.
+    ModelMismatch,
     /// A queued move does not start where the previously queued move ends.
     DiscontinuousMove,
     /// A path segment was added while the look-ahead buffer is full.
@@ -110,6 +112,10 @@ impl fmt::Display for Error {
             ),
             Error::NoConvergence => write!(f, "the planner's solver did not converge"),
             Error::QueueFull => write!(f, "the stepper queue is full"),
+            Error::ModelMismatch => write!(
+                f,
+                "the plan was made for a different sampled model than the stepper's"
+            ),
             Error::DiscontinuousMove => write!(
                 f,
                 "the move does not start where the previously queued move ends"

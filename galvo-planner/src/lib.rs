@@ -17,6 +17,7 @@ pub mod min_energy;
 pub mod model;
 pub mod optimal;
 pub mod profile;
+pub mod stepper;
 #[cfg(test)]
 mod test_support;
 

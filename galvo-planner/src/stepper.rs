@@ -1,0 +1,314 @@
+//! The per-sample state-update stepper: what the galvo loop calls every
+//! sample (or once per DMA block).
+//!
+//! A [`Stepper`] owns one axis's commanded state and a ring of queued input
+//! voltages. Every sample it advances
+//! `Z(k+1) = Z(k) + ((Ad − I)·Z(k) + Bd·U(k))` in `f32` and yields the
+//! commanded motor angle θ. When a move's last sample is reached the state
+//! snaps to the move's exact planned target, so `f32` rounding never
+//! accumulates from one move to the next; when no move is queued it holds
+//! the last position without integrating.
+//!
+//! ## Per-sample cost
+//!
+//! The Cortex-M4F FPU is single precision only, so the update is `f32`
+//! with the model stored as `Ad − I` (the increment form keeps the
+//! near-one diagonal of `Ad` from losing the small rates in rounding) and a
+//! compensated (Kahan) accumulation of the state. Per sample and axis:
+//! `S²` multiply-adds for `(Ad − I)·Z`, `S` for `Bd·U`, and `4·S` for the
+//! compensated sum, i.e. **3 states: 9 + 3 + 12 = 24 multiply-adds ≈ 36
+//! flops; 5 states: 25 + 5 + 20 = 50 ≈ 80 flops**, plus a ring-buffer read
+//! and a counter compare. On the M4F (1-cycle `vmla`/`vadd`, plus loads)
+//! that is roughly 60–100 cycles for the rigid model, i.e. < 12 % of the
+//! ≈ 1680-cycle budget per sample for two axes at 100 kHz.
+//!
+//! Accuracy (tests): over ±10° moves the `f32` angle stays within 2e-8 rad
+//! (about one `f32` ulp) of the `f64` ZOH simulation at Ts = 10 µs and 1 µs;
+//! without the compensated sum the error reaches 7e-7 rad at Ts = 1 µs.
+//!
+//! ## Queueing
+//!
+//! Moves are appended with [`Stepper::queue`] while one runs; each must start
+//! at the state where the previously queued one ends
+//! ([`Stepper::end_state`]). Capacity is fixed at compile time: `CAP` input
+//! samples in the ring and `Q` moves.
+
+use crate::error::Error;
+use crate::jump::{JumpPlan, XyJump};
+use crate::linalg::{Matrix, Vector, at};
+use crate::model::{Discrete, THETA};
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct QueuedMove<const S: usize> {
+    samples: usize,
+    target: Vector<S>,
+}
+
+/// One axis: model, commanded state, queued inputs.
+#[derive(Debug, Clone)]
+pub struct Stepper<const S: usize, const CAP: usize, const Q: usize = 4> {
+    a_minus_i: [[f32; S]; S],
+    bd: [f32; S],
+    ad64: Matrix<S, S>,
+    bd64: Vector<S>,
+    z: [f32; S],
+    comp: [f32; S],
+    ring: [f32; CAP],
+    read: usize,
+    queued: usize,
+    moves: [QueuedMove<S>; Q],
+    move_read: usize,
+    move_count: usize,
+    k_in_move: usize,
+    end_state: Vector<S>,
+}
+
+fn to_f32<const S: usize>(z: &Vector<S>) -> [f32; S] {
+    core::array::from_fn(|i| at(z, i) as f32)
+}
+
+/// Relative tolerance for "the plan starts where the queue ends".
+const CONTINUITY_TOL: f64 = 1e-9;
+
+impl<const S: usize, const CAP: usize, const Q: usize> Stepper<S, CAP, Q> {
+    /// A stepper at rest at `theta_rad` for the sampled model `disc`.
+    pub fn new(disc: &Discrete<S>, theta_rad: f64) -> Result<Self, Error> {
+        let theta_rad = crate::error::finite("theta_rad", theta_rad)?;
+        let rest = disc.model().rest_state(theta_rad);
+        let ad = disc.ad();
+        let a_minus_i = core::array::from_fn(|i| {
+            core::array::from_fn(|j| {
+                let a = ad.get(i).map_or(0.0, |row| at(row, j));
+                (if i == j { a - 1.0 } else { a }) as f32
+            })
+        });
+        Ok(Self {
+            a_minus_i,
+            bd: to_f32(disc.bd()),
+            ad64: *ad,
+            bd64: *disc.bd(),
+            z: to_f32(&rest),
+            comp: [0.0; S],
+            ring: [0.0; CAP],
+            read: 0,
+            queued: 0,
+            moves: [QueuedMove {
+                samples: 0,
+                target: rest,
+            }; Q],
+            move_read: 0,
+            move_count: 0,
+            k_in_move: 0,
+            end_state: rest,
+        })
+    }
+
+    /// Checks whether `plan` could be queued now (same model, starts where
+    /// the queue ends, room in the ring and the move list).
+    pub fn check_queue(&self, plan: &JumpPlan<S>) -> Result<(), Error> {
+        if plan.discrete().ad() != &self.ad64 || plan.discrete().bd() != &self.bd64 {
+            return Err(Error::ModelMismatch);
+        }
+        let continuous = plan
+            .start_state()
+            .iter()
+            .zip(self.end_state.iter())
+            .all(|(a, b)| libm::fabs(a - b) <= CONTINUITY_TOL * (1.0 + libm::fabs(*b)));
+        if !continuous {
+            return Err(Error::DiscontinuousMove);
+        }
+        if plan.samples() > 0 && (self.move_count >= Q || self.queued + plan.samples() > CAP) {
+            return Err(Error::QueueFull);
+        }
+        Ok(())
+    }
+
+    /// Appends `plan` behind the queued moves. Its voltages are copied into
+    /// the ring (as `f32`); the plan itself is not kept.
+    pub fn queue(&mut self, plan: &JumpPlan<S>) -> Result<(), Error> {
+        self.check_queue(plan)?;
+        let n = plan.samples();
+        if n == 0 {
+            return Ok(());
+        }
+        let tail = (self.read + self.queued) % CAP;
+        let ring = &mut self.ring;
+        plan.for_each_input_rev(|k, u| {
+            if let Some(slot) = ring.get_mut((tail + k) % CAP) {
+                *slot = u as f32;
+            }
+        });
+        let slot = (self.move_read + self.move_count) % Q;
+        if let Some(m) = self.moves.get_mut(slot) {
+            *m = QueuedMove {
+                samples: n,
+                target: *plan.target_state(),
+            };
+        }
+        self.move_count += 1;
+        self.queued += n;
+        self.end_state = *plan.target_state();
+        Ok(())
+    }
+
+    /// Advances one sample period and returns the commanded motor angle θ
+    /// (rad) at the new sample. Idle: returns the held angle.
+    #[inline]
+    pub fn step(&mut self) -> f32 {
+        if self.move_count == 0 {
+            return self.position_rad();
+        }
+        let u = self.ring.get(self.read).copied().unwrap_or(0.0);
+        self.read = (self.read + 1) % CAP;
+        self.queued = self.queued.saturating_sub(1);
+        // Z += (Ad − I)·Z + Bd·u, with compensated summation.
+        let z = self.z;
+        for (((zi, ci), row), b) in self
+            .z
+            .iter_mut()
+            .zip(self.comp.iter_mut())
+            .zip(self.a_minus_i.iter())
+            .zip(self.bd.iter())
+        {
+            let mut inc = b * u;
+            for (a, x) in row.iter().zip(z.iter()) {
+                inc += a * x;
+            }
+            let y = inc - *ci;
+            let t = *zi + y;
+            *ci = (t - *zi) - y;
+            *zi = t;
+        }
+        self.k_in_move += 1;
+        let current = self.moves.get(self.move_read).copied();
+        if let Some(m) = current
+            && self.k_in_move >= m.samples
+        {
+            // Land exactly on the planned target.
+            self.z = to_f32(&m.target);
+            self.comp = [0.0; S];
+            self.k_in_move = 0;
+            self.move_read = (self.move_read + 1) % Q;
+            self.move_count -= 1;
+        }
+        self.position_rad()
+    }
+
+    /// Fills `out` with the commanded angle of the next `out.len()` samples.
+    pub fn fill(&mut self, out: &mut [f32]) {
+        for o in out.iter_mut() {
+            *o = self.step();
+        }
+    }
+
+    /// Commanded motor angle now, rad.
+    pub fn position_rad(&self) -> f32 {
+        self.z.get(THETA).copied().unwrap_or(0.0)
+    }
+    /// Full commanded state now (θ, ω, I[, φ, ω_φ]).
+    pub fn state(&self) -> &[f32; S] {
+        &self.z
+    }
+    /// True when no move is running or queued (holding position).
+    pub fn is_idle(&self) -> bool {
+        self.move_count == 0
+    }
+    /// Queued samples left, including the rest of the running move.
+    pub fn remaining_samples(&self) -> usize {
+        self.queued
+    }
+    /// Free input slots in the ring.
+    pub fn free_samples(&self) -> usize {
+        CAP - self.queued
+    }
+    /// Moves queued, including the running one.
+    pub fn queued_moves(&self) -> usize {
+        self.move_count
+    }
+    /// The state where the last queued move ends (plan the next one from
+    /// here).
+    pub fn end_state(&self) -> &Vector<S> {
+        &self.end_state
+    }
+    /// θ of [`end_state`](Self::end_state), rad.
+    pub fn end_position_rad(&self) -> f64 {
+        at(&self.end_state, THETA)
+    }
+
+    /// Drops the queued moves that have not started yet; the running move
+    /// completes. Returns how many were dropped.
+    pub fn clear_pending(&mut self) -> usize {
+        if self.move_count <= 1 {
+            return 0;
+        }
+        let dropped = self.move_count - 1;
+        let remaining_in_current = self
+            .moves
+            .get(self.move_read)
+            .map_or(0, |m| m.samples.saturating_sub(self.k_in_move));
+        self.queued = remaining_in_current;
+        self.move_count = 1;
+        if let Some(m) = self.moves.get(self.move_read) {
+            self.end_state = m.target;
+        }
+        dropped
+    }
+}
+
+/// Both mirror axes of a galvo scanner, stepped together.
+#[derive(Debug, Clone)]
+pub struct XyStepper<const S: usize, const CAP: usize, const Q: usize = 4> {
+    /// X mirror.
+    pub x: Stepper<S, CAP, Q>,
+    /// Y mirror.
+    pub y: Stepper<S, CAP, Q>,
+}
+
+impl<const S: usize, const CAP: usize, const Q: usize> XyStepper<S, CAP, Q> {
+    /// Both axes at rest at `theta_rad = [θx, θy]`.
+    pub fn new(
+        disc_x: &Discrete<S>,
+        disc_y: &Discrete<S>,
+        theta_rad: [f64; 2],
+    ) -> Result<Self, Error> {
+        let [tx, ty] = theta_rad;
+        Ok(Self {
+            x: Stepper::new(disc_x, tx)?,
+            y: Stepper::new(disc_y, ty)?,
+        })
+    }
+
+    /// Queues both axes of a jump, or neither.
+    pub fn queue_jump(&mut self, jump: &XyJump<S>) -> Result<(), Error> {
+        self.x.check_queue(&jump.x)?;
+        self.y.check_queue(&jump.y)?;
+        self.x.queue(&jump.x)?;
+        self.y.queue(&jump.y)
+    }
+
+    /// One sample of both axes: `[θx, θy]`, rad.
+    #[inline]
+    pub fn step(&mut self) -> [f32; 2] {
+        [self.x.step(), self.y.step()]
+    }
+
+    /// Fills a block of `[θx, θy]` samples.
+    pub fn fill(&mut self, out: &mut [[f32; 2]]) {
+        for o in out.iter_mut() {
+            *o = self.step();
+        }
+    }
+
+    /// True when both axes hold position.
+    pub fn is_idle(&self) -> bool {
+        self.x.is_idle() && self.y.is_idle()
+    }
+
+    /// Where the queued jumps end, `[θx, θy]`, rad.
+    pub fn end_position_rad(&self) -> [f64; 2] {
+        [self.x.end_position_rad(), self.y.end_position_rad()]
+    }
+}
+
+#[cfg(test)]
+mod tests;

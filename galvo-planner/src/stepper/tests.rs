@@ -1,0 +1,209 @@
+extern crate std;
+
+use super::*;
+use crate::jump::{JumpSync, Method, plan_jump, plan_xy_jump};
+use crate::test_support::{DEG, flex, rigid, simulate};
+use proptest::prelude::*;
+use std::vec::Vec;
+
+/// Runs the plan through a fresh stepper and the f64 ZOH simulation and
+/// returns the largest θ difference over the move.
+fn tracking_error<const S: usize>(plan: &JumpPlan<S>) -> f64 {
+    let mut st: Stepper<S, 4096> =
+        Stepper::new(plan.discrete(), plan.start_state()[0]).expect("stepper");
+    st.queue(plan).expect("queue");
+    let (states, _) = simulate(plan);
+    let mut worst = 0.0f64;
+    for z in states.iter().skip(1) {
+        let theta = st.step();
+        worst = worst.max((f64::from(theta) - z[0]).abs());
+    }
+    assert!(st.is_idle());
+    // Snapped to the exact target (as f32).
+    assert_eq!(st.position_rad(), plan.target_state()[0] as f32);
+    worst
+}
+
+#[test]
+fn f32_stepper_tracks_the_f64_plan() {
+    for ts in [10e-6, 1e-6] {
+        let d = rigid(ts);
+        for method in [
+            Method::TimeOptimal,
+            Method::SEED,
+            Method::SCurve,
+            Method::TCurve,
+        ] {
+            for (from, to) in [(-10.0, 10.0), (3.0, 3.05), (12.0, -8.0)] {
+                let plan = plan_jump(&d, from * DEG, to * DEG, method, 4096).expect("plan");
+                let e = tracking_error(&plan);
+                assert!(e <= 1e-6, "Ts {ts} {method:?} {from}→{to}: {e} rad");
+            }
+        }
+        let df = flex(ts);
+        let plan = plan_jump(&df, -10.0 * DEG, 10.0 * DEG, Method::SEED, 4096).expect("plan");
+        let e = tracking_error(&plan);
+        assert!(e <= 1e-6, "flex Ts {ts}: {e} rad");
+    }
+}
+
+#[test]
+fn queue_while_moving_then_hold() {
+    let d = rigid(10e-6);
+    let mut st: Stepper<3, 256> = Stepper::new(&d, 0.0).expect("stepper");
+    let a = plan_jump(&d, 0.0, 5.0 * DEG, Method::TimeOptimal, 256).expect("a");
+    st.queue(&a).expect("queue a");
+    assert!(!st.is_idle());
+    let mut out = Vec::new();
+    for _ in 0..a.samples() / 2 {
+        out.push(st.step());
+    }
+    // Queue the next move from where the queue ends, mid-move.
+    assert_eq!(st.end_position_rad(), 5.0 * DEG);
+    let b = plan_jump(&d, st.end_position_rad(), -2.0 * DEG, Method::SEED, 256).expect("b");
+    st.queue(&b).expect("queue b");
+    assert_eq!(st.queued_moves(), 2);
+    while !st.is_idle() {
+        out.push(st.step());
+    }
+    assert_eq!(out.len(), a.samples() + b.samples());
+    // The sample at the junction is exactly a's target.
+    assert_eq!(out[a.samples() - 1], (5.0 * DEG) as f32);
+    assert_eq!(*out.last().expect("samples"), (-2.0 * DEG) as f32);
+    // Idle: holds without drifting.
+    for _ in 0..1000 {
+        assert_eq!(st.step(), (-2.0 * DEG) as f32);
+    }
+    assert_eq!(st.state(), &[(-2.0 * DEG) as f32, 0.0, 0.0]);
+}
+
+#[test]
+fn fill_equals_stepping() {
+    let d = rigid(10e-6);
+    let plan = plan_jump(&d, 0.0, 7.0 * DEG, Method::SEED, 512).expect("plan");
+    let mut a: Stepper<3, 512> = Stepper::new(&d, 0.0).expect("stepper");
+    a.queue(&plan).expect("queue");
+    let mut b = a.clone();
+    let mut block = [0.0f32; 32];
+    let mut filled = Vec::new();
+    for _ in 0..4 {
+        a.fill(&mut block);
+        filled.extend_from_slice(&block);
+    }
+    let stepped: Vec<f32> = (0..128).map(|_| b.step()).collect();
+    assert_eq!(filled, stepped);
+}
+
+#[test]
+fn queue_errors() {
+    let d = rigid(10e-6);
+    let mut st: Stepper<3, 40, 2> = Stepper::new(&d, 0.0).expect("stepper");
+    // Does not start where the queue ends.
+    let off = plan_jump(&d, 1.0 * DEG, 2.0 * DEG, Method::SEED, 64).expect("plan");
+    assert_eq!(st.queue(&off), Err(Error::DiscontinuousMove));
+    // Too many samples for the ring.
+    let long = plan_jump(&d, 0.0, 20.0 * DEG, Method::TimeOptimal, 1000).expect("plan");
+    assert!(long.samples() > 40);
+    assert_eq!(st.queue(&long), Err(Error::QueueFull));
+    // Move slots: Q = 2.
+    let m1 = plan_jump(&d, 0.0, 0.1 * DEG, Method::TimeOptimal, 64).expect("plan");
+    let m2 = plan_jump(&d, 0.1 * DEG, 0.2 * DEG, Method::TimeOptimal, 64).expect("plan");
+    let m3 = plan_jump(&d, 0.2 * DEG, 0.3 * DEG, Method::TimeOptimal, 64).expect("plan");
+    st.queue(&m1).expect("m1");
+    st.queue(&m2).expect("m2");
+    assert_eq!(st.queue(&m3), Err(Error::QueueFull));
+    // Another model.
+    let other = rigid(5e-6);
+    let p = plan_jump(&other, 0.2 * DEG, 0.3 * DEG, Method::TimeOptimal, 64).expect("plan");
+    assert_eq!(st.check_queue(&p), Err(Error::ModelMismatch));
+    // Zero-length moves are accepted and change nothing.
+    let hold = plan_jump(&d, 0.2 * DEG, 0.2 * DEG, Method::SEED, 0).expect("hold");
+    st.queue(&hold).expect("hold");
+    assert_eq!(st.queued_moves(), 2);
+    assert!(Stepper::<3, 8>::new(&d, f64::NAN).is_err());
+}
+
+#[test]
+fn clear_pending_keeps_the_running_move() {
+    let d = rigid(10e-6);
+    let mut st: Stepper<3, 512> = Stepper::new(&d, 0.0).expect("stepper");
+    let a = plan_jump(&d, 0.0, 3.0 * DEG, Method::TimeOptimal, 512).expect("a");
+    let b = plan_jump(&d, 3.0 * DEG, 6.0 * DEG, Method::TimeOptimal, 512).expect("b");
+    st.queue(&a).expect("a");
+    st.queue(&b).expect("b");
+    st.step();
+    assert_eq!(st.clear_pending(), 1);
+    assert_eq!(st.end_position_rad(), 3.0 * DEG);
+    assert_eq!(st.remaining_samples(), a.samples() - 1);
+    while !st.is_idle() {
+        st.step();
+    }
+    assert_eq!(st.position_rad(), (3.0 * DEG) as f32);
+}
+
+#[test]
+fn xy_jumps() {
+    let d = rigid(10e-6);
+    let from = [0.0, 0.0];
+    let to = [10.0 * DEG, 0.5 * DEG];
+    for sync in [JumpSync::Independent, JumpSync::SameDuration] {
+        let jump = plan_xy_jump(&d, &d, from, to, Method::TimeOptimal, sync, 1024).expect("jump");
+        let mut xy: XyStepper<3, 1024> = XyStepper::new(&d, &d, from).expect("xy");
+        xy.queue_jump(&jump).expect("queue");
+        let mut n = 0;
+        let mut y_done_at = None;
+        while !xy.is_idle() {
+            xy.step();
+            n += 1;
+            if y_done_at.is_none() && xy.y.is_idle() {
+                y_done_at = Some(n);
+            }
+        }
+        assert_eq!(n, jump.samples());
+        assert_eq!(xy.step(), [to[0] as f32, to[1] as f32]);
+        match sync {
+            JumpSync::Independent => assert!(y_done_at < Some(n)),
+            JumpSync::SameDuration => {
+                assert_eq!(y_done_at, Some(n));
+                assert!(jump.y.max_abs_u_v() < 24.0);
+            }
+        }
+    }
+    // Atomic: if Y does not fit, X is not queued either.
+    let mut xy: XyStepper<3, 40> = XyStepper::new(&d, &d, from).expect("xy");
+    let jump = plan_xy_jump(
+        &d,
+        &d,
+        from,
+        [0.1 * DEG, 20.0 * DEG],
+        Method::TimeOptimal,
+        JumpSync::Independent,
+        1024,
+    )
+    .expect("jump");
+    assert_eq!(xy.queue_jump(&jump), Err(Error::QueueFull));
+    assert!(xy.x.is_idle());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+
+    /// A long sequence of random moves: every move ends exactly on its
+    /// target and the f32 state never drifts from the f64 plan.
+    #[test]
+    fn no_drift_across_many_moves(targets in proptest::collection::vec(-12.0f64..12.0, 1..30)) {
+        let d = rigid(10e-6);
+        let mut st: Stepper<3, 256> = Stepper::new(&d, 0.0).expect("stepper");
+        for t in targets {
+            let plan = plan_jump(&d, st.end_position_rad(), t * DEG, Method::TimeOptimal, 256).expect("plan");
+            st.queue(&plan).expect("queue");
+            let (states, _) = simulate(&plan);
+            for z in states.iter().skip(1) {
+                let th = st.step();
+                prop_assert!((f64::from(th) - z[0]).abs() <= 1e-6);
+            }
+            prop_assert!(st.is_idle());
+            prop_assert_eq!(st.position_rad(), (t * DEG) as f32);
+        }
+    }
+}
