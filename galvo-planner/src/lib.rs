@@ -16,6 +16,7 @@ pub mod linalg;
 pub mod min_energy;
 pub mod model;
 pub mod optimal;
+pub mod path;
 pub mod profile;
 pub mod stepper;
 #[cfg(test)]
