@@ -1,0 +1,429 @@
+//! Simulated FashionStar serial-bus servos: pure models (no async, no I/O,
+//! no clock of their own: time comes in as `now_us`) that parse the real
+//! request bytes with the firmware's own decoder and answer with real
+//! response frames.
+//!
+//! Behaviour modelled:
+//! * set angle (code 8) moves linearly in time from the angle at command
+//!   time to the target over `interval_ms`; set angle by interval (11) and
+//!   by velocity (12) follow a trapezoidal velocity profile with the
+//!   commanded acceleration/deceleration times ([`motion`]); a new command
+//!   replaces the running one from wherever the servo is (the servo's
+//!   default "interruptible" setting, SDK `FSUS_PARAM_RESPONSE_SWITCH`);
+//! * sync (25) applies each contained entry to the addressed servo;
+//! * damping (9) stops the servo where it is;
+//! * targets are clamped to the servo's ±180.0° range; velocities below
+//!   1 °/s are taken as 1 °/s (the SDK's minimum);
+//! * the reported angle is the true angle rounded to 0.1°;
+//! * ping, query angle, query monitor (fixed plausible voltage and
+//!   temperature) and read data (addresses 1–5 and 34) are answered;
+//!   motion commands are not (SDK default, no response);
+//! * fault injection: a slowness factor (every move takes `factor` times
+//!   longer) and a silent flag (the servo still obeys commands but answers
+//!   nothing, like a broken return line).
+
+pub mod motion;
+
+use laser_app::servo::protocol::{
+    Monitor, ReadData, Request, RequestDecoder, Response, SetAngle, SetAngleByInterval,
+    SetAngleByVelocity,
+};
+
+use motion::Motion;
+
+/// Servo bus baud rate, bit/s.
+pub const BAUD: u64 = 115_200;
+/// Bits on the wire per byte (8N1: start, 8 data, stop).
+pub const BITS_PER_BYTE: u64 = 10;
+/// Time one byte takes on the wire, µs: 10 bits at 115200 baud is 86.8 µs,
+/// rounded up to whole µs so that byte times add up exactly whatever the
+/// chunking (0.2 % slow; the simulated UART uses the same value).
+pub const BYTE_TIME_US: u64 = (BITS_PER_BYTE * 1_000_000).div_ceil(BAUD);
+/// Delay between the last byte of a request and the first byte of the
+/// answer, µs.
+pub const PROCESSING_DELAY_US: u64 = 200;
+/// The servo's angle range, 0.1° (±180.0°).
+pub const RANGE_TENTHS_DEG: i16 = 1800;
+/// Supply voltage reported by query monitor and read data, mV.
+pub const SUPPLY_MV: u16 = 7400;
+/// Temperature reported, raw NTC ADC value (≈ 30 °C by the SDK's
+/// conversion with B = 3435 and 2048 = 25 °C).
+pub const TEMPERATURE_RAW: u16 = 1854;
+/// Current drawn while holding, mA.
+pub const IDLE_CURRENT_MA: u16 = 20;
+/// Current drawn while moving, mA.
+pub const MOVING_CURRENT_MA: u16 = 150;
+/// Slowest velocity a servo moves at, °/s.
+const MIN_VELOCITY_DEG_S: f64 = 1.0;
+
+/// Time `bytes` bytes take on the wire, µs ([`BYTE_TIME_US`] each).
+pub fn wire_time_us(bytes: usize) -> u64 {
+    bytes as u64 * BYTE_TIME_US
+}
+
+/// `deg` as the servo reports it: 0.1° steps, within ±180.0°.
+pub fn quantise_tenths(deg: f64) -> i16 {
+    let tenths = (deg * 10.0).round();
+    let limit = f64::from(RANGE_TENTHS_DEG);
+    // Clamped to ±1800 first, so the cast is exact (NaN casts to 0).
+    tenths.clamp(-limit, limit) as i16
+}
+
+fn clamp_target_deg(angle_tenths_deg: i16) -> f64 {
+    f64::from(angle_tenths_deg.clamp(-RANGE_TENTHS_DEG, RANGE_TENTHS_DEG)) / 10.0
+}
+
+/// One simulated servo.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimServo {
+    id: u8,
+    motion: Motion,
+    slow_factor: f64,
+    silent: bool,
+}
+
+impl SimServo {
+    /// Servo `id` at 0°, normal speed, answering.
+    pub fn new(id: u8) -> Self {
+        Self {
+            id,
+            motion: Motion::hold(0.0),
+            slow_factor: 1.0,
+            silent: false,
+        }
+    }
+
+    /// The same servo standing at `deg` degrees instead.
+    pub fn with_angle_deg(mut self, deg: f64) -> Self {
+        self.motion = Motion::hold(deg);
+        self
+    }
+
+    /// Bus id.
+    pub fn id(&self) -> u8 {
+        self.id
+    }
+
+    /// True angle at `now_us`, degrees (unquantised, for drawing).
+    pub fn angle_deg(&self, now_us: u64) -> f64 {
+        self.motion.angle_at(now_us as f64)
+    }
+
+    /// Angle at `now_us` as the servo reports it, 0.1°.
+    pub fn angle_tenths(&self, now_us: u64) -> i16 {
+        quantise_tenths(self.angle_deg(now_us))
+    }
+
+    /// Target of the current (or last) move, 0.1°.
+    pub fn target_tenths(&self) -> i16 {
+        quantise_tenths(self.motion.target_deg())
+    }
+
+    /// When the current move ends, µs (rounded up).
+    pub fn arrival_us(&self) -> u64 {
+        self.motion.end_us().max(0.0).ceil() as u64
+    }
+
+    /// Whether the servo is still moving at `now_us`.
+    pub fn is_moving(&self, now_us: u64) -> bool {
+        (now_us as f64) < self.motion.end_us()
+    }
+
+    /// Movement slowness: every move commanded from now on takes this many
+    /// times longer (fault injection `servo-slow:<factor>`).
+    pub fn slow_factor(&self) -> f64 {
+        self.slow_factor
+    }
+
+    /// Sets the slowness factor (values that are not finite and positive
+    /// mean 1).
+    pub fn set_slow_factor(&mut self, factor: f64) {
+        self.slow_factor = if factor.is_finite() && factor > 0.0 {
+            factor
+        } else {
+            1.0
+        };
+    }
+
+    /// Whether the servo answers nothing.
+    pub fn is_silent(&self) -> bool {
+        self.silent
+    }
+
+    /// Silences the servo (it still obeys commands) or lets it answer again.
+    pub fn set_silent(&mut self, silent: bool) {
+        self.silent = silent;
+    }
+
+    /// Carries out `request`, received completely at `now_us`, if it
+    /// addresses this servo; returns the answer the servo sends, if any.
+    pub fn execute(&mut self, now_us: u64, request: &Request) -> Option<Response> {
+        let t = now_us as f64;
+        let from = self.angle_deg(now_us);
+        let mine = |id: &u8| *id == self.id;
+        match request {
+            Request::SetAngle(c) if mine(&c.id) => self.set_angle(t, from, c),
+            Request::SetAngleByInterval(c) if mine(&c.id) => self.by_interval(t, from, c),
+            Request::SetAngleByVelocity(c) if mine(&c.id) => self.by_velocity(t, from, c),
+            Request::Damping { id, .. } if mine(id) => self.motion = Motion::hold(from),
+            Request::SyncSetAngle(entries) => {
+                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
+                    self.set_angle(t, from, c);
+                }
+            }
+            Request::SyncSetAngleByInterval(entries) => {
+                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
+                    self.by_interval(t, from, c);
+                }
+            }
+            Request::SyncSetAngleByVelocity(entries) => {
+                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
+                    self.by_velocity(t, from, c);
+                }
+            }
+            _ => {}
+        }
+        if self.silent || request.id() != Some(self.id) {
+            return None;
+        }
+        self.answer(now_us, request)
+    }
+
+    fn set_angle(&mut self, t: f64, from: f64, c: &SetAngle) {
+        let to = clamp_target_deg(c.angle_tenths_deg);
+        let interval = f64::from(c.interval_ms) * 1000.0 * self.slow_factor;
+        self.motion = Motion::by_interval(t, from, to, interval, 0.0, 0.0);
+    }
+
+    fn by_interval(&mut self, t: f64, from: f64, c: &SetAngleByInterval) {
+        let to = clamp_target_deg(c.angle_tenths_deg);
+        let k = 1000.0 * self.slow_factor;
+        self.motion = Motion::by_interval(
+            t,
+            from,
+            to,
+            f64::from(c.interval_ms) * k,
+            f64::from(c.t_acc_ms) * k,
+            f64::from(c.t_dec_ms) * k,
+        );
+    }
+
+    fn by_velocity(&mut self, t: f64, from: f64, c: &SetAngleByVelocity) {
+        let to = clamp_target_deg(c.angle_tenths_deg);
+        let k = 1000.0 * self.slow_factor;
+        let velocity = (f64::from(c.velocity_tenths_deg_s) / 10.0).max(MIN_VELOCITY_DEG_S);
+        self.motion = Motion::by_velocity(
+            t,
+            from,
+            to,
+            velocity / self.slow_factor,
+            f64::from(c.t_acc_ms) * k,
+            f64::from(c.t_dec_ms) * k,
+        );
+    }
+
+    fn monitor(&self, now_us: u64) -> Monitor {
+        let moving = self.is_moving(now_us);
+        let current_ma = if moving {
+            MOVING_CURRENT_MA
+        } else {
+            IDLE_CURRENT_MA
+        };
+        Monitor {
+            id: self.id,
+            voltage_mv: SUPPLY_MV,
+            current_ma,
+            power_mw: (u32::from(SUPPLY_MV) * u32::from(current_ma) / 1000) as u16,
+            temperature_raw: TEMPERATURE_RAW,
+            status: u8::from(moving),
+            angle_tenths_deg: i32::from(self.angle_tenths(now_us)),
+            turns: 0,
+        }
+    }
+
+    fn answer(&self, now_us: u64, request: &Request) -> Option<Response> {
+        let id = self.id;
+        match request {
+            Request::Ping { .. } => Some(Response::Ping { id }),
+            Request::QueryAngle { .. } => Some(Response::Angle {
+                id,
+                angle_tenths_deg: self.angle_tenths(now_us),
+            }),
+            Request::QueryMonitor { .. } => Some(Response::Monitor(self.monitor(now_us))),
+            Request::ReadData { address, .. } => {
+                let m = self.monitor(now_us);
+                let data: &[u8] = match address {
+                    1 => &m.voltage_mv.to_le_bytes(),
+                    2 => &m.current_ma.to_le_bytes(),
+                    3 => &m.power_mw.to_le_bytes(),
+                    4 => &m.temperature_raw.to_le_bytes(),
+                    5 => &[m.status],
+                    34 => &[id],
+                    _ => return None,
+                };
+                Some(Response::ReadData(ReadData {
+                    id,
+                    address: *address,
+                    data: heapless::Vec::from_slice(data).ok()?,
+                }))
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Direction of a frame on the servo bus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BusDirection {
+    /// Controller → servo (request).
+    Tx,
+    /// Servo → controller (response).
+    Rx,
+}
+
+/// One complete frame seen on the bus.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct BusFrame {
+    /// When its first byte started on the wire, µs.
+    pub t_us: u64,
+    /// Direction.
+    pub direction: BusDirection,
+    /// The frame's bytes.
+    pub bytes: Vec<u8>,
+}
+
+/// Several simulated servos sharing one half-duplex line.
+#[derive(Default)]
+pub struct SimServoBus {
+    servos: Vec<SimServo>,
+    decoder: RequestDecoder,
+    /// The line is busy with responses until then, µs.
+    line_free_at_us: u64,
+    frames: Vec<BusFrame>,
+    decode_errors: u64,
+}
+
+impl SimServoBus {
+    /// Servos with the given ids at 0°, each with `slow_factor`.
+    pub fn new(ids: &[u8], slow_factor: f64) -> Self {
+        Self::from_servos(
+            ids.iter()
+                .map(|&id| {
+                    let mut servo = SimServo::new(id);
+                    servo.set_slow_factor(slow_factor);
+                    servo
+                })
+                .collect(),
+        )
+    }
+
+    /// A bus with these servos.
+    pub fn from_servos(servos: Vec<SimServo>) -> Self {
+        Self {
+            servos,
+            ..Self::default()
+        }
+    }
+
+    /// Servo `id`.
+    pub fn servo(&self, id: u8) -> Option<&SimServo> {
+        self.servos.iter().find(|s| s.id == id)
+    }
+
+    /// Servo `id`, mutable (fault injection, test setup).
+    pub fn servo_mut(&mut self, id: u8) -> Option<&mut SimServo> {
+        self.servos.iter_mut().find(|s| s.id == id)
+    }
+
+    /// Silences servo `id` (it answers nothing) or lets it answer again.
+    pub fn set_silent(&mut self, id: u8, silent: bool) {
+        if let Some(servo) = self.servo_mut(id) {
+            servo.set_silent(silent);
+        }
+    }
+
+    /// Sets the slowness factor of every servo.
+    pub fn set_slow_factor(&mut self, factor: f64) {
+        for servo in &mut self.servos {
+            servo.set_slow_factor(factor);
+        }
+    }
+
+    /// True angle of servo `id` at `now_us`, degrees (for drawing).
+    pub fn angle_deg(&self, id: u8, now_us: u64) -> Option<f64> {
+        self.servo(id).map(|s| s.angle_deg(now_us))
+    }
+
+    /// Angle of servo `id` at `now_us` as it reports it, 0.1°.
+    pub fn angle_tenths_at(&self, id: u8, now_us: u64) -> Option<i16> {
+        self.servo(id).map(|s| s.angle_tenths(now_us))
+    }
+
+    /// The servos hear `bytes`, the last of which finished arriving at
+    /// `now_us` (earlier ones [`BYTE_TIME_US`] apart before it). Returns each
+    /// answer as `(ready_at_us, frame bytes)`: `ready_at_us` is when its
+    /// first byte starts on the wire, [`PROCESSING_DELAY_US`] after the
+    /// request's last byte, or later if the line is still busy with an
+    /// earlier answer; each answer then occupies the line for its own byte
+    /// time ([`wire_time_us`]).
+    pub fn receive(&mut self, now_us: u64, bytes: &[u8]) -> Vec<(u64, Vec<u8>)> {
+        let mut answers = Vec::new();
+        let n = bytes.len();
+        for (i, &byte) in bytes.iter().enumerate() {
+            let byte_end_us = now_us.saturating_sub(wire_time_us(n - 1 - i));
+            self.decoder.push(byte);
+            while let Some(event) = self.decoder.poll() {
+                match event {
+                    Ok(request) => self.handle(byte_end_us, &request, &mut answers),
+                    Err(_) => self.decode_errors += 1,
+                }
+            }
+        }
+        answers
+    }
+
+    fn handle(&mut self, end_us: u64, request: &Request, answers: &mut Vec<(u64, Vec<u8>)>) {
+        let frame = request.to_frame().map(|f| f.to_vec()).unwrap_or_default();
+        self.frames.push(BusFrame {
+            t_us: end_us.saturating_sub(wire_time_us(frame.len())),
+            direction: BusDirection::Tx,
+            bytes: frame,
+        });
+        for servo in &mut self.servos {
+            let Some(response) = servo.execute(end_us, request) else {
+                continue;
+            };
+            let Ok(frame) = response.to_frame() else {
+                continue;
+            };
+            let start = (end_us + PROCESSING_DELAY_US).max(self.line_free_at_us);
+            self.line_free_at_us = start + wire_time_us(frame.len());
+            self.frames.push(BusFrame {
+                t_us: start,
+                direction: BusDirection::Rx,
+                bytes: frame.to_vec(),
+            });
+            answers.push((start, frame.to_vec()));
+        }
+    }
+
+    /// Every complete frame seen so far (requests as decoded, responses as
+    /// sent), in order.
+    pub fn frames(&self) -> &[BusFrame] {
+        &self.frames
+    }
+
+    /// Takes the frame log, leaving it empty.
+    pub fn take_frames(&mut self) -> Vec<BusFrame> {
+        std::mem::take(&mut self.frames)
+    }
+
+    /// Request bytes that did not form a valid frame (bad length, bad
+    /// checksum, unknown code) so far.
+    pub fn decode_errors(&self) -> u64 {
+        self.decode_errors
+    }
+}
+
+#[cfg(test)]
+mod tests;
