@@ -165,6 +165,11 @@ fn certified_infeasible(d: &Discrete<3>, dist: f64, m: usize) -> bool {
         return true;
     }
     let g = columns(d, m);
+    if m == 1 {
+        // One generator spans a line; (D, 0, 0) is off it unless parallel.
+        let n = cross(&g[0], &[dist, 0.0, 0.0]);
+        return dot3(&n, &n).sqrt() > 1e-9 * dot3(&g[0], &g[0]).sqrt() * dist;
+    }
     // Jacobi scaling of the state coordinates.
     let s: Vector<3> =
         core::array::from_fn(|i| 1.0 / g.iter().map(|v| v[i] * v[i]).sum::<f64>().sqrt());
@@ -391,5 +396,41 @@ proptest! {
         for (x, y) in inputs(&fwd).iter().zip(&inputs(&rev)) {
             prop_assert!((x + y).abs() <= 1e-9);
         }
+    }
+}
+
+/// Critically damped electrics (double pole): the closed form is replaced
+/// by the matrix exponential, with the same guarantees.
+#[test]
+fn double_pole_uses_the_general_response() {
+    let base = RigidParams::REFERENCE;
+    // (R/L)² = 4·Kt²/(J·L)  →  R = 2·Kt·√(L/J).
+    let r = 2.0 * base.kt_nm_per_a * (base.l_h / base.j_kg_m2).sqrt();
+    let p = RigidParams { r_ohm: r, ..base };
+    let d = p.model().and_then(|m| m.discretize(10e-6)).expect("valid");
+    for step in [0.05, 2.0, 20.0] {
+        let plan = plan_jump(&d, 0.0, step * DEG, Method::TimeOptimal, 10_000).expect("plan");
+        assert_lands(&plan, true, "double pole");
+        assert!(certified_infeasible(&d, step * DEG, plan.samples() - 2));
+    }
+}
+
+#[test]
+fn extreme_periods_and_distances() {
+    for (ts, step) in [
+        (0.2e-6, 0.05),
+        (0.2e-6, 20.0),
+        (100e-6, 0.05),
+        (100e-6, 20.0),
+        (10e-6, 90.0),
+        (10e-6, 1e-4),
+    ] {
+        let d = rigid(ts);
+        let plan = plan_jump(&d, 0.0, step * DEG, Method::TimeOptimal, 1_000_000).expect("plan");
+        assert_lands(&plan, true, "extreme");
+        assert!(
+            certified_infeasible(&d, step * DEG, plan.samples().saturating_sub(2)),
+            "Ts {ts} {step}°"
+        );
     }
 }
