@@ -62,6 +62,8 @@ pub enum Error {
     NoConvergence,
     /// The stepper's move queue or sample ring has no room for this move.
     QueueFull,
+    /// The stepper is still moving; it can only be re-seated when idle.
+    StepperBusy,
     /// A plan made for a different sampled model than the stepper's.
     ModelMismatch,
     /// A queued move does not start where the previously queued move ends.
@@ -112,6 +114,7 @@ impl fmt::Display for Error {
             ),
             Error::NoConvergence => write!(f, "the planner's solver did not converge"),
             Error::QueueFull => write!(f, "the stepper queue is full"),
+            Error::StepperBusy => write!(f, "the stepper is still executing a move"),
             Error::ModelMismatch => write!(
                 f,
                 "the plan was made for a different sampled model than the stepper's"

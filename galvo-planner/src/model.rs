@@ -251,6 +251,12 @@ impl<const S: usize> LinearModel<S> {
         &self.drive
     }
 
+    /// Which state components are angles (θ, and φ for the flexible model):
+    /// at rest they all equal the position, the others are zero.
+    pub fn position_states(&self) -> &[bool; S] {
+        &self.position_states
+    }
+
     /// The state at rest at mechanical angle `theta_rad` (all angles equal,
     /// all speeds and the current zero). Rest states are equilibria with
     /// `U = 0`.
@@ -272,7 +278,7 @@ impl<const S: usize> LinearModel<S> {
 
     /// Exact zero-order-hold discretisation with sample period `ts_s`:
     /// `Ad = e^{A·Ts}`, `Bd = ∫₀^Ts e^{A·τ} dτ · B` (scaling and squaring, see
-    /// [`expm_and_integral`](crate::linalg::expm_and_integral)).
+    /// [`expm_and_integral`]).
     ///
     /// Fails with [`Error::InvalidSamplePeriod`] for a zero, negative or
     /// non-finite period and with [`Error::NotControllable`] when the sampled

@@ -61,6 +61,8 @@ pub struct Stepper<const S: usize, const CAP: usize, const Q: usize = 4> {
     move_count: usize,
     k_in_move: usize,
     end_state: Vector<S>,
+    /// Which states are angles (θ, φ).
+    rest_mask: [bool; S],
 }
 
 fn to_f32<const S: usize>(z: &Vector<S>) -> [f32; S] {
@@ -100,6 +102,7 @@ impl<const S: usize, const CAP: usize, const Q: usize> Stepper<S, CAP, Q> {
             move_count: 0,
             k_in_move: 0,
             end_state: rest,
+            rest_mask: *disc.model().position_states(),
         })
     }
 
@@ -235,6 +238,34 @@ impl<const S: usize, const CAP: usize, const Q: usize> Stepper<S, CAP, Q> {
         at(&self.end_state, THETA)
     }
 
+    /// Re-seats an idle stepper at rest at `theta_rad` (e.g. where a marked
+    /// path, which drives the mirrors directly, left them), so the next jump
+    /// is planned and queued from there. Fails with
+    /// [`Error::StepperBusy`] while a move is queued.
+    pub fn hold_at(&mut self, theta_rad: f64) -> Result<(), Error> {
+        let theta_rad = crate::error::finite("theta_rad", theta_rad)?;
+        if !self.is_idle() {
+            return Err(Error::StepperBusy);
+        }
+        let mut rest = self.end_state;
+        for (i, v) in rest.iter_mut().enumerate() {
+            *v = if self.position_state(i) {
+                theta_rad
+            } else {
+                0.0
+            };
+        }
+        self.z = to_f32(&rest);
+        self.comp = [0.0; S];
+        self.end_state = rest;
+        Ok(())
+    }
+
+    /// Whether state `i` is an angle (equal to θ at rest).
+    fn position_state(&self, i: usize) -> bool {
+        self.rest_mask.get(i).copied().unwrap_or(false)
+    }
+
     /// Drops the queued moves that have not started yet; the running move
     /// completes. Returns how many were dropped.
     pub fn clear_pending(&mut self) -> usize {
@@ -302,6 +333,19 @@ impl<const S: usize, const CAP: usize, const Q: usize> XyStepper<S, CAP, Q> {
     /// True when both axes hold position.
     pub fn is_idle(&self) -> bool {
         self.x.is_idle() && self.y.is_idle()
+    }
+
+    /// Re-seats both idle axes at rest at `theta_rad = [θx, θy]` (see
+    /// [`Stepper::hold_at`]); neither moves if one is busy.
+    pub fn hold_at(&mut self, theta_rad: [f64; 2]) -> Result<(), Error> {
+        if !self.is_idle() {
+            return Err(Error::StepperBusy);
+        }
+        let [tx, ty] = theta_rad;
+        crate::error::finite("theta_rad", tx)?;
+        crate::error::finite("theta_rad", ty)?;
+        self.x.hold_at(tx)?;
+        self.y.hold_at(ty)
     }
 
     /// Where the queued jumps end, `[θx, θy]`, rad.

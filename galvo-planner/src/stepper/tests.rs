@@ -185,6 +185,26 @@ fn xy_jumps() {
     assert!(xy.x.is_idle());
 }
 
+#[test]
+fn hold_at_reseats_an_idle_stepper_only() {
+    let d = rigid(10e-6);
+    let mut st: Stepper<3, 256> = Stepper::new(&d, 0.0).expect("stepper");
+    st.hold_at(0.1).expect("idle");
+    assert_eq!(st.state(), &[0.1f32, 0.0, 0.0]);
+    assert_eq!(st.step(), 0.1f32);
+    let plan = plan_jump(&d, 0.1, 0.2, Method::TimeOptimal, 256).expect("plan");
+    st.queue(&plan).expect("queue from the new position");
+    assert_eq!(st.hold_at(0.5), Err(Error::StepperBusy));
+    assert!(matches!(st.hold_at(f64::NAN), Err(Error::NonFinite { .. })));
+    let df = flex(10e-6);
+    let mut sf: Stepper<5, 64> = Stepper::new(&df, 0.0).expect("stepper");
+    sf.hold_at(-0.2).expect("idle");
+    assert_eq!(sf.end_state(), &[-0.2, 0.0, 0.0, -0.2, 0.0]);
+    let mut xy: XyStepper<3, 64> = XyStepper::new(&d, &d, [0.0, 0.0]).expect("xy");
+    xy.hold_at([0.01, -0.02]).expect("idle");
+    assert_eq!(xy.end_position_rad(), [0.01, -0.02]);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
 
