@@ -15,12 +15,14 @@
 //! with the model stored as `Ad − I` (the increment form keeps the
 //! near-one diagonal of `Ad` from losing the small rates in rounding) and a
 //! compensated (Kahan) accumulation of the state. Per sample and axis:
-//! `S²` multiply-adds for `(Ad − I)·Z`, `S` for `Bd·U`, and `4·S` for the
-//! compensated sum, i.e. **3 states: 9 + 3 + 12 = 24 multiply-adds ≈ 36
-//! flops; 5 states: 25 + 5 + 20 = 50 ≈ 80 flops**, plus a ring-buffer read
-//! and a counter compare. On the M4F (1-cycle `vmla`/`vadd`, plus loads)
-//! that is roughly 60–100 cycles for the rigid model, i.e. < 12 % of the
-//! ≈ 1680-cycle budget per sample for two axes at 100 kHz.
+//! each state row costs `1 + S` multiplies and `S` adds for
+//! `(Ad − I)·Z + Bd·U` and 4 add/subs for the compensated sum, i.e.
+//! **rigid (S = 3): 12 mul + 9 add + 12 add = 33 flops; flexible (S = 5):
+//! 30 + 25 + 20 = 75 flops**, plus a ring-buffer read and a counter
+//! compare. On the M4F (single-cycle `vmul`/`vadd`, plus loads and
+//! stores) that is roughly 50–100 cycles per axis for the rigid model,
+//! i.e. under 12 % of the ≈ 1680-cycle budget per sample for two axes at
+//! 100 kHz.
 //!
 //! Accuracy (tests): over ±10° moves the `f32` angle stays within 2e-8 rad
 //! (about one `f32` ulp) of the `f64` ZOH simulation at Ts = 10 µs and 1 µs;

@@ -281,17 +281,19 @@ fn meets_the_optimality_bounds() {
     }
 }
 
-/// At Ts = 10 µs the planner actually hits the discrete optimum exactly
-/// for the acceptance step sizes (stronger than required).
+/// At Ts = 10 µs and 1 µs the planner actually hits the discrete optimum
+/// exactly for the acceptance step sizes (stronger than required).
 #[test]
-fn is_exactly_optimal_at_10_us() {
-    let d = rigid(10e-6);
-    for step in STEPS_DEG {
-        let plan = plan_jump(&d, 0.0, step * DEG, Method::TimeOptimal, 100_000).expect("plan");
-        assert!(
-            certified_infeasible(&d, step * DEG, plan.samples() - 1),
-            "{step}°: one sample less might be feasible"
-        );
+fn is_exactly_optimal_at_10_and_1_us() {
+    for ts in [10e-6, 1e-6] {
+        let d = rigid(ts);
+        for step in STEPS_DEG {
+            let plan = plan_jump(&d, 0.0, step * DEG, Method::TimeOptimal, 100_000).expect("plan");
+            assert!(
+                certified_infeasible(&d, step * DEG, plan.samples() - 1),
+                "Ts {ts}, {step}°: one sample less might be feasible"
+            );
+        }
     }
 }
 
