@@ -21,7 +21,9 @@
 //! bracket is `(Tmax − Tmin)/2^p` wide and the plan uses `Tmax`.
 
 use crate::error::{Error, finite, positive};
-use crate::jump::{InputLaw, JumpPlan, MethodKind, PlanInfo, finite_state};
+use crate::jump::{
+    InputLaw, JumpPlan, MAX_PLAN_SAMPLES, MethodKind, PlanInfo, effective_capacity, finite_state,
+};
 use crate::linalg::{Matrix, Vector, at, at2, dot, mat_vec, spd_solve_scaled, vec_add, vec_sub};
 use crate::model::{Discrete, accumulate_outer};
 
@@ -171,6 +173,12 @@ pub fn plan_min_energy<const S: usize>(
     if z0 == z1 && n == 0 {
         return Ok(JumpPlan::hold(disc, *z0));
     }
+    if n > MAX_PLAN_SAMPLES {
+        return Err(Error::CapacityExceeded {
+            needed: n,
+            capacity: MAX_PLAN_SAMPLES,
+        });
+    }
     let sol = min_energy_at(disc, z0, z1, n, 2).ok_or(Error::NotReachable { samples: n })?;
     Ok(JumpPlan::new(
         disc,
@@ -224,6 +232,7 @@ pub fn plan_seed<const S: usize>(
     if z0 == z1 {
         return Ok(JumpPlan::hold(disc, *z0));
     }
+    let capacity = effective_capacity(capacity);
     let ts = disc.ts_s();
     let limit = disc.u_max_v() * (1.0 - LIMIT_MARGIN);
     let mut evaluations = 0u32;

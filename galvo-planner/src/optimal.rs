@@ -23,7 +23,11 @@
 //!    by construction.
 //!
 //! When `⌈T/Ts⌉ ≤ 3` (tiny moves) the unique 3-sample (dead-beat) input is
-//! tried first.
+//! tried first. For a strongly underdamped coil (complex poles) the optimum
+//! may need more switches; when no two-switch solution exists the planner
+//! falls back to the fastest minimum-energy input
+//! ([`OptimalStructure::MinEnergyFallback`]), so a valid request still gets
+//! an exact, feasible plan.
 //!
 //! Cost: the closed-form response makes every evaluation two `expm1` (real
 //! poles) and a few dozen flops, no matrix exponential and no buffer; a
@@ -33,26 +37,50 @@
 use crate::error::{Error, finite};
 use crate::jump::{InputLaw, JumpPlan, MethodKind, PlanInfo};
 use crate::linalg::{Matrix, Vector, at, expm_and_integral, mat_vec, solve};
-use crate::min_energy::min_energy_at;
+use crate::min_energy::{SeedConfig, min_energy_at};
 use crate::model::{Discrete, ModelKind};
+
+/// How a time-optimal plan was built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OptimalStructure {
+    /// The unique 3-sample input (tiny moves).
+    DeadBeat,
+    /// Sampled `+,−,+` bang-bang with a free last sample (the normal case).
+    BangBang,
+    /// The two-switch structure does not exist for this galvo (strongly
+    /// underdamped coil: complex poles) or was not found: the fastest
+    /// minimum-energy input (bisection to 2⁻²⁴ of the bracket) is used
+    /// instead. Feasible and exact, but not guaranteed time-optimal.
+    MinEnergyFallback,
+}
+
+/// The continuous-time bang-bang optimum.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContinuousOptimum {
+    /// Minimum move time `T`, s: a lower bound for any input held constant
+    /// over samples (valid as such when the poles are real).
+    pub time_s: f64,
+    /// Switching instants `(t1, t2)`, s.
+    pub switches_s: (f64, f64),
+}
 
 /// Diagnostics of a time-optimal plan.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OptimalInfo {
-    /// Continuous-time minimum move time `T`, s: a lower bound for any
-    /// input held constant over samples.
-    pub continuous_time_s: f64,
-    /// Continuous-time switching instants `(t1, t2)`, s.
-    pub continuous_switches_s: (f64, f64),
-    /// `⌈T/Ts⌉`: the sample-count lower bound implied by `T`.
+    /// How the plan was built.
+    pub structure: OptimalStructure,
+    /// The continuous-time optimum, when it was found.
+    pub continuous: Option<ContinuousOptimum>,
+    /// `⌈T/Ts⌉` (0 when the continuous optimum is unknown).
     pub samples_lower_bound: usize,
-    /// Sampled switch points `(s1, s2)` in samples (0 for the dead-beat case).
+    /// Sampled switch points `(s1, s2)` in samples (bang-bang only).
     pub switch_samples: (f64, f64),
-    /// Voltage of the free last sample, V (signed for the actual move).
+    /// Voltage of the free last sample, V, signed (bang-bang only).
     pub last_sample_v: f64,
-    /// True when the unique 3-sample input was used (tiny moves).
-    pub deadbeat: bool,
 }
+
+/// Halvings of the minimum-energy fallback.
+const FALLBACK_HALVINGS: u32 = 24;
 
 /// The sampled bang-bang input law.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -528,6 +556,7 @@ pub fn plan_time_optimal<const S: usize>(
     }
     let from_rad = finite("from_rad", from_rad)?;
     let to_rad = finite("to_rad", to_rad)?;
+    let capacity = crate::jump::effective_capacity(capacity);
     let model = disc.model();
     let z0 = model.rest_state(from_rad);
     let z1 = model.rest_state(to_rad);
@@ -555,17 +584,19 @@ pub fn plan_time_optimal<const S: usize>(
     let current_scale = u_max / drive.r_ohm;
     let jerk = drive.kt_nm_per_a * u_max / (drive.j_kg_m2 * drive.l_h);
     let tau_e = drive.l_h / drive.r_ohm;
-    let cont = continuous_optimum(&resp, u_max, d, omega_scale, current_scale, jerk, tau_e)
-        .ok_or(Error::NoConvergence)?;
-    let [t1, t2, t_c] = cont;
-    let n_lo = crate::min_energy::samples_for(t_c, ts).max(1);
+    let cont = continuous_optimum(&resp, u_max, d, omega_scale, current_scale, jerk, tau_e);
+    let n_lo = cont.map_or(1, |[_, _, t_c]| {
+        crate::min_energy::samples_for(t_c, ts).max(1)
+    });
     let mut info = OptimalInfo {
-        continuous_time_s: t_c,
-        continuous_switches_s: (t1, t2),
-        samples_lower_bound: n_lo,
+        structure: OptimalStructure::BangBang,
+        continuous: cont.map(|[t1, t2, t_c]| ContinuousOptimum {
+            time_s: t_c,
+            switches_s: (t1, t2),
+        }),
+        samples_lower_bound: if cont.is_some() { n_lo } else { 0 },
         switch_samples: (0.0, 0.0),
         last_sample_v: 0.0,
-        deadbeat: false,
     };
     if n_lo <= S {
         if S > capacity {
@@ -577,7 +608,7 @@ pub fn plan_time_optimal<const S: usize>(
         if let Some(sol) = min_energy_at(disc, &z0, &z1, S, 2)
             && sol.max_abs_u_v <= u_max
         {
-            info.deadbeat = true;
+            info.structure = OptimalStructure::DeadBeat;
             return Ok(JumpPlan::new(
                 disc,
                 z0,
@@ -589,39 +620,48 @@ pub fn plan_time_optimal<const S: usize>(
             ));
         }
     }
-    let scales = [d, omega_scale, current_scale];
-    let first = n_lo.saturating_sub(1).max(S + 1);
-    for n in first..first + EXTRA_SAMPLE_COUNTS {
-        if n > capacity {
-            return Err(Error::CapacityExceeded {
-                needed: n,
-                capacity,
-            });
-        }
-        let guess = (t1 / ts, t2 / ts);
-        if let Some([s1, s2, v]) = sampled_bang_bang(&resp, ts, u_max, d, n, guess, scales) {
-            info.switch_samples = (s1, s2);
-            info.last_sample_v = sign * v;
-            let law = BangBang {
-                n,
-                s1,
-                s2,
-                v_last: v,
-                u_max_v: u_max,
-                sign,
-            };
-            return Ok(JumpPlan::new(
-                disc,
-                z0,
-                z1,
-                n,
-                InputLaw::BangBang(law),
-                MethodKind::TimeOptimal,
-                PlanInfo::Optimal(info),
-            ));
+    if let Some([t1, t2, _]) = cont {
+        let scales = [d, omega_scale, current_scale];
+        let first = n_lo.saturating_sub(1).max(S + 1);
+        for n in first..first.saturating_add(EXTRA_SAMPLE_COUNTS) {
+            if n > capacity {
+                return Err(Error::CapacityExceeded {
+                    needed: n,
+                    capacity,
+                });
+            }
+            let guess = (t1 / ts, t2 / ts);
+            if let Some([s1, s2, v]) = sampled_bang_bang(&resp, ts, u_max, d, n, guess, scales) {
+                info.switch_samples = (s1, s2);
+                info.last_sample_v = sign * v;
+                let law = BangBang {
+                    n,
+                    s1,
+                    s2,
+                    v_last: v,
+                    u_max_v: u_max,
+                    sign,
+                };
+                return Ok(JumpPlan::new(
+                    disc,
+                    z0,
+                    z1,
+                    n,
+                    InputLaw::BangBang(law),
+                    MethodKind::TimeOptimal,
+                    PlanInfo::Optimal(info),
+                ));
+            }
         }
     }
-    Err(Error::NoConvergence)
+    // No two-switch solution: the fastest minimum-energy input instead.
+    let cfg = SeedConfig {
+        p: FALLBACK_HALVINGS,
+        bracket_s: None,
+    };
+    let plan = crate::min_energy::plan_seed(disc, &z0, &z1, cfg, capacity)?;
+    info.structure = OptimalStructure::MinEnergyFallback;
+    Ok(plan.relabel(MethodKind::TimeOptimal, PlanInfo::Optimal(info)))
 }
 
 #[cfg(test)]

@@ -168,6 +168,13 @@ const EMPTY_BLOCK: Block = Block {
 };
 
 /// The running block's frozen profile, in `f32` for the per-sample path.
+///
+/// Sample `j` of the block (j = 1, 2, …) is at time `base + j·Ts` from the
+/// block start. To keep `f32` time arithmetic exact enough over long blocks,
+/// the phase of sample `j` is decided by integer compares against the
+/// first sample index of each phase (`j_cruise`, `j_decel`, `j_end`,
+/// computed in `f64` at freeze time), and times inside a phase are
+/// `offset + (j − j_phase)·Ts` with a small `offset ∈ (0, Ts]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Exec {
     active: bool,
@@ -183,14 +190,24 @@ struct Exec {
     vp: f32,
     v1: f32,
     accel: f32,
-    t_acc: f32,
-    t_cruise_end: f32,
-    t_total: f32,
     d_acc: f32,
-    /// Time of the last emitted sample relative to the block start (≤ 0).
+    t_dec: f32,
+    /// `base` as f32 (acceleration phase times are small).
     base: f32,
+    /// First sample index in the cruise / deceleration phase / after the end.
+    j_cruise: u32,
+    j_decel: u32,
+    j_end: u32,
+    /// Time of sample `j_cruise` after the end of acceleration, of sample
+    /// `j_decel` after the start of deceleration (both in (0, Ts]).
+    off_cruise: f32,
+    off_decel: f32,
     /// Samples emitted in this block.
     k: u32,
+    /// `base` and the block duration in f64, for the carry into the next
+    /// block.
+    base64: f64,
+    t_total64: f64,
     /// Frozen exit speed (f64, pins the next block's entry).
     exit: f64,
 }
@@ -209,14 +226,29 @@ const IDLE_EXEC: Exec = Exec {
     vp: 0.0,
     v1: 0.0,
     accel: 0.0,
-    t_acc: 0.0,
-    t_cruise_end: 0.0,
-    t_total: 0.0,
     d_acc: 0.0,
+    t_dec: 0.0,
     base: 0.0,
+    j_cruise: 0,
+    j_decel: 0,
+    j_end: 0,
+    off_cruise: 0.0,
+    off_decel: 0.0,
     k: 0,
+    base64: 0.0,
+    t_total64: 0.0,
     exit: 0.0,
 };
+
+/// First sample index `j ≥ 1` with `base + j·ts > t` and the time of that
+/// sample after `t`.
+fn first_sample_after(base: f64, ts: f64, t: f64) -> (u32, f32) {
+    let j = libm::floor((t - base) / ts) + 1.0;
+    let j = j.max(1.0);
+    // Saturating conversion (blocks longer than 2³² samples are absurd).
+    let ju = j as u32;
+    (ju, (base + f64::from(ju) * ts - t) as f32)
+}
 
 /// GRBL-style look-ahead planner and sampler with room for `CAP` blocks.
 ///
@@ -494,12 +526,10 @@ impl<const CAP: usize> PathPlanner<CAP> {
             )
             .min(p.v_nominal)
             .min(b.v_nominal),
+            // New path, after a jump, or everything before has been executed
+            // (the spot is at rest).
             _ => 0.0,
         };
-        if prev.is_none() {
-            // Everything before has been executed: the spot is at rest.
-            b.max_entry = 0.0;
-        }
         self.push(b)?;
         self.pen = b.end;
         self.next_starts_path = false;
@@ -567,10 +597,11 @@ impl<const CAP: usize> PathPlanner<CAP> {
 
     /// Freezes the head block's profile. `base` is the time of the last
     /// emitted sample relative to the block start (≤ 0).
-    fn freeze_head(&mut self, base: f32) {
+    fn freeze_head(&mut self, base: f64) {
         let Some(b) = self.block(0).copied() else {
             return;
         };
+        let ts = self.limits.ts_s;
         let v0 = b.entry;
         let v1 = self.exit_speed(0);
         let (a, l, vn) = (b.accel, b.length, b.v_nominal);
@@ -603,11 +634,22 @@ impl<const CAP: usize> PathPlanner<CAP> {
         e.vp = vp as f32;
         e.v1 = v1 as f32;
         e.accel = a as f32;
-        e.t_acc = t_acc as f32;
-        e.t_cruise_end = (t_acc + t_cruise) as f32;
-        e.t_total = (t_acc + t_cruise + t_dec) as f32;
         e.d_acc = d_acc as f32;
-        e.base = base;
+        e.t_dec = t_dec as f32;
+        e.base = base as f32;
+        e.base64 = base;
+        let t_total = t_acc + t_cruise + t_dec;
+        e.t_total64 = t_total;
+        let (jc, oc) = first_sample_after(base, ts, t_acc);
+        let (jd, od) = first_sample_after(base, ts, t_acc + t_cruise);
+        // Strictly after the end (a sample exactly at the end still
+        // belongs to the block).
+        let (je, _) = first_sample_after(base, ts, t_total);
+        e.j_cruise = jc;
+        e.off_cruise = oc;
+        e.j_decel = jd;
+        e.off_decel = od;
+        e.j_end = je;
         e.k = 0;
         e.exit = v1;
         self.exec = e;
@@ -620,21 +662,23 @@ impl<const CAP: usize> PathPlanner<CAP> {
         }
     }
 
-    /// Position and speed in the running block at time `tau`.
-    fn eval_exec(&self, tau: f32) -> ([f32; 2], f32) {
+    /// Position and speed in the running block at its sample `j` (< j_end).
+    fn eval_exec(&self, j: u32) -> ([f32; 2], f32) {
         let e = &self.exec;
-        let (s, v) = if tau <= e.t_acc {
+        let ts = self.limits.ts_s as f32;
+        let (s, v) = if j < e.j_cruise {
+            let tau = e.base + j as f32 * ts;
             (e.v0 * tau + 0.5 * e.accel * tau * tau, e.v0 + e.accel * tau)
-        } else if tau <= e.t_cruise_end {
-            (e.d_acc + e.vp * (tau - e.t_acc), e.vp)
-        } else if tau < e.t_total {
-            let r = e.t_total - tau;
+        } else if j < e.j_decel {
+            let tau = e.off_cruise + (j - e.j_cruise) as f32 * ts;
+            (e.d_acc + e.vp * tau, e.vp)
+        } else {
+            // Time left until the end of the block.
+            let r = (e.t_dec - (e.off_decel + (j - e.j_decel) as f32 * ts)).max(0.0);
             (
                 e.length - (e.v1 * r + 0.5 * e.accel * r * r),
                 e.v1 + e.accel * r,
             )
-        } else {
-            (e.length, e.v1)
         };
         let s = s.clamp(0.0, e.length);
         let p = if e.arc {
@@ -651,8 +695,8 @@ impl<const CAP: usize> PathPlanner<CAP> {
 
     /// Advances one sample period (or reports a jump / idleness).
     pub fn next_sample(&mut self) -> MarkSample {
-        let ts = self.limits.ts_s as f32;
-        let mut carry: f32 = 0.0;
+        let ts = self.limits.ts_s;
+        let mut carry = 0.0f64;
         loop {
             if !self.exec.active {
                 let Some(b) = self.block(0).copied() else {
@@ -673,10 +717,10 @@ impl<const CAP: usize> PathPlanner<CAP> {
                 self.replan();
             }
             let e = self.exec;
-            let tau = e.base + (e.k + 1) as f32 * ts;
-            if tau <= e.t_total {
-                self.exec.k += 1;
-                let (p, v) = self.eval_exec(tau);
+            let j = e.k.saturating_add(1);
+            if j < e.j_end {
+                self.exec.k = j;
+                let (p, v) = self.eval_exec(j);
                 self.position = p;
                 return MarkSample::Mark {
                     x_mm: p[0],
@@ -701,7 +745,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
                     speed_mm_s: 0.0,
                 };
             }
-            carry = e.base + e.k as f32 * ts - e.t_total;
+            carry = e.base64 + f64::from(e.k) * ts - e.t_total64;
         }
     }
 
@@ -761,7 +805,7 @@ fn trapezoid(v0: f64, v1: f64, vn: f64, a: f64, l: f64) -> (f64, f64, f64, f64, 
             .max(v0)
             .max(v1);
         let d_acc = ((vp * vp - v0 * v0) / (2.0 * a)).clamp(0.0, l);
-        ((vp), d_acc, (vp - v0) / a, 0.0, (vp - v1) / a)
+        (vp, d_acc, (vp - v0) / a, 0.0, (vp - v1) / a)
     }
 }
 

@@ -309,6 +309,7 @@ pub fn plan_profile<const S: usize>(
     if from_rad == to_rad {
         return Ok(JumpPlan::hold(disc, z0));
     }
+    let capacity = crate::jump::effective_capacity(capacity);
     let drive = *disc.model().drive();
     let limits = limits.unwrap_or_else(|| ProfileLimits::from_drive(kind, &drive, disc.u_max_v()));
     let profile = Profile::new(kind, to_rad - from_rad, limits)?;
@@ -326,28 +327,39 @@ pub fn plan_profile<const S: usize>(
             capacity,
         });
     }
-    let n = (steps as usize).max(S);
-    if n > capacity {
-        return Err(Error::CapacityExceeded {
-            needed: n,
-            capacity,
-        });
-    }
-    // Where the averaged voltages alone would land.
-    let (an, _) = disc.power(n);
-    let mut reached = mat_vec(&an, &z0);
-    let mut g = *disc.bd();
-    for j in 0..n {
-        let u = profile.average_u_v(&drive, ts, n - 1 - j);
-        for (r, gi) in reached.iter_mut().zip(g.iter()) {
-            *r += gi * u;
+    let n_profile = (steps as usize).max(S);
+    // The landing correction normally works over the profile's own samples;
+    // when the sampled model is nearly uncontrollable over so few samples
+    // (near-pathological sampling, tiny moves), give it up to 2·S more
+    // samples of zero profile voltage at the end.
+    let mut found = None;
+    for n in n_profile..n_profile.saturating_add(2 * S + 1) {
+        if n > capacity {
+            return Err(Error::CapacityExceeded {
+                needed: n,
+                capacity,
+            });
         }
-        g = mat_vec(disc.ad(), &g);
+        // Where the averaged voltages alone would land.
+        let (an, _) = disc.power(n);
+        let mut reached = mat_vec(&an, &z0);
+        let mut g = *disc.bd();
+        for j in 0..n {
+            let u = profile.average_u_v(&drive, ts, n - 1 - j);
+            for (r, gi) in reached.iter_mut().zip(g.iter()) {
+                *r += gi * u;
+            }
+            g = mat_vec(disc.ad(), &g);
+        }
+        let d = vec_sub(&z1, &reached);
+        let w = gramian(disc, n);
+        let offset = |k: usize| profile.average_u_v(&drive, ts, k);
+        if let Some(sol) = solve(disc, &w, &d, n, 2, &offset) {
+            found = Some((n, sol));
+            break;
+        }
     }
-    let d = vec_sub(&z1, &reached);
-    let w = gramian(disc, n);
-    let offset = |k: usize| profile.average_u_v(&drive, ts, k);
-    let sol = solve(disc, &w, &d, n, 2, &offset).ok_or(Error::NotReachable { samples: n })?;
+    let (n, sol) = found.ok_or(Error::NotReachable { samples: n_profile })?;
     let method = match kind {
         ProfileKind::Trapezoid => MethodKind::TCurve,
         ProfileKind::SCurve => MethodKind::SCurve,

@@ -122,7 +122,9 @@ impl<const S: usize, const CAP: usize, const Q: usize> Stepper<S, CAP, Q> {
         if !continuous {
             return Err(Error::DiscontinuousMove);
         }
-        if plan.samples() > 0 && (self.move_count >= Q || self.queued + plan.samples() > CAP) {
+        if plan.samples() > 0
+            && (self.move_count >= Q || self.queued.saturating_add(plan.samples()) > CAP)
+        {
             return Err(Error::QueueFull);
         }
         Ok(())

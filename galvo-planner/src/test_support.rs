@@ -7,6 +7,19 @@ use crate::jump::JumpPlan;
 use crate::linalg::Vector;
 use crate::model::{Discrete, FlexParams, RigidParams};
 
+/// Property-test configuration with `default` cases, or `PROPTEST_CASES`
+/// when set (for stress runs).
+pub fn cases(default: u32) -> proptest::test_runner::Config {
+    let n = std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default);
+    proptest::test_runner::Config {
+        cases: n,
+        ..proptest::test_runner::Config::default()
+    }
+}
+
 /// Degrees → radians.
 pub const DEG: f64 = core::f64::consts::PI / 180.0;
 /// The step sizes of the acceptance criteria, mechanical degrees.

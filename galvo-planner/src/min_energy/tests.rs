@@ -246,7 +246,7 @@ fn capacity_and_invalid_requests_are_errors() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+    #![proptest_config(crate::test_support::cases(24))]
 
     /// Reversing a move reverses its input: planning b→a gives exactly the
     /// negated voltages of a→b (the model is linear and rest states are

@@ -374,7 +374,7 @@ fn feed_is_capped_by_the_limit() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+    #![proptest_config(crate::test_support::cases(48))]
 
     /// Random polylines streamed through a 16-block buffer while sampling
     /// (segments arrive while earlier ones run): never above the speed or

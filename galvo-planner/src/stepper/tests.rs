@@ -206,7 +206,7 @@ fn hold_at_reseats_an_idle_stepper_only() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
+    #![proptest_config(crate::test_support::cases(16))]
 
     /// A long sequence of random moves: every move ends exactly on its
     /// target and the f32 state never drifts from the f64 plan.

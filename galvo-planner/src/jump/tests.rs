@@ -1,0 +1,129 @@
+extern crate std;
+
+use super::*;
+use crate::model::{FlexParams, RigidParams};
+use crate::test_support::{DEG, assert_lands, inputs, rigid};
+use proptest::prelude::*;
+
+fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+    (lo.ln()..hi.ln()).prop_map(f64::exp)
+}
+
+proptest! {
+    #![proptest_config(crate::test_support::cases(64))]
+
+    /// Far outside the reference galvo (parameters over decades, tiny and
+    /// huge voltage limits, sample periods from 0.1 µs to 1 ms, distances
+    /// from 1e-9 to 10 rad): every method either returns a plan that lands
+    /// (and, for the model-based planners, respects Umax) or a typed
+    /// capacity error — no panic, no hang, no wrong plan.
+    #[test]
+    fn wide_parameter_ranges_give_plans_or_typed_errors(
+        kt in log_uniform(1e-4, 1.0), j in log_uniform(1e-10, 1e-5), l in log_uniform(1e-6, 1e-2),
+        r in log_uniform(0.1, 100.0), umax in log_uniform(0.01, 1000.0), ts in log_uniform(1e-7, 1e-3),
+        dist in log_uniform(1e-9, 10.0), neg: bool,
+    ) {
+        let p = RigidParams { kt_nm_per_a: kt, j_kg_m2: j, l_h: l, r_ohm: r, u_max_v: umax };
+        let Ok(d) = p.model().and_then(|m| m.discretize(ts)) else {
+            return Ok(());
+        };
+        let to = if neg { -dist } else { dist };
+        for method in [Method::TimeOptimal, Method::SEED, Method::TCurve, Method::SCurve] {
+            match plan_jump(&d, 0.0, to, method, 20_000) {
+                Ok(plan) => {
+                    let model_based = matches!(method, Method::TimeOptimal | Method::Seed(_));
+                    // Landing relative to the move's own scales.
+                    let u = inputs(&plan);
+                    let mut z = *plan.start_state();
+                    for uk in &u {
+                        z = d.step(&z, *uk);
+                    }
+                    let w_scale = umax / kt;
+                    let i_scale = umax / r;
+                    prop_assert!((z[0] - to).abs() <= 1e-6 * dist.max(1e-3), "{method:?}: θ off by {}", z[0] - to);
+                    prop_assert!(z[1].abs() <= 1e-6 * w_scale, "{method:?}: ω {}", z[1]);
+                    prop_assert!(z[2].abs() <= 1e-6 * i_scale, "{method:?}: I {}", z[2]);
+                    if model_based {
+                        prop_assert!(plan.max_abs_u_v() <= umax);
+                    }
+                }
+                Err(Error::CapacityExceeded { .. }) => {}
+                Err(e) => prop_assert!(false, "{method:?}: unexpected error {e}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn xy_jump_plans_both_axes_and_validates_periods() {
+    let d = rigid(10e-6);
+    let jump = plan_xy_jump(
+        &d,
+        &d,
+        [0.0, 0.0],
+        [5.0 * DEG, -DEG],
+        Method::TimeOptimal,
+        JumpSync::Independent,
+        1000,
+    )
+    .expect("jump");
+    assert_lands(&jump.x, true, "x");
+    assert_lands(&jump.y, true, "y");
+    assert_eq!(jump.samples(), jump.x.samples().max(jump.y.samples()));
+    let same = plan_xy_jump(
+        &d,
+        &d,
+        [0.0, 0.0],
+        [5.0 * DEG, -DEG],
+        Method::TimeOptimal,
+        JumpSync::SameDuration,
+        1000,
+    )
+    .expect("jump");
+    assert_eq!(same.x.samples(), same.y.samples());
+    assert_eq!(same.y.method(), MethodKind::MinEnergy);
+    assert_lands(&same.y, true, "stretched y");
+    let other = rigid(5e-6);
+    assert!(matches!(
+        plan_xy_jump(
+            &d,
+            &other,
+            [0.0; 2],
+            [0.1; 2],
+            Method::SEED,
+            JumpSync::Independent,
+            1000
+        ),
+        Err(Error::InvalidSamplePeriod { .. })
+    ));
+}
+
+#[test]
+fn plan_accessors_are_consistent() {
+    let d = rigid(10e-6);
+    let plan = plan_jump(&d, 0.1, 0.2, Method::SEED, 1000).expect("plan");
+    assert_eq!(plan.method(), MethodKind::Seed);
+    assert_eq!(plan.method().name(), Method::SEED.name());
+    assert!((plan.move_time_s() - plan.samples() as f64 * 10e-6).abs() < 1e-18);
+    let u = inputs(&plan);
+    let peak = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert_eq!(plan.max_abs_u_v(), peak);
+    // final_state (superposition) agrees with the forward simulation.
+    let sim = d.simulate(plan.start_state(), &u, |_, _, _| {});
+    for (a, b) in plan.final_state().iter().zip(sim) {
+        assert!((a - b).abs() < 1e-9);
+    }
+    let mut short = [0.0; 3];
+    assert!(matches!(
+        plan.write_u_v(&mut short),
+        Err(Error::CapacityExceeded { capacity: 3, .. })
+    ));
+    let flex = FlexParams::REFERENCE
+        .model()
+        .and_then(|m| m.discretize(10e-6))
+        .expect("valid");
+    assert_eq!(
+        plan_jump(&flex, 0.0, 0.1, Method::TimeOptimal, 100),
+        Err(Error::UnsupportedModel)
+    );
+}
