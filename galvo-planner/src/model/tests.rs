@@ -237,7 +237,9 @@ fn invalid_parameters_are_typed_errors() {
 fn reference_flex_resonance_is_10_khz() {
     let f = FlexParams::REFERENCE;
     assert!((f.resonance_hz() - 10e3).abs() < 1e-6);
-    assert!((f.k_nm_per_rad - 19.739208802178716).abs() < 1e-9);
+    // K = ω²·Jm·Jl/(Jm + Jl) with ω = 2π·10 kHz, Jm = Jl = 1e-8 kg·m².
+    let w = 2.0 * core::f64::consts::PI * 10e3;
+    assert!((f.k_nm_per_rad - w * w * 0.5e-8).abs() < 1e-9);
 }
 
 // ---- pathological sampling ----------------------------------------------
