@@ -1,2 +1,25 @@
 #![no_std]
-//! Geometry layer of the laser pointing controller.
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::indexing_slicing,
+        clippy::panic
+    )
+)]
+//! Geometry layer of the laser pointing controller (SPEC §4, §5).
+
+pub mod error;
+pub mod frames;
+pub mod real;
+pub mod servo;
+pub mod stepper;
+
+pub use error::{Error, Joint};
+pub use frames::{BoardFrame, BoardPoint, BoardPose, GlobalPoint, PointMm};
+pub use real::Real;
+pub use servo::{Direction, ServoAxis, WireAngles};
+pub use stepper::StepperAxis;

@@ -1,0 +1,179 @@
+//! The crate's one error type.
+
+use core::fmt;
+
+/// A gimbal joint (servo axis).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Joint {
+    /// Yaw α, rotation about the global z axis.
+    Yaw,
+    /// Pitch β, rotation about the yawed horizontal axis.
+    Pitch,
+}
+
+impl Joint {
+    /// Lower-case name (`"yaw"`, `"pitch"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Joint::Yaw => "yaw",
+            Joint::Pitch => "pitch",
+        }
+    }
+}
+
+/// Everything that can go wrong in this crate. Functions document which
+/// variants they return; none of them panics or returns NaN instead.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Error {
+    /// An input (named) is NaN or infinite.
+    NonFinite {
+        /// Which input, e.g. `"x_cm"`.
+        what: &'static str,
+    },
+    /// A configuration value is out of its domain (e.g. a zero scale).
+    InvalidConfig {
+        /// What is wrong, e.g. `"ol_cm must be >= 0"`.
+        what: &'static str,
+    },
+    /// The target is within the laser offset circle: no beam offset by
+    /// `OL` from the gimbal centre can pass through it.
+    InsideOffsetCircle,
+    /// The board (or the target) is not in front of the gimbal (`x_g <= 0`).
+    BehindGimbal,
+    /// The beam (or galvo deflection) is parallel to the board or points
+    /// away from it, so it has no spot on the board.
+    MissesBoard,
+    /// A joint angle maps to a servo angle outside the servo's limits.
+    JointLimit {
+        /// Which joint.
+        joint: Joint,
+        /// Servo angle the joint angle maps to, degrees.
+        servo_deg: f64,
+        /// Lower servo limit, degrees.
+        min_deg: f64,
+        /// Upper servo limit, degrees.
+        max_deg: f64,
+    },
+    /// A stepper angle needs more microsteps than an `i32` holds.
+    StepsOutOfRange,
+    /// A grid index outside the configured grid.
+    GridIndexOutOfRange {
+        /// Column index.
+        xi: i16,
+        /// Row index.
+        yi: i16,
+    },
+    /// A DAC code above the converter's full scale (4095 for 12 bits).
+    DacCodeOutOfRange {
+        /// The code given.
+        code: u16,
+    },
+    /// A path would need more interpolation steps than supported.
+    TooManySteps,
+    /// A path is shorter than it must be (e.g. a circle radius below one step).
+    PathTooShort,
+    /// An arc's end point is not on the circle through its start point
+    /// (radii differ by more than half a step).
+    EndNotOnCircle,
+    /// Fewer measured points than the model has coefficients (6).
+    TooFewPoints {
+        /// Number of points given.
+        n: usize,
+    },
+    /// The measured points do not determine the quadratic (collinear,
+    /// repeated, or on one conic).
+    DegeneratePoints,
+    /// Compensation (inverse of the error model) did not converge.
+    NotConverged,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Error::NonFinite { what } => write!(f, "{what} is not a finite number"),
+            Error::InvalidConfig { what } => write!(f, "invalid configuration: {what}"),
+            Error::InsideOffsetCircle => {
+                f.write_str("target is inside the laser offset circle (distance <= OL)")
+            }
+            Error::BehindGimbal => f.write_str("target is behind the gimbal"),
+            Error::MissesBoard => f.write_str("beam does not hit the board"),
+            Error::JointLimit {
+                joint,
+                servo_deg,
+                min_deg,
+                max_deg,
+            } => write!(
+                f,
+                "{} servo angle {servo_deg:.2} deg is outside its limits [{min_deg}, {max_deg}] deg",
+                joint.name()
+            ),
+            Error::StepsOutOfRange => f.write_str("stepper angle out of the i32 microstep range"),
+            Error::GridIndexOutOfRange { xi, yi } => {
+                write!(f, "grid index ({xi}, {yi}) is outside the grid")
+            }
+            Error::DacCodeOutOfRange { code } => {
+                write!(f, "DAC code {code} is above full scale")
+            }
+            Error::TooManySteps => f.write_str("path needs too many interpolation steps"),
+            Error::PathTooShort => f.write_str("path is shorter than one step"),
+            Error::EndNotOnCircle => f.write_str("arc end point is not on the circle"),
+            Error::TooFewPoints { n } => {
+                write!(f, "need at least 6 measured points, got {n}")
+            }
+            Error::DegeneratePoints => {
+                f.write_str("measured points are degenerate (collinear, repeated or on one conic)")
+            }
+            Error::NotConverged => f.write_str("error-model compensation did not converge"),
+        }
+    }
+}
+
+impl core::error::Error for Error {}
+
+/// Returns `Err(NonFinite)` unless `v` is finite.
+pub(crate) fn finite(v: f64, what: &'static str) -> Result<f64, Error> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(Error::NonFinite { what })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::string::ToString;
+
+    #[test]
+    fn display_names_the_problem() {
+        assert_eq!(
+            Error::NonFinite { what: "x_cm" }.to_string(),
+            "x_cm is not a finite number"
+        );
+        let limit = Error::JointLimit {
+            joint: Joint::Pitch,
+            servo_deg: 140.0,
+            min_deg: -135.0,
+            max_deg: 135.0,
+        };
+        assert_eq!(
+            limit.to_string(),
+            "pitch servo angle 140.00 deg is outside its limits [-135, 135] deg"
+        );
+        assert_eq!(
+            Error::TooFewPoints { n: 3 }.to_string(),
+            "need at least 6 measured points, got 3"
+        );
+    }
+
+    #[test]
+    fn finite_rejects_nan_and_infinity() {
+        assert_eq!(finite(1.5, "a"), Ok(1.5));
+        assert_eq!(finite(f64::NAN, "a"), Err(Error::NonFinite { what: "a" }));
+        assert_eq!(
+            finite(f64::NEG_INFINITY, "b"),
+            Err(Error::NonFinite { what: "b" })
+        );
+    }
+}
