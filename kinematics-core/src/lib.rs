@@ -14,12 +14,16 @@
 
 pub mod error;
 pub mod frames;
+pub mod grid;
+pub mod pattern;
 pub mod real;
 pub mod servo;
 pub mod stepper;
 
 pub use error::{Error, Joint};
 pub use frames::{BoardFrame, BoardPoint, BoardPose, GlobalPoint, PointMm};
+pub use grid::{Grid, GridIndex};
+pub use pattern::Pattern;
 pub use real::Real;
 pub use servo::{Direction, ServoAxis, WireAngles};
 pub use stepper::StepperAxis;
