@@ -14,6 +14,7 @@
 
 pub mod error;
 pub mod frames;
+pub mod gimbal;
 pub mod grid;
 pub mod pattern;
 pub mod real;
@@ -22,6 +23,7 @@ pub mod stepper;
 
 pub use error::{Error, Joint};
 pub use frames::{BoardFrame, BoardPoint, BoardPose, GlobalPoint, PointMm};
+pub use gimbal::{Gimbal, GimbalGeometry, GimbalModel, JointAngles};
 pub use grid::{Grid, GridIndex};
 pub use pattern::Pattern;
 pub use real::Real;
