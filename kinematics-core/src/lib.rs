@@ -14,6 +14,7 @@
 
 pub mod error;
 pub mod frames;
+pub mod galvo;
 pub mod gimbal;
 pub mod grid;
 pub mod pattern;
@@ -23,6 +24,7 @@ pub mod stepper;
 
 pub use error::{Error, Joint};
 pub use frames::{BoardFrame, BoardPoint, BoardPose, GlobalPoint, PointMm};
+pub use galvo::{DacAxis, DacCode, DacCodes, Galvo, GalvoGeometry, MirrorAngles};
 pub use gimbal::{Gimbal, GimbalGeometry, GimbalModel, JointAngles};
 pub use grid::{Grid, GridIndex};
 pub use pattern::Pattern;

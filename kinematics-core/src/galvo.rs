@@ -1,0 +1,531 @@
+//! Two-mirror galvo kinematics and the DAC mapping (SPEC §4.5).
+//!
+//! The X mirror comes first, the Y mirror `e` after it, the board `d` after
+//! the Y mirror; a mechanical rotation θ deflects the beam by 2θ. Exact
+//! mapping with the pincushion term:
+//! `y = d·tan(2θy)`, `x = (√(d² + y²) + e)·tan(2θx)`; the inverse solves y
+//! first: `θy = atan(y / d) / 2`, `θx = atan(x / (√(d² + y²) + e)) / 2`.
+//! Board x/y are the board frame's (mm), with the galvo axis through Q.
+//!
+//! Generic over [`Real`]: `f64` is the reference, `f32` the per-sample path
+//! for the Cortex-M4F (held to the `f64` one within 0.001 mm over the ±12.5°
+//! field by the tests). DAC code ↔ mechanical angle is linear per axis,
+//! `code = round(offset_code + codes_per_rad · θ)`, clamped to 0..=4095
+//! with the clamp reported.
+
+use crate::error::Error;
+use crate::frames::PointMm;
+use crate::real::Real;
+
+/// Highest code of the 12-bit DAC.
+pub const DAC_MAX_CODE: u16 = 4095;
+/// SPEC default distance Y mirror → board, mm.
+pub const DEFAULT_D_MM: f64 = 400.0;
+/// SPEC default mirror separation, mm.
+pub const DEFAULT_E_MM: f64 = 10.0;
+/// SPEC default mechanical half range mapped onto the DAC span, degrees.
+pub const DEFAULT_HALF_RANGE_DEG: f64 = 12.5;
+/// Mid-scale of the 12-bit DAC (code for 0°, before rounding).
+pub const DAC_MID_CODE: f64 = 2047.5;
+
+/// Mechanical mirror angles, radians (the beam turns by twice these).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MirrorAngles<F = f64> {
+    /// X mirror (first), mechanical radians.
+    pub x_rad: F,
+    /// Y mirror (second), mechanical radians.
+    pub y_rad: F,
+}
+
+/// Mirror geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GalvoGeometry<F = f64> {
+    /// Distance from the Y mirror to the board, mm (> 0).
+    pub d_mm: F,
+    /// Separation of the X and Y mirrors, mm (≥ 0).
+    pub e_mm: F,
+}
+
+impl<F: Real> Default for GalvoGeometry<F> {
+    /// SPEC defaults: d = 400 mm, e = 10 mm.
+    fn default() -> Self {
+        Self {
+            d_mm: F::from_f64(DEFAULT_D_MM),
+            e_mm: F::from_f64(DEFAULT_E_MM),
+        }
+    }
+}
+
+impl<F: Real> GalvoGeometry<F> {
+    #[inline]
+    fn validate(&self) -> Result<(), Error> {
+        if self.d_mm <= F::ZERO || !self.d_mm.is_finite() {
+            return Err(Error::InvalidConfig {
+                what: "galvo d_mm must be finite and > 0",
+            });
+        }
+        if self.e_mm < F::ZERO || !self.e_mm.is_finite() {
+            return Err(Error::InvalidConfig {
+                what: "galvo e_mm must be finite and >= 0",
+            });
+        }
+        Ok(())
+    }
+
+    /// Mirror angles that put the spot on board point `p` (mm).
+    ///
+    /// Errors: [`Error::NonFinite`], [`Error::InvalidConfig`].
+    #[inline]
+    pub fn ik(&self, p: PointMm<F>) -> Result<MirrorAngles<F>, Error> {
+        self.validate()?;
+        p.check_finite()?;
+        let y_rad = (p.y_mm / self.d_mm).atan() * F::HALF;
+        let path_mm = (self.d_mm * self.d_mm + p.y_mm * p.y_mm).sqrt() + self.e_mm;
+        let x_rad = (p.x_mm / path_mm).atan() * F::HALF;
+        Ok(MirrorAngles { x_rad, y_rad })
+    }
+
+    /// Board point (mm) of the spot for mirror angles `a`.
+    ///
+    /// Errors: [`Error::NonFinite`], [`Error::InvalidConfig`],
+    /// [`Error::MissesBoard`] (a deflection of 90° or more).
+    #[inline]
+    pub fn fk(&self, a: MirrorAngles<F>) -> Result<PointMm<F>, Error> {
+        self.validate()?;
+        if !a.x_rad.is_finite() {
+            return Err(Error::NonFinite { what: "x_rad" });
+        }
+        if !a.y_rad.is_finite() {
+            return Err(Error::NonFinite { what: "y_rad" });
+        }
+        let (bx, by) = (a.x_rad * F::TWO, a.y_rad * F::TWO);
+        if bx.abs() >= F::FRAC_PI_2 || by.abs() >= F::FRAC_PI_2 {
+            return Err(Error::MissesBoard);
+        }
+        let y_mm = self.d_mm * by.tan();
+        let x_mm = ((self.d_mm * self.d_mm + y_mm * y_mm).sqrt() + self.e_mm) * bx.tan();
+        PointMm { x_mm, y_mm }
+            .check_finite()
+            .map_err(|_| Error::MissesBoard)
+    }
+}
+
+/// A DAC output code with its clamp flag.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DacCode {
+    /// Code written to the DAC, 0..=4095.
+    pub code: u16,
+    /// The angle was outside the DAC range and the code was clamped.
+    pub clamped: bool,
+}
+
+/// Linear mapping of one axis: `code = round(offset_code + codes_per_rad·θ)`
+/// with θ the mechanical angle in radians.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DacAxis<F = f64> {
+    /// DAC codes per mechanical radian (sign = direction), non-zero.
+    pub codes_per_rad: F,
+    /// Code for 0 rad (before rounding).
+    pub offset_code: F,
+}
+
+impl<F: Real> Default for DacAxis<F> {
+    /// SPEC default: ±12.5° mechanical spans the 12-bit range,
+    /// `code = round(2047.5 + θ / 12.5° · 2047.5)`.
+    fn default() -> Self {
+        Self::spanning(DEFAULT_HALF_RANGE_DEG)
+    }
+}
+
+impl<F: Real> DacAxis<F> {
+    /// The axis whose full 12-bit range spans `±half_range_deg` mechanical.
+    pub fn spanning(half_range_deg: f64) -> Self {
+        Self {
+            codes_per_rad: F::from_f64(DAC_MID_CODE / half_range_deg.to_radians()),
+            offset_code: F::from_f64(DAC_MID_CODE),
+        }
+    }
+
+    /// DAC code for mechanical angle `theta_rad`, clamped to 0..=4095 (and
+    /// flagged) when outside the range.
+    ///
+    /// Errors: [`Error::NonFinite`] (angle or mapping).
+    #[inline]
+    pub fn angle_to_code(&self, theta_rad: F) -> Result<DacCode, Error> {
+        let code = (self.offset_code + self.codes_per_rad * theta_rad).round();
+        if !code.is_finite() {
+            return Err(Error::NonFinite { what: "DAC code" });
+        }
+        let max = F::from_f64(f64::from(DAC_MAX_CODE));
+        Ok(if code < F::ZERO {
+            DacCode {
+                code: 0,
+                clamped: true,
+            }
+        } else if code > max {
+            DacCode {
+                code: DAC_MAX_CODE,
+                clamped: true,
+            }
+        } else {
+            DacCode {
+                // Whole and within 0..=4095: the cast is exact.
+                code: code.to_f64() as u16,
+                clamped: false,
+            }
+        })
+    }
+
+    /// Mechanical angle (radians) of DAC code `code`.
+    ///
+    /// Errors: [`Error::DacCodeOutOfRange`] (> 4095),
+    /// [`Error::InvalidConfig`] (zero or non-finite mapping).
+    #[inline]
+    pub fn code_to_angle(&self, code: u16) -> Result<F, Error> {
+        if code > DAC_MAX_CODE {
+            return Err(Error::DacCodeOutOfRange { code });
+        }
+        if !self.codes_per_rad.is_finite()
+            || self.codes_per_rad == F::ZERO
+            || !self.offset_code.is_finite()
+        {
+            return Err(Error::InvalidConfig {
+                what: "DAC codes_per_rad must be finite and non-zero",
+            });
+        }
+        Ok((F::from_f64(f64::from(code)) - self.offset_code) / self.codes_per_rad)
+    }
+}
+
+/// DAC codes of both axes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DacCodes {
+    /// X axis (DAC1 channel 1).
+    pub x: DacCode,
+    /// Y axis (DAC1 channel 2).
+    pub y: DacCode,
+}
+
+impl DacCodes {
+    /// Whether either axis was clamped.
+    pub fn clamped(&self) -> bool {
+        self.x.clamped || self.y.clamped
+    }
+}
+
+/// A complete galvo: geometry and both DAC mappings. `Copy`; [`Default`]
+/// holds the SPEC defaults. Use `Galvo<f32>` per sample, `Galvo<f64>` as
+/// the reference; [`Galvo::cast`] converts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Galvo<F = f64> {
+    /// Mirror geometry.
+    pub geometry: GalvoGeometry<F>,
+    /// X mirror DAC mapping.
+    pub dac_x: DacAxis<F>,
+    /// Y mirror DAC mapping.
+    pub dac_y: DacAxis<F>,
+}
+
+impl<F: Real> Default for Galvo<F> {
+    /// SPEC defaults: d = 400 mm, e = 10 mm, ±12.5° on both DAC axes.
+    fn default() -> Self {
+        Self {
+            geometry: GalvoGeometry::default(),
+            dac_x: DacAxis::default(),
+            dac_y: DacAxis::default(),
+        }
+    }
+}
+
+impl<F: Real> Galvo<F> {
+    /// Board point (mm) → mirror angles → DAC codes.
+    ///
+    /// Errors: [`Error::NonFinite`], [`Error::InvalidConfig`].
+    #[inline]
+    pub fn board_to_codes(&self, p: PointMm<F>) -> Result<DacCodes, Error> {
+        let a = self.geometry.ik(p)?;
+        self.angles_to_codes(a)
+    }
+
+    /// Mirror angles → DAC codes.
+    ///
+    /// Errors: [`Error::NonFinite`].
+    #[inline]
+    pub fn angles_to_codes(&self, a: MirrorAngles<F>) -> Result<DacCodes, Error> {
+        Ok(DacCodes {
+            x: self.dac_x.angle_to_code(a.x_rad)?,
+            y: self.dac_y.angle_to_code(a.y_rad)?,
+        })
+    }
+
+    /// DAC codes → mirror angles.
+    ///
+    /// Errors: [`Error::DacCodeOutOfRange`], [`Error::InvalidConfig`].
+    pub fn codes_to_angles(&self, x_code: u16, y_code: u16) -> Result<MirrorAngles<F>, Error> {
+        Ok(MirrorAngles {
+            x_rad: self.dac_x.code_to_angle(x_code)?,
+            y_rad: self.dac_y.code_to_angle(y_code)?,
+        })
+    }
+
+    /// DAC codes → board point (mm).
+    ///
+    /// Errors: [`Error::DacCodeOutOfRange`], [`Error::InvalidConfig`],
+    /// [`Error::MissesBoard`].
+    pub fn codes_to_board(&self, x_code: u16, y_code: u16) -> Result<PointMm<F>, Error> {
+        self.geometry.fk(self.codes_to_angles(x_code, y_code)?)
+    }
+
+    /// The same galvo in another float type (e.g. `f64` settings → `f32`
+    /// per-sample copy).
+    pub fn cast<G: Real>(&self) -> Galvo<G> {
+        let c = |v: F| G::from_f64(v.to_f64());
+        Galvo {
+            geometry: GalvoGeometry {
+                d_mm: c(self.geometry.d_mm),
+                e_mm: c(self.geometry.e_mm),
+            },
+            dac_x: DacAxis {
+                codes_per_rad: c(self.dac_x.codes_per_rad),
+                offset_code: c(self.dac_x.offset_code),
+            },
+            dac_y: DacAxis {
+                codes_per_rad: c(self.dac_y.codes_per_rad),
+                offset_code: c(self.dac_y.offset_code),
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const FIELD_RAD: f64 = 12.5 * core::f64::consts::PI / 180.0;
+
+    /// Independent model of the galvo: trace the beam through the two
+    /// mirrors as rotations of its direction vector (X mirror turns it by
+    /// 2θx about the y axis at the origin; after e mm along the optical axis
+    /// the Y mirror turns it by 2θy about the x axis; the board is d mm
+    /// further), then intersect with the board plane.
+    fn ray_trace(d: f64, e: f64, tx: f64, ty: f64) -> (f64, f64) {
+        let (s1, c1) = libm::sincos(2.0 * tx);
+        // Direction after the X mirror.
+        let dir = [s1, 0.0, c1];
+        // Hits the Y mirror's axis plane z = e.
+        let t = e / dir[2];
+        let hit = [dir[0] * t, 0.0, e];
+        // Rotate about x by 2θy: (x, y, z) → (x, y cos − z sin…) toward +y.
+        let (s2, c2) = libm::sincos(2.0 * ty);
+        let dir = [dir[0], dir[2] * s2, dir[2] * c2];
+        let t = d / dir[2];
+        (hit[0] + dir[0] * t, hit[1] + dir[1] * t)
+    }
+
+    #[test]
+    fn matches_an_independent_ray_trace() {
+        let g = GalvoGeometry::<f64>::default();
+        for (tx, ty) in [(0.1, 0.0), (0.0, -0.2), (0.15, 0.2), (-0.2, -0.1)] {
+            let p = g
+                .fk(MirrorAngles {
+                    x_rad: tx,
+                    y_rad: ty,
+                })
+                .unwrap();
+            let (x, y) = ray_trace(400.0, 10.0, tx, ty);
+            assert!((p.x_mm - x).abs() < 1e-9 && (p.y_mm - y).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn hand_computed_axes() {
+        let g = GalvoGeometry::<f64>::default();
+        // θy = 0: x = (d + e)·tan 2θx; 5° → 410·tan 10°.
+        let p = g
+            .fk(MirrorAngles {
+                x_rad: 5f64.to_radians(),
+                y_rad: 0.0,
+            })
+            .unwrap();
+        assert!((p.x_mm - 410.0 * libm::tan(10f64.to_radians())).abs() < 1e-12);
+        assert_eq!(p.y_mm, 0.0);
+        // θx = 0: y = d·tan 2θy, no x.
+        let a = g.ik(PointMm::new(0.0, 400.0)).unwrap();
+        assert!((a.y_rad - 22.5f64.to_radians()).abs() < 1e-15);
+        assert_eq!(a.x_rad, 0.0);
+    }
+
+    #[test]
+    fn pincushion_needs_less_x_angle_off_axis() {
+        // The same board x at larger |y| has a longer beam path: smaller θx.
+        let g = GalvoGeometry::<f64>::default();
+        let on = g.ik(PointMm::new(100.0, 0.0)).unwrap();
+        let off = g.ik(PointMm::new(100.0, 150.0)).unwrap();
+        assert!(off.x_rad < on.x_rad);
+    }
+
+    #[test]
+    fn dac_mapping_spec_values() {
+        let dac = DacAxis::<f64>::default();
+        let deg = |d: f64| d.to_radians();
+        assert_eq!(dac.angle_to_code(deg(12.5)).unwrap().code, 4095);
+        assert_eq!(dac.angle_to_code(deg(-12.5)).unwrap().code, 0);
+        // round(2047.5) = 2048 (half away from zero).
+        assert_eq!(dac.angle_to_code(0.0).unwrap().code, 2048);
+        // One LSB ≈ 0.0061° mechanical ≈ 0.085 mm at 400 mm (SPEC).
+        let lsb_rad = dac.code_to_angle(2049).unwrap() - dac.code_to_angle(2048).unwrap();
+        assert!((lsb_rad.to_degrees() - 0.0061).abs() < 0.00005);
+        let lsb_mm = 400.0 * libm::tan(2.0 * lsb_rad);
+        assert!((lsb_mm - 0.085).abs() < 0.001, "{lsb_mm}");
+        let over = dac.angle_to_code(deg(13.0)).unwrap();
+        assert_eq!(
+            over,
+            DacCode {
+                code: 4095,
+                clamped: true
+            }
+        );
+        let under = dac.angle_to_code(deg(-20.0)).unwrap();
+        assert_eq!(
+            under,
+            DacCode {
+                code: 0,
+                clamped: true
+            }
+        );
+        assert!(!dac.angle_to_code(deg(12.49)).unwrap().clamped);
+    }
+
+    #[test]
+    fn errors_instead_of_nan() {
+        let g = Galvo::<f32>::default();
+        assert_eq!(
+            g.board_to_codes(PointMm::new(f32::NAN, 0.0)),
+            Err(Error::NonFinite { what: "x_mm" })
+        );
+        assert_eq!(
+            g.dac_x.angle_to_code(f32::INFINITY),
+            Err(Error::NonFinite { what: "DAC code" })
+        );
+        assert_eq!(
+            g.codes_to_board(4096, 0),
+            Err(Error::DacCodeOutOfRange { code: 4096 })
+        );
+        assert_eq!(
+            g.geometry.fk(MirrorAngles {
+                x_rad: 0.8,
+                y_rad: 0.0
+            }),
+            Err(Error::MissesBoard)
+        );
+        assert_eq!(
+            g.geometry.fk(MirrorAngles {
+                x_rad: 0.0,
+                y_rad: f32::NAN
+            }),
+            Err(Error::NonFinite { what: "y_rad" })
+        );
+        let flat = GalvoGeometry::<f64> {
+            d_mm: 0.0,
+            e_mm: 10.0,
+        };
+        assert!(matches!(
+            flat.ik(PointMm::new(1.0, 1.0)),
+            Err(Error::InvalidConfig { .. })
+        ));
+        let neg_e = GalvoGeometry::<f64> {
+            d_mm: 400.0,
+            e_mm: f64::NAN,
+        };
+        assert!(matches!(
+            neg_e.fk(MirrorAngles::default()),
+            Err(Error::InvalidConfig { .. })
+        ));
+        let dead = DacAxis::<f64> {
+            codes_per_rad: 0.0,
+            offset_code: 2047.5,
+        };
+        assert!(matches!(
+            dead.code_to_angle(10),
+            Err(Error::InvalidConfig { .. })
+        ));
+    }
+
+    #[test]
+    fn every_code_round_trips() {
+        let g64 = Galvo::<f64>::default();
+        let g32 = Galvo::<f32>::default();
+        for code in 0..=DAC_MAX_CODE {
+            let a = g64.dac_x.code_to_angle(code).unwrap();
+            assert_eq!(g64.dac_x.angle_to_code(a).unwrap().code, code);
+            let a = g32.dac_y.code_to_angle(code).unwrap();
+            let c = g32.dac_y.angle_to_code(a).unwrap();
+            assert_eq!((c.code, c.clamped), (code, false));
+        }
+    }
+
+    #[test]
+    fn cast_keeps_the_values() {
+        let g = Galvo::<f64>::default().cast::<f32>();
+        assert_eq!(g, Galvo::<f32>::default());
+        let back = g.cast::<f64>();
+        assert!(
+            (back.dac_x.codes_per_rad - Galvo::<f64>::default().dac_x.codes_per_rad).abs() < 1e-3
+        );
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        #[test]
+        fn fk_of_ik_is_identity(x in -250.0f64..250.0, y in -250.0f64..250.0, d in 50.0f64..1000.0, e in 0.0f64..50.0) {
+            let g = GalvoGeometry { d_mm: d, e_mm: e };
+            let p = g.fk(g.ik(PointMm::new(x, y)).unwrap()).unwrap();
+            prop_assert!((p.x_mm - x).abs() < 1e-9 && (p.y_mm - y).abs() < 1e-9);
+        }
+
+        #[test]
+        fn ik_of_fk_is_identity(tx in -FIELD_RAD..FIELD_RAD, ty in -FIELD_RAD..FIELD_RAD) {
+            let g = GalvoGeometry::<f64>::default();
+            let a = g.ik(g.fk(MirrorAngles { x_rad: tx, y_rad: ty }).unwrap()).unwrap();
+            prop_assert!((a.x_rad - tx).abs() < 1e-14 && (a.y_rad - ty).abs() < 1e-14);
+        }
+
+        #[test]
+        fn angle_code_angle_within_half_an_lsb(t in -FIELD_RAD..FIELD_RAD) {
+            let dac = DacAxis::<f64>::default();
+            let c = dac.angle_to_code(t).unwrap();
+            prop_assert!(!c.clamped);
+            let back = dac.code_to_angle(c.code).unwrap();
+            prop_assert!((back - t).abs() * dac.codes_per_rad <= 0.5 + 1e-9);
+        }
+
+        // The f32 per-sample path against the f64 reference over the field.
+        #[test]
+        fn f32_matches_f64_within_a_micron(tx in -FIELD_RAD..FIELD_RAD, ty in -FIELD_RAD..FIELD_RAD) {
+            let g64 = Galvo::<f64>::default();
+            let g32 = Galvo::<f32>::default();
+            let a32 = MirrorAngles { x_rad: tx as f32, y_rad: ty as f32 };
+            let a64 = MirrorAngles { x_rad: f64::from(a32.x_rad), y_rad: f64::from(a32.y_rad) };
+            // FK: same angles, both precisions.
+            let p64 = g64.geometry.fk(a64).unwrap();
+            let p32 = g32.geometry.fk(a32).unwrap();
+            prop_assert!((f64::from(p32.x_mm) - p64.x_mm).abs() < 1e-3);
+            prop_assert!((f64::from(p32.y_mm) - p64.y_mm).abs() < 1e-3);
+            // IK: the f32 angles for a target land within 0.001 mm of it.
+            let target = PointMm::new(p64.x_mm as f32, p64.y_mm as f32);
+            let ik32 = g32.geometry.ik(target).unwrap();
+            let landed = g64.geometry.fk(MirrorAngles {
+                x_rad: f64::from(ik32.x_rad), y_rad: f64::from(ik32.y_rad),
+            }).unwrap();
+            prop_assert!((landed.x_mm - f64::from(target.x_mm)).abs() < 1e-3);
+            prop_assert!((landed.y_mm - f64::from(target.y_mm)).abs() < 1e-3);
+            // DAC codes agree except at a rounding boundary (±1 code).
+            let c64 = g64.board_to_codes(PointMm::new(f64::from(target.x_mm), f64::from(target.y_mm))).unwrap();
+            let c32 = g32.board_to_codes(target).unwrap();
+            prop_assert!((i32::from(c64.x.code) - i32::from(c32.x.code)).abs() <= 1);
+            prop_assert!((i32::from(c64.y.code) - i32::from(c32.y.code)).abs() <= 1);
+        }
+    }
+}
