@@ -296,6 +296,23 @@ mod tests {
     }
 
     #[test]
+    fn seed_error_vanishes_at_laser_height() {
+        // A target at board height OL needs β = 0 (a level beam stays at
+        // height OL whatever the yaw), and the seed also finds β = 0 there:
+        // no error however far off-centre.
+        let seed = Gimbal::with_model(GimbalModel::Seed);
+        for x in [-20.0, -11.5, 3.0, 15.0] {
+            let p = BoardPoint::new(x, 5.4);
+            assert!(seed.ik(p).unwrap().pitch_deg.abs() < 1e-12);
+            assert!(seed.pointing_error_cm(p).unwrap() < 1e-12);
+        }
+        // Below it the seed's error grows with the distance from that level.
+        let lower = seed.pointing_error_cm(BoardPoint::new(11.5, -7.7)).unwrap();
+        let upper = seed.pointing_error_cm(BoardPoint::new(11.5, 7.7)).unwrap();
+        assert!(lower > 4.0 * upper);
+    }
+
+    #[test]
     fn servo_limits_are_enforced_by_ik() {
         let mut g = Gimbal::default();
         g.geometry.yaw.max_deg = 10.0;
