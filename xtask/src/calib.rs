@@ -1,6 +1,495 @@
-//! `cargo xtask calib …`: error-model fitting.
+//! `cargo xtask calib …`: error-model fitting (SPEC §5).
+//!
+//! `calib fit --input FILE.csv [--output FILE]` reads measured points (CSV
+//! header exactly `x,y,dx,dy`, all mm: commanded position and the error
+//! spot − commanded), fits the quadratic of each axis and prints one JSON
+//! object `{"dx":{"coef":[c0..c5],"sse":…,"r2":…,"rmse":…,"n":…},"dy":{…}}`
+//! (coefficients for 1, x, y, x², xy, y²; `rmse` is null for exactly 6
+//! points). Errors print `{"error":"…"}` (naming the CSV line) and exit 1.
+//!
+//! `--output FILE` writes the model as firmware command lines: `#` comment
+//! lines, then `set err.dx.c0 <mm>` … `set err.dy.c5 <mm>` at full
+//! precision. Paste it into the USB command line (or run it with
+//! `cargo xtask sim --script FILE`), then `save`.
+
+use std::fmt::Write as _;
+use std::fs::File;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use kinematics_core::{AxisFit, FitReport, MeasuredPoint, fit};
+use serde::Serialize;
+
+use crate::kin::error_json;
+
+/// Largest |coefficient| the firmware's `set err.*` accepts (its range).
+const FIRMWARE_COEF_LIMIT: f64 = 1e3;
+/// Longest line the firmware's command line accepts, bytes.
+const FIRMWARE_MAX_LINE: usize = 128;
+/// Column names, in order.
+const HEADER: [&str; 4] = ["x", "y", "dx", "dy"];
+
+/// `cargo xtask calib …`
 #[derive(clap::Args, Debug)]
-pub struct CalibArgs {}
-pub fn run(_args: CalibArgs) -> anyhow::Result<std::process::ExitCode> {
-    anyhow::bail!("calib: being written")
+pub struct CalibArgs {
+    #[command(subcommand)]
+    command: CalibCommand,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum CalibCommand {
+    /// Fit the error model to measured points; prints JSON.
+    Fit(FitArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct FitArgs {
+    /// Measured points: CSV with header `x,y,dx,dy` (mm).
+    #[arg(long)]
+    input: PathBuf,
+    /// Also write the model as firmware `set err.*` command lines here.
+    #[arg(long)]
+    output: Option<PathBuf>,
+}
+
+#[derive(Serialize)]
+struct AxisOut {
+    coef: [f64; 6],
+    sse: f64,
+    r2: f64,
+    rmse: Option<f64>,
+    n: usize,
+}
+
+impl From<&AxisFit> for AxisOut {
+    fn from(f: &AxisFit) -> Self {
+        Self {
+            coef: f.coef,
+            sse: f.sse,
+            r2: f.r2,
+            rmse: f.rmse,
+            n: f.n,
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct FitOut {
+    dx: AxisOut,
+    dy: AxisOut,
+}
+
+/// Runs `calib …`.
+pub fn run(args: CalibArgs) -> anyhow::Result<ExitCode> {
+    let CalibCommand::Fit(a) = args.command;
+    Ok(match fit_command(&a) {
+        Ok(json) => {
+            println!("{json}");
+            ExitCode::SUCCESS
+        }
+        Err(msg) => {
+            println!("{}", error_json(&msg));
+            ExitCode::FAILURE
+        }
+    })
+}
+
+fn fit_command(a: &FitArgs) -> Result<String, String> {
+    let file =
+        File::open(&a.input).map_err(|e| format!("cannot read {}: {e}", a.input.display()))?;
+    let points = read_points(file).map_err(|e| format!("{}: {e}", a.input.display()))?;
+    let report = fit(&points).map_err(|e| format!("fit failed: {e}"))?;
+    if let Some(out) = &a.output {
+        let text = firmware_commands(&report, &a.input)?;
+        std::fs::write(out, text).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+    }
+    fit_json(&report)
+}
+
+fn fit_json(report: &FitReport) -> Result<String, String> {
+    serde_json::to_string(&FitOut {
+        dx: (&report.dx).into(),
+        dy: (&report.dy).into(),
+    })
+    .map_err(|e| e.to_string())
+}
+
+/// Parses the measured points. The header must be `x,y,dx,dy`; fields may
+/// be padded with spaces; blank lines and lines starting with `#` are
+/// skipped. Errors name the 1-based line.
+fn read_points(mut input: impl Read) -> Result<Vec<MeasuredPoint>, String> {
+    let mut bytes = Vec::new();
+    input
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read: {e}"))?;
+    // 1-based line where the record at `pos` starts. csv positions a record
+    // at the blank or comment lines it skipped before it, so skip those too.
+    let line_of = |pos: &csv::Position| {
+        let mut at = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
+        loop {
+            match bytes.get(at) {
+                Some(b'\n' | b'\r') => at += 1,
+                Some(b'#') => {
+                    let rest = bytes.get(at..).unwrap_or_default();
+                    at += rest
+                        .iter()
+                        .position(|&b| b == b'\n')
+                        .map_or(rest.len(), |i| i + 1);
+                }
+                _ => break,
+            }
+        }
+        1 + bytes.iter().take(at).filter(|&&b| b == b'\n').count()
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(bytes.as_slice());
+    let mut points = Vec::new();
+    let mut header_seen = false;
+    for record in reader.records() {
+        let record = record.map_err(|e| match e.position() {
+            Some(pos) => format!("line {}: {e}", line_of(pos)),
+            None => e.to_string(),
+        })?;
+        let line = record.position().map_or(0, line_of);
+        if !header_seen {
+            if record.iter().ne(HEADER) {
+                let found: Vec<&str> = record.iter().collect();
+                return Err(format!(
+                    "line {line}: header must be exactly `x,y,dx,dy`, found `{}`",
+                    found.join(",")
+                ));
+            }
+            header_seen = true;
+            continue;
+        }
+        if record.len() != HEADER.len() {
+            return Err(format!(
+                "line {line}: expected 4 fields (x,y,dx,dy), found {}",
+                record.len()
+            ));
+        }
+        let mut v = [0.0; 4];
+        for ((slot, text), name) in v.iter_mut().zip(record.iter()).zip(HEADER) {
+            *slot = text
+                .parse::<f64>()
+                .map_err(|_| format!("line {line}: column {name}: `{text}` is not a number"))?;
+            if !slot.is_finite() {
+                return Err(format!(
+                    "line {line}: column {name}: `{text}` is not a finite number"
+                ));
+            }
+        }
+        let [x_mm, y_mm, dx_mm, dy_mm] = v;
+        points.push(MeasuredPoint {
+            x_mm,
+            y_mm,
+            dx_mm,
+            dy_mm,
+        });
+    }
+    if !header_seen {
+        return Err("line 1: empty file, expected the header `x,y,dx,dy`".into());
+    }
+    Ok(points)
+}
+
+/// A value in the shortest form that parses back to exactly `v`, short
+/// enough for a firmware command line.
+fn exact_number(v: f64) -> String {
+    let plain = format!("{v}");
+    if plain.len() <= 24 {
+        plain
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// Printable ASCII only (the firmware rejects other bytes), at most
+/// `FIRMWARE_MAX_LINE` bytes.
+fn comment_line(text: &str) -> String {
+    let mut line: String = format!("# {text}")
+        .chars()
+        .map(|c| {
+            if c == ' ' || c.is_ascii_graphic() {
+                c
+            } else {
+                '?'
+            }
+        })
+        .collect();
+    line.truncate(FIRMWARE_MAX_LINE);
+    line
+}
+
+/// The model as firmware command lines (see the module docs).
+fn firmware_commands(report: &FitReport, source: &Path) -> Result<String, String> {
+    let mut out = String::new();
+    let comments = [
+        "Error model for the laser pointing controller (SPEC 5), written by".to_owned(),
+        format!(
+            "`cargo xtask calib fit` from {} ({} points).",
+            source.display(),
+            report.dx.n
+        ),
+        "err.<axis>.c0..c5: d = c0 + c1*x + c2*y + c3*x^2 + c4*x*y + c5*y^2 (x, y, d in mm)."
+            .into(),
+        axis_summary("dx", &report.dx),
+        axis_summary("dy", &report.dy),
+        "Paste into the USB command line (or `cargo xtask sim --script FILE`), then `save`.".into(),
+    ];
+    for c in comments {
+        let _ = writeln!(out, "{}", comment_line(&c));
+    }
+    for (axis, f) in [("dx", &report.dx), ("dy", &report.dy)] {
+        for (i, c) in f.coef.iter().enumerate() {
+            if c.abs() > FIRMWARE_COEF_LIMIT {
+                return Err(format!(
+                    "err.{axis}.c{i} = {c} mm is outside the firmware's range +-{FIRMWARE_COEF_LIMIT}; \
+                     check the units (mm) of the CSV"
+                ));
+            }
+            let _ = writeln!(out, "set err.{axis}.c{i} {}", exact_number(*c));
+        }
+    }
+    Ok(out)
+}
+
+fn axis_summary(axis: &str, f: &AxisFit) -> String {
+    let rmse = f
+        .rmse
+        .map_or_else(|| "n/a (6 points)".into(), |r| format!("{r:.6} mm"));
+    format!(
+        "{axis}: SSE {:.6} mm^2, R^2 {:.6}, RMSE {rmse}",
+        f.sse, f.r2
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Known quadratic behind `kinematics-core/tests/data/quadratic_noise.csv`
+    /// (11 × 11 grid over ±100 mm, Gaussian noise σ = 0.02 mm; see
+    /// kinematics-core/README.md).
+    const TRUE_DX: [f64; 6] = [0.5, 0.004, -0.002, 2e-5, -1e-5, 3e-5];
+    const TRUE_DY: [f64; 6] = [-0.3, 0.001, 0.006, -1e-5, 2e-5, -2e-5];
+    const SIGMA_MM: f64 = 0.02;
+
+    fn data_file() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../kinematics-core/tests/data/quadratic_noise.csv")
+    }
+
+    fn tmp(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("xtask-calib-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn recovers_the_known_quadratic_from_the_noisy_grid() {
+        let points = read_points(File::open(data_file()).unwrap()).unwrap();
+        assert_eq!(points.len(), 121);
+        let report = fit(&points).unwrap();
+        // Standard errors for σ = 0.02 on an 11 × 11 grid over ±100 mm are
+        // about 0.004 (c0), 2.6e-5 (linear), 4e-7 (quadratic); allow 5σ.
+        let tol = [0.02, 1.3e-4, 1.3e-4, 2e-6, 2e-6, 2e-6];
+        for (fit, truth) in [(&report.dx, TRUE_DX), (&report.dy, TRUE_DY)] {
+            for ((c, t), tol) in fit.coef.iter().zip(truth).zip(tol) {
+                assert!((c - t).abs() < tol, "{c} vs {t}");
+            }
+            // RMSE estimates σ (115 residual degrees of freedom: ±20 %).
+            let rmse = fit.rmse.unwrap();
+            assert!((rmse - SIGMA_MM).abs() < 0.2 * SIGMA_MM, "rmse {rmse}");
+            assert!(fit.r2 > 0.99 && fit.r2 <= 1.0);
+            assert_eq!(fit.n, 121);
+        }
+    }
+
+    #[test]
+    fn command_prints_json_and_writes_firmware_commands() {
+        let out = tmp("model.txt");
+        let args = FitArgs {
+            input: data_file(),
+            output: Some(out.clone()),
+        };
+        let json: serde_json::Value = serde_json::from_str(&fit_command(&args).unwrap()).unwrap();
+        let dx = &json["dx"];
+        assert_eq!(dx["coef"].as_array().unwrap().len(), 6);
+        assert_eq!(dx["n"].as_u64(), Some(121));
+        for key in ["sse", "r2", "rmse"] {
+            assert!(dx[key].is_f64() && json["dy"][key].is_f64(), "{key}");
+        }
+        let text = std::fs::read_to_string(&out).unwrap();
+        std::fs::remove_file(&out).ok();
+        let mut sets = Vec::new();
+        for line in text.lines() {
+            assert!(line.len() <= FIRMWARE_MAX_LINE, "{line}");
+            assert!(
+                line.bytes().all(|b| b == b' ' || b.is_ascii_graphic()),
+                "{line}"
+            );
+            if let Some(rest) = line.strip_prefix("set ") {
+                let (name, value) = rest.split_once(' ').unwrap();
+                sets.push((name.to_owned(), value.parse::<f64>().unwrap()));
+            } else {
+                assert!(line.starts_with('#'), "{line}");
+            }
+        }
+        // Exactly the 12 parameters, in order, each the printed coefficient bit for bit.
+        let names: Vec<String> = ["dx", "dy"]
+            .iter()
+            .flat_map(|a| (0..6).map(move |i| format!("err.{a}.c{i}")))
+            .collect();
+        assert_eq!(sets.iter().map(|s| s.0.clone()).collect::<Vec<_>>(), names);
+        for (k, (_, v)) in sets.iter().enumerate() {
+            let axis = if k < 6 { "dx" } else { "dy" };
+            assert_eq!(*v, json[axis]["coef"][k % 6].as_f64().unwrap());
+        }
+    }
+
+    #[test]
+    fn numbers_round_trip_and_stay_short() {
+        for v in [
+            0.0,
+            -0.5,
+            1.2345678901234567e-7,
+            3e-300,
+            -1e300,
+            2.5e-5,
+            1.0 / 3.0,
+        ] {
+            let s = exact_number(v);
+            assert_eq!(s.parse::<f64>().unwrap(), v, "{s}");
+            assert!(s.len() <= 24, "{s}");
+        }
+        assert_eq!(exact_number(0.004), "0.004");
+    }
+
+    #[test]
+    fn long_or_non_ascii_comments_are_made_safe() {
+        let c = comment_line(&format!("from /tmp/Δ/{}", "x".repeat(300)));
+        assert!(c.len() == FIRMWARE_MAX_LINE && c.starts_with("# from /tmp/?/"));
+    }
+
+    #[test]
+    fn parses_padding_comments_blank_lines_and_six_points() {
+        let csv = "# measured 2024-05-31\n x , y ,dx, dy\n\n0,0,1,0\n10,0,1.1,0\n0,10,0.9,0\n\
+                   20,0,1.3,0\n10,10,1,0\n0,20,0.7,0.5\n";
+        let pts = read_points(csv.as_bytes()).unwrap();
+        assert_eq!(pts.len(), 6);
+        assert_eq!(
+            pts[5],
+            MeasuredPoint {
+                x_mm: 0.0,
+                y_mm: 20.0,
+                dx_mm: 0.7,
+                dy_mm: 0.5
+            }
+        );
+        let report = fit(&pts).unwrap();
+        assert_eq!(report.dx.rmse, None);
+        assert!(fit_json(&report).unwrap().contains(r#""rmse":null"#));
+    }
+
+    #[test]
+    fn malformed_csv_names_the_line() {
+        let err = |csv: &str| read_points(csv.as_bytes()).unwrap_err();
+        assert_eq!(
+            err("x,y,dz,dy\n1,2,3,4\n"),
+            "line 1: header must be exactly `x,y,dx,dy`, found `x,y,dz,dy`"
+        );
+        assert_eq!(
+            err(""),
+            "line 1: empty file, expected the header `x,y,dx,dy`"
+        );
+        assert_eq!(
+            err("x,y,dx,dy\n1,2,3,4\n1,2,3\n"),
+            "line 3: expected 4 fields (x,y,dx,dy), found 3"
+        );
+        assert_eq!(
+            err("x,y,dx,dy\n1,2,3,4\n\n5,6,abc,8\n"),
+            "line 4: column dx: `abc` is not a number"
+        );
+        assert_eq!(
+            err("x,y,dx,dy\n1,2,3,4\n5,inf,7,8\n"),
+            "line 3: column y: `inf` is not a finite number"
+        );
+        assert_eq!(
+            err("x,y,dx,dy\n1,2,3,4,5\n"),
+            "line 2: expected 4 fields (x,y,dx,dy), found 5"
+        );
+        assert_eq!(
+            err("# run 3\nx,y,dx,dy\n# note\n1,2,3,4\n# c\n\n5,6,7\n"),
+            "line 7: expected 4 fields (x,y,dx,dy), found 3"
+        );
+        let bad_utf8: &[u8] = b"x,y,dx,dy\n1,2,\xff,4\n";
+        let e = read_points(bad_utf8).unwrap_err();
+        assert!(e.starts_with("line 2:"), "{e}");
+    }
+
+    #[test]
+    fn fit_and_file_errors_are_reported() {
+        let missing = FitArgs {
+            input: tmp("does-not-exist.csv"),
+            output: None,
+        };
+        assert!(
+            fit_command(&missing)
+                .unwrap_err()
+                .starts_with("cannot read")
+        );
+        let few = tmp("few.csv");
+        std::fs::write(&few, "x,y,dx,dy\n0,0,0,0\n1,0,0,0\n").unwrap();
+        let e = fit_command(&FitArgs {
+            input: few.clone(),
+            output: None,
+        })
+        .unwrap_err();
+        assert_eq!(e, "fit failed: need at least 6 measured points, got 2");
+        let line = tmp("line.csv");
+        let rows: String = (0..8).map(|i| format!("{i},{},0.1,0\n", 2 * i)).collect();
+        std::fs::write(&line, format!("x,y,dx,dy\n{rows}")).unwrap();
+        let e = fit_command(&FitArgs {
+            input: line.clone(),
+            output: None,
+        })
+        .unwrap_err();
+        assert!(e.contains("degenerate"), "{e}");
+        let e = fit_command(&FitArgs {
+            input: data_file(),
+            output: Some(tmp("no-such-dir").join("model.txt")),
+        })
+        .unwrap_err();
+        assert!(e.starts_with("cannot write"), "{e}");
+        std::fs::remove_file(few).ok();
+        std::fs::remove_file(line).ok();
+    }
+
+    #[test]
+    fn coefficients_outside_the_firmware_range_are_refused() {
+        // Δx = 5000 mm everywhere (e.g. metres mistaken for mm).
+        let pts: Vec<MeasuredPoint> = [
+            (0.0, 0.0),
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (2.0, 0.0),
+            (1.0, 1.0),
+            (0.0, 2.0),
+        ]
+        .iter()
+        .map(|&(x_mm, y_mm)| MeasuredPoint {
+            x_mm,
+            y_mm,
+            dx_mm: 5000.0,
+            dy_mm: 0.0,
+        })
+        .collect();
+        let report = fit(&pts).unwrap();
+        let e = firmware_commands(&report, Path::new("m.csv")).unwrap_err();
+        assert!(e.starts_with("err.dx.c0 = "), "{e}");
+    }
 }
