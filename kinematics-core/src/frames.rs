@@ -172,7 +172,7 @@ impl BoardFrame {
         finite(self.pose.dy_cm, "pose.dy_cm")?;
         finite(self.pose.dz_cm, "pose.dz_cm")?;
         finite(self.pose.roll_deg, "pose.roll_deg")?;
-        if self.plane_x_cm() > 0.0 {
+        if self.plane_x() > 0.0 {
             Ok(())
         } else {
             Err(Error::BehindGimbal)
@@ -181,7 +181,15 @@ impl BoardFrame {
 
     /// Global x of the board plane (`oq_cm + pose.dx_cm`), cm. The roll is
     /// about global x, so the board stays the plane `x_g = plane_x_cm`.
-    pub fn plane_x_cm(&self) -> f64 {
+    ///
+    /// Errors: as [`validate`](Self::validate).
+    pub fn plane_x_cm(&self) -> Result<f64, Error> {
+        self.validate()?;
+        Ok(self.plane_x())
+    }
+
+    /// [`plane_x_cm`](Self::plane_x_cm) without the checks.
+    fn plane_x(&self) -> f64 {
         self.oq_cm + self.pose.dx_cm
     }
 
@@ -201,7 +209,7 @@ impl BoardFrame {
         let (s, c) = self.roll_sin_cos();
         // Rx(roll) · (0, −u, v) + origin.
         Ok(GlobalPoint {
-            x_cm: self.plane_x_cm(),
+            x_cm: self.plane_x(),
             y_cm: self.pose.dy_cm - c * u - s * v,
             z_cm: self.pose.dz_cm - s * u + c * v,
         })
@@ -285,6 +293,7 @@ mod tests {
         };
         let g = f.board_to_global(BoardPoint::new(0.0, 0.0)).unwrap();
         assert_eq!(g, GlobalPoint::new(27.0, 0.5, -1.0));
+        assert_eq!(f.plane_x_cm(), Ok(27.0));
     }
 
     #[test]

@@ -13,7 +13,7 @@
 //! `code = round(offset_code + codes_per_rad · θ)`, clamped to 0..=4095
 //! with the clamp reported.
 
-use crate::error::Error;
+use crate::error::{Error, finite};
 use crate::frames::PointMm;
 use crate::real::Real;
 
@@ -133,13 +133,25 @@ impl<F: Real> Default for DacAxis<F> {
     /// SPEC default: ±12.5° mechanical spans the 12-bit range,
     /// `code = round(2047.5 + θ / 12.5° · 2047.5)`.
     fn default() -> Self {
-        Self::spanning(DEFAULT_HALF_RANGE_DEG)
+        Self::span_of(DEFAULT_HALF_RANGE_DEG)
     }
 }
 
 impl<F: Real> DacAxis<F> {
-    /// The axis whose full 12-bit range spans `±half_range_deg` mechanical.
-    pub fn spanning(half_range_deg: f64) -> Self {
+    /// The axis whose full 12-bit range spans `±half_range_deg` mechanical
+    /// (degrees, finite and > 0).
+    ///
+    /// Errors: [`Error::NonFinite`], [`Error::InvalidConfig`].
+    pub fn spanning(half_range_deg: f64) -> Result<Self, Error> {
+        if finite(half_range_deg, "half_range_deg")? <= 0.0 {
+            return Err(Error::InvalidConfig {
+                what: "DAC half range must be > 0",
+            });
+        }
+        Ok(Self::span_of(half_range_deg))
+    }
+
+    fn span_of(half_range_deg: f64) -> Self {
         Self {
             codes_per_rad: F::from_f64(DAC_MID_CODE / half_range_deg.to_radians()),
             offset_code: F::from_f64(DAC_MID_CODE),
@@ -463,6 +475,24 @@ mod tests {
             let c = g32.dac_y.angle_to_code(a).unwrap();
             assert_eq!((c.code, c.clamped), (code, false));
         }
+    }
+
+    #[test]
+    fn spanning_other_ranges() {
+        // ±20° over the 12-bit range: 20° → 4095, 10° → round(3071.25).
+        let dac = DacAxis::<f64>::spanning(20.0).unwrap();
+        assert_eq!(dac.angle_to_code(20f64.to_radians()).unwrap().code, 4095);
+        assert_eq!(dac.angle_to_code(10f64.to_radians()).unwrap().code, 3071);
+        assert!(matches!(
+            DacAxis::<f32>::spanning(0.0),
+            Err(Error::InvalidConfig { .. })
+        ));
+        assert_eq!(
+            DacAxis::<f32>::spanning(f64::NAN),
+            Err(Error::NonFinite {
+                what: "half_range_deg"
+            })
+        );
     }
 
     #[test]

@@ -27,18 +27,30 @@ pub struct StepperAxis {
 impl Default for StepperAxis {
     /// The seed's 1.8° / 32 = 0.05625° per microstep, normal direction.
     fn default() -> Self {
-        Self::from_motor(SEED_FULL_STEP_DEG, SEED_MICROSTEPS)
+        Self {
+            deg_per_step: SEED_FULL_STEP_DEG / f64::from(SEED_MICROSTEPS),
+            direction: Direction::Normal,
+        }
     }
 }
 
 impl StepperAxis {
-    /// An axis for a motor with `full_step_deg` per full step driven at
-    /// `microsteps` microsteps per full step (0 is taken as 1).
-    pub fn from_motor(full_step_deg: f64, microsteps: u16) -> Self {
-        Self {
-            deg_per_step: full_step_deg / f64::from(microsteps.max(1)),
-            direction: Direction::Normal,
+    /// An axis for a motor with `full_step_deg` (> 0) per full step driven
+    /// at `microsteps` (≥ 1) microsteps per full step.
+    ///
+    /// Errors: [`Error::NonFinite`], [`Error::InvalidConfig`].
+    pub fn from_motor(full_step_deg: f64, microsteps: u16) -> Result<Self, Error> {
+        if microsteps == 0 {
+            return Err(Error::InvalidConfig {
+                what: "microsteps must be >= 1",
+            });
         }
+        let axis = Self {
+            deg_per_step: finite(full_step_deg, "full_step_deg")? / f64::from(microsteps),
+            direction: Direction::Normal,
+        };
+        axis.validate()?;
+        Ok(axis)
     }
 
     fn validate(&self) -> Result<(), Error> {
@@ -116,7 +128,25 @@ mod tests {
             bad.steps_to_angle(1),
             Err(Error::InvalidConfig { .. })
         ));
-        assert_eq!(StepperAxis::from_motor(1.8, 0).deg_per_step, 1.8);
+        assert!(matches!(
+            StepperAxis::from_motor(1.8, 0),
+            Err(Error::InvalidConfig { .. })
+        ));
+        assert!(matches!(
+            StepperAxis::from_motor(-1.8, 16),
+            Err(Error::InvalidConfig { .. })
+        ));
+        assert_eq!(
+            StepperAxis::from_motor(f64::NAN, 16),
+            Err(Error::NonFinite {
+                what: "full_step_deg"
+            })
+        );
+        // 0.9° motor at 16 microsteps.
+        assert_eq!(
+            StepperAxis::from_motor(0.9, 16).unwrap().deg_per_step,
+            0.05625
+        );
     }
 
     proptest! {

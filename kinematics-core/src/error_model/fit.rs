@@ -290,8 +290,8 @@ mod tests {
         let pts = grid(
             [-5.0, 5.0, 15.0].into_iter(),
             [-13.0, -3.0, 7.0].into_iter(),
-            |x, y| q.eval(x, y) + eps * r(x, y),
-            |x, y| q.eval(x, y),
+            |x, y| q.value(x, y) + eps * r(x, y),
+            |x, y| q.value(x, y),
         );
         let fit = fit(&pts).unwrap();
         for (a, b) in fit.dx.coef.iter().zip(q.coef.iter()) {
@@ -324,7 +324,7 @@ mod tests {
         .map(|&(x, y)| MeasuredPoint {
             x_mm: x,
             y_mm: y,
-            dx_mm: q.eval(x, y),
+            dx_mm: q.value(x, y),
             dy_mm: 0.5,
         })
         .collect();
@@ -386,14 +386,14 @@ mod tests {
         let pts = grid(
             (0..11).map(|i| 1000.0 + f64::from(i) * 100.0),
             (0..11).map(|i| -500.0 + f64::from(i) * 100.0),
-            |x, y| q.eval(x, y),
-            |x, y| -q.eval(y, x),
+            |x, y| q.value(x, y),
+            |x, y| -q.value(y, x),
         );
         let fit = fit(&pts).unwrap();
         for p in &pts {
             let m = fit.model();
-            assert!((m.dx.eval(p.x_mm, p.y_mm) - p.dx_mm).abs() < 1e-9);
-            assert!((m.dy.eval(p.x_mm, p.y_mm) - p.dy_mm).abs() < 1e-9);
+            assert!((m.dx.value(p.x_mm, p.y_mm) - p.dx_mm).abs() < 1e-9);
+            assert!((m.dy.value(p.x_mm, p.y_mm) - p.dy_mm).abs() < 1e-9);
         }
         for (a, b) in fit.dx.coef.iter().zip(q.coef.iter()) {
             assert!((a - b).abs() <= 1e-9 * b.abs().max(1e-6), "{a} vs {b}");
@@ -450,7 +450,7 @@ mod tests {
             let mut pts = grid(
                 (0..5).map(|i| f64::from(i) * 0.5 - 1.0),
                 (0..5).map(|i| f64::from(i) * 0.5 - 1.0),
-                |x, y| q.eval(x, y),
+                |x, y| q.value(x, y),
                 |_, _| 0.0,
             );
             for (p, e) in pts.iter_mut().zip(&noise) {
@@ -462,7 +462,7 @@ mod tests {
                 prop_assert!((a - b).abs() < 1e-9, "{} vs {}", a, b);
             }
             let sse: f64 = pts.iter().map(|p| {
-                let r = p.dx_mm - Quadratic::new(reference).eval(p.x_mm, p.y_mm);
+                let r = p.dx_mm - Quadratic::new(reference).value(p.x_mm, p.y_mm);
                 r * r
             }).sum();
             prop_assert!((fit.dx.sse - sse).abs() < 1e-9);
@@ -480,13 +480,13 @@ mod tests {
             let pts = grid(
                 (0..7).map(|i| x0 + f64::from(i) * pitch),
                 (0..5).map(|i| y0 + f64::from(i) * pitch),
-                |x, y| q.eval(x, y),
-                |x, y| q.eval(x, y) * 2.0,
+                |x, y| q.value(x, y),
+                |x, y| q.value(x, y) * 2.0,
             );
             let m = fit(&pts).unwrap().model();
             for p in &pts {
-                prop_assert!((m.dx.eval(p.x_mm, p.y_mm) - p.dx_mm).abs() < 1e-9);
-                prop_assert!((m.dy.eval(p.x_mm, p.y_mm) - p.dy_mm).abs() < 1e-9);
+                prop_assert!((m.dx.value(p.x_mm, p.y_mm) - p.dx_mm).abs() < 1e-9);
+                prop_assert!((m.dy.value(p.x_mm, p.y_mm) - p.dy_mm).abs() < 1e-9);
             }
         }
     }

@@ -10,7 +10,7 @@ mod fit;
 
 pub use fit::{AxisFit, FitReport, MeasuredPoint, fit};
 
-use crate::error::Error;
+use crate::error::{Error, finite};
 use crate::frames::{BoardPoint, PointMm};
 
 /// Number of coefficients per axis.
@@ -35,21 +35,25 @@ impl Quadratic {
         Self { coef }
     }
 
-    /// Δ (mm) at `(x_mm, y_mm)`. No checks: non-finite in, non-finite out
-    /// (the checked entry points are on [`ErrorModel`]).
-    #[inline]
-    pub fn eval(&self, x_mm: f64, y_mm: f64) -> f64 {
-        let [c0, c1, c2, c3, c4, c5] = self.coef;
-        c0 + x_mm * (c1 + c3 * x_mm + c4 * y_mm) + y_mm * (c2 + c5 * y_mm)
+    /// Δ (mm) at `(x_mm, y_mm)` (mm).
+    ///
+    /// Errors: [`Error::NonFinite`] (input, coefficient or overflowing result).
+    pub fn eval(&self, x_mm: f64, y_mm: f64) -> Result<f64, Error> {
+        finite(x_mm, "x_mm")?;
+        finite(y_mm, "y_mm")?;
+        if !self.coef.iter().all(|c| c.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "error-model coefficient",
+            });
+        }
+        finite(self.value(x_mm, y_mm), "error-model value")
     }
 
-    /// `(∂Δ/∂x, ∂Δ/∂y)` at `(x_mm, y_mm)`, mm/mm.
-    pub fn gradient(&self, x_mm: f64, y_mm: f64) -> (f64, f64) {
-        let [_, c1, c2, c3, c4, c5] = self.coef;
-        (
-            c1 + 2.0 * c3 * x_mm + c4 * y_mm,
-            c2 + c4 * x_mm + 2.0 * c5 * y_mm,
-        )
+    /// Δ without checks (callers validated), Horner-style.
+    #[inline]
+    pub(crate) fn value(&self, x_mm: f64, y_mm: f64) -> f64 {
+        let [c0, c1, c2, c3, c4, c5] = self.coef;
+        c0 + x_mm * (c1 + c3 * x_mm + c4 * y_mm) + y_mm * (c2 + c5 * y_mm)
     }
 }
 
@@ -95,8 +99,8 @@ impl ErrorModel {
         self.check()?;
         p.check_finite()?;
         PointMm {
-            x_mm: self.dx.eval(p.x_mm, p.y_mm),
-            y_mm: self.dy.eval(p.x_mm, p.y_mm),
+            x_mm: self.dx.value(p.x_mm, p.y_mm),
+            y_mm: self.dy.value(p.x_mm, p.y_mm),
         }
         .check_finite()
     }
@@ -128,8 +132,8 @@ impl ErrorModel {
         let tol = COMPENSATION_TOL * libm::hypot(target.x_mm, target.y_mm).max(1.0);
         let mut c = target;
         for _ in 0..MAX_ITERATIONS {
-            let ex = self.dx.eval(c.x_mm, c.y_mm);
-            let ey = self.dy.eval(c.x_mm, c.y_mm);
+            let ex = self.dx.value(c.x_mm, c.y_mm);
+            let ey = self.dy.value(c.x_mm, c.y_mm);
             // Residual of the current command.
             let rx = c.x_mm + ex - target.x_mm;
             let ry = c.y_mm + ey - target.y_mm;
@@ -165,9 +169,19 @@ mod tests {
     fn eval_hand_computed() {
         let q = Quadratic::new([1.0, 2.0, 3.0, 4.0, 5.0, 6.0]);
         // 1 + 2·2 + 3·(−1) + 4·4 + 5·(−2) + 6·1 = 14.
-        assert_eq!(q.eval(2.0, -1.0), 14.0);
-        // ∂/∂x = 2 + 8·2 + 5·(−1) = 13; ∂/∂y = 3 + 5·2 + 12·(−1) = 1.
-        assert_eq!(q.gradient(2.0, -1.0), (13.0, 1.0));
+        assert_eq!(q.eval(2.0, -1.0), Ok(14.0));
+        assert_eq!(
+            q.eval(f64::NAN, 0.0),
+            Err(Error::NonFinite { what: "x_mm" })
+        );
+        assert_eq!(
+            q.eval(1e200, 1e200),
+            Err(Error::NonFinite {
+                what: "error-model value"
+            })
+        );
+        let bad = Quadratic::new([0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0]);
+        assert!(bad.eval(0.0, 0.0).is_err());
     }
 
     #[test]

@@ -150,7 +150,7 @@ impl Gimbal {
     pub fn fk(&self, j: JointAngles) -> Result<BoardPoint, Error> {
         self.validate()?;
         let frame = &self.geometry.frame;
-        let g = self.model.fk(self.geometry.ol_cm, frame.plane_x_cm(), j)?;
+        let g = self.model.fk(self.geometry.ol_cm, frame.plane_x_cm()?, j)?;
         frame.global_to_board(g)
     }
 
