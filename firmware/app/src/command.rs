@@ -11,6 +11,9 @@ use core::fmt::{self, Write as _};
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
+use embassy_sync::signal::Signal;
+
+use crate::settings::{LaserMode, ParamSpec};
 
 /// Longest reply line, bytes (longer lines are cut).
 pub const REPLY_LINE_LEN: usize = 120;
@@ -18,9 +21,116 @@ pub const REPLY_LINE_LEN: usize = 120;
 /// Text of one reply line.
 pub type ReplyText = heapless::String<REPLY_LINE_LEN>;
 
-/// A parsed, validated command for the sequencer.
-#[derive(Debug, Clone, PartialEq)]
+/// A board point, cm (board frame: x right, y up, origin at Q).
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PointCm {
+    /// Board x, cm.
+    pub x_cm: f64,
+    /// Board y, cm.
+    pub y_cm: f64,
+}
+
+/// Visiting order of the full grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum GridOrder {
+    /// Every row left to right.
+    Raster,
+    /// Alternate rows reversed (shortest travel).
+    Serpentine,
+}
+
+/// Direction of a circle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Rotation {
+    /// Clockwise.
+    Cw,
+    /// Counter-clockwise.
+    Ccw,
+}
+
+/// A test pattern or path (SPEC §4.6).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Pattern {
+    /// Grid (0, 0).
+    Home,
+    /// The four grid corners, clockwise from top left.
+    Corner,
+    /// xi = −6..6 on yi = 0.
+    Horizontal,
+    /// yi = 4..−4 on xi = 0.
+    Vertical,
+    /// The seed's subset: yi = 2..−2, xi = −3..3.
+    VisitAll,
+    /// Every grid point.
+    GridFull(GridOrder),
+    /// Straight line A → B.
+    Line {
+        /// Start, cm.
+        from: PointCm,
+        /// End, cm.
+        to: PointCm,
+    },
+    /// Full circle.
+    Circle {
+        /// Centre, cm.
+        centre: PointCm,
+        /// Radius, cm.
+        radius_cm: f64,
+        /// Direction.
+        rotation: Rotation,
+    },
+    /// Rectangle border through two opposite corners.
+    Rect {
+        /// One corner, cm.
+        a: PointCm,
+        /// The opposite corner, cm.
+        b: PointCm,
+    },
+}
+
+impl Pattern {
+    /// Name used on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Pattern::Home => "home",
+            Pattern::Corner => "corner",
+            Pattern::Horizontal => "horizontal",
+            Pattern::Vertical => "vertical",
+            Pattern::VisitAll => "visit-all",
+            Pattern::GridFull(GridOrder::Raster) => "grid-full raster",
+            Pattern::GridFull(GridOrder::Serpentine) => "grid-full serpentine",
+            Pattern::Line { .. } => "line",
+            Pattern::Circle { .. } => "circle",
+            Pattern::Rect { .. } => "rect",
+        }
+    }
+
+    /// Whether this is a drawn path (no dwell between its points) rather
+    /// than a set of grid points.
+    pub fn is_path(&self) -> bool {
+        matches!(
+            self,
+            Pattern::Line { .. } | Pattern::Circle { .. } | Pattern::Rect { .. }
+        )
+    }
+}
+
+/// Which kinematic model aims the gimbal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum AimModel {
+    /// The exact coupled model (SPEC §4.3), default.
+    Exact,
+    /// The seed's approximate model (SPEC §4.2), for comparison.
+    Seed,
+}
+
+/// A parsed, validated command for the sequencer.
+#[derive(Clone, Copy)]
 pub enum Command {
     /// List the commands.
     Help,
@@ -28,6 +138,110 @@ pub enum Command {
     Version,
     /// Uptime, build and current state.
     Status,
+    /// Run a pattern, repeating until stopped unless `once`.
+    Pattern {
+        /// What to run.
+        pattern: Pattern,
+        /// Run a single pass.
+        once: bool,
+    },
+    /// Stop whatever runs; laser off.
+    Stop,
+    /// Aim at a board point and hold it.
+    Goto(PointCm),
+    /// Aim at a grid point and hold it.
+    Grid {
+        /// Column index.
+        xi: i8,
+        /// Row index.
+        yi: i8,
+    },
+    /// Laser mode.
+    Laser(LaserMode),
+    /// Kinematic model.
+    Model(AimModel),
+    /// Set a parameter.
+    Set {
+        /// Which.
+        param: &'static ParamSpec,
+        /// New value (range-checked again by the sequencer).
+        value: f64,
+    },
+    /// Read a parameter.
+    Get(&'static ParamSpec),
+    /// List every parameter.
+    Params,
+    /// Store the parameters in flash.
+    Save,
+}
+
+impl Command {
+    /// The command's name, for logs.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Command::Help => "help",
+            Command::Version => "version",
+            Command::Status => "status",
+            Command::Pattern { .. } => "pattern",
+            Command::Stop => "stop",
+            Command::Goto(_) => "goto",
+            Command::Grid { .. } => "grid",
+            Command::Laser(_) => "laser",
+            Command::Model(_) => "model",
+            Command::Set { .. } => "set",
+            Command::Get(_) => "get",
+            Command::Params => "params",
+            Command::Save => "save",
+        }
+    }
+}
+
+impl core::fmt::Debug for Command {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Command::Pattern { pattern, once } => write!(f, "pattern {pattern:?} once={once}"),
+            Command::Goto(p) => write!(f, "goto {p:?}"),
+            Command::Grid { xi, yi } => write!(f, "grid {xi} {yi}"),
+            Command::Laser(m) => write!(f, "laser {}", m.name()),
+            Command::Model(m) => write!(f, "model {m:?}"),
+            Command::Set { param, value } => write!(f, "set {} {value}", param.name),
+            Command::Get(param) => write!(f, "get {}", param.name),
+            other => f.write_str(other.name()),
+        }
+    }
+}
+
+impl PartialEq for Command {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (
+                Command::Pattern {
+                    pattern: a,
+                    once: x,
+                },
+                Command::Pattern {
+                    pattern: b,
+                    once: y,
+                },
+            ) => a == b && x == y,
+            (Command::Goto(a), Command::Goto(b)) => a == b,
+            (Command::Grid { xi: a, yi: b }, Command::Grid { xi: c, yi: d }) => a == c && b == d,
+            (Command::Laser(a), Command::Laser(b)) => a == b,
+            (Command::Model(a), Command::Model(b)) => a == b,
+            (Command::Set { param: a, value: x }, Command::Set { param: b, value: y }) => {
+                a.name == b.name && x == y
+            }
+            (Command::Get(a), Command::Get(b)) => a.name == b.name,
+            (a, b) => core::mem::discriminant(a) == core::mem::discriminant(b),
+        }
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Command {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "{}", defmt::Debug2Format(self))
+    }
 }
 
 /// One item of a reply. Every command gets zero or more `Data` lines and
@@ -74,6 +288,8 @@ impl fmt::Write for Truncating {
 pub const COMMAND_QUEUE_DEPTH: usize = 2;
 /// Depth of the reply queue.
 pub const REPLY_QUEUE_DEPTH: usize = 4;
+/// Depth of the notice queue.
+pub const EVENT_QUEUE_DEPTH: usize = 4;
 
 /// Channels between the console task and the sequencer task.
 pub struct CommandLink {
@@ -81,6 +297,11 @@ pub struct CommandLink {
     pub commands: Channel<CriticalSectionRawMutex, Command, COMMAND_QUEUE_DEPTH>,
     /// Sequencer → console.
     pub replies: Channel<CriticalSectionRawMutex, Reply, REPLY_QUEUE_DEPTH>,
+    /// Unsolicited notices (faults, recoveries) → console, printed between
+    /// replies. Sent with `try_send`: dropped when the console is behind.
+    pub events: Channel<CriticalSectionRawMutex, ReplyText, EVENT_QUEUE_DEPTH>,
+    /// Stop request from the board's button: stop and laser off, no reply.
+    pub stop_request: Signal<CriticalSectionRawMutex, ()>,
 }
 
 impl CommandLink {
@@ -89,7 +310,15 @@ impl CommandLink {
         Self {
             commands: Channel::new(),
             replies: Channel::new(),
+            events: Channel::new(),
+            stop_request: Signal::new(),
         }
+    }
+
+    /// Queues an unsolicited notice line for the console (dropped if the
+    /// queue is full: notices must never block the sequencer).
+    pub fn notify(&self, args: fmt::Arguments<'_>) {
+        let _ = self.events.try_send(reply_text(args));
     }
 
     /// Sends one data line of the current reply.

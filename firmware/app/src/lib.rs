@@ -4,12 +4,17 @@
 //!
 //! Dataflow (one module per stage):
 //! [`usb`] (command-line task body) → [`command`] (the command channel) →
-//! [`sequencer`] (task body that runs commands and patterns).
-//! Text handling lives in [`cli`].
+//! [`sequencer`] (task body that runs commands and patterns) →
+//! [`servo`] (servo task body and FashionStar codec).
+//! Text handling lives in [`cli`], parameters in [`settings`], shared
+//! state for LEDs/watchdog/simulator in [`status`].
 
 pub mod build_info;
 pub mod cli;
 pub mod command;
 mod log;
 pub mod sequencer;
+pub mod servo;
+pub mod settings;
+pub mod status;
 pub mod usb;

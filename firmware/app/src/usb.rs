@@ -3,14 +3,20 @@
 //! to the host.
 //!
 //! Generic over `embedded_io_async` so the same code runs on the USB CDC-ACM
-//! class on the target and on stdin/stdout in the host simulator.
+//! class on the target and on the simulated host's pipes.
+//!
+//! Protocol: every line gets zero or more data lines and then exactly one
+//! `ok` or `error: <reason>`. Unsolicited notices (servo faults and
+//! recoveries) are printed between replies in brackets: `[error: …]`,
+//! `[info: …]`.
 
+use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, with_timeout};
 use embedded_io_async::{Read, Write};
 
 use crate::cli::line::LineAssembler;
 use crate::cli::parse::parse_line;
-use crate::command::{CommandLink, Reply};
+use crate::command::{CommandLink, Reply, ReplyText};
 use crate::log;
 
 /// A reply write that takes longer than this (host not reading) is dropped,
@@ -40,10 +46,16 @@ pub async fn run_console<R: Read, W: Write>(
     let mut assembler = LineAssembler::new();
     let mut chunk = [0u8; 64];
     loop {
-        let n = match rx.read(&mut chunk).await {
-            Ok(0) => return ConsoleEnd::EndOfInput,
-            Ok(n) => n,
-            Err(_) => return ConsoleEnd::ReadFailed,
+        let n = match select(rx.read(&mut chunk), link.events.receive()).await {
+            Either::First(Ok(0)) => return ConsoleEnd::EndOfInput,
+            Either::First(Ok(n)) => n,
+            Either::First(Err(_)) => return ConsoleEnd::ReadFailed,
+            Either::Second(notice) => {
+                if write_notice(tx, &notice).await.is_err() {
+                    return ConsoleEnd::WriteFailed;
+                }
+                continue;
+            }
         };
         for &byte in chunk.iter().take(n) {
             let Some(line) = assembler.push(byte) else {
@@ -96,6 +108,21 @@ async fn handle_line<W: Write>(line: &str, tx: &mut W, link: &CommandLink) -> Re
         if reply.is_final() {
             return Ok(());
         }
+    }
+}
+
+/// Writes an unsolicited notice as `[text]`: brackets tell notices from
+/// replies (which are data lines, `ok` or `error: …`).
+async fn write_notice<W: Write>(tx: &mut W, notice: &ReplyText) -> Result<(), W::Error> {
+    let write = async {
+        tx.write_all(b"[").await?;
+        tx.write_all(notice.as_bytes()).await?;
+        tx.write_all(b"]\r\n").await?;
+        tx.flush().await
+    };
+    match with_timeout(WRITE_TIMEOUT, write).await {
+        Ok(result) => result,
+        Err(_) => Ok(()),
     }
 }
 

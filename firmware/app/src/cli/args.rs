@@ -28,7 +28,7 @@ impl<'a> Args<'a> {
     }
 
     /// The next word parsed as a finite number within `[min, max]`.
-    pub fn number(&mut self, what: &'static str, min: f32, max: f32) -> Result<f32, CommandError> {
+    pub fn number(&mut self, what: &'static str, min: f64, max: f64) -> Result<f64, CommandError> {
         let text = self.word(what)?;
         parse_number(text, what, min, max)
     }
@@ -52,10 +52,10 @@ impl<'a> Args<'a> {
 pub fn parse_number(
     text: &str,
     what: &'static str,
-    min: f32,
-    max: f32,
-) -> Result<f32, CommandError> {
-    let value: f32 = text.parse().map_err(|_| CommandError::InvalidArgument {
+    min: f64,
+    max: f64,
+) -> Result<f64, CommandError> {
+    let value: f64 = text.parse().map_err(|_| CommandError::InvalidArgument {
         expected: what,
         got: word(text),
     })?;
@@ -85,8 +85,8 @@ pub fn parse_integer(
     if !(min..=max).contains(&value) {
         return Err(CommandError::OutOfRange {
             what,
-            min: min as f32,
-            max: max as f32,
+            min: f64::from(min),
+            max: f64::from(max),
         });
     }
     Ok(value)

@@ -43,9 +43,9 @@ pub enum CommandError {
         /// What the value is.
         what: &'static str,
         /// Lowest accepted value.
-        min: f32,
+        min: f64,
         /// Highest accepted value.
-        max: f32,
+        max: f64,
     },
     /// The command is valid but cannot run now (e.g. unreachable target);
     /// the message says why.

@@ -2,7 +2,14 @@
 
 use super::args::Args;
 use super::error::{CommandError, word};
-use crate::command::Command;
+use crate::command::{AimModel, Command, GridOrder, Pattern, PointCm, Rotation};
+use crate::settings::{LaserMode, find_param};
+
+/// Largest board coordinate accepted anywhere, cm.
+pub const BOARD_LIMIT_CM: f64 = 200.0;
+/// Largest grid index magnitude accepted by the parser (the sequencer
+/// checks against the configured grid).
+const GRID_INDEX_LIMIT: i32 = 20;
 
 /// Parses one command line. Blank lines and `#` comments parse to `None`
 /// (they are acknowledged with `ok` and do nothing, so a file of commands
@@ -14,12 +21,69 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
     }
     let mut args = Args::new(text);
     let name = args.word("command")?;
-    let command = if name.eq_ignore_ascii_case("help") {
+    let is = |candidate: &str| name.eq_ignore_ascii_case(candidate);
+    let command = if is("help") {
         Command::Help
-    } else if name.eq_ignore_ascii_case("version") {
+    } else if is("version") {
         Command::Version
-    } else if name.eq_ignore_ascii_case("status") {
+    } else if is("status") {
         Command::Status
+    } else if is("stop") {
+        Command::Stop
+    } else if is("params") {
+        Command::Params
+    } else if is("save") {
+        Command::Save
+    } else if is("pattern") {
+        return parse_pattern(args).map(Some);
+    } else if is("goto") {
+        Command::Goto(point(&mut args, "x_cm", "y_cm")?)
+    } else if is("grid") {
+        let xi = args.integer("xi", -GRID_INDEX_LIMIT, GRID_INDEX_LIMIT)? as i8;
+        let yi = args.integer("yi", -GRID_INDEX_LIMIT, GRID_INDEX_LIMIT)? as i8;
+        Command::Grid { xi, yi }
+    } else if is("laser") {
+        let mode = args.word("on|off|auto|dwell")?;
+        Command::Laser(
+            [
+                LaserMode::On,
+                LaserMode::Off,
+                LaserMode::Auto,
+                LaserMode::Dwell,
+            ]
+            .into_iter()
+            .find(|m| m.name().eq_ignore_ascii_case(mode))
+            .ok_or(CommandError::InvalidArgument {
+                expected: "on|off|auto|dwell",
+                got: word(mode),
+            })?,
+        )
+    } else if is("model") {
+        let model = args.word("exact|seed")?;
+        Command::Model(if model.eq_ignore_ascii_case("exact") {
+            AimModel::Exact
+        } else if model.eq_ignore_ascii_case("seed") {
+            AimModel::Seed
+        } else {
+            return Err(CommandError::InvalidArgument {
+                expected: "exact|seed",
+                got: word(model),
+            });
+        })
+    } else if is("set") {
+        let name = args.word("parameter name")?;
+        let param = find_param(name).ok_or(CommandError::InvalidArgument {
+            expected: "a parameter name (see 'params')",
+            got: word(name),
+        })?;
+        let value = args.number(param.name, param.min, param.max)?;
+        Command::Set { param, value }
+    } else if is("get") {
+        let name = args.word("parameter name")?;
+        Command::Get(find_param(name).ok_or(CommandError::InvalidArgument {
+            expected: "a parameter name (see 'params')",
+            got: word(name),
+        })?)
     } else {
         return Err(CommandError::UnknownCommand(word(name)));
     };
@@ -27,11 +91,105 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
     Ok(Some(command))
 }
 
+fn point(args: &mut Args<'_>, x: &'static str, y: &'static str) -> Result<PointCm, CommandError> {
+    Ok(PointCm {
+        x_cm: args.number(x, -BOARD_LIMIT_CM, BOARD_LIMIT_CM)?,
+        y_cm: args.number(y, -BOARD_LIMIT_CM, BOARD_LIMIT_CM)?,
+    })
+}
+
+/// `pattern <name> [args] [once]`.
+fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
+    let name = args.word("pattern name (see 'help')")?;
+    let is = |candidate: &str| name.eq_ignore_ascii_case(candidate);
+    let pattern = if is("home") {
+        Pattern::Home
+    } else if is("corner") {
+        Pattern::Corner
+    } else if is("horizontal") {
+        Pattern::Horizontal
+    } else if is("vertical") {
+        Pattern::Vertical
+    } else if is("visit-all") {
+        Pattern::VisitAll
+    } else if is("grid-full") {
+        // Optional order word; anything else is left for `once`.
+        let mut peek = args.clone();
+        match peek.next_word() {
+            Some(w) if w.eq_ignore_ascii_case("serpentine") => {
+                args = peek;
+                Pattern::GridFull(GridOrder::Serpentine)
+            }
+            Some(w) if w.eq_ignore_ascii_case("raster") => {
+                args = peek;
+                Pattern::GridFull(GridOrder::Raster)
+            }
+            _ => Pattern::GridFull(GridOrder::Raster),
+        }
+    } else if is("line") {
+        Pattern::Line {
+            from: point(&mut args, "x0_cm", "y0_cm")?,
+            to: point(&mut args, "x1_cm", "y1_cm")?,
+        }
+    } else if is("rect") {
+        Pattern::Rect {
+            a: point(&mut args, "x0_cm", "y0_cm")?,
+            b: point(&mut args, "x1_cm", "y1_cm")?,
+        }
+    } else if is("circle") {
+        let centre = point(&mut args, "cx_cm", "cy_cm")?;
+        let radius_cm = args.number("radius_cm", 0.1, BOARD_LIMIT_CM)?;
+        let mut peek = args.clone();
+        let rotation = match peek.next_word() {
+            Some(w) if w.eq_ignore_ascii_case("cw") => {
+                args = peek;
+                Rotation::Cw
+            }
+            Some(w) if w.eq_ignore_ascii_case("ccw") => {
+                args = peek;
+                Rotation::Ccw
+            }
+            _ => Rotation::Ccw,
+        };
+        Pattern::Circle {
+            centre,
+            radius_cm,
+            rotation,
+        }
+    } else {
+        return Err(CommandError::InvalidArgument {
+            expected: "home|corner|horizontal|vertical|visit-all|grid-full|line|circle|rect",
+            got: word(name),
+        });
+    };
+    let once = match args.next_word() {
+        None => false,
+        Some(w) if w.eq_ignore_ascii_case("once") => true,
+        Some(w) => return Err(CommandError::UnexpectedArgument(word(w))),
+    };
+    args.finish()?;
+    Ok(Command::Pattern { pattern, once })
+}
+
 /// One line per command for `help`.
 pub const HELP_LINES: &[&str] = &[
-    "help                 this list",
-    "version              firmware version and build",
-    "status               uptime, build, state",
+    "pattern home|corner|horizontal|vertical|visit-all [once]",
+    "pattern grid-full [raster|serpentine] [once]",
+    "pattern line <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
+    "pattern circle <cx_cm> <cy_cm> <radius_cm> [cw|ccw] [once]",
+    "pattern rect <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
+    "stop                         stop the pattern, laser off",
+    "goto <x_cm> <y_cm>           aim at a board point",
+    "grid <xi> <yi>               aim at a grid point",
+    "laser on|off|auto|dwell      laser mode",
+    "model exact|seed             gimbal kinematic model",
+    "set <param> <value>          change a parameter",
+    "get <param>                  read a parameter",
+    "params                       list parameters",
+    "save                         store parameters in flash",
+    "status                       state, target, faults",
+    "version                      firmware version",
+    "help                         this list",
 ];
 
 #[cfg(test)]
@@ -40,11 +198,21 @@ mod tests {
     use super::*;
     use std::string::ToString;
 
+    fn ok(line: &str) -> Command {
+        match parse_line(line) {
+            Ok(Some(c)) => c,
+            other => panic!("{line:?} → {other:?}"),
+        }
+    }
+
     #[test]
     fn parses_the_basic_commands_case_insensitively() {
-        assert_eq!(parse_line("help"), Ok(Some(Command::Help)));
-        assert_eq!(parse_line("  VERSION \t"), Ok(Some(Command::Version)));
-        assert_eq!(parse_line("Status"), Ok(Some(Command::Status)));
+        assert_eq!(ok("help"), Command::Help);
+        assert_eq!(ok("  VERSION \t"), Command::Version);
+        assert_eq!(ok("Status"), Command::Status);
+        assert_eq!(ok("stop"), Command::Stop);
+        assert_eq!(ok("params"), Command::Params);
+        assert_eq!(ok("save"), Command::Save);
     }
 
     #[test]
@@ -72,20 +240,133 @@ mod tests {
             parse_line("version 2"),
             Err(CommandError::UnexpectedArgument(word("2")))
         );
+        assert!(parse_line("pattern corner twice").is_err());
+        assert!(parse_line("goto 1 2 3").is_err());
     }
 
     #[test]
-    fn every_command_in_help_parses() {
-        for line in HELP_LINES {
-            let name = line.split_ascii_whitespace().next().unwrap_or("");
-            // Commands whose help shows arguments are checked in their own tests.
-            if line.contains('<') {
-                continue;
+    fn patterns_with_options() {
+        assert_eq!(
+            ok("pattern corner once"),
+            Command::Pattern {
+                pattern: Pattern::Corner,
+                once: true
             }
-            assert!(
-                parse_line(name).is_ok(),
-                "help lists '{name}' but it does not parse"
-            );
+        );
+        assert_eq!(
+            ok("pattern grid-full serpentine"),
+            Command::Pattern {
+                pattern: Pattern::GridFull(GridOrder::Serpentine),
+                once: false
+            }
+        );
+        assert_eq!(
+            ok("pattern grid-full once"),
+            Command::Pattern {
+                pattern: Pattern::GridFull(GridOrder::Raster),
+                once: true
+            }
+        );
+        assert_eq!(
+            ok("pattern circle 0 0 5 cw once"),
+            Command::Pattern {
+                pattern: Pattern::Circle {
+                    centre: PointCm {
+                        x_cm: 0.0,
+                        y_cm: 0.0
+                    },
+                    radius_cm: 5.0,
+                    rotation: Rotation::Cw
+                },
+                once: true
+            }
+        );
+        assert_eq!(
+            ok("pattern line -5 1 5 -1"),
+            Command::Pattern {
+                pattern: Pattern::Line {
+                    from: PointCm {
+                        x_cm: -5.0,
+                        y_cm: 1.0
+                    },
+                    to: PointCm {
+                        x_cm: 5.0,
+                        y_cm: -1.0
+                    }
+                },
+                once: false
+            }
+        );
+        assert!(matches!(
+            parse_line("pattern spiral"),
+            Err(CommandError::InvalidArgument { .. })
+        ));
+        assert_eq!(
+            parse_line("pattern line 1 2 3"),
+            Err(CommandError::MissingArgument("y1_cm"))
+        );
+        assert!(matches!(
+            parse_line("pattern circle 0 0 0"),
+            Err(CommandError::OutOfRange { .. })
+        ));
+    }
+
+    #[test]
+    fn goto_grid_laser_model_set_get() {
+        assert_eq!(
+            ok("goto 1.5 -2"),
+            Command::Goto(PointCm {
+                x_cm: 1.5,
+                y_cm: -2.0
+            })
+        );
+        assert!(parse_line("goto nan 0").is_err());
+        assert!(parse_line("goto 1e6 0").is_err());
+        assert_eq!(ok("grid -6 4"), Command::Grid { xi: -6, yi: 4 });
+        assert!(parse_line("grid 0.5 1").is_err());
+        assert_eq!(ok("laser DWELL"), Command::Laser(LaserMode::Dwell));
+        assert!(parse_line("laser maybe").is_err());
+        assert_eq!(ok("model seed"), Command::Model(AimModel::Seed));
+        assert!(parse_line("model exactish").is_err());
+        let Command::Set { param, value } = ok("set dwell_ms 250") else {
+            panic!("not a set");
+        };
+        assert_eq!((param.name, value), ("dwell_ms", 250.0));
+        assert!(matches!(
+            parse_line("set dwell_ms -3"),
+            Err(CommandError::OutOfRange { .. })
+        ));
+        assert!(parse_line("set nosuch 1").is_err());
+        assert!(parse_line("set dwell_ms").is_err());
+        assert!(matches!(ok("get err.dx.c3"), Command::Get(p) if p.name == "err.dx.c3"));
+    }
+
+    #[test]
+    fn every_help_line_names_a_command_that_parses_with_its_example() {
+        let examples = [
+            "pattern home once",
+            "pattern grid-full raster once",
+            "pattern line 0 0 1 1 once",
+            "pattern circle 0 0 1 cw once",
+            "pattern rect 0 0 1 1 once",
+            "stop",
+            "goto 1 1",
+            "grid 1 1",
+            "laser on",
+            "model exact",
+            "set dwell_ms 1",
+            "get dwell_ms",
+            "params",
+            "save",
+            "status",
+            "version",
+            "help",
+        ];
+        assert_eq!(examples.len(), HELP_LINES.len());
+        for (line, example) in HELP_LINES.iter().zip(examples) {
+            let name = line.split_ascii_whitespace().next().unwrap_or("");
+            assert!(example.starts_with(name));
+            assert!(matches!(parse_line(example), Ok(Some(_))), "{example}");
         }
     }
 }

@@ -1,0 +1,256 @@
+//! Command handling: each command gets its reply here, and changes state
+//! only when it is accepted.
+
+use super::targets::{self, PatternError, Target};
+use super::{LaserSwitch, Phase, Run, Sequencer, SettingsStore};
+use crate::build_info;
+use crate::cli::parse::HELP_LINES;
+use crate::command::{AimModel, Command, Pattern, PointCm};
+use crate::settings::{PARAMS, ParamLine};
+use crate::status::Activity;
+
+impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
+    /// Runs one command and sends its reply.
+    pub(super) async fn handle_command(&mut self, command: Command) {
+        let link = self.link;
+        match command {
+            Command::Help => {
+                for line in HELP_LINES {
+                    link.data(format_args!("{line}")).await;
+                }
+                link.ok().await;
+            }
+            Command::Version => {
+                link.data(format_args!(
+                    "{} {} (git {}, {} build for {})",
+                    build_info::PRODUCT,
+                    build_info::VERSION,
+                    build_info::GIT_REV,
+                    build_info::PROFILE,
+                    build_info::TARGET
+                ))
+                .await;
+                link.ok().await;
+            }
+            Command::Status => {
+                self.report_status().await;
+                link.ok().await;
+            }
+            Command::Stop => {
+                self.stop("stop command");
+                link.ok().await;
+            }
+            Command::Pattern { pattern, once } => match self.check_pattern(&pattern) {
+                Ok(()) => {
+                    self.start(Run::new(Some(pattern), None, once));
+                    link.ok().await;
+                }
+                Err(reason) => link.error(reason).await,
+            },
+            Command::Goto(point) => self.goto(Target { point, grid: None }).await,
+            Command::Grid { xi, yi } => match targets::grid_point(&self.settings, xi, yi) {
+                Ok(target) => self.goto(target).await,
+                Err(reason) => link.error(reason).await,
+            },
+            Command::Laser(mode) => {
+                self.settings.laser_mode = mode;
+                link.ok().await;
+            }
+            Command::Model(model) => {
+                self.model = model;
+                // Re-aim the current point with the new model.
+                if self.run.is_some() {
+                    self.begin_point();
+                }
+                link.ok().await;
+            }
+            Command::Set { param, value } => {
+                let before = self.settings;
+                match self.settings.set(param, value) {
+                    Ok(()) => match self.check_current_run() {
+                        Ok(()) => link.ok().await,
+                        Err(reason) => {
+                            self.settings = before;
+                            link.error(reason).await;
+                        }
+                    },
+                    Err(e) => link.error(e).await,
+                }
+            }
+            Command::Get(param) => {
+                link.data(format_args!(
+                    "{}",
+                    ParamLine(param, self.settings.get(param))
+                ))
+                .await;
+                link.ok().await;
+            }
+            Command::Params => {
+                for param in PARAMS {
+                    link.data(format_args!(
+                        "{}",
+                        ParamLine(param, self.settings.get(param))
+                    ))
+                    .await;
+                }
+                link.ok().await;
+            }
+            Command::Save => {
+                let record = self.settings.to_record();
+                match self.store.save(&record).await {
+                    Ok(()) => link.ok().await,
+                    Err(reason) => link.error(reason).await,
+                }
+            }
+        }
+    }
+
+    /// Aims at one target and holds it; refuses unreachable targets.
+    async fn goto(&mut self, target: Target) {
+        match targets::check_target(&self.settings, self.model, &target) {
+            Ok(_) => {
+                self.start(Run::new(None, Some(target), true));
+                self.link.ok().await;
+            }
+            Err(e) => self.link.error(e).await,
+        }
+    }
+
+    /// Every point of `pattern` must be reachable before it starts.
+    fn check_pattern(&self, pattern: &Pattern) -> Result<(), PatternError> {
+        targets::check_pattern(pattern, &self.settings, self.model)
+    }
+
+    /// After a parameter change, the running pattern (if any) must still be
+    /// reachable; it continues with the new values from its next point.
+    fn check_current_run(&self) -> Result<(), PatternError> {
+        match self.run {
+            Some(Run {
+                pattern: Some(pattern),
+                ..
+            }) => self.check_pattern(&pattern),
+            Some(Run {
+                single: Some(target),
+                ..
+            }) => targets::check_target(&self.settings, self.model, &target).map(|_| ()),
+            _ => Ok(()),
+        }
+    }
+
+    async fn report_status(&self) {
+        let link = self.link;
+        let s = self.status.snapshot();
+        let uptime_ms = self.booted_at.elapsed().as_millis();
+        link.data(format_args!(
+            "uptime: {}.{:03} s",
+            uptime_ms / 1000,
+            uptime_ms % 1000
+        ))
+        .await;
+        link.data(format_args!(
+            "build: {} {} git {} {}",
+            build_info::PRODUCT,
+            build_info::VERSION,
+            build_info::GIT_REV,
+            build_info::PROFILE
+        ))
+        .await;
+        match s.activity {
+            Activity::Idle => link.data(format_args!("state: idle")).await,
+            Activity::Goto => link.data(format_args!("state: goto")).await,
+            Activity::Pattern(p) => {
+                link.data(format_args!(
+                    "state: pattern {}{} point {} pass {}",
+                    p.name(),
+                    if self.run.is_some_and(|r| r.once) {
+                        " once"
+                    } else {
+                        ""
+                    },
+                    s.point_index.unwrap_or(0),
+                    s.pass
+                ))
+                .await
+            }
+        }
+        let phase = match s.phase {
+            None => "-",
+            Some(Phase::Moving) => "moving",
+            Some(Phase::Dwelling) => "dwelling",
+            Some(Phase::Holding) => "holding",
+        };
+        link.data(format_args!("phase: {phase}")).await;
+        link.data(format_args!(
+            "model: {}",
+            match self.model {
+                AimModel::Exact => "exact",
+                AimModel::Seed => "seed",
+            }
+        ))
+        .await;
+        if let Some((target, aim)) = s.target {
+            let PointCm { x_cm, y_cm } = target.point;
+            match target.grid {
+                Some((xi, yi)) => {
+                    link.data(format_args!(
+                        "target: ({x_cm:.3}, {y_cm:.3}) cm grid ({xi}, {yi})"
+                    ))
+                    .await
+                }
+                None => {
+                    link.data(format_args!("target: ({x_cm:.3}, {y_cm:.3}) cm"))
+                        .await
+                }
+            }
+            link.data(format_args!(
+                "joint: yaw {:.3} deg pitch {:.3} deg",
+                aim.yaw_deg, aim.pitch_deg
+            ))
+            .await;
+            link.data(format_args!(
+                "servo: yaw {:.1} deg pitch {:.1} deg (wire {} {})",
+                f64::from(aim.yaw_wire) / 10.0,
+                f64::from(aim.pitch_wire) / 10.0,
+                aim.yaw_wire,
+                aim.pitch_wire
+            ))
+            .await;
+        }
+        if let Some((yaw, pitch)) = self.measured {
+            link.data(format_args!(
+                "measured: yaw {:.1} deg pitch {:.1} deg",
+                f64::from(yaw) / 10.0,
+                f64::from(pitch) / 10.0
+            ))
+            .await;
+        }
+        link.data(format_args!(
+            "laser: {} (mode {})",
+            if s.laser_on { "on" } else { "off" },
+            self.settings.laser_mode.name()
+        ))
+        .await;
+        match s.faulty_servo {
+            Some(id) => {
+                link.data(format_args!("faults: servo {id} not responding"))
+                    .await
+            }
+            None => link.data(format_args!("faults: none")).await,
+        }
+    }
+}
+
+impl Run {
+    pub(super) fn new(pattern: Option<Pattern>, single: Option<Target>, once: bool) -> Self {
+        Self {
+            pattern,
+            single,
+            once,
+            index: 0,
+            pass: 0,
+            phase: Phase::Moving,
+            seq: 0,
+            dwell_until: None,
+        }
+    }
+}

@@ -1,0 +1,5 @@
+//! The FashionStar servo bus: the frame codec ([`protocol`]) and the servo
+//! task body ([`task`]).
+
+pub mod protocol;
+pub mod task;
