@@ -4,6 +4,7 @@
 mod calib;
 mod kin;
 mod plan;
+mod sim;
 mod toolchain;
 
 use std::process::ExitCode;
@@ -27,6 +28,8 @@ enum Command {
     Flash,
     /// Print the release firmware's size (text/data/bss) against the budget.
     Size,
+    /// Run the firmware tasks on the host against simulated servos (virtual time).
+    Sim(sim::SimArgs),
     /// Gimbal kinematics: `kin ik`, `kin fk`, `kin grid-error`.
     Kin(kin::KinArgs),
     /// Error-model calibration: `calib fit --input FILE.csv`.
@@ -42,6 +45,7 @@ fn main() -> ExitCode {
         Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
         Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
+        Command::Sim(args) => sim::run_sim(args),
         Command::Kin(args) => kin::run(args),
         Command::Calib(args) => calib::run(args),
         Command::Plan(args) => plan::run(args),

@@ -7,17 +7,17 @@ macro_rules! make_log_macro {
     ($d:tt $name:ident => $backend:ident) => {
         #[allow(unused_macros)]
         macro_rules! $name {
-                                    ($d($d arg:tt)*) => {{
-                                        #[cfg(feature = "defmt")]
-                                        ::defmt::$backend!($d($d arg)*);
-                                        #[cfg(feature = "log")]
-                                        ::log::$backend!($d($d arg)*);
-                                        #[cfg(not(any(feature = "defmt", feature = "log")))]
-                                        if false {
-                                            let _ = ::core::format_args!($d($d arg)*);
+                                            ($d($d arg:tt)*) => {{
+                                                #[cfg(feature = "defmt")]
+                                                ::defmt::$backend!($d($d arg)*);
+                                                #[cfg(feature = "log")]
+                                                ::log::$backend!($d($d arg)*);
+                                                #[cfg(not(any(feature = "defmt", feature = "log")))]
+                                                if false {
+                                                    let _ = ::core::format_args!($d($d arg)*);
+                                                }
+                                            }};
                                         }
-                                    }};
-                                }
         #[allow(unused_imports)]
         pub(crate) use $name;
     };

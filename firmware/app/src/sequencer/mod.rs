@@ -226,6 +226,8 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             yaw_tenths: aim.yaw_wire,
             pitch_tenths: aim.pitch_wire,
             interval_ms,
+            ids: (self.settings.yaw.id, self.settings.pitch.id),
+            deadband_tenths: (self.settings.deadband_deg * 10.0) as u16,
         };
         // Newest request wins: drop one the servo task has not taken yet.
         let _ = self.servo.requests.try_receive();
@@ -293,13 +295,20 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 self.publish();
             }
             ServoOutcome::Fault { seq, id, fault } => {
-                if self.run.is_some_and(|r| r.seq == seq) {
-                    self.faulty_servo = Some(id);
-                    self.link.notify(format_args!(
-                        "error: servo {id} fault ({fault:?}); pattern stopped, laser off"
-                    ));
-                    self.stop("servo fault");
+                // A fault of an older, superseded move is stale; any other
+                // fault (of the current move, or found by the servo task's
+                // health check while dwelling or idle) stops everything.
+                if self
+                    .run
+                    .is_some_and(|r| r.seq != seq && r.phase == Phase::Moving)
+                {
+                    return;
                 }
+                self.faulty_servo = Some(id);
+                self.link.notify(format_args!(
+                    "error: servo {id} fault ({fault:?}); pattern stopped, laser off"
+                ));
+                self.stop("servo fault");
             }
             ServoOutcome::Present { .. } | ServoOutcome::Superseded { .. } => {}
         }

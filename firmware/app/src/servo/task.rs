@@ -8,7 +8,7 @@ use core::sync::atomic::{AtomicU32, Ordering};
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
-use embassy_time::{Duration, Instant, Timer, with_timeout};
+use embassy_time::{Duration, Instant, Timer, with_deadline, with_timeout};
 use embedded_io_async::{Read, Write};
 
 use super::protocol::{MAX_FRAME_LEN, Request, Response, ResponseDecoder, SetAngle};
@@ -34,6 +34,10 @@ pub struct ServoBusConfig {
     /// Arrival deadline beyond the commanded interval, ms (plus 50 % of
     /// the interval); a move not finished by then is a fault.
     pub arrival_margin_ms: u16,
+    /// Period of the health check while no move runs (both angles are
+    /// queried, so a servo that stops answering during a dwell or a held
+    /// goto is a fault within this period plus the retries), ms.
+    pub health_check_ms: u16,
 }
 
 impl Default for ServoBusConfig {
@@ -46,6 +50,7 @@ impl Default for ServoBusConfig {
             retries: 2,
             poll_period_ms: 10,
             arrival_margin_ms: 300,
+            health_check_ms: 100,
         }
     }
 }
@@ -66,6 +71,10 @@ pub enum ServoRequest {
         pitch_tenths: i16,
         /// Commanded travel time, ms.
         interval_ms: u16,
+        /// Bus ids `(yaw, pitch)` (from the settings; used from now on).
+        ids: (u8, u8),
+        /// Arrival deadband, 0.1° (used from now on).
+        deadband_tenths: u16,
     },
     /// Ping both servos and report whether they answer.
     Probe {
@@ -203,21 +212,35 @@ impl<R: Read, W: Write> ServoBus<R, W> {
         }
     }
 
-    /// Serves requests forever.
+    /// Serves requests forever. Between requests it checks the servos'
+    /// health (answering servos) and pings faulty ones for recovery.
     pub async fn run(&mut self, link: &ServoLink) -> ! {
         let mut next_recovery_ping = Instant::now() + RECOVERY_PING_PERIOD;
+        let health_period = Duration::from_millis(u64::from(self.config.health_check_ms.max(1)));
+        let mut next_health_check = Instant::now() + health_period;
+        // Request number of the last move (faults found by the health check
+        // belong to it).
+        let mut last_seq = 0;
         loop {
             link.alive.fetch_add(1, Ordering::Relaxed);
-            let request = match with_timeout(IDLE_TICK, link.requests.receive()).await {
+            let wake = next_health_check.min(Instant::now() + IDLE_TICK);
+            let request = match with_deadline(wake, link.requests.receive()).await {
                 Ok(request) => request,
                 Err(_) => {
-                    if self.faulty.iter().any(|f| *f) && Instant::now() >= next_recovery_ping {
-                        next_recovery_ping = Instant::now() + RECOVERY_PING_PERIOD;
+                    let now = Instant::now();
+                    if now >= next_health_check {
+                        next_health_check = now + health_period;
+                        self.health_check(link, last_seq).await;
+                    }
+                    if self.faulty.iter().any(|f| *f) && now >= next_recovery_ping {
+                        next_recovery_ping = now + RECOVERY_PING_PERIOD;
                         self.ping_faulty(link).await;
                     }
                     continue;
                 }
             };
+            last_seq = request.seq();
+            next_health_check = Instant::now() + health_period;
             let outcome = self.serve(request, link).await;
             match outcome {
                 ServoOutcome::Fault { id, fault, .. } => {
@@ -239,6 +262,23 @@ impl<R: Read, W: Write> ServoBus<R, W> {
         }
         if id == self.config.pitch_id {
             self.faulty[1] = faulty;
+        }
+    }
+
+    /// Queries the angle of every servo not yet known faulty; one that does
+    /// not answer is reported as a fault of move `seq`.
+    async fn health_check(&mut self, link: &ServoLink, seq: u32) {
+        for (slot, id) in [(0, self.config.yaw_id), (1, self.config.pitch_id)] {
+            if self.faulty.get(slot).copied().unwrap_or(true) {
+                continue;
+            }
+            if let Err(fault) = self.query_angle(id).await {
+                log::warning!("servo {}: fault {:?} while holding", id, fault);
+                self.set_faulty(id, true);
+                link.outcomes
+                    .send(ServoOutcome::Fault { seq, id, fault })
+                    .await;
+            }
         }
     }
 
@@ -272,7 +312,15 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                 yaw_tenths,
                 pitch_tenths,
                 interval_ms,
+                ids: (yaw_id, pitch_id),
+                deadband_tenths,
             } => {
+                if (yaw_id, pitch_id) != (self.config.yaw_id, self.config.pitch_id) {
+                    self.faulty = [false; 2];
+                }
+                self.config.yaw_id = yaw_id;
+                self.config.pitch_id = pitch_id;
+                self.config.deadband_tenths = deadband_tenths;
                 let entry = |id, angle_tenths_deg| SetAngle {
                     id,
                     angle_tenths_deg,

@@ -1,0 +1,168 @@
+//! Draws a run as SVG: the board with its grid, the spot's path (solid
+//! where the laser was on, faint where it was off), and each dwell point.
+
+use anyhow::{Result, anyhow};
+use plotters::prelude::*;
+
+use crate::recorder::Recording;
+
+/// Board area drawn, half-width and half-height, cm.
+const HALF_WIDTH_CM: f64 = 16.0;
+const HALF_HEIGHT_CM: f64 = 11.0;
+
+/// Grid geometry to draw (indices −half_cols..=half_cols etc.).
+#[derive(Debug, Clone, Copy)]
+pub struct GridView {
+    /// Pitch, cm.
+    pub pitch_cm: f64,
+    /// Half the number of columns.
+    pub half_cols: i32,
+    /// Half the number of rows.
+    pub half_rows: i32,
+}
+
+/// Renders `recording` into an SVG document.
+pub fn render_svg(recording: &Recording, grid: GridView, title: &str) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (960, 680)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(36)
+            .y_label_area_size(44)
+            .build_cartesian_2d(
+                -HALF_WIDTH_CM..HALF_WIDTH_CM,
+                -HALF_HEIGHT_CM..HALF_HEIGHT_CM,
+            )
+            .map_err(|e| anyhow!("{e}"))?;
+        chart
+            .configure_mesh()
+            .x_desc("board x (cm)")
+            .y_desc("board y (cm)")
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+
+        let grid_points: Vec<(f64, f64)> = (-grid.half_rows..=grid.half_rows)
+            .flat_map(|yi| {
+                (-grid.half_cols..=grid.half_cols)
+                    .map(move |xi| (f64::from(xi) * grid.pitch_cm, f64::from(yi) * grid.pitch_cm))
+            })
+            .collect();
+        chart
+            .draw_series(
+                grid_points
+                    .iter()
+                    .map(|&p| Circle::new(p, 3, ShapeStyle::from(&BLACK.mix(0.25)).filled())),
+            )
+            .map_err(|e| anyhow!("{e}"))?
+            .label("grid point")
+            .legend(|(x, y)| Circle::new((x + 10, y), 3, BLACK.mix(0.25).filled()));
+
+        // Path, split into runs of equal laser state.
+        let mut runs: Vec<(bool, Vec<(f64, f64)>)> = Vec::new();
+        for s in &recording.spot {
+            match runs.last_mut() {
+                Some((on, pts)) if *on == s.laser => pts.push((s.x_cm, s.y_cm)),
+                _ => {
+                    let mut pts = Vec::new();
+                    if let Some(&p) = runs.last().and_then(|(_, prev)| prev.last()) {
+                        pts.push(p);
+                    }
+                    pts.push((s.x_cm, s.y_cm));
+                    runs.push((s.laser, pts));
+                }
+            }
+        }
+        let mut labelled_on = false;
+        let mut labelled_off = false;
+        for (on, pts) in runs {
+            let style = if on {
+                ShapeStyle::from(&RED).stroke_width(2)
+            } else {
+                ShapeStyle::from(&BLUE.mix(0.25)).stroke_width(1)
+            };
+            let series = chart
+                .draw_series(LineSeries::new(pts, style))
+                .map_err(|e| anyhow!("{e}"))?;
+            if on && !labelled_on {
+                labelled_on = true;
+                series
+                    .label("gimbal spot, laser on")
+                    .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+            } else if !on && !labelled_off {
+                labelled_off = true;
+                series
+                    .label("gimbal spot, laser off")
+                    .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.mix(0.25)));
+            }
+        }
+
+        if !recording.dwells.is_empty() {
+            chart
+                .draw_series(recording.dwells.iter().map(|d| {
+                    Cross::new(
+                        d.spot_cm,
+                        6,
+                        ShapeStyle::from(&GREEN.mix(0.9)).stroke_width(2),
+                    )
+                }))
+                .map_err(|e| anyhow!("{e}"))?
+                .label("dwell (spot)")
+                .legend(|(x, y)| Cross::new((x + 10, y), 5, GREEN.stroke_width(2)));
+        }
+
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.3))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| anyhow!("{e}"))?;
+        root.present().map_err(|e| anyhow!("{e}"))?;
+    }
+    Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recorder::{DwellRecord, SpotSample};
+
+    #[test]
+    fn svg_has_path_grid_and_dwells() {
+        let rec = Recording {
+            spot: (0..50)
+                .map(|i| SpotSample {
+                    t_us: i * 1000,
+                    x_cm: i as f64 * 0.2 - 5.0,
+                    y_cm: 1.0,
+                    laser: i > 10,
+                })
+                .collect(),
+            dwells: vec![DwellRecord {
+                t_us: 0,
+                target_cm: (0.0, 0.0),
+                grid: Some((0, 0)),
+                spot_cm: (0.0, 0.0),
+                laser: true,
+            }],
+            ..Default::default()
+        };
+        let grid = GridView {
+            pitch_cm: 1.916,
+            half_cols: 6,
+            half_rows: 4,
+        };
+        let svg = render_svg(&rec, grid, "test").unwrap();
+        assert!(svg.starts_with("<svg"));
+        assert!(
+            svg.matches("<circle").count() >= 13 * 9,
+            "grid points drawn"
+        );
+        assert!(svg.contains("<polyline"), "path drawn");
+        assert!(svg.contains("board x (cm)"));
+    }
+}

@@ -1,0 +1,140 @@
+//! What the simulation records: the laser spot over time, the dwell points,
+//! laser switching and every frame on the servo bus.
+
+use std::fmt::Write as _;
+
+/// A sample of the simulated laser spot (from the simulated servos' actual
+/// angles through the exact forward kinematics).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpotSample {
+    /// Simulated time, µs.
+    pub t_us: u64,
+    /// Board x, cm.
+    pub x_cm: f64,
+    /// Board y, cm.
+    pub y_cm: f64,
+    /// Laser output at that time.
+    pub laser: bool,
+}
+
+/// The spot while the sequencer dwelt on a point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DwellRecord {
+    /// When the dwell started, µs.
+    pub t_us: u64,
+    /// Commanded board point, cm.
+    pub target_cm: (f64, f64),
+    /// Grid index of the target, if it is a grid point.
+    pub grid: Option<(i8, i8)>,
+    /// Where the spot actually was, cm.
+    pub spot_cm: (f64, f64),
+    /// Laser state during the dwell.
+    pub laser: bool,
+}
+
+/// Direction of a frame on the servo bus.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Direction {
+    /// Firmware → servo.
+    Tx,
+    /// Servo → firmware.
+    Rx,
+}
+
+/// One frame on the servo bus.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FrameRecord {
+    /// When its first byte went on the wire, µs.
+    pub t_us: u64,
+    /// Direction.
+    pub direction: Direction,
+    /// The bytes as sent (after any injected corruption).
+    pub bytes: Vec<u8>,
+}
+
+/// Everything recorded during a run.
+#[derive(Debug, Default, Clone)]
+pub struct Recording {
+    /// Spot samples.
+    pub spot: Vec<SpotSample>,
+    /// Dwell points.
+    pub dwells: Vec<DwellRecord>,
+    /// Laser switching: (t µs, on).
+    pub laser_events: Vec<(u64, bool)>,
+    /// Servo-bus frames.
+    pub frames: Vec<FrameRecord>,
+}
+
+impl Recording {
+    /// `--frames` format: `t_ms direction hex-bytes`, one frame per line.
+    pub fn frames_text(&self) -> String {
+        let mut out = String::new();
+        for f in &self.frames {
+            let dir = match f.direction {
+                Direction::Tx => "tx",
+                Direction::Rx => "rx",
+            };
+            let _ = write!(out, "{:.3} {dir}", f.t_us as f64 / 1000.0);
+            for b in &f.bytes {
+                let _ = write!(out, " {b:02x}");
+            }
+            out.push('\n');
+        }
+        out
+    }
+
+    /// `--trace` format: CSV `t_ms,x_cm,y_cm,laser`.
+    pub fn trace_csv(&self) -> String {
+        let mut out = String::from("t_ms,x_cm,y_cm,laser\n");
+        for s in &self.spot {
+            let _ = writeln!(
+                out,
+                "{:.3},{:.4},{:.4},{}",
+                s.t_us as f64 / 1000.0,
+                s.x_cm,
+                s.y_cm,
+                u8::from(s.laser)
+            );
+        }
+        out
+    }
+
+    /// Laser state at time `t_us` (off before the first event).
+    pub fn laser_at(&self, t_us: u64) -> bool {
+        self.laser_events
+            .iter()
+            .take_while(|(t, _)| *t <= t_us)
+            .last()
+            .is_some_and(|(_, on)| *on)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_dump_is_time_direction_hex() {
+        let rec = Recording {
+            frames: vec![FrameRecord {
+                t_us: 1500,
+                direction: Direction::Tx,
+                bytes: vec![0x12, 0x4c, 0x01, 0x01, 0x00, 0x60],
+            }],
+            ..Default::default()
+        };
+        assert_eq!(rec.frames_text(), "1.500 tx 12 4c 01 01 00 60\n");
+    }
+
+    #[test]
+    fn laser_state_follows_events() {
+        let rec = Recording {
+            laser_events: vec![(100, true), (300, false)],
+            ..Default::default()
+        };
+        assert!(!rec.laser_at(50));
+        assert!(rec.laser_at(100));
+        assert!(rec.laser_at(299));
+        assert!(!rec.laser_at(300));
+    }
+}

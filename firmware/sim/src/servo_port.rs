@@ -1,0 +1,165 @@
+//! The simulated servo UART: the firmware's servo task writes real request
+//! bytes here and reads real response bytes, with 115200-baud wire timing,
+//! delivered by the simulated FashionStar servos of [`crate::servo_model`].
+//! Fault injection (silent servo, corrupted bytes, slow servos) happens on
+//! this path.
+
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::convert::Infallible;
+use std::rc::Rc;
+
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::signal::Signal;
+use embassy_time::{Instant, Timer};
+
+use crate::recorder::{Direction, FrameRecord, Recording};
+use crate::servo_model::SimServoBus;
+
+/// Time one byte takes on the wire at 115200 baud 8N1 (10 bits), µs.
+pub const BYTE_TIME_US: u64 = 87;
+
+/// Injected servo-bus faults.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BusFaults {
+    /// Servo `id` stops answering at `t_ms`.
+    pub silent: Vec<(u8, u64)>,
+    /// Probability that a response byte is corrupted (one bit flipped).
+    pub corrupt_probability: f64,
+}
+
+/// The bus seen from the firmware: write requests, read responses.
+pub struct SimServoPort {
+    bus: Rc<RefCell<SimServoBus>>,
+    recording: Rc<RefCell<Recording>>,
+    faults: BusFaults,
+    /// Response bytes with the time each becomes readable, µs.
+    incoming: RefCell<VecDeque<(u64, u8)>>,
+    arrived: Signal<CriticalSectionRawMutex, ()>,
+    rng: RefCell<u64>,
+}
+
+impl SimServoPort {
+    /// A port on `bus`, recording frames into `recording`.
+    pub fn new(
+        bus: Rc<RefCell<SimServoBus>>,
+        recording: Rc<RefCell<Recording>>,
+        faults: BusFaults,
+        seed: u64,
+    ) -> Self {
+        Self {
+            bus,
+            recording,
+            faults,
+            incoming: RefCell::default(),
+            arrived: Signal::new(),
+            rng: RefCell::new(seed | 1),
+        }
+    }
+
+    fn random_unit(&self) -> f64 {
+        let mut x = self.rng.borrow_mut();
+        *x ^= *x << 13;
+        *x ^= *x >> 7;
+        *x ^= *x << 17;
+        (*x >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn apply_silence(&self, now_us: u64) {
+        let mut bus = self.bus.borrow_mut();
+        for &(id, t_ms) in &self.faults.silent {
+            if now_us >= t_ms * 1000 {
+                bus.set_silent(id, true);
+            }
+        }
+    }
+
+    async fn write_bytes(&self, bytes: &[u8]) {
+        let start = Instant::now().as_micros();
+        // The bytes are on the wire for their transmission time.
+        Timer::after_micros(BYTE_TIME_US * bytes.len() as u64).await;
+        let done = Instant::now().as_micros();
+        self.recording.borrow_mut().frames.push(FrameRecord {
+            t_us: start,
+            direction: Direction::Tx,
+            bytes: bytes.to_vec(),
+        });
+        self.apply_silence(done);
+        let responses = self.bus.borrow_mut().receive(done, bytes);
+        for (ready_at_us, mut response) in responses {
+            for byte in response.iter_mut() {
+                if self.faults.corrupt_probability > 0.0
+                    && self.random_unit() < self.faults.corrupt_probability
+                {
+                    *byte ^= 1 << (self.random_unit() * 8.0) as u32;
+                }
+            }
+            self.recording.borrow_mut().frames.push(FrameRecord {
+                t_us: ready_at_us,
+                direction: Direction::Rx,
+                bytes: response.clone(),
+            });
+            let mut incoming = self.incoming.borrow_mut();
+            for (i, byte) in response.into_iter().enumerate() {
+                incoming.push_back((ready_at_us + BYTE_TIME_US * (i as u64 + 1), byte));
+            }
+        }
+        self.arrived.signal(());
+    }
+
+    async fn read_bytes(&self, buf: &mut [u8]) -> usize {
+        loop {
+            let now = Instant::now().as_micros();
+            let next = self.incoming.borrow().front().map(|(t, _)| *t);
+            match next {
+                Some(t) if t <= now => {
+                    let mut incoming = self.incoming.borrow_mut();
+                    let mut n = 0;
+                    while n < buf.len() {
+                        match incoming.front() {
+                            Some(&(t, byte)) if t <= now => {
+                                buf[n] = byte;
+                                n += 1;
+                                incoming.pop_front();
+                            }
+                            _ => break,
+                        }
+                    }
+                    return n;
+                }
+                Some(t) => Timer::at(Instant::from_micros(t)).await,
+                None => self.arrived.wait().await,
+            }
+        }
+    }
+}
+
+/// Firmware-side handle implementing `embedded_io_async::{Read, Write}`.
+#[derive(Clone)]
+pub struct PortHandle(pub Rc<SimServoPort>);
+
+impl embedded_io_async::ErrorType for PortHandle {
+    type Error = Infallible;
+}
+
+impl embedded_io_async::Write for PortHandle {
+    async fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
+        self.0.write_bytes(buf).await;
+        Ok(buf.len())
+    }
+
+    /// `write` returns once its bytes have left the wire, so there is
+    /// never anything buffered to flush.
+    async fn flush(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+impl embedded_io_async::Read for PortHandle {
+    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Infallible> {
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        Ok(self.0.read_bytes(buf).await)
+    }
+}

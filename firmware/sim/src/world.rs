@@ -1,0 +1,294 @@
+//! Assembles a simulation: the firmware's task bodies (console, sequencer,
+//! servo task — the same code the target runs) wired to a simulated USB
+//! host, simulated FashionStar servos on a simulated UART, a recording
+//! laser, and a sampler that follows the laser spot.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use embassy_time::Timer;
+use laser_app::command::CommandLink;
+use laser_app::sequencer::{LaserSwitch, Sequencer, SettingsStore};
+use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
+use laser_app::status::{Activity, Phase, StatusBoard};
+
+use crate::executor::{self, RunEnd};
+use crate::physics::PhysicalGimbal;
+use crate::recorder::{DwellRecord, Recording, SpotSample};
+use crate::script::Step;
+use crate::servo_model::SimServoBus;
+use crate::servo_port::{BusFaults, PortHandle, SimServoPort};
+use crate::usb_host::{Transcript, UsbHost, script_task, terminal_task};
+
+/// How to run a simulation.
+#[derive(Debug, Clone)]
+pub struct SimOptions {
+    /// The command lines to type (and waits).
+    pub script: Vec<Step>,
+    /// Pace with the wall clock instead of jumping over idle time.
+    pub realtime: bool,
+    /// Keep running after the script until the sequencer is idle.
+    pub until_idle: bool,
+    /// Injected servo-bus faults.
+    pub faults: BusFaults,
+    /// Servos move this many times slower than commanded (1 = nominal).
+    pub slow_factor: f64,
+    /// Hard limit on simulated time, ms.
+    pub max_time_ms: u64,
+    /// Print the terminal transcript on stdout as it happens.
+    pub echo: bool,
+    /// Period of the spot sampler, µs.
+    pub sample_period_us: u64,
+    /// Saved settings record to boot with (as if read from flash).
+    pub saved_settings: Option<Vec<u8>>,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        Self {
+            script: Vec::new(),
+            realtime: false,
+            until_idle: false,
+            faults: BusFaults::default(),
+            slow_factor: 1.0,
+            max_time_ms: 600_000,
+            echo: false,
+            sample_period_us: 2_000,
+            saved_settings: None,
+        }
+    }
+}
+
+/// What a simulation produced.
+#[derive(Debug, Clone)]
+pub struct SimReport {
+    /// Everything the terminal sent and received.
+    pub transcript: Transcript,
+    /// Spot, dwells, laser switching, servo-bus frames.
+    pub recording: Recording,
+    /// Why the run ended.
+    pub end: RunEnd,
+    /// Simulated time at the end, µs.
+    pub end_time_us: u64,
+    /// The sequencer was idle (or holding a goto) at the end.
+    pub idle_at_end: bool,
+    /// Settings record saved with `save` during the run, if any.
+    pub saved_settings: Option<Vec<u8>>,
+}
+
+impl SimReport {
+    /// Whether `--until-idle` should exit 0: script done, idle, and no
+    /// `error:` reply unless errors are allowed.
+    pub fn succeeded(&self, allow_errors: bool) -> bool {
+        self.transcript.script_done
+            && self.idle_at_end
+            && (allow_errors || self.transcript.error_replies == 0)
+    }
+}
+
+/// The laser output: records every switch with its time.
+struct RecordingLaser(Rc<RefCell<Recording>>);
+
+impl LaserSwitch for RecordingLaser {
+    fn set(&mut self, on: bool) {
+        let t = crate::clock::now_us();
+        self.0.borrow_mut().laser_events.push((t, on));
+    }
+}
+
+/// Settings "flash" in memory.
+struct MemoryStore(Rc<RefCell<Option<Vec<u8>>>>);
+
+impl SettingsStore for MemoryStore {
+    async fn load(&mut self, buf: &mut [u8]) -> usize {
+        match &*self.0.borrow() {
+            Some(record) => {
+                let n = record.len().min(buf.len());
+                buf[..n].copy_from_slice(&record[..n]);
+                n
+            }
+            None => 0,
+        }
+    }
+
+    async fn save(&mut self, record: &[u8]) -> Result<(), &'static str> {
+        *self.0.borrow_mut() = Some(record.to_vec());
+        Ok(())
+    }
+}
+
+fn is_idle(status: &StatusBoard) -> bool {
+    let s = status.snapshot();
+    match s.activity {
+        Activity::Idle => true,
+        Activity::Goto => s.phase == Some(Phase::Holding),
+        Activity::Pattern(_) => false,
+    }
+}
+
+/// Runs one simulation to its end. Independent runs may execute on
+/// different threads at the same time.
+pub fn run(options: SimOptions) -> SimReport {
+    let link: &'static CommandLink = Box::leak(Box::new(CommandLink::new()));
+    let servo_link: &'static ServoLink = Box::leak(Box::new(ServoLink::new()));
+    let status: &'static StatusBoard = Box::leak(Box::new(StatusBoard::new()));
+    let host = Rc::new(UsbHost::new(options.echo));
+    let recording = Rc::new(RefCell::new(Recording::default()));
+    let flash = Rc::new(RefCell::new(options.saved_settings.clone()));
+    let gimbal = PhysicalGimbal::default();
+    let bus = Rc::new(RefCell::new(SimServoBus::new(
+        &[gimbal.yaw_id, gimbal.pitch_id],
+        options.slow_factor,
+    )));
+    let port = Rc::new(SimServoPort::new(
+        bus.clone(),
+        recording.clone(),
+        options.faults.clone(),
+        0x5eed,
+    ));
+
+    let end = {
+        let (host, recording, flash, bus, script) = (
+            host.clone(),
+            recording.clone(),
+            flash.clone(),
+            bus.clone(),
+            options.script.clone(),
+        );
+        let until_idle = options.until_idle;
+        let stop_host = host.clone();
+        executor::run(
+            options.realtime,
+            options.max_time_ms * 1000,
+            move |spawner| {
+                let console_host = host.clone();
+                executor::spawn(&spawner, async move {
+                    let mut rx = &console_host.to_device;
+                    let mut tx = &console_host.from_device;
+                    laser_app::usb::run_console(&mut rx, &mut tx, link).await;
+                });
+                executor::spawn(&spawner, script_task(script, host.clone()));
+                executor::spawn(&spawner, terminal_task(host.clone()));
+                let servo_port = port.clone();
+                executor::spawn(&spawner, async move {
+                    ServoBus::new(
+                        PortHandle(servo_port.clone()),
+                        PortHandle(servo_port),
+                        ServoBusConfig::default(),
+                    )
+                    .run(servo_link)
+                    .await;
+                });
+                let laser = RecordingLaser(recording.clone());
+                let store = MemoryStore(flash.clone());
+                executor::spawn(&spawner, async move {
+                    let mut sequencer =
+                        Sequencer::new(link, servo_link, status, laser, store).await;
+                    sequencer.run().await;
+                });
+                executor::spawn(
+                    &spawner,
+                    spot_sampler(
+                        bus.clone(),
+                        recording.clone(),
+                        status,
+                        gimbal,
+                        options.sample_period_us,
+                    ),
+                );
+            },
+            move || {
+                let done = stop_host.transcript.borrow().script_done;
+                done && (!until_idle || is_idle(status))
+            },
+        )
+    };
+    let transcript = host.transcript.borrow().clone();
+    let recording = recording.borrow().clone();
+    let saved_settings = flash.borrow().clone();
+    SimReport {
+        transcript,
+        recording,
+        end,
+        end_time_us: crate::clock::now_us(),
+        idle_at_end: is_idle(status),
+        saved_settings,
+    }
+}
+
+/// Samples the spot from the simulated servos' true angles, and records
+/// where it was at the end of each dwell.
+async fn spot_sampler(
+    bus: Rc<RefCell<SimServoBus>>,
+    recording: Rc<RefCell<Recording>>,
+    status: &'static StatusBoard,
+    gimbal: PhysicalGimbal,
+    period_us: u64,
+) {
+    let mut open_dwell: Option<(DwellKey, usize)> = None;
+    loop {
+        let t_us = crate::clock::now_us();
+        let (yaw_deg, pitch_deg) = {
+            let bus = bus.borrow();
+            (
+                bus.angle_deg(gimbal.yaw_id, t_us).unwrap_or(0.0),
+                bus.angle_deg(gimbal.pitch_id, t_us).unwrap_or(0.0),
+            )
+        };
+        {
+            let mut rec = recording.borrow_mut();
+            let laser = rec.laser_at(t_us);
+            let spot = gimbal.spot_cm(yaw_deg, pitch_deg);
+            if let Some((x_cm, y_cm)) = spot {
+                rec.spot.push(SpotSample {
+                    t_us,
+                    x_cm,
+                    y_cm,
+                    laser,
+                });
+            }
+            let s = status.snapshot();
+            let dwelling = matches!(s.phase, Some(Phase::Dwelling | Phase::Holding));
+            let key = DwellKey {
+                index: s.point_index,
+                pass: s.pass,
+                target: s
+                    .target
+                    .map(|(t, _)| (t.point.x_cm.to_bits(), t.point.y_cm.to_bits())),
+            };
+            match (dwelling, s.target, spot) {
+                (true, Some((target, _)), Some(spot_cm)) => {
+                    // The dwell record keeps the last spot seen during the dwell
+                    // (the servos settle onto their quantised target).
+                    match open_dwell {
+                        Some((open_key, i)) if open_key == key => {
+                            if let Some(record) = rec.dwells.get_mut(i) {
+                                record.spot_cm = spot_cm;
+                                record.laser &= laser;
+                            }
+                        }
+                        _ => {
+                            rec.dwells.push(DwellRecord {
+                                t_us,
+                                target_cm: (target.point.x_cm, target.point.y_cm),
+                                grid: target.grid,
+                                spot_cm,
+                                laser,
+                            });
+                            open_dwell = Some((key, rec.dwells.len() - 1));
+                        }
+                    }
+                }
+                _ => open_dwell = None,
+            }
+        }
+        Timer::after_micros(period_us).await;
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct DwellKey {
+    index: Option<usize>,
+    pass: u32,
+    target: Option<(u64, u64)>,
+}

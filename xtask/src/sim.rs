@@ -1,0 +1,209 @@
+//! `cargo xtask sim`: run the firmware's tasks on the host against simulated
+//! servos, in virtual time, and draw where the laser went.
+
+use std::io::Read as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use laser_sim::script::{DEMO_SCRIPT, parse_script};
+use laser_sim::servo_port::BusFaults;
+use laser_sim::world::{SimOptions, run};
+
+/// Options of `cargo xtask sim`.
+#[derive(clap::Args, Debug)]
+pub struct SimArgs {
+    /// Script of command lines (`wait <ms>` pauses; `#` comments); `-`
+    /// reads it from stdin. Without it, piped stdin is the script, and a
+    /// terminal or empty stdin runs the demo (writing sim.svg).
+    #[arg(long)]
+    script: Option<PathBuf>,
+    /// Write the drawing (board, grid, laser path, dwell points) as SVG.
+    #[arg(long)]
+    svg: Option<PathBuf>,
+    /// Write every servo-bus frame: `t_ms tx|rx hex-bytes`.
+    #[arg(long)]
+    frames: Option<PathBuf>,
+    /// Write the spot trace as CSV `t_ms,x_cm,y_cm,laser`.
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    /// Inject a fault: `servo-silent:<id>@<t_ms>`, `servo-corrupt:<probability>`,
+    /// `servo-slow:<factor>` (repeatable).
+    #[arg(long = "fault")]
+    faults: Vec<String>,
+    /// Run until the script has ended and the sequencer is idle; exit 1 if
+    /// any command got `error:` (unless --allow-errors).
+    #[arg(long)]
+    until_idle: bool,
+    /// With --until-idle: `error:` replies do not fail the run.
+    #[arg(long)]
+    allow_errors: bool,
+    /// Pace with the wall clock (interactive use) instead of virtual time.
+    #[arg(long)]
+    realtime: bool,
+    /// Stop after this much simulated time, s.
+    #[arg(long, default_value_t = 600.0)]
+    max_time_s: f64,
+    /// Log level of the firmware logs on stderr (error, warn, info, debug, trace, off).
+    #[arg(long, default_value = "info")]
+    log: String,
+}
+
+/// Parses the `--fault` specs.
+pub fn parse_faults(specs: &[String]) -> Result<(BusFaults, f64)> {
+    let mut faults = BusFaults::default();
+    let mut slow = 1.0;
+    for spec in specs {
+        let (kind, value) = spec
+            .split_once(':')
+            .with_context(|| format!("fault {spec:?}: expected <kind>:<value>"))?;
+        match kind {
+            "servo-silent" => {
+                let (id, t) = value.split_once('@').with_context(|| {
+                    format!("fault {spec:?}: expected servo-silent:<id>@<t_ms>")
+                })?;
+                let id: u8 = id
+                    .parse()
+                    .with_context(|| format!("fault {spec:?}: bad servo id"))?;
+                let t_ms: u64 = t
+                    .parse()
+                    .with_context(|| format!("fault {spec:?}: bad time"))?;
+                faults.silent.push((id, t_ms));
+            }
+            "servo-corrupt" => {
+                let p: f64 = value
+                    .parse()
+                    .with_context(|| format!("fault {spec:?}: bad probability"))?;
+                if !(0.0..=1.0).contains(&p) {
+                    bail!("fault {spec:?}: probability must be in [0, 1]");
+                }
+                faults.corrupt_probability = p;
+            }
+            "servo-slow" => {
+                let f: f64 = value
+                    .parse()
+                    .with_context(|| format!("fault {spec:?}: bad factor"))?;
+                if !(1.0..=100.0).contains(&f) {
+                    bail!("fault {spec:?}: factor must be in [1, 100]");
+                }
+                slow = f;
+            }
+            other => {
+                bail!("unknown fault kind {other:?} (servo-silent, servo-corrupt, servo-slow)")
+            }
+        }
+    }
+    Ok((faults, slow))
+}
+
+fn read_stdin() -> Result<String> {
+    let mut text = String::new();
+    std::io::stdin()
+        .read_to_string(&mut text)
+        .context("cannot read the script from stdin")?;
+    Ok(text)
+}
+
+/// Runs `cargo xtask sim`.
+pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
+    let level: log::LevelFilter = args.log.parse().map_err(|_| {
+        anyhow::anyhow!(
+            "bad --log level {:?} (off, error, warn, info, debug, trace)",
+            args.log
+        )
+    })?;
+    laser_sim::logger::init(level);
+    let script_text = match &args.script {
+        Some(path) if path.as_os_str() == "-" => read_stdin()?,
+        Some(path) => std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read script {}", path.display()))?,
+        // Piped lines are the script; a terminal or empty input runs the demo.
+        None if std::io::IsTerminal::is_terminal(&std::io::stdin()) => String::new(),
+        None => read_stdin()?,
+    };
+    let demo = args.script.is_none() && script_text.trim().is_empty();
+    let script_text = if demo {
+        DEMO_SCRIPT.to_owned()
+    } else {
+        script_text
+    };
+    let script = parse_script(&script_text)?;
+    let (faults, slow_factor) = parse_faults(&args.faults)?;
+    let svg = args
+        .svg
+        .clone()
+        .or_else(|| demo.then(|| PathBuf::from("sim.svg")));
+    let until_idle = args.until_idle || demo;
+    if !(args.max_time_s.is_finite() && args.max_time_s > 0.0) {
+        bail!("--max-time-s must be positive");
+    }
+    if demo {
+        eprintln!("xtask sim: no script given, running the demo:\n{DEMO_SCRIPT}");
+    }
+    let report = run(SimOptions {
+        script,
+        realtime: args.realtime,
+        until_idle,
+        faults,
+        slow_factor,
+        max_time_ms: (args.max_time_s * 1000.0) as u64,
+        echo: true,
+        ..SimOptions::default()
+    });
+    if let Some(path) = &svg {
+        let drawing = laser_sim::render(&report, "laser pointing controller — simulation")?;
+        std::fs::write(path, drawing)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!("xtask sim: drawing written to {}", path.display());
+    }
+    if let Some(path) = &args.frames {
+        std::fs::write(path, report.recording.frames_text())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(path) = &args.trace {
+        std::fs::write(path, report.recording.trace_csv())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    eprintln!(
+        "xtask sim: ended at t = {:.3} s ({:?}); {} dwell points, {} servo frames, {} error replies",
+        report.end_time_us as f64 / 1e6,
+        report.end,
+        report.recording.dwells.len(),
+        report.recording.frames.len(),
+        report.transcript.error_replies
+    );
+    if until_idle && !report.succeeded(args.allow_errors) {
+        if !report.idle_at_end {
+            eprintln!("xtask sim: the sequencer was still busy when the run ended");
+        }
+        return Ok(ExitCode::FAILURE);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fault_specs_parse_and_reject_nonsense() {
+        let specs = [
+            "servo-silent:1@2500".to_owned(),
+            "servo-corrupt:0.05".to_owned(),
+            "servo-slow:3".to_owned(),
+        ];
+        let (faults, slow) = parse_faults(&specs).unwrap();
+        assert_eq!(faults.silent, vec![(1, 2500)]);
+        assert_eq!(faults.corrupt_probability, 0.05);
+        assert_eq!(slow, 3.0);
+        for bad in [
+            "servo-silent:1",
+            "servo-corrupt:2",
+            "servo-slow:0.5",
+            "gremlins:1",
+            "x",
+        ] {
+            assert!(parse_faults(&[bad.to_owned()]).is_err(), "{bad}");
+        }
+    }
+}
