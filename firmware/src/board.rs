@@ -11,15 +11,40 @@
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
 
-use embassy_stm32::Config;
+use embassy_stm32::exti::ExtiInput;
+use embassy_stm32::flash::Flash;
+use embassy_stm32::gpio::{Level, Output, Pull, Speed};
+use embassy_stm32::mode::Async;
+use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::time::Hertz;
+use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
+use embassy_stm32::{Peri, bind_interrupts, dma, exti, peripherals, usb};
+use embassy_usb::UsbDevice;
+use embassy_usb::class::cdc_acm::{BufferedReceiver, CdcAcmClass, Sender, State};
+use static_cell::StaticCell;
+
+use crate::settings_flash::FlashSettings;
+use crate::tasks::{LaserPin, UsbDriver};
+
+bind_interrupts!(struct Irqs {
+    OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
+    USART2 => usart::InterruptHandler<peripherals::USART2>;
+    DMA1_STREAM5 => dma::InterruptHandler<peripherals::DMA1_CH5>;
+    DMA1_STREAM6 => dma::InterruptHandler<peripherals::DMA1_CH6>;
+    EXTI0 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI0>;
+});
+
+/// USB full-speed bulk packet size, bytes.
+const USB_PACKET_BYTES: u16 = 64;
+/// Servo bus baud rate (FashionStar default).
+const SERVO_BAUD: u32 = 115_200;
 
 /// System clock, Hz (from the 8 MHz HSE crystal through the PLL).
 pub const SYSCLK_HZ: u32 = 168_000_000;
 
 /// Clock tree: 8 MHz HSE → PLL → 168 MHz SYSCLK, 48 MHz for USB,
 /// APB1 42 MHz (timers 84 MHz), APB2 84 MHz (timers 168 MHz).
-pub fn clock_config() -> Config {
+pub fn clock_config() -> embassy_stm32::Config {
     use embassy_stm32::rcc::*;
     let mut config = embassy_stm32::Config::default();
     config.rcc.hse = Some(Hse {
@@ -40,4 +65,125 @@ pub fn clock_config() -> Config {
     config.rcc.sys = Sysclk::PLL1_P;
     config.rcc.mux.clk48sel = mux::Clk48sel::PLL1_Q;
     config
+}
+
+/// Everything the tasks need, configured.
+pub struct Board {
+    /// Laser enable (PB0), low.
+    pub laser: LaserPin,
+    /// USB device stack.
+    pub usb_device: UsbDevice<'static, UsbDriver>,
+    /// CDC-ACM transmit half.
+    pub usb_tx: Sender<'static, UsbDriver>,
+    /// CDC-ACM receive half (buffered).
+    pub usb_rx: BufferedReceiver<'static, UsbDriver>,
+    /// Servo UART transmit (DMA).
+    pub servo_tx: UartTx<'static, Async>,
+    /// Servo UART receive (DMA ring buffer).
+    pub servo_rx: RingBufferedUartRx<'static>,
+    /// Heartbeat LED (PD12).
+    pub heartbeat_led: Output<'static>,
+    /// Laser LED (PD13).
+    pub laser_led: Output<'static>,
+    /// Fault LED (PD14).
+    pub fault_led: Output<'static>,
+    /// User button (PA0).
+    pub button: ExtiInput<'static, Async>,
+    /// Settings flash sector.
+    pub settings: FlashSettings,
+    /// Independent watchdog.
+    pub iwdg: Peri<'static, IWDG>,
+}
+
+/// Brings the board up: laser off first, then clocks and peripherals.
+pub fn init() -> Board {
+    let p = embassy_stm32::init(clock_config());
+    // Laser off before anything else can run.
+    let laser = LaserPin(Output::new(p.PB0, Level::Low, Speed::Low));
+    defmt::info!(
+        "{} {} (git {}) booting at {} MHz",
+        laser_app::build_info::PRODUCT,
+        laser_app::build_info::VERSION,
+        laser_app::build_info::GIT_REV,
+        SYSCLK_HZ / 1_000_000
+    );
+
+    // USB CDC-ACM on OTG FS (PA12 DP, PA11 DM).
+    static EP_OUT_BUFFER: StaticCell<[u8; 256]> = StaticCell::new();
+    let mut usb_config = usb::Config::default();
+    // VBUS sensing (PA9) is not needed: the board is powered from USB.
+    usb_config.vbus_detection = false;
+    let driver = usb::Driver::new_fs(
+        p.USB_OTG_FS,
+        Irqs,
+        p.PA12,
+        p.PA11,
+        EP_OUT_BUFFER.init([0; 256]),
+        usb_config,
+    );
+    let mut device_config = embassy_usb::Config::new(0xc0de, 0xcafe);
+    device_config.manufacturer = Some("laser-pointer");
+    device_config.product = Some("Laser pointing controller");
+    device_config.serial_number = Some(laser_app::build_info::VERSION);
+    device_config.max_power = 100;
+    device_config.max_packet_size_0 = 64;
+
+    static CONFIG_DESCRIPTOR: StaticCell<[u8; 256]> = StaticCell::new();
+    static BOS_DESCRIPTOR: StaticCell<[u8; 256]> = StaticCell::new();
+    static CONTROL_BUF: StaticCell<[u8; 64]> = StaticCell::new();
+    static CDC_STATE: StaticCell<State> = StaticCell::new();
+    static USB_RX_BUFFER: StaticCell<[u8; USB_PACKET_BYTES as usize]> = StaticCell::new();
+    let mut builder = embassy_usb::Builder::new(
+        driver,
+        device_config,
+        CONFIG_DESCRIPTOR.init([0; 256]),
+        BOS_DESCRIPTOR.init([0; 256]),
+        &mut [],
+        CONTROL_BUF.init([0; 64]),
+    );
+    let class = CdcAcmClass::new(&mut builder, CDC_STATE.init(State::new()), USB_PACKET_BYTES);
+    let device = builder.build();
+    let (usb_tx, usb_rx) = class.split();
+    let usb_rx = usb_rx.into_buffered(USB_RX_BUFFER.init([0; USB_PACKET_BYTES as usize]));
+
+    // Servo bus: USART2 (PA2 TX, PA3 RX), DMA1 stream 6 (TX) / 5 (RX).
+    let mut uart_config = usart::Config::default();
+    uart_config.baudrate = SERVO_BAUD;
+    static SERVO_RX_DMA: StaticCell<[u8; 256]> = StaticCell::new();
+    let (servo_tx, servo_rx) = match Uart::new(
+        p.USART2,
+        p.PA3,
+        p.PA2,
+        p.DMA1_CH6,
+        p.DMA1_CH5,
+        Irqs,
+        uart_config,
+    ) {
+        Ok(uart) => {
+            let (tx, rx) = uart.split();
+            (tx, rx.into_ring_buffered(SERVO_RX_DMA.init([0; 256])))
+        }
+        Err(_) => defmt::panic!("USART2 configuration rejected"),
+    };
+
+    let heartbeat_led = Output::new(p.PD12, Level::Low, Speed::Low);
+    let laser_led = Output::new(p.PD13, Level::Low, Speed::Low);
+    let fault_led = Output::new(p.PD14, Level::Low, Speed::Low);
+    let button = ExtiInput::new(p.PA0, p.EXTI0, Pull::Down, Irqs);
+    let settings = FlashSettings::new(Flash::new_blocking(p.FLASH));
+
+    Board {
+        laser,
+        usb_device: device,
+        usb_tx,
+        usb_rx,
+        servo_tx,
+        servo_rx,
+        heartbeat_led,
+        laser_led,
+        fault_led,
+        button,
+        settings,
+        iwdg: p.IWDG,
+    }
 }

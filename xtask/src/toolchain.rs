@@ -214,12 +214,8 @@ fn llvm_size_path() -> Result<PathBuf> {
 /// `cargo xtask size`: builds the release image, prints text/data/bss and
 /// fails when it exceeds the flash or RAM budget.
 pub fn size() -> Result<()> {
-    let elf = workspace_root()
-        .join("target")
-        .join(TARGET)
-        .join("release")
-        .join("firmware");
-    let elf = if elf.exists() { elf } else { build_firmware()? };
+    // Always (re)build: a stale ELF would report an old size.
+    let elf = build_firmware()?;
     let llvm_size = llvm_size_path()?;
     let out = Command::new(&llvm_size)
         .arg(&elf)

@@ -55,10 +55,13 @@ pub fn parse_number(
     min: f64,
     max: f64,
 ) -> Result<f64, CommandError> {
-    let value: f64 = text.parse().map_err(|_| CommandError::InvalidArgument {
-        expected: what,
-        got: word(text),
-    })?;
+    let value: f64 =
+        lexical_parse_float::FromLexical::from_lexical(text.as_bytes()).map_err(|_| {
+            CommandError::InvalidArgument {
+                expected: what,
+                got: word(text),
+            }
+        })?;
     if !value.is_finite() {
         return Err(CommandError::InvalidArgument {
             expected: what,
@@ -143,6 +146,42 @@ mod tests {
             Args::new("goto").skip_command().number("x_cm", -1.0, 1.0),
             Err(CommandError::MissingArgument("x_cm"))
         );
+    }
+
+    #[test]
+    fn usual_number_spellings_are_accepted() {
+        for (text, value) in [
+            ("+5", 5.0),
+            (".5", 0.5),
+            ("5.", 5.0),
+            ("-0", 0.0),
+            ("1e-3", 1e-3),
+            ("2E1", 20.0),
+        ] {
+            assert_eq!(parse_number(text, "v", -100.0, 100.0), Ok(value), "{text}");
+        }
+        for bad in ["", "-", "e3", "1e", "0x10", "1..2", "5 ", "１"] {
+            assert!(parse_number(bad, "v", -100.0, 100.0).is_err(), "{bad:?}");
+        }
+    }
+
+    proptest::proptest! {
+        /// Decimal text of any finite f64 (shortest round-trip form, as
+        /// `cargo xtask calib fit --output` prints coefficients, and the
+        /// exponent form) parses back to exactly the same value.
+        #[test]
+        fn decimal_text_round_trips_exactly(bits in proptest::prelude::any::<u64>()) {
+            extern crate std;
+            let value = f64::from_bits(bits);
+            proptest::prop_assume!(value.is_finite());
+            for text in [std::format!("{value}"), std::format!("{value:e}")] {
+                proptest::prop_assert_eq!(
+                    parse_number(&text, "v", f64::MIN, f64::MAX).map(f64::to_bits),
+                    Ok(value.to_bits()),
+                    "{}", text
+                );
+            }
+        }
     }
 
     impl<'a> Args<'a> {

@@ -220,7 +220,7 @@ impl<R: Read, W: Write> ServoBus<R, W> {
         let mut next_health_check = Instant::now() + health_period;
         // Request number of the last move (faults found by the health check
         // belong to it).
-        let mut last_seq = 0;
+        let mut last_move: Option<u32> = None;
         loop {
             link.alive.fetch_add(1, Ordering::Relaxed);
             let wake = next_health_check.min(Instant::now() + IDLE_TICK);
@@ -228,9 +228,14 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                 Ok(request) => request,
                 Err(_) => {
                     let now = Instant::now();
-                    if now >= next_health_check {
+                    // Only after a move: ids and deadband come with moves
+                    // (from the settings), so before the first one this
+                    // task does not know which servos to expect.
+                    if let Some(seq) = last_move
+                        && now >= next_health_check
+                    {
                         next_health_check = now + health_period;
-                        self.health_check(link, last_seq).await;
+                        self.health_check(link, seq).await;
                     }
                     if self.faulty.iter().any(|f| *f) && now >= next_recovery_ping {
                         next_recovery_ping = now + RECOVERY_PING_PERIOD;
@@ -239,7 +244,9 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                     continue;
                 }
             };
-            last_seq = request.seq();
+            if let ServoRequest::Move { seq, .. } = request {
+                last_move = Some(seq);
+            }
             next_health_check = Instant::now() + health_period;
             let outcome = self.serve(request, link).await;
             match outcome {

@@ -1,0 +1,17 @@
+//! Panic handler: laser off first (straight through the GPIO registers, as
+//! nothing else can be trusted in a panic), then log and halt. The watchdog
+//! then resets the MCU; the laser stays off through reset.
+
+use core::panic::PanicInfo;
+
+use embassy_stm32::pac;
+
+/// Bit of the laser-enable pin in GPIOB (PB0; see `board`).
+const LASER_PIN_BIT: usize = 0;
+
+#[panic_handler]
+fn panic(info: &PanicInfo<'_>) -> ! {
+    pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
+    defmt::error!("panic: {}", defmt::Display2Format(info));
+    cortex_m::asm::udf()
+}
