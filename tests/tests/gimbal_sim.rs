@@ -2,7 +2,7 @@
 //! console, sequencer and servo task against simulated FashionStar servos.
 
 use laser_sim::recorder::Direction;
-use laser_sim::servo_port::BusFaults;
+use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::SimOptions;
 use system_tests::{run_to_idle, run_with, sent_at, spec_patterns};
 
@@ -127,7 +127,11 @@ fn stop_turns_the_laser_off_at_once() {
 fn a_silent_servo_is_a_fault_with_the_laser_off_within_the_timeout() {
     let options = SimOptions {
         faults: BusFaults {
-            silent: vec![(1, 1500)],
+            silent: vec![SilentWindow {
+                id: 1,
+                from_ms: 1500,
+                until_ms: None,
+            }],
             ..BusFaults::default()
         },
         ..SimOptions::default()
@@ -389,4 +393,49 @@ fn goto_holds_the_point_with_the_seed_model_off_by_its_known_error() {
         "seed model off by {:.2} mm",
         end(&seed)
     );
+}
+
+#[test]
+fn a_servo_that_answers_again_is_reported_recovered_and_patterns_run_again() {
+    let options = SimOptions {
+        faults: BusFaults {
+            silent: vec![SilentWindow {
+                id: 0,
+                from_ms: 1500,
+                until_ms: Some(2500),
+            }],
+            ..BusFaults::default()
+        },
+        ..SimOptions::default()
+    };
+    let report = run_with(
+        "pattern corner\nwait 3500\nset dwell_ms 50\npattern corner once\n",
+        options,
+    );
+    let notice_at = |prefix: &str| {
+        report
+            .transcript
+            .notices
+            .iter()
+            .find(|(_, n)| n.starts_with(prefix))
+            .map(|(t, _)| *t)
+            .unwrap_or_else(|| panic!("no {prefix} notice in {:?}", report.transcript.notices))
+    };
+    let fault = notice_at("[error: servo 0");
+    let recovered = notice_at("[info: servo 0 answering again");
+    assert!(fault < 1_700_000, "fault at {fault} µs");
+    // Faulty servos are pinged every 500 ms.
+    assert!(
+        (2_500_000..3_100_000).contains(&recovered),
+        "recovered at {recovered} µs"
+    );
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let after: Vec<_> = report
+        .recording
+        .dwells
+        .iter()
+        .filter(|d| d.t_us > recovered)
+        .filter_map(|d| d.grid)
+        .collect();
+    assert_eq!(after, vec![(-6, 4), (6, 4), (6, -4), (-6, -4)]);
 }

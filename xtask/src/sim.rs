@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use laser_sim::script::{DEMO_SCRIPT, parse_script};
-use laser_sim::servo_port::BusFaults;
+use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, run};
 
 /// Options of `cargo xtask sim`.
@@ -27,7 +27,7 @@ pub struct SimArgs {
     /// Write the spot trace as CSV `t_ms,x_cm,y_cm,laser`.
     #[arg(long)]
     trace: Option<PathBuf>,
-    /// Inject a fault: `servo-silent:<id>@<t_ms>`, `servo-corrupt:<probability>`,
+    /// Inject a fault: `servo-silent:<id>@<t_ms>[-<end_ms>]`, `servo-corrupt:<probability>`,
     /// `servo-slow:<factor>` (repeatable).
     #[arg(long = "fault")]
     faults: Vec<String>,
@@ -59,16 +59,31 @@ pub fn parse_faults(specs: &[String]) -> Result<(BusFaults, f64)> {
             .with_context(|| format!("fault {spec:?}: expected <kind>:<value>"))?;
         match kind {
             "servo-silent" => {
-                let (id, t) = value.split_once('@').with_context(|| {
-                    format!("fault {spec:?}: expected servo-silent:<id>@<t_ms>")
+                let (id, times) = value.split_once('@').with_context(|| {
+                    format!("fault {spec:?}: expected servo-silent:<id>@<t_ms>[-<end_ms>]")
                 })?;
                 let id: u8 = id
                     .parse()
                     .with_context(|| format!("fault {spec:?}: bad servo id"))?;
-                let t_ms: u64 = t
+                let (from, until) = match times.split_once('-') {
+                    Some((from, until)) => (from, Some(until)),
+                    None => (times, None),
+                };
+                let from_ms: u64 = from
                     .parse()
-                    .with_context(|| format!("fault {spec:?}: bad time"))?;
-                faults.silent.push((id, t_ms));
+                    .with_context(|| format!("fault {spec:?}: bad start time"))?;
+                let until_ms = until
+                    .map(|t| t.parse::<u64>())
+                    .transpose()
+                    .with_context(|| format!("fault {spec:?}: bad end time"))?;
+                if until_ms.is_some_and(|end| end <= from_ms) {
+                    bail!("fault {spec:?}: the silence must end after it starts");
+                }
+                faults.silent.push(SilentWindow {
+                    id,
+                    from_ms,
+                    until_ms,
+                });
             }
             "servo-corrupt" => {
                 let p: f64 = value
@@ -189,15 +204,32 @@ mod tests {
     fn fault_specs_parse_and_reject_nonsense() {
         let specs = [
             "servo-silent:1@2500".to_owned(),
+            "servo-silent:0@100-400".to_owned(),
             "servo-corrupt:0.05".to_owned(),
             "servo-slow:3".to_owned(),
         ];
         let (faults, slow) = parse_faults(&specs).unwrap();
-        assert_eq!(faults.silent, vec![(1, 2500)]);
+        assert_eq!(
+            faults.silent,
+            vec![
+                SilentWindow {
+                    id: 1,
+                    from_ms: 2500,
+                    until_ms: None
+                },
+                SilentWindow {
+                    id: 0,
+                    from_ms: 100,
+                    until_ms: Some(400)
+                }
+            ]
+        );
         assert_eq!(faults.corrupt_probability, 0.05);
         assert_eq!(slow, 3.0);
         for bad in [
             "servo-silent:1",
+            "servo-silent:1@500-400",
+            "servo-silent:1@5-x",
             "servo-corrupt:2",
             "servo-slow:0.5",
             "gremlins:1",

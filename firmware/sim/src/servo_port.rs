@@ -22,10 +22,29 @@ pub const BYTE_TIME_US: u64 = 87;
 /// Injected servo-bus faults.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct BusFaults {
-    /// Servo `id` stops answering at `t_ms`.
-    pub silent: Vec<(u8, u64)>,
+    /// Servos that stop answering for a while.
+    pub silent: Vec<SilentWindow>,
     /// Probability that a response byte is corrupted (one bit flipped).
     pub corrupt_probability: f64,
+}
+
+/// Servo `id` does not answer from `from_ms` until `until_ms` (for good
+/// when `None`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SilentWindow {
+    /// Bus id.
+    pub id: u8,
+    /// Start of the silence, simulated ms.
+    pub from_ms: u64,
+    /// End of the silence, simulated ms.
+    pub until_ms: Option<u64>,
+}
+
+impl SilentWindow {
+    /// Whether the servo is silent at `t_us`.
+    pub fn covers(&self, t_us: u64) -> bool {
+        t_us >= self.from_ms * 1000 && self.until_ms.is_none_or(|end| t_us < end * 1000)
+    }
 }
 
 /// The bus seen from the firmware: write requests, read responses.
@@ -67,10 +86,13 @@ impl SimServoPort {
 
     fn apply_silence(&self, now_us: u64) {
         let mut bus = self.bus.borrow_mut();
-        for &(id, t_ms) in &self.faults.silent {
-            if now_us >= t_ms * 1000 {
-                bus.set_silent(id, true);
-            }
+        for window in &self.faults.silent {
+            let silent = self
+                .faults
+                .silent
+                .iter()
+                .any(|w| w.id == window.id && w.covers(now_us));
+            bus.set_silent(window.id, silent);
         }
     }
 

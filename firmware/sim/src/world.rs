@@ -41,6 +41,9 @@ pub struct SimOptions {
     pub sample_period_us: u64,
     /// Saved settings record to boot with (as if read from flash).
     pub saved_settings: Option<Vec<u8>>,
+    /// The true gimbal: bus ids, geometry, servo mounting and board pose
+    /// (set a pose or zero error to model a real, imperfect build).
+    pub physical: PhysicalGimbal,
 }
 
 impl Default for SimOptions {
@@ -55,6 +58,7 @@ impl Default for SimOptions {
             echo: false,
             sample_period_us: 2_000,
             saved_settings: None,
+            physical: PhysicalGimbal::default(),
         }
     }
 }
@@ -135,7 +139,7 @@ pub fn run(options: SimOptions) -> SimReport {
     let host = Rc::new(UsbHost::new(options.echo));
     let recording = Rc::new(RefCell::new(Recording::default()));
     let flash = Rc::new(RefCell::new(options.saved_settings.clone()));
-    let gimbal = PhysicalGimbal::default();
+    let gimbal = options.physical;
     let bus = Rc::new(RefCell::new(SimServoBus::new(
         &[gimbal.yaw_id, gimbal.pitch_id],
         options.slow_factor,
