@@ -298,8 +298,15 @@ fn a_circle_is_drawn_on_its_path_and_closes() {
 
 #[test]
 fn saved_settings_survive_a_reboot_and_a_corrupt_record_falls_back_to_defaults() {
-    let first = run_to_idle("set dwell_ms 123\nset oq_cm 30\nsave\n");
-    assert!(first.succeeded(false));
+    let first = run_with(
+        "pattern corner\nsave\nstop\nset dwell_ms 123\nset oq_cm 30\nsave\n",
+        SimOptions::default(),
+    );
+    assert_eq!(
+        first.transcript.error_replies, 1,
+        "save is refused while a pattern runs: {:?}",
+        first.transcript.lines
+    );
     let record = first.saved_settings.expect("save wrote a record");
     let rebooted = run_with(
         "get dwell_ms\nget oq_cm\n",

@@ -95,6 +95,12 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 }
                 link.ok().await;
             }
+            // Erasing the flash sector stalls the CPU for about a second on
+            // the target: not while the laser draws.
+            Command::Save if self.run.is_some() => {
+                link.error("stop the running pattern or goto before save")
+                    .await;
+            }
             Command::Save => {
                 let record = self.settings.to_record();
                 match self.store.save(&record).await {
