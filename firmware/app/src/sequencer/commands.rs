@@ -224,7 +224,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
         }
         if let Some((yaw, pitch)) = self.measured {
             link.data(format_args!(
-                "measured: yaw {:.1} deg pitch {:.1} deg",
+                "measured at arrival: yaw {:.1} deg pitch {:.1} deg",
                 f64::from(yaw) / 10.0,
                 f64::from(pitch) / 10.0
             ))
