@@ -446,3 +446,38 @@ fn a_servo_that_answers_again_is_reported_recovered_and_patterns_run_again() {
         .collect();
     assert_eq!(after, vec![(-6, 4), (6, 4), (6, -4), (-6, -4)]);
 }
+
+#[test]
+fn laser_stays_off_while_idle_and_in_dwell_mode_lights_only_the_points() {
+    let report =
+        run_to_idle("laser on\nwait 300\nlaser dwell\nset dwell_ms 100\npattern corner once\n");
+    assert!(report.succeeded(false));
+    let started = sent_at(&report, "pattern corner once");
+    assert!(
+        report
+            .recording
+            .laser_events
+            .iter()
+            .all(|&(t, on)| !on || t >= started),
+        "never on before a pattern runs: {:?}",
+        report.recording.laser_events
+    );
+    let corners: Vec<(f64, f64)> = spec_patterns::corner()
+        .into_iter()
+        .map(|(xi, yi)| (f64::from(xi) * PITCH_CM, f64::from(yi) * PITCH_CM))
+        .collect();
+    let lit: Vec<_> = report.recording.spot.iter().filter(|s| s.laser).collect();
+    assert!(!lit.is_empty(), "the laser lit the points");
+    for s in lit {
+        let nearest = corners
+            .iter()
+            .map(|c| ((s.x_cm - c.0).powi(2) + (s.y_cm - c.1).powi(2)).sqrt())
+            .fold(f64::INFINITY, f64::min);
+        // Within the 0.5° arrival deadband of a corner (~3 mm at 30 cm).
+        assert!(
+            nearest < 0.35,
+            "lit {:.2} cm from the nearest corner",
+            nearest
+        );
+    }
+}

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
+use laser_sim::executor::RunEnd;
 use laser_sim::script::{DEMO_SCRIPT, parse_script};
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, run};
@@ -187,6 +188,12 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         report.recording.frames.len(),
         report.transcript.error_replies
     );
+    if report.end == RunEnd::Livelock {
+        eprintln!(
+            "xtask sim: a task kept running without letting time pass (busy loop); run stopped"
+        );
+        return Ok(ExitCode::FAILURE);
+    }
     if until_idle && !report.succeeded(args.allow_errors) {
         if !report.idle_at_end {
             eprintln!("xtask sim: the sequencer was still busy when the run ended");

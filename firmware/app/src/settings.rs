@@ -34,8 +34,6 @@ pub enum LaserMode {
     Auto,
     /// On only while dwelling on a point.
     Dwell,
-    /// Forced on (while not faulted).
-    On,
     /// Forced off.
     Off,
 }
@@ -46,28 +44,21 @@ impl LaserMode {
         match self {
             LaserMode::Auto => "auto",
             LaserMode::Dwell => "dwell",
-            LaserMode::On => "on",
             LaserMode::Off => "off",
         }
     }
 
     fn from_code(code: f64) -> Option<Self> {
-        [
-            LaserMode::Auto,
-            LaserMode::Dwell,
-            LaserMode::On,
-            LaserMode::Off,
-        ]
-        .into_iter()
-        .find(|m| m.code() == code)
+        [LaserMode::Auto, LaserMode::Dwell, LaserMode::Off]
+            .into_iter()
+            .find(|m| m.code() == code)
     }
 
     fn code(self) -> f64 {
         match self {
             LaserMode::Auto => 0.0,
             LaserMode::Dwell => 1.0,
-            LaserMode::On => 2.0,
-            LaserMode::Off => 3.0,
+            LaserMode::Off => 2.0,
         }
     }
 }
@@ -344,8 +335,8 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "laser.mode",
         min: 0.0,
-        max: 3.0,
-        help: "0 auto, 1 dwell, 2 on, 3 off",
+        max: 2.0,
+        help: "0 auto, 1 dwell, 2 off",
         slot: Slot::Laser,
     },
     err_coef!("err.dx.c0", err_dx, 0),
@@ -446,7 +437,7 @@ fn check_value(param: &ParamSpec, value: f64) -> Result<(), CommandError> {
             Err(CommandError::Rejected("direction must be 1 or -1"))
         }
         Slot::Laser if LaserMode::from_code(value).is_none() => {
-            Err(CommandError::Rejected("laser.mode must be 0, 1, 2 or 3"))
+            Err(CommandError::Rejected("laser.mode must be 0, 1 or 2"))
         }
         _ => Ok(()),
     }

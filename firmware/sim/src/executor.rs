@@ -39,7 +39,13 @@ pub enum RunEnd {
     TimeLimit,
     /// Every task waits and no timer is pending: nothing can happen again.
     Quiescent,
+    /// Tasks kept waking each other without letting time pass (a busy
+    /// loop in a task body: on the target it would starve the CPU).
+    Livelock,
 }
+
+/// Polls at one instant after which a run counts as livelocked.
+pub const MAX_POLLS_PER_INSTANT: u32 = 1_000_000;
 
 /// Runs tasks spawned by `init` until `stop()` is true (checked whenever
 /// the tasks are idle), time passes `limit_us`, or nothing can happen.
@@ -56,8 +62,13 @@ pub fn run(
     )));
     init(executor.spawner());
     loop {
+        let mut polls = 0u32;
         loop {
             while pending.swap(false, Ordering::SeqCst) {
+                polls += 1;
+                if polls > MAX_POLLS_PER_INSTANT {
+                    return RunEnd::Livelock;
+                }
                 // SAFETY: poll is only ever called from this loop, never
                 // re-entrantly (the pender only sets a flag).
                 unsafe { executor.poll() };
@@ -110,6 +121,24 @@ mod tests {
         assert_eq!(end, RunEnd::Quiescent);
         assert_eq!(*log.borrow(), vec![(1_500_000, "b"), (10_000_000, "a")]);
         assert!(wall.elapsed() < std::time::Duration::from_secs(2));
+    }
+
+    #[test]
+    fn a_busy_loop_is_reported_not_run_forever() {
+        let end = run(
+            false,
+            2_000_000,
+            |spawner| {
+                spawn(&spawner, async {
+                    loop {
+                        embassy_futures::yield_now().await;
+                    }
+                });
+            },
+            || false,
+        );
+        assert_eq!(end, RunEnd::Livelock);
+        assert_eq!(clock::now_us(), 0);
     }
 
     #[test]

@@ -84,7 +84,8 @@ impl SimReport {
     /// Whether `--until-idle` should exit 0: script done, idle, and no
     /// `error:` reply unless errors are allowed.
     pub fn succeeded(&self, allow_errors: bool) -> bool {
-        self.transcript.script_done
+        self.end != RunEnd::Livelock
+            && self.transcript.script_done
             && self.idle_at_end
             && (allow_errors || self.transcript.error_replies == 0)
     }

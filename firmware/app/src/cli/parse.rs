@@ -44,19 +44,21 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
         Command::Grid { xi, yi }
     } else if is("laser") {
         let mode = args.word("on|off|auto|dwell")?;
+        // `on` enables the laser for runs: SPEC §9 keeps it off whenever no
+        // pattern or goto is active, so `on` is `auto`.
+        let mode = if mode.eq_ignore_ascii_case("on") {
+            "auto"
+        } else {
+            mode
+        };
         Command::Laser(
-            [
-                LaserMode::On,
-                LaserMode::Off,
-                LaserMode::Auto,
-                LaserMode::Dwell,
-            ]
-            .into_iter()
-            .find(|m| m.name().eq_ignore_ascii_case(mode))
-            .ok_or(CommandError::InvalidArgument {
-                expected: "on|off|auto|dwell",
-                got: word(mode),
-            })?,
+            [LaserMode::Off, LaserMode::Auto, LaserMode::Dwell]
+                .into_iter()
+                .find(|m| m.name().eq_ignore_ascii_case(mode))
+                .ok_or(CommandError::InvalidArgument {
+                    expected: "on|off|auto|dwell",
+                    got: word(mode),
+                })?,
         )
     } else if is("model") {
         let model = args.word("exact|seed")?;
@@ -325,6 +327,8 @@ mod tests {
         assert_eq!(ok("grid -6 4"), Command::Grid { xi: -6, yi: 4 });
         assert!(parse_line("grid 0.5 1").is_err());
         assert_eq!(ok("laser DWELL"), Command::Laser(LaserMode::Dwell));
+        assert_eq!(ok("laser on"), Command::Laser(LaserMode::Auto));
+        assert_eq!(ok("laser off"), Command::Laser(LaserMode::Off));
         assert!(parse_line("laser maybe").is_err());
         assert_eq!(ok("model seed"), Command::Model(AimModel::Seed));
         assert!(parse_line("model exactish").is_err());

@@ -18,7 +18,6 @@ pub fn laser_wanted(mode: LaserMode, phase: Option<Phase>, faulted: bool) -> boo
     }
     match mode {
         LaserMode::Off => false,
-        LaserMode::On => true,
         LaserMode::Auto => phase.is_some(),
         LaserMode::Dwell => matches!(phase, Some(Phase::Dwelling | Phase::Holding)),
     }
@@ -33,12 +32,7 @@ mod tests {
         for mode in [LaserMode::Auto, LaserMode::Dwell, LaserMode::Off] {
             assert!(!laser_wanted(mode, None, false));
         }
-        for mode in [
-            LaserMode::Auto,
-            LaserMode::Dwell,
-            LaserMode::On,
-            LaserMode::Off,
-        ] {
+        for mode in [LaserMode::Auto, LaserMode::Dwell, LaserMode::Off] {
             for phase in [None, Some(Phase::Moving), Some(Phase::Dwelling)] {
                 assert!(!laser_wanted(mode, phase, true));
             }
@@ -53,6 +47,5 @@ mod tests {
         assert!(laser_wanted(LaserMode::Dwell, Some(Phase::Dwelling), false));
         assert!(laser_wanted(LaserMode::Dwell, Some(Phase::Holding), false));
         assert!(!laser_wanted(LaserMode::Off, Some(Phase::Dwelling), false));
-        assert!(laser_wanted(LaserMode::On, None, false));
     }
 }

@@ -231,11 +231,11 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                     // Only after a move: ids and deadband come with moves
                     // (from the settings), so before the first one this
                     // task does not know which servos to expect.
-                    if let Some(seq) = last_move
-                        && now >= next_health_check
-                    {
+                    if now >= next_health_check {
                         next_health_check = now + health_period;
-                        self.health_check(link, seq).await;
+                        if let Some(seq) = last_move {
+                            self.health_check(link, seq).await;
+                        }
                     }
                     if self.faulty.iter().any(|f| *f) && now >= next_recovery_ping {
                         next_recovery_ping = now + RECOVERY_PING_PERIOD;
