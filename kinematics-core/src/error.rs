@@ -102,11 +102,15 @@ impl fmt::Display for Error {
                 servo_deg,
                 min_deg,
                 max_deg,
-            } => write!(
-                f,
-                "{} servo angle {servo_deg:.2} deg is outside its limits [{min_deg}, {max_deg}] deg",
-                joint.name()
-            ),
+            } => {
+                write!(f, "{} servo angle ", joint.name())?;
+                write_hundredths(f, servo_deg)?;
+                f.write_str(" deg is outside its limits [")?;
+                write_hundredths(f, min_deg)?;
+                f.write_str(", ")?;
+                write_hundredths(f, max_deg)?;
+                f.write_str("] deg")
+            }
             Error::StepsOutOfRange => f.write_str("stepper angle out of the i32 microstep range"),
             Error::GridIndexOutOfRange { xi, yi } => {
                 write!(f, "grid index ({xi}, {yi}) is outside the grid")
@@ -129,6 +133,26 @@ impl fmt::Display for Error {
 }
 
 impl core::error::Error for Error {}
+
+/// Writes `v` with two decimals by integer arithmetic: the firmware links
+/// no `core` float formatting (its flash budget), so neither does this
+/// crate's `Display`.
+fn write_hundredths(f: &mut fmt::Formatter<'_>, v: f64) -> fmt::Result {
+    let hundredths = libm::round(libm::fabs(v) * 100.0);
+    if !hundredths.is_finite() || hundredths >= 1e15 {
+        return f.write_str(if v.is_nan() { "NaN" } else { "out of range" });
+    }
+    let units = hundredths as u64;
+    let sign = if v < 0.0 && units != 0 { "-" } else { "" };
+    write!(f, "{sign}{}.{:02}", units / 100, units % 100)
+}
+
+/// `v` limited to `[lo, hi]` for finite, ordered bounds. Unlike
+/// `f64::clamp` it cannot panic, so it links no float formatting (the
+/// panic message formats the bounds): the firmware's flash budget.
+pub(crate) fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
+    v.max(lo).min(hi)
+}
 
 /// Returns `Err(NonFinite)` unless `v` is finite.
 pub(crate) fn finite(v: f64, what: &'static str) -> Result<f64, Error> {
@@ -159,7 +183,7 @@ mod tests {
         };
         assert_eq!(
             limit.to_string(),
-            "pitch servo angle 140.00 deg is outside its limits [-135, 135] deg"
+            "pitch servo angle 140.00 deg is outside its limits [-135.00, 135.00] deg"
         );
         assert_eq!(
             Error::TooFewPoints { n: 3 }.to_string(),

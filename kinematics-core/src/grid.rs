@@ -6,7 +6,7 @@
 //! `(xi, yi)` is the board point `(xi·pitch + x_offset, yi·pitch + y_offset)`
 //! (the seed's `MoveToGrid`).
 
-use crate::error::{Error, finite};
+use crate::error::{Error, clamp, finite};
 use crate::frames::BoardPoint;
 use crate::pattern::{Pattern, PatternIndices};
 
@@ -131,7 +131,7 @@ impl Grid {
         let nearest = |v_cm: f64, off_cm: f64, max: i8| -> i8 {
             let m = f64::from(max);
             // Clamped to ±127, so the cast is exact.
-            libm::round((v_cm - off_cm) / self.pitch_cm).clamp(-m, m) as i8
+            clamp(libm::round((v_cm - off_cm) / self.pitch_cm), -m, m) as i8
         };
         Ok(GridIndex {
             xi: nearest(p.x_cm, self.x_offset_cm, self.max_xi()),

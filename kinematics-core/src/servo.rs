@@ -5,7 +5,7 @@
 //! `[min_deg, max_deg]` and quantised to the servo's 0.1° resolution: the
 //! wire value is `round(10 · servo_deg)` as an `i16` (tenths of a degree).
 
-use crate::error::{Error, Joint, finite};
+use crate::error::{Error, Joint, clamp, finite};
 
 /// Wire units (FashionStar angle field) per degree: the field is in 0.1°.
 pub const WIRE_PER_DEG: f64 = 10.0;
@@ -138,7 +138,7 @@ impl ServoAxis {
     pub fn joint_to_wire(&self, joint: Joint, joint_deg: f64) -> Result<i16, Error> {
         let servo_deg = self.joint_to_servo_deg(joint, joint_deg)?;
         let (lo, hi) = self.wire_limits();
-        let wire = libm::round(servo_deg * WIRE_PER_DEG).clamp(lo, hi);
+        let wire = clamp(libm::round(servo_deg * WIRE_PER_DEG), lo, hi);
         // Validated: lo..=hi lies within i16, so the cast is exact.
         Ok(wire as i16)
     }

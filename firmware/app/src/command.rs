@@ -13,6 +13,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
+use crate::cli::format::Shortest;
 use crate::settings::{LaserMode, ParamSpec};
 
 /// Longest reply line, bytes (longer lines are cut).
@@ -196,15 +197,46 @@ impl Command {
     }
 }
 
-impl core::fmt::Debug for Command {
+/// The pattern in command-line syntax (`circle 2 1 4 ccw`).
+impl fmt::Display for Pattern {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let cm = |p: PointCm| (Shortest(p.x_cm), Shortest(p.y_cm));
+        match *self {
+            Pattern::Line { from, to } | Pattern::Rect { a: from, b: to } => {
+                let ((x0, y0), (x1, y1)) = (cm(from), cm(to));
+                write!(f, "{} {x0} {y0} {x1} {y1}", self.name())
+            }
+            Pattern::Circle {
+                centre,
+                radius_cm,
+                rotation,
+            } => {
+                let (x, y) = cm(centre);
+                let turn = match rotation {
+                    Rotation::Cw => "cw",
+                    Rotation::Ccw => "ccw",
+                };
+                write!(f, "circle {x} {y} {} {turn}", Shortest(radius_cm))
+            }
+            _ => f.write_str(self.name()),
+        }
+    }
+}
+
+/// The command in command-line syntax (numbers in shortest form: no
+/// `core` float formatting, see [`crate::cli::format`]).
+impl fmt::Debug for Command {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Command::Pattern { pattern, once } => write!(f, "pattern {pattern:?} once={once}"),
-            Command::Goto(p) => write!(f, "goto {p:?}"),
+            Command::Pattern { pattern, once } => {
+                write!(f, "pattern {pattern}{}", if *once { " once" } else { "" })
+            }
+            Command::Goto(p) => write!(f, "goto {} {}", Shortest(p.x_cm), Shortest(p.y_cm)),
             Command::Grid { xi, yi } => write!(f, "grid {xi} {yi}"),
             Command::Laser(m) => write!(f, "laser {}", m.name()),
-            Command::Model(m) => write!(f, "model {m:?}"),
-            Command::Set { param, value } => write!(f, "set {} {value}", param.name),
+            Command::Model(AimModel::Exact) => f.write_str("model exact"),
+            Command::Model(AimModel::Seed) => f.write_str("model seed"),
+            Command::Set { param, value } => write!(f, "set {} {}", param.name, Shortest(*value)),
             Command::Get(param) => write!(f, "get {}", param.name),
             other => f.write_str(other.name()),
         }

@@ -8,6 +8,7 @@
 use core::fmt;
 
 use crate::cli::error::CommandError;
+use crate::cli::format::Shortest;
 
 /// One axis of the servo gimbal: wire mapping of SPEC §4.4.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -448,7 +449,13 @@ pub struct ParamLine<'a>(pub &'a ParamSpec, pub f64);
 
 impl fmt::Display for ParamLine<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} = {}  # {}", self.0.name, self.1, self.0.help)
+        write!(
+            f,
+            "{} = {}  # {}",
+            self.0.name,
+            Shortest(self.1),
+            self.0.help
+        )
     }
 }
 

@@ -13,7 +13,7 @@
 
 use super::JointAngles;
 use super::exact::{MIN_BEAM_X, check_ol};
-use crate::error::{Error, finite};
+use crate::error::{Error, clamp, finite};
 use crate::frames::GlobalPoint;
 
 /// Seed IK: joint angles for the global point `p` (cm), `ol_cm` = OL (cm).
@@ -33,7 +33,7 @@ pub fn ik(ol_cm: f64, p: GlobalPoint) -> Result<JointAngles, Error> {
     if op3_cm <= ol_cm {
         return Err(Error::InsideOffsetCircle);
     }
-    let lambda_rad = libm::acos((ol_cm / op3_cm).clamp(0.0, 1.0));
+    let lambda_rad = libm::acos(clamp(ol_cm / op3_cm, 0.0, 1.0));
     let pitch_rad = core::f64::consts::FRAC_PI_2 - (theta_rad + lambda_rad);
     Ok(JointAngles {
         yaw_deg: yaw_rad.to_degrees(),

@@ -2,6 +2,8 @@
 
 use core::fmt;
 
+use super::format::Shortest;
+
 /// A word quoted in an error message, truncated to fit.
 pub type Word = heapless::String<24>;
 
@@ -64,7 +66,12 @@ impl fmt::Display for CommandError {
             }
             CommandError::UnexpectedArgument(w) => write!(f, "unexpected argument '{w}'"),
             CommandError::OutOfRange { what, min, max } => {
-                write!(f, "{what} out of range [{min}, {max}]")
+                write!(
+                    f,
+                    "{what} out of range [{}, {}]",
+                    Shortest(*min),
+                    Shortest(*max)
+                )
             }
             CommandError::Rejected(why) => f.write_str(why),
         }

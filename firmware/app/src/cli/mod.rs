@@ -3,5 +3,6 @@
 
 pub mod args;
 pub mod error;
+pub mod format;
 pub mod line;
 pub mod parse;

@@ -4,6 +4,7 @@
 use super::targets::{self, PatternError, Target};
 use super::{LaserSwitch, Phase, Run, Sequencer, SettingsStore};
 use crate::build_info;
+use crate::cli::format::Fixed;
 use crate::cli::parse::HELP_LINES;
 use crate::command::{AimModel, Command, Pattern, PointCm};
 use crate::settings::{PARAMS, ParamLine};
@@ -196,27 +197,26 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
         .await;
         if let Some((target, aim)) = s.target {
             let PointCm { x_cm, y_cm } = target.point;
+            let (x_cm, y_cm) = (Fixed::<3>(x_cm), Fixed::<3>(y_cm));
             match target.grid {
                 Some((xi, yi)) => {
                     link.data(format_args!(
-                        "target: ({x_cm:.3}, {y_cm:.3}) cm grid ({xi}, {yi})"
+                        "target: ({x_cm}, {y_cm}) cm grid ({xi}, {yi})"
                     ))
                     .await
                 }
-                None => {
-                    link.data(format_args!("target: ({x_cm:.3}, {y_cm:.3}) cm"))
-                        .await
-                }
+                None => link.data(format_args!("target: ({x_cm}, {y_cm}) cm")).await,
             }
             link.data(format_args!(
-                "joint: yaw {:.3} deg pitch {:.3} deg",
-                aim.yaw_deg, aim.pitch_deg
+                "joint: yaw {} deg pitch {} deg",
+                Fixed::<3>(aim.yaw_deg),
+                Fixed::<3>(aim.pitch_deg)
             ))
             .await;
             link.data(format_args!(
-                "servo: yaw {:.1} deg pitch {:.1} deg (wire {} {})",
-                f64::from(aim.yaw_wire) / 10.0,
-                f64::from(aim.pitch_wire) / 10.0,
+                "servo: yaw {} deg pitch {} deg (wire {} {})",
+                Fixed::<1>(f64::from(aim.yaw_wire) / 10.0),
+                Fixed::<1>(f64::from(aim.pitch_wire) / 10.0),
                 aim.yaw_wire,
                 aim.pitch_wire
             ))
@@ -224,9 +224,9 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
         }
         if let Some((yaw, pitch)) = self.measured {
             link.data(format_args!(
-                "measured at arrival: yaw {:.1} deg pitch {:.1} deg",
-                f64::from(yaw) / 10.0,
-                f64::from(pitch) / 10.0
+                "measured at arrival: yaw {} deg pitch {} deg",
+                Fixed::<1>(f64::from(yaw) / 10.0),
+                Fixed::<1>(f64::from(pitch) / 10.0)
             ))
             .await;
         }

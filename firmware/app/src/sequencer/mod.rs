@@ -16,6 +16,7 @@ use embassy_time::{Duration, Instant, Timer};
 
 pub use self::laser::{LaserSwitch, laser_wanted};
 use self::targets::{Aim, Target};
+use crate::cli::format::Fixed;
 use crate::command::{AimModel, CommandLink, Pattern};
 use crate::log;
 use crate::servo::task::{ServoLink, ServoOutcome, ServoRequest};
@@ -211,8 +212,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 let why = crate::command::reply_text(format_args!("{e}"));
                 log::warning!("target unreachable: {}", why.as_str());
                 self.link.notify(format_args!(
-                    "error: target ({:.2}, {:.2}) cm unreachable: {}; stopped, laser off",
-                    target.point.x_cm, target.point.y_cm, why
+                    "error: target ({}, {}) cm unreachable: {}; stopped, laser off",
+                    Fixed::<2>(target.point.x_cm),
+                    Fixed::<2>(target.point.y_cm),
+                    why
                 ));
                 self.stop("unreachable target");
                 return;

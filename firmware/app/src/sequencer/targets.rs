@@ -7,6 +7,7 @@
 use kinematics_core as kc;
 use kinematics_core::{BoardPoint, Criterion, ErrorModel, Gimbal, Grid, GridIndex};
 
+use crate::cli::format::Fixed;
 use crate::command::{AimModel, GridOrder, Pattern, PointCm, Rotation};
 use crate::settings::{AxisSettings, Settings};
 
@@ -253,8 +254,9 @@ impl core::fmt::Display for PatternError {
                 error,
             } => write!(
                 f,
-                "{pattern} point {index} ({:.2}, {:.2}) cm unreachable: {error}",
-                point.x_cm, point.y_cm
+                "{pattern} point {index} ({}, {}) cm unreachable: {error}",
+                Fixed::<2>(point.x_cm),
+                Fixed::<2>(point.y_cm)
             ),
             PatternError::Empty { pattern } => write!(f, "{pattern} has no points on this grid"),
         }

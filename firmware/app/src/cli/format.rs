@@ -1,0 +1,115 @@
+//! Number formatting for replies without `core`'s float formatting, whose
+//! Grisu/Dragon code and tables cost ~12 KB of the firmware's 128 KiB
+//! flash budget.
+//!
+//! [`Shortest`] prints the shortest text that parses back to the same
+//! `f64` (Ryū, `ryu` crate with its small tables): for values users read
+//! back and may paste again (`get`, `params`, ranges). [`Fixed`] prints a
+//! fixed number of decimals by integer arithmetic: for status lines.
+
+use core::fmt;
+
+/// `f64` in its shortest round-trip form (`1000`, `0.25`, `2.96e-5`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shortest(pub f64);
+
+impl fmt::Display for Shortest {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = self.0;
+        if !v.is_finite() {
+            return f.write_str(if v.is_nan() {
+                "NaN"
+            } else if v > 0.0 {
+                "inf"
+            } else {
+                "-inf"
+            });
+        }
+        // Whole numbers (parameter values, limits) print without ".0".
+        if v == libm::trunc(v) && v.abs() < 1e15 {
+            return write!(f, "{}", v as i64);
+        }
+        let mut buf = ryu::Buffer::new();
+        f.write_str(buf.format_finite(v))
+    }
+}
+
+/// `f64` rounded to `DECIMALS` places (`Fixed::<3>(5.0)` → `5.000`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fixed<const DECIMALS: u32>(pub f64);
+
+impl<const DECIMALS: u32> fmt::Display for Fixed<DECIMALS> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let scale = 10u64.pow(DECIMALS);
+        let scaled = libm::round(libm::fabs(self.0) * scale as f64);
+        // Beyond 2^53 the decimals are meaningless: shortest form instead.
+        if !scaled.is_finite() || scaled >= 9.0e15 {
+            return Shortest(self.0).fmt(f);
+        }
+        let units = scaled as u64;
+        let sign = if self.0 < 0.0 && units != 0 { "-" } else { "" };
+        let (whole, fraction) = (units / scale, units % scale);
+        if DECIMALS == 0 {
+            write!(f, "{sign}{whole}")
+        } else {
+            write!(
+                f,
+                "{sign}{whole}.{fraction:0width$}",
+                width = DECIMALS as usize
+            )
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::format;
+
+    #[test]
+    fn fixed_rounds_to_its_decimals() {
+        assert_eq!(format!("{}", Fixed::<3>(5.0)), "5.000");
+        assert_eq!(format!("{}", Fixed::<3>(-3.0)), "-3.000");
+        assert_eq!(format!("{}", Fixed::<2>(11.496)), "11.50");
+        assert_eq!(format!("{}", Fixed::<1>(-0.04)), "0.0");
+        assert_eq!(format!("{}", Fixed::<1>(-11.35)), "-11.4");
+        assert_eq!(format!("{}", Fixed::<3>(0.0005)), "0.001");
+        assert_eq!(format!("{}", Fixed::<0>(2.5)), "3");
+        assert_eq!(format!("{}", Fixed::<2>(f64::NAN)), "NaN");
+        assert_eq!(format!("{}", Fixed::<2>(1e300)), "1e300");
+    }
+
+    #[test]
+    fn shortest_prints_whole_numbers_plainly() {
+        assert_eq!(format!("{}", Shortest(1000.0)), "1000");
+        assert_eq!(format!("{}", Shortest(-135.0)), "-135");
+        assert_eq!(format!("{}", Shortest(0.25)), "0.25");
+        assert_eq!(format!("{}", Shortest(-0.0)), "0");
+        assert_eq!(format!("{}", Shortest(f64::NEG_INFINITY)), "-inf");
+    }
+
+    proptest::proptest! {
+        /// encode∘decode: every finite value's text parses back exactly
+        /// with the command line's own number parser.
+        #[test]
+        fn shortest_round_trips_through_the_parser(bits in proptest::prelude::any::<u64>()) {
+            let v = f64::from_bits(bits);
+            proptest::prop_assume!(v.is_finite());
+            let text = format!("{}", Shortest(v));
+            let back = crate::cli::args::parse_number(&text, "v", f64::MIN, f64::MAX);
+            proptest::prop_assert_eq!(back.map(|b| b == v), Ok(true), "{}", text);
+        }
+
+        /// Fixed agrees with core's formatting away from rounding ties.
+        #[test]
+        fn fixed_matches_core(v in -1.0e6f64..1.0e6) {
+            let scaled = (v * 1000.0).abs();
+            proptest::prop_assume!((scaled - scaled.trunc() - 0.5).abs() > 1e-6);
+            let ours = format!("{}", Fixed::<3>(v));
+            let core = format!("{v:.3}");
+            let core = if core == "-0.000" { "0.000".into() } else { core };
+            proptest::prop_assert_eq!(ours, core);
+        }
+    }
+}
