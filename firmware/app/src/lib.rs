@@ -12,6 +12,7 @@
 pub mod build_info;
 pub mod cli;
 pub mod command;
+pub mod galvo;
 mod log;
 pub mod sequencer;
 pub mod servo;

@@ -3,6 +3,7 @@
 //! simulated FashionStar servos and galvos, and records where the laser went.
 
 pub mod clock;
+pub mod dac;
 pub mod drawing;
 pub mod executor;
 pub mod logger;

@@ -1,0 +1,145 @@
+//! The galvo loop body (`laser-app`) feeding the simulated DAC in virtual
+//! time: the sample stream is continuous, points are reached within
+//! 0.1 mm with the laser on only there, and a loop slower than the sample
+//! rate underruns, turns the laser off and says so.
+
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::sync::atomic::Ordering;
+
+use kinematics_core::Galvo;
+use laser_app::galvo::{GalvoConfig, GalvoEvent, GalvoLink, GalvoLoop, GalvoRequest};
+use laser_sim::dac::{DacRecording, SimDac};
+use laser_sim::executor::{self, RunEnd};
+
+/// Corner points of a 160 mm square and its centre, mm.
+const POINTS: [(f32, f32); 5] = [
+    (-80.0, 80.0),
+    (80.0, 80.0),
+    (80.0, -80.0),
+    (-80.0, -80.0),
+    (0.0, 0.0),
+];
+
+struct Run {
+    recording: DacRecording,
+    events: Vec<GalvoEvent>,
+    underruns: u32,
+    end: RunEnd,
+}
+
+fn run(compute_ns_per_sample: u64) -> Run {
+    let link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
+    let recording = Rc::new(RefCell::new(DacRecording::default()));
+    let events: Rc<RefCell<Vec<GalvoEvent>>> = Rc::default();
+    let finished = Rc::new(RefCell::new(false));
+    let (rec, ev, fin) = (recording.clone(), events.clone(), finished.clone());
+    let end = executor::run(
+        false,
+        2_000_000,
+        move |spawner| {
+            executor::spawn(&spawner, async move {
+                let mut dac = SimDac::new(128, 10, compute_ns_per_sample, rec);
+                let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
+                galvo.run(&mut dac, link).await;
+            });
+            executor::spawn(&spawner, async move {
+                for (i, &(x_mm, y_mm)) in POINTS.iter().enumerate() {
+                    link.requests
+                        .send(GalvoRequest::Point {
+                            seq: i as u32,
+                            x_mm,
+                            y_mm,
+                            dwell_us: 2_000,
+                        })
+                        .await;
+                }
+                // Until every point is done or refused, or an underrun.
+                let mut closed = 0;
+                while closed < POINTS.len() {
+                    let event = link.events.receive().await;
+                    ev.borrow_mut().push(event);
+                    match event {
+                        GalvoEvent::Underrun(_) => break,
+                        _ => closed += 1,
+                    }
+                }
+                embassy_time::Timer::after_millis(5).await;
+                *fin.borrow_mut() = true;
+            });
+        },
+        move || *finished.borrow(),
+    );
+    let recording = recording.borrow().clone();
+    let events = events.borrow().clone();
+    Run {
+        recording,
+        events,
+        underruns: link.underruns.load(Ordering::Relaxed),
+        end,
+    }
+}
+
+#[test]
+fn points_are_reached_with_a_continuous_stream_and_no_underrun() {
+    let run = run(0);
+    assert_eq!(run.end, RunEnd::Stopped);
+    assert_eq!(run.underruns, 0);
+    assert!(run.recording.underruns.is_empty());
+    assert_eq!(
+        run.events,
+        (0..5)
+            .map(|seq| GalvoEvent::Done { seq })
+            .collect::<Vec<_>>()
+    );
+    let galvo = Galvo::<f64>::default();
+    let samples = &run.recording.samples;
+    // Continuous: one sample per period from start to end, whole halves.
+    assert_eq!(samples.len() % 128, 0);
+    assert!(samples.len() > 5 * 200, "{} samples", samples.len());
+    // Laser on exactly at the points: 5 × 2 ms of dwell at 100 kHz.
+    let lit: Vec<_> = samples.iter().filter(|s| s.laser).collect();
+    assert_eq!(lit.len(), 5 * 200);
+    for s in lit {
+        let p = galvo
+            .codes_to_board(s.x_code, s.y_code)
+            .expect("codes in range");
+        assert!(
+            POINTS
+                .iter()
+                .any(|&(x, y)| (p.x_mm - f64::from(x)).abs() < 0.1
+                    && (p.y_mm - f64::from(y)).abs() < 0.1),
+            "lit at ({:.3}, {:.3}) mm",
+            p.x_mm,
+            p.y_mm
+        );
+    }
+    // Each point's dwell is one unbroken run of lit samples.
+    let switches = samples
+        .windows(2)
+        .filter(|w| w[0].laser != w[1].laser)
+        .count();
+    assert_eq!(switches, 2 * 5);
+}
+
+#[test]
+fn a_loop_slower_than_the_sample_rate_underruns_and_turns_the_laser_off() {
+    // 12 µs of compute per 10 µs sample.
+    let run = run(12_000);
+    assert!(run.underruns > 0);
+    assert!(
+        matches!(run.events.last(), Some(GalvoEvent::Underrun(_))),
+        "{:?}",
+        run.events
+    );
+    let (first_replay, halves) = run.recording.underruns[0];
+    // After the replayed stale halves (and the two buffers' old content),
+    // everything the DAC outputs is dark.
+    let after_report = first_replay + (halves as usize + 2) * 128;
+    assert!(
+        run.recording.samples[after_report.min(run.recording.samples.len())..]
+            .iter()
+            .all(|s| !s.laser),
+        "laser off after the underrun"
+    );
+}
