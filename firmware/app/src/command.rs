@@ -32,42 +32,14 @@ pub struct PointCm {
     pub y_cm: f64,
 }
 
-/// Visiting order of the full grid.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum GridOrder {
-    /// Every row left to right.
-    Raster,
-    /// Alternate rows reversed (shortest travel).
-    Serpentine,
-}
-
-/// Direction of a circle.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Rotation {
-    /// Clockwise.
-    Cw,
-    /// Counter-clockwise.
-    Ccw,
-}
+pub use kinematics_core::{Pattern as GridPattern, Rotation};
 
 /// A test pattern or path (SPEC §4.6).
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Pattern {
-    /// Grid (0, 0).
-    Home,
-    /// The four grid corners, clockwise from top left.
-    Corner,
-    /// xi = −6..6 on yi = 0.
-    Horizontal,
-    /// yi = 4..−4 on xi = 0.
-    Vertical,
-    /// The seed's subset: yi = 2..−2, xi = −3..3.
-    VisitAll,
-    /// Every grid point.
-    GridFull(GridOrder),
+    /// A grid pattern: home, corner, horizontal, vertical, visit-all, full
+    /// grid raster or serpentine.
+    Grid(GridPattern),
     /// Straight line A → B.
     Line {
         /// Start, cm.
@@ -97,13 +69,7 @@ impl Pattern {
     /// Name used on the command line.
     pub fn name(&self) -> &'static str {
         match self {
-            Pattern::Home => "home",
-            Pattern::Corner => "corner",
-            Pattern::Horizontal => "horizontal",
-            Pattern::Vertical => "vertical",
-            Pattern::VisitAll => "visit-all",
-            Pattern::GridFull(GridOrder::Raster) => "grid-full raster",
-            Pattern::GridFull(GridOrder::Serpentine) => "grid-full serpentine",
+            Pattern::Grid(grid) => grid.name(),
             Pattern::Line { .. } => "line",
             Pattern::Circle { .. } => "circle",
             Pattern::Rect { .. } => "rect",
@@ -266,6 +232,13 @@ impl PartialEq for Command {
             (Command::Get(a), Command::Get(b)) => a.name == b.name,
             (a, b) => core::mem::discriminant(a) == core::mem::discriminant(b),
         }
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Pattern {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "{}", defmt::Display2Format(self))
     }
 }
 

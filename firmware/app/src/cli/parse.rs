@@ -2,7 +2,7 @@
 
 use super::args::Args;
 use super::error::{CommandError, word};
-use crate::command::{AimModel, Command, GridOrder, Pattern, PointCm, Rotation};
+use crate::command::{AimModel, Command, GridPattern, Pattern, PointCm, Rotation};
 use crate::settings::{LaserMode, find_param};
 
 /// Largest board coordinate accepted anywhere, cm.
@@ -104,30 +104,23 @@ fn point(args: &mut Args<'_>, x: &'static str, y: &'static str) -> Result<PointC
 fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
     let name = args.word("pattern name (see 'help')")?;
     let is = |candidate: &str| name.eq_ignore_ascii_case(candidate);
-    let pattern = if is("home") {
-        Pattern::Home
-    } else if is("corner") {
-        Pattern::Corner
-    } else if is("horizontal") {
-        Pattern::Horizontal
-    } else if is("vertical") {
-        Pattern::Vertical
-    } else if is("visit-all") {
-        Pattern::VisitAll
-    } else if is("grid-full") {
+    let pattern = if is("grid-full") {
         // Optional order word; anything else is left for `once`.
         let mut peek = args.clone();
         match peek.next_word() {
             Some(w) if w.eq_ignore_ascii_case("serpentine") => {
                 args = peek;
-                Pattern::GridFull(GridOrder::Serpentine)
+                Pattern::Grid(GridPattern::FullSerpentine)
             }
             Some(w) if w.eq_ignore_ascii_case("raster") => {
                 args = peek;
-                Pattern::GridFull(GridOrder::Raster)
+                Pattern::Grid(GridPattern::FullRaster)
             }
-            _ => Pattern::GridFull(GridOrder::Raster),
+            _ => Pattern::Grid(GridPattern::FullRaster),
         }
+    } else if let Some(grid) = GridPattern::from_name(name) {
+        // home, corner, horizontal, vertical, visit-all
+        Pattern::Grid(grid)
     } else if is("line") {
         Pattern::Line {
             from: point(&mut args, "x0_cm", "y0_cm")?,
@@ -251,21 +244,21 @@ mod tests {
         assert_eq!(
             ok("pattern corner once"),
             Command::Pattern {
-                pattern: Pattern::Corner,
+                pattern: Pattern::Grid(GridPattern::Corner),
                 once: true
             }
         );
         assert_eq!(
             ok("pattern grid-full serpentine"),
             Command::Pattern {
-                pattern: Pattern::GridFull(GridOrder::Serpentine),
+                pattern: Pattern::Grid(GridPattern::FullSerpentine),
                 once: false
             }
         );
         assert_eq!(
             ok("pattern grid-full once"),
             Command::Pattern {
-                pattern: Pattern::GridFull(GridOrder::Raster),
+                pattern: Pattern::Grid(GridPattern::FullRaster),
                 once: true
             }
         );

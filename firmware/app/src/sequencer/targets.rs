@@ -8,7 +8,7 @@ use kinematics_core as kc;
 use kinematics_core::{BoardPoint, Criterion, ErrorModel, Gimbal, Grid, GridIndex};
 
 use crate::cli::format::Fixed;
-use crate::command::{AimModel, GridOrder, Pattern, PointCm, Rotation};
+use crate::command::{AimModel, Pattern, PointCm};
 use crate::settings::{AxisSettings, Settings};
 
 /// One point the sequencer visits.
@@ -127,18 +127,12 @@ pub fn grid_point(settings: &Settings, xi: i8, yi: i8) -> Result<Target, kc::Err
     })
 }
 
-/// The grid pattern of `kinematics-core` behind a grid [`Pattern`].
+/// The grid pattern behind a grid [`Pattern`].
 fn grid_pattern(pattern: &Pattern) -> Option<kc::Pattern> {
-    Some(match pattern {
-        Pattern::Home => kc::Pattern::Home,
-        Pattern::Corner => kc::Pattern::Corner,
-        Pattern::Horizontal => kc::Pattern::Horizontal,
-        Pattern::Vertical => kc::Pattern::Vertical,
-        Pattern::VisitAll => kc::Pattern::VisitAll,
-        Pattern::GridFull(GridOrder::Raster) => kc::Pattern::FullRaster,
-        Pattern::GridFull(GridOrder::Serpentine) => kc::Pattern::FullSerpentine,
-        Pattern::Line { .. } | Pattern::Circle { .. } | Pattern::Rect { .. } => return None,
-    })
+    match pattern {
+        Pattern::Grid(grid) => Some(*grid),
+        Pattern::Line { .. } | Pattern::Circle { .. } | Pattern::Rect { .. } => None,
+    }
 }
 
 /// The points of a path pattern, interpolated point by point (midpoint
@@ -180,14 +174,8 @@ fn path_points(pattern: &Pattern, settings: &Settings) -> Option<Result<PathPoin
             centre,
             radius_cm,
             rotation,
-        } => {
-            let rotation = match rotation {
-                Rotation::Cw => kc::Rotation::Cw,
-                Rotation::Ccw => kc::Rotation::Ccw,
-            };
-            kc::ArcSteps::circle(board(centre), radius_cm, rotation, step, criterion)
-                .map(PathPoints::Arc)
-        }
+        } => kc::ArcSteps::circle(board(centre), radius_cm, rotation, step, criterion)
+            .map(PathPoints::Arc),
         Pattern::Rect { a, b } => {
             kc::RectSteps::new(board(a), board(b), step, criterion).map(PathPoints::Rect)
         }
@@ -391,12 +379,12 @@ mod tests {
     fn patterns_yield_their_points_in_order_and_end() {
         let s = Settings::default();
         let corner: heapless::Vec<(i8, i8), 8> = (0..)
-            .map_while(|i| pattern_target(&Pattern::Corner, i, &s))
+            .map_while(|i| pattern_target(&Pattern::Grid(kc::Pattern::Corner), i, &s))
             .filter_map(|t| t.grid)
             .collect();
         assert_eq!(corner.as_slice(), &[(-6, 4), (6, 4), (6, -4), (-6, -4)]);
         let n = (0..)
-            .map_while(|i| pattern_target(&Pattern::GridFull(GridOrder::Serpentine), i, &s))
+            .map_while(|i| pattern_target(&Pattern::Grid(kc::Pattern::FullSerpentine), i, &s))
             .count();
         assert_eq!(n, 13 * 9);
         let line = Pattern::Line {
@@ -427,7 +415,8 @@ mod tests {
     fn check_pattern_names_the_first_unreachable_point() {
         let mut s = Settings::default();
         s.yaw.min_deg = -10.0;
-        let e = check_pattern(&Pattern::Corner, &s, AimModel::Exact).unwrap_err();
+        let e =
+            check_pattern(&Pattern::Grid(kc::Pattern::Corner), &s, AimModel::Exact).unwrap_err();
         let text = std::format!("{e}");
         assert!(
             text.starts_with("corner point 1 (11.50, 7.66) cm unreachable"),
@@ -439,7 +428,7 @@ mod tests {
                 y_cm: 0.0,
             },
             radius_cm: 0.01,
-            rotation: Rotation::Cw,
+            rotation: kc::Rotation::Cw,
         };
         assert!(check_pattern(&tiny, &Settings::default(), AimModel::Exact).is_err());
     }
