@@ -80,7 +80,8 @@ pub async fn sequencer(
     laser: LaserPin,
     store: FlashSettings,
 ) -> ! {
-    let mut sequencer = Sequencer::new(link, servo, status, laser, store).await;
+    // No galvo output in this build yet (see README, Status).
+    let mut sequencer = Sequencer::new(link, servo, None, status, laser, store).await;
     sequencer.run().await
 }
 

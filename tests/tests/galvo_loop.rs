@@ -8,7 +8,7 @@ use std::rc::Rc;
 use std::sync::atomic::Ordering;
 
 use kinematics_core::Galvo;
-use laser_app::galvo::{GalvoConfig, GalvoEvent, GalvoLink, GalvoLoop, GalvoRequest};
+use laser_app::galvo::{DacSample, GalvoConfig, GalvoEvent, GalvoLink, GalvoLoop, GalvoRequest};
 use laser_sim::dac::{DacRecording, SimDac};
 use laser_sim::executor::{self, RunEnd};
 
@@ -39,7 +39,7 @@ fn run(compute_ns_per_sample: u64) -> Run {
         2_000_000,
         move |spawner| {
             executor::spawn(&spawner, async move {
-                let mut dac = SimDac::new(128, 10, compute_ns_per_sample, rec);
+                let mut dac = SimDac::new(128, 10_000, compute_ns_per_sample, rec);
                 let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
                 galvo.run(&mut dac, link).await;
             });
@@ -93,7 +93,10 @@ fn points_are_reached_with_a_continuous_stream_and_no_underrun() {
             .collect::<Vec<_>>()
     );
     let galvo = Galvo::<f64>::default();
-    let samples = &run.recording.samples;
+    let samples: Vec<DacSample> = run.recording.iter().map(|(_, s)| s).collect();
+    // One sample every 10 µs, no gaps.
+    let times: Vec<u64> = run.recording.iter().map(|(t, _)| t).collect();
+    assert!(times.windows(2).all(|w| w[1] - w[0] == 10_000));
     // Continuous: one sample per period from start to end, whole halves.
     assert_eq!(samples.len() % 128, 0);
     assert!(samples.len() > 5 * 200, "{} samples", samples.len());
@@ -137,9 +140,10 @@ fn a_loop_slower_than_the_sample_rate_underruns_and_turns_the_laser_off() {
     // everything the DAC outputs is dark.
     let after_report = first_replay + (halves as usize + 2) * 128;
     assert!(
-        run.recording.samples[after_report.min(run.recording.samples.len())..]
+        run.recording
             .iter()
-            .all(|s| !s.laser),
+            .skip(after_report)
+            .all(|(_, s)| !s.laser),
         "laser off after the underrun"
     );
 }

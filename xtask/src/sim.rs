@@ -28,6 +28,13 @@ pub struct SimArgs {
     /// Write the spot trace as CSV `t_ms,x_cm,y_cm,laser`.
     #[arg(long)]
     trace: Option<PathBuf>,
+    /// Write every galvo DAC sample as CSV `k,t_s,dac_x,dac_y,laser`.
+    #[arg(long)]
+    dac: Option<PathBuf>,
+    /// Galvo loop compute time per DAC sample, ns (models a slower CPU:
+    /// above the 10 µs sample period the loop underruns).
+    #[arg(long, default_value_t = 0)]
+    galvo_cost_ns: u64,
     /// Inject a fault: `servo-silent:<id>@<t_ms>[-<end_ms>]`, `servo-corrupt:<probability>`,
     /// `servo-slow:<factor>` (repeatable).
     #[arg(long = "fault")]
@@ -164,6 +171,7 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         slow_factor,
         max_time_ms: (args.max_time_s * 1000.0) as u64,
         echo: true,
+        galvo_cost_ns_per_sample: args.galvo_cost_ns,
         ..SimOptions::default()
     });
     if let Some(path) = &svg {
@@ -180,12 +188,18 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         std::fs::write(path, report.recording.trace_csv())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
+    if let Some(path) = &args.dac {
+        std::fs::write(path, report.dac.csv())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     eprintln!(
-        "xtask sim: ended at t = {:.3} s ({:?}); {} dwell points, {} servo frames, {} error replies",
+        "xtask sim: ended at t = {:.3} s ({:?}); {} dwell points, {} servo frames, {} galvo DAC samples, {} galvo underruns, {} error replies",
         report.end_time_us as f64 / 1e6,
         report.end,
         report.recording.dwells.len(),
         report.recording.frames.len(),
+        report.dac.len(),
+        report.galvo_underruns,
         report.transcript.error_replies
     );
     if report.end == RunEnd::Livelock {

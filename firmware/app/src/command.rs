@@ -14,7 +14,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
 use crate::cli::format::Shortest;
-use crate::settings::{LaserMode, ParamSpec};
+use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
 
 /// Longest reply line, bytes (longer lines are cut).
 pub const REPLY_LINE_LEN: usize = 120;
@@ -86,6 +86,40 @@ impl Pattern {
     }
 }
 
+/// Which actuator draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Actuator {
+    /// The servo gimbal (default).
+    Gimbal,
+    /// The two-mirror galvo scanner.
+    Galvo,
+    /// Both, visiting the same board points together.
+    Both,
+}
+
+impl Actuator {
+    /// Name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Actuator::Gimbal => "gimbal",
+            Actuator::Galvo => "galvo",
+            Actuator::Both => "both",
+        }
+    }
+
+    /// Whether the gimbal takes part.
+    pub fn uses_gimbal(self) -> bool {
+        self != Actuator::Galvo
+    }
+
+    /// Whether the galvo takes part (never in a build without galvo
+    /// output, so the compiler drops those paths).
+    pub fn uses_galvo(self) -> bool {
+        crate::galvo::GALVO_OUTPUT && self != Actuator::Gimbal
+    }
+}
+
 /// Which kinematic model aims the gimbal.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -140,6 +174,12 @@ pub enum Command {
     Params,
     /// Store the parameters in flash.
     Save,
+    /// Choose the actuator(s).
+    Target(Actuator),
+    /// Choose the galvo jump planner.
+    Planner(JumpPlanner),
+    /// Galvo loop state.
+    GalvoStatus,
 }
 
 impl Command {
@@ -159,6 +199,9 @@ impl Command {
             Command::Get(_) => "get",
             Command::Params => "params",
             Command::Save => "save",
+            Command::Target(_) => "target",
+            Command::Planner(_) => "planner",
+            Command::GalvoStatus => "galvo status",
         }
     }
 }
@@ -200,6 +243,8 @@ impl fmt::Debug for Command {
             Command::Goto(p) => write!(f, "goto {} {}", Shortest(p.x_cm), Shortest(p.y_cm)),
             Command::Grid { xi, yi } => write!(f, "grid {xi} {yi}"),
             Command::Laser(m) => write!(f, "laser {}", m.name()),
+            Command::Target(a) => write!(f, "target {}", a.name()),
+            Command::Planner(p) => write!(f, "planner {}", p.name()),
             Command::Model(AimModel::Exact) => f.write_str("model exact"),
             Command::Model(AimModel::Seed) => f.write_str("model seed"),
             Command::Set { param, value } => write!(f, "set {} {}", param.name, Shortest(*value)),
@@ -225,6 +270,8 @@ impl PartialEq for Command {
             (Command::Goto(a), Command::Goto(b)) => a == b,
             (Command::Grid { xi: a, yi: b }, Command::Grid { xi: c, yi: d }) => a == c && b == d,
             (Command::Laser(a), Command::Laser(b)) => a == b,
+            (Command::Target(a), Command::Target(b)) => a == b,
+            (Command::Planner(a), Command::Planner(b)) => a == b,
             (Command::Model(a), Command::Model(b)) => a == b,
             (Command::Set { param: a, value: x }, Command::Set { param: b, value: y }) => {
                 a.name == b.name && x == y
@@ -329,6 +376,11 @@ impl CommandLink {
     /// Sends one data line of the current reply.
     pub async fn data(&self, args: fmt::Arguments<'_>) {
         self.replies.send(Reply::Data(reply_text(args))).await;
+    }
+
+    /// Sends one data line already formatted.
+    pub async fn data_line(&self, line: ReplyText) {
+        self.replies.send(Reply::Data(line)).await;
     }
 
     /// Closes the current reply with `ok`.

@@ -64,6 +64,89 @@ impl LaserMode {
     }
 }
 
+/// Jump planner of the galvo.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum JumpPlanner {
+    /// Time-optimal bang-bang jumps (default).
+    Optimal,
+    /// The patent's bisection method (minimum-energy input).
+    Seed,
+}
+
+impl JumpPlanner {
+    /// Name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            JumpPlanner::Optimal => "optimal",
+            JumpPlanner::Seed => "seed",
+        }
+    }
+}
+
+/// The galvo scanner: geometry (SPEC §4.5), DAC mapping, mirror drive
+/// (SPEC §6) and laser timing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GalvoSettings {
+    /// Y mirror to board distance d, mm.
+    pub d_mm: f64,
+    /// Mirror separation e, mm.
+    pub e_mm: f64,
+    /// X DAC codes per radian of mechanical mirror angle (sign = direction).
+    pub x_codes_per_rad: f64,
+    /// X DAC code at mirror angle 0.
+    pub x_offset_code: f64,
+    /// Y DAC codes per radian.
+    pub y_codes_per_rad: f64,
+    /// Y DAC code at mirror angle 0.
+    pub y_offset_code: f64,
+    /// Motor torque constant Kt, N·m/A.
+    pub kt_nm_per_a: f64,
+    /// Rotor + mirror inertia J, kg·m².
+    pub j_kg_m2: f64,
+    /// Coil inductance L, H.
+    pub l_h: f64,
+    /// Coil resistance R, Ω.
+    pub r_ohm: f64,
+    /// Drive voltage limit Umax, V.
+    pub u_max_v: f64,
+    /// DAC sample period, µs.
+    pub sample_period_us: f64,
+    /// Jump planner.
+    pub planner: JumpPlanner,
+    /// Hold after a jump lands before the laser turns on, µs.
+    pub laser_on_delay_us: f64,
+    /// Hold after the laser turns off before the next jump, µs.
+    pub laser_off_delay_us: f64,
+}
+
+impl Default for GalvoSettings {
+    /// SPEC defaults: d 400 mm, e 10 mm, ±12.5° over the 12-bit DAC, the
+    /// reference galvo drive, 100 kHz, time-optimal jumps, 100 µs delays.
+    fn default() -> Self {
+        let dac = kinematics_core::DacAxis::<f64>::default();
+        let geometry = kinematics_core::GalvoGeometry::<f64>::default();
+        let drive = galvo_planner::RigidParams::REFERENCE;
+        Self {
+            d_mm: geometry.d_mm,
+            e_mm: geometry.e_mm,
+            x_codes_per_rad: dac.codes_per_rad,
+            x_offset_code: dac.offset_code,
+            y_codes_per_rad: dac.codes_per_rad,
+            y_offset_code: dac.offset_code,
+            kt_nm_per_a: drive.kt_nm_per_a,
+            j_kg_m2: drive.j_kg_m2,
+            l_h: drive.l_h,
+            r_ohm: drive.r_ohm,
+            u_max_v: drive.u_max_v,
+            sample_period_us: 10.0,
+            planner: JumpPlanner::Optimal,
+            laser_on_delay_us: 100.0,
+            laser_off_delay_us: 100.0,
+        }
+    }
+}
+
 /// Every user parameter.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
@@ -101,6 +184,8 @@ pub struct Settings {
     pub err_dx: [f64; 6],
     /// Error-model coefficients for y, mm.
     pub err_dy: [f64; 6],
+    /// The galvo scanner.
+    pub galvo: GalvoSettings,
 }
 
 impl Default for Settings {
@@ -132,6 +217,7 @@ impl Default for Settings {
             laser_mode: LaserMode::Auto,
             err_dx: [0.0; 6],
             err_dy: [0.0; 6],
+            galvo: GalvoSettings::default(),
         }
     }
 }
@@ -143,6 +229,9 @@ enum Slot {
     Count(fn(&mut Settings) -> &mut u8),
     Sign(fn(&mut Settings) -> &mut i8),
     Laser,
+    // Only in builds with galvo output.
+    #[cfg_attr(not(feature = "galvo"), allow(dead_code))]
+    Planner,
 }
 
 /// Description of one parameter.
@@ -352,6 +441,122 @@ pub const PARAMS: &[ParamSpec] = &[
     err_coef!("err.dy.c3", err_dy, 3),
     err_coef!("err.dy.c4", err_dy, 4),
     err_coef!("err.dy.c5", err_dy, 5),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.d_mm",
+        50.0,
+        5000.0,
+        "galvo Y mirror to board distance d, mm",
+        |s| s.galvo.d_mm
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.e_mm",
+        0.0,
+        100.0,
+        "galvo mirror separation e, mm",
+        |s| s.galvo.e_mm
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.x_codes_per_rad",
+        -1e6,
+        1e6,
+        "galvo X DAC codes per rad (sign = direction)",
+        |s| s.galvo.x_codes_per_rad
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.x_offset_code",
+        0.0,
+        4095.0,
+        "galvo X DAC code at angle 0",
+        |s| s.galvo.x_offset_code
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.y_codes_per_rad",
+        -1e6,
+        1e6,
+        "galvo Y DAC codes per rad (sign = direction)",
+        |s| s.galvo.y_codes_per_rad
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.y_offset_code",
+        0.0,
+        4095.0,
+        "galvo Y DAC code at angle 0",
+        |s| s.galvo.y_offset_code
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.kt_nm_per_a",
+        1e-4,
+        1.0,
+        "galvo motor torque constant Kt, N*m/A",
+        |s| s.galvo.kt_nm_per_a
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.j_kg_m2",
+        1e-10,
+        1e-4,
+        "galvo rotor+mirror inertia J, kg*m^2",
+        |s| s.galvo.j_kg_m2
+    ),
+    #[cfg(feature = "galvo")]
+    real!("galvo.l_h", 1e-6, 0.1, "galvo coil inductance L, H", |s| s
+        .galvo
+        .l_h),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.r_ohm",
+        0.1,
+        100.0,
+        "galvo coil resistance R, ohm",
+        |s| s.galvo.r_ohm
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.u_max_v",
+        1.0,
+        100.0,
+        "galvo drive voltage limit Umax, V",
+        |s| s.galvo.u_max_v
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.ts_us",
+        5.0,
+        1000.0,
+        "galvo DAC sample period, us",
+        |s| s.galvo.sample_period_us
+    ),
+    #[cfg(feature = "galvo")]
+    ParamSpec {
+        name: "galvo.planner",
+        min: 0.0,
+        max: 1.0,
+        help: "galvo jump planner: 0 optimal, 1 seed",
+        slot: Slot::Planner,
+    },
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.laser_on_delay_us",
+        0.0,
+        10_000.0,
+        "galvo hold before laser on after a jump, us",
+        |s| s.galvo.laser_on_delay_us
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.laser_off_delay_us",
+        0.0,
+        10_000.0,
+        "galvo hold after laser off before a jump, us",
+        |s| s.galvo.laser_off_delay_us
+    ),
 ];
 
 /// Finds a parameter by name (case-insensitive).
@@ -368,6 +573,10 @@ impl Settings {
             Slot::Count(place) => f64::from(*place(&mut copy)),
             Slot::Sign(place) => f64::from(*place(&mut copy)),
             Slot::Laser => self.laser_mode.code(),
+            Slot::Planner => match self.galvo.planner {
+                JumpPlanner::Optimal => 0.0,
+                JumpPlanner::Seed => 1.0,
+            },
         }
     }
 
@@ -393,6 +602,13 @@ impl Settings {
                     self.laser_mode = mode;
                 }
             }
+            Slot::Planner => {
+                self.galvo.planner = if value == 1.0 {
+                    JumpPlanner::Seed
+                } else {
+                    JumpPlanner::Optimal
+                };
+            }
         }
     }
 
@@ -412,6 +628,9 @@ impl Settings {
                     "servo min_deg must be below max_deg",
                 ));
             }
+        }
+        if self.galvo.x_codes_per_rad == 0.0 || self.galvo.y_codes_per_rad == 0.0 {
+            return Err(CommandError::Rejected("galvo codes_per_rad must not be 0"));
         }
         if self.yaw.id == self.pitch.id {
             return Err(CommandError::Rejected("yaw.id and pitch.id must differ"));
@@ -437,6 +656,9 @@ fn check_value(param: &ParamSpec, value: f64) -> Result<(), CommandError> {
         Slot::Sign(_) if value != 1.0 && value != -1.0 => {
             Err(CommandError::Rejected("direction must be 1 or -1"))
         }
+        Slot::Planner if value != 0.0 && value != 1.0 => {
+            Err(CommandError::Rejected("galvo.planner must be 0 or 1"))
+        }
         Slot::Laser if LaserMode::from_code(value).is_none() => {
             Err(CommandError::Rejected("laser.mode must be 0, 1 or 2"))
         }
@@ -460,7 +682,7 @@ impl fmt::Display for ParamLine<'_> {
 }
 
 /// Saved-record layout version; bump when [`PARAMS`] changes.
-pub const RECORD_VERSION: u16 = 1;
+pub const RECORD_VERSION: u16 = 2;
 /// Record magic.
 const RECORD_MAGIC: [u8; 4] = *b"LPS1";
 /// Bytes of a saved record: magic, version, count, values, CRC-32.

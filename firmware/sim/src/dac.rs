@@ -2,14 +2,13 @@
 //! in virtual time, with the same refill deadlines as the target's
 //! timer-triggered DMA, so a loop that is too slow underruns here too.
 //!
-//! Half `h` is output during `[start + h·H, start + (h+1)·H)` (`H` = half
-//! length × sample period). Its physical buffer is free once the DAC has
-//! moved on to half `h − 1`, and must be written before half `h` starts.
-//! The loop's compute time is modelled by charging
-//! `compute_ns_per_sample` per written sample before the deadline check.
-//! A late write makes the DAC replay the stale content of each half it
-//! reaches, exactly as circular DMA does, and every output sample is
-//! recorded.
+//! The DAC outputs half after half without gaps. A half's physical buffer
+//! is free once the DAC has moved on to the half before it, and must be
+//! written before the DAC reaches it. The loop's compute time is modelled
+//! by charging `compute_ns_per_sample` per written sample before the
+//! deadline check. A late write makes the DAC replay the stale content of
+//! each half it reaches, exactly as circular DMA does. Every output sample
+//! is recorded with its time.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -17,30 +16,59 @@ use std::rc::Rc;
 use embassy_time::{Instant, Timer};
 use laser_app::galvo::{DacSample, DacStream, Underrun};
 
-/// Every sample the DAC output, in order: sample `k` was output at
-/// `start_us + k · period_us`.
+/// Every sample the DAC output, in order, with its output time, stored
+/// as runs of identical samples (a DAC holding still for minutes costs one
+/// entry, not millions).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DacRecording {
-    /// Time of sample 0, µs.
-    pub start_us: u64,
-    /// Sample period, µs.
-    pub period_us: u64,
-    /// The output samples.
-    pub samples: Vec<DacSample>,
+    runs: Vec<SampleRun>,
+    len: usize,
     /// `(first sample index, halves)` of each underrun: where stale
     /// samples were replayed.
     pub underruns: Vec<(usize, u32)>,
 }
 
+/// `count` equal samples from `start_ns`, one per `period_ns`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct SampleRun {
+    start_ns: u64,
+    period_ns: u64,
+    count: u64,
+    sample: DacSample,
+}
+
 impl DacRecording {
+    /// Samples output so far.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether nothing was output.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Every sample with its output time (ns), in order.
+    pub fn iter(&self) -> impl Iterator<Item = (u64, DacSample)> + '_ {
+        self.runs
+            .iter()
+            .flat_map(|r| (0..r.count).map(move |i| (r.start_ns + i * r.period_ns, r.sample)))
+    }
+
+    /// Runs of equal samples: `(start ns, period ns, count, sample)`.
+    pub fn runs(&self) -> impl Iterator<Item = (u64, u64, u64, DacSample)> + '_ {
+        self.runs
+            .iter()
+            .map(|r| (r.start_ns, r.period_ns, r.count, r.sample))
+    }
+
     /// `k,t_s,dac_x,dac_y,laser` for every sample (`--dac` file).
     pub fn csv(&self) -> String {
         let mut out = String::from("k,t_s,dac_x,dac_y,laser\n");
-        for (k, s) in self.samples.iter().enumerate() {
-            let t_us = self.start_us + k as u64 * self.period_us;
+        for (k, (t_ns, s)) in self.iter().enumerate() {
             out.push_str(&format!(
                 "{k},{:.6},{},{},{}\n",
-                t_us as f64 * 1e-6,
+                t_ns as f64 * 1e-9,
                 s.x_code,
                 s.y_code,
                 u8::from(s.laser)
@@ -48,64 +76,98 @@ impl DacRecording {
         }
         out
     }
+
+    fn push_half(&mut self, start_ns: u64, period_ns: u64, half: &[DacSample]) {
+        for (i, &sample) in half.iter().enumerate() {
+            let t_ns = start_ns + i as u64 * period_ns;
+            self.len += 1;
+            if let Some(last) = self.runs.last_mut()
+                && last.sample == sample
+                && last.period_ns == period_ns
+                && last.start_ns + last.count * period_ns == t_ns
+            {
+                last.count += 1;
+                continue;
+            }
+            self.runs.push(SampleRun {
+                start_ns: t_ns,
+                period_ns,
+                count: 1,
+                sample,
+            });
+        }
+    }
 }
 
 /// The simulated DAC (implements [`DacStream`]).
 pub struct SimDac {
     half_len: usize,
-    period_us: u64,
-    start_us: u64,
-    /// Index of the next half to write.
+    /// Period for halves written from now on, ns.
+    period_ns: u64,
+    /// When the DAC starts the half to be written next (its deadline), ns.
+    next_start_ns: u64,
+    /// When the DAC started the half before it (the buffer is free from
+    /// then), ns.
+    free_from_ns: u64,
+    /// Index of the next half (selects the physical buffer).
     next_half: u64,
-    /// Content of the two physical halves.
-    buffers: [Vec<DacSample>; 2],
+    /// Content and period (ns) of the two physical halves.
+    buffers: [(Vec<DacSample>, u64); 2],
     compute_ns_per_sample: u64,
     recording: Rc<RefCell<DacRecording>>,
 }
 
 impl SimDac {
-    /// A DAC with `half_len`-sample halves at `period_us` per sample,
+    /// A DAC with `half_len`-sample halves at `period_ns` per sample,
     /// starting one half period from now (time to fill the first half),
-    /// charging `compute_ns_per_sample` of loop time per sample.
+    /// charging `compute_ns_per_sample` of loop time per written sample.
     pub fn new(
         half_len: usize,
-        period_us: u64,
+        period_ns: u64,
         compute_ns_per_sample: u64,
         recording: Rc<RefCell<DacRecording>>,
     ) -> Self {
         let half_len = half_len.max(1);
-        let period_us = period_us.max(1);
-        let start_us = Instant::now().as_micros() + half_len as u64 * period_us;
-        {
-            let mut rec = recording.borrow_mut();
-            rec.start_us = start_us;
-            rec.period_us = period_us;
-        }
+        let period_ns = period_ns.max(1);
+        let now_ns = Instant::now().as_micros() * 1000;
         Self {
             half_len,
-            period_us,
-            start_us,
+            period_ns,
+            next_start_ns: now_ns + half_len as u64 * period_ns,
+            free_from_ns: now_ns,
             next_half: 0,
             buffers: [
-                vec![DacSample::default(); half_len],
-                vec![DacSample::default(); half_len],
+                (vec![DacSample::default(); half_len], period_ns),
+                (vec![DacSample::default(); half_len], period_ns),
             ],
             compute_ns_per_sample,
             recording,
         }
     }
 
-    fn half_us(&self) -> u64 {
-        self.half_len as u64 * self.period_us
-    }
-
-    /// Start of half `h`'s output, µs.
-    fn half_start_us(&self, h: u64) -> u64 {
-        self.start_us + h * self.half_us()
-    }
-
     fn physical(h: u64) -> usize {
         (h % 2) as usize
+    }
+
+    /// The DAC moves on past the half at `next_start_ns` with the content
+    /// its buffer holds.
+    fn advance(&mut self, written: Option<&[DacSample]>) {
+        let slot = Self::physical(self.next_half);
+        if let Some(samples) = written {
+            let buffer = &mut self.buffers[slot];
+            buffer.0.clear();
+            buffer.0.extend(samples.iter().copied().take(self.half_len));
+            let last = samples.last().copied().unwrap_or_default();
+            buffer.0.resize(self.half_len, last);
+            buffer.1 = self.period_ns;
+        }
+        let (content, period_ns) = &self.buffers[slot];
+        self.recording
+            .borrow_mut()
+            .push_half(self.next_start_ns, *period_ns, content);
+        self.free_from_ns = self.next_start_ns;
+        self.next_start_ns += self.half_len as u64 * period_ns;
+        self.next_half += 1;
     }
 }
 
@@ -114,42 +176,38 @@ impl DacStream for SimDac {
         self.half_len
     }
 
-    async fn write_half(&mut self, samples: &[DacSample]) -> Result<(), Underrun> {
-        let compute_us = (self.compute_ns_per_sample * samples.len() as u64).div_ceil(1000);
-        Timer::after_micros(compute_us).await;
-        let now = Instant::now().as_micros();
-        let deadline = self.half_start_us(self.next_half);
-        let mut result = Ok(());
-        if now > deadline {
-            // The DAC reached these halves before they were written and
-            // replayed what their buffers held.
-            let halves = ((now - deadline) / self.half_us() + 1) as u32;
-            let mut rec = self.recording.borrow_mut();
-            let at = rec.samples.len();
-            rec.underruns.push((at, halves));
-            for h in self.next_half..self.next_half + u64::from(halves) {
-                let stale = self.buffers[Self::physical(h)].clone();
-                rec.samples.extend_from_slice(&stale);
-            }
-            self.next_half += u64::from(halves);
-            result = Err(Underrun { halves });
-        } else {
-            // The buffer is free once the DAC reads the previous half.
-            let free_at = deadline.saturating_sub(self.half_us());
-            if now < free_at {
-                Timer::at(Instant::from_micros(free_at)).await;
-            }
+    fn set_sample_period(&mut self, period_s: f64) {
+        if period_s.is_finite() && period_s > 0.0 {
+            self.period_ns = (period_s * 1e9).round().max(1.0) as u64;
         }
-        let h = self.next_half;
-        let buffer = &mut self.buffers[Self::physical(h)];
-        buffer.clear();
-        buffer.extend(samples.iter().copied().take(self.half_len));
-        buffer.resize(self.half_len, samples.last().copied().unwrap_or_default());
-        self.recording
-            .borrow_mut()
-            .samples
-            .extend_from_slice(buffer);
-        self.next_half += 1;
-        result
+    }
+
+    async fn write_half(&mut self, samples: &[DacSample]) -> Result<(), Underrun> {
+        let compute_ns = self.compute_ns_per_sample * samples.len() as u64;
+        Timer::after_micros(compute_ns.div_ceil(1000)).await;
+        let now_ns = Instant::now().as_micros() * 1000;
+        let mut halves = 0;
+        while now_ns > self.next_start_ns {
+            // The DAC reached this half before it was written: stale replay.
+            if halves == 0 {
+                let at = self.recording.borrow().len();
+                self.recording.borrow_mut().underruns.push((at, 0));
+            }
+            self.advance(None);
+            halves += 1;
+        }
+        if halves > 0 {
+            if let Some(last) = self.recording.borrow_mut().underruns.last_mut() {
+                last.1 = halves;
+            }
+        } else if now_ns < self.free_from_ns {
+            Timer::at(Instant::from_micros(self.free_from_ns.div_ceil(1000))).await;
+        }
+        self.advance(Some(samples));
+        if halves > 0 {
+            Err(Underrun { halves })
+        } else {
+            Ok(())
+        }
     }
 }

@@ -21,8 +21,23 @@ pub struct GridView {
     pub half_rows: i32,
 }
 
-/// Renders `recording` into an SVG document.
-pub fn render_svg(recording: &Recording, grid: GridView, title: &str) -> Result<String> {
+/// The galvo spot to draw, cm.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct GalvoTrace {
+    /// Path of the spot while it moved (laser off: jumps).
+    pub path: Vec<(f64, f64)>,
+    /// Where the laser was on.
+    pub lit: Vec<(f64, f64)>,
+}
+
+/// Renders the gimbal's `recording` and the `galvo` trace into an SVG
+/// document.
+pub fn render_svg(
+    recording: &Recording,
+    galvo: &GalvoTrace,
+    grid: GridView,
+    title: &str,
+) -> Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (960, 680)).into_drawing_area();
@@ -114,6 +129,29 @@ pub fn render_svg(recording: &Recording, grid: GridView, title: &str) -> Result<
                 .legend(|(x, y)| Cross::new((x + 10, y), 5, GREEN.stroke_width(2)));
         }
 
+        if galvo.path.len() > 1 {
+            chart
+                .draw_series(LineSeries::new(
+                    galvo.path.iter().copied(),
+                    ShapeStyle::from(&MAGENTA.mix(0.3)).stroke_width(1),
+                ))
+                .map_err(|e| anyhow!("{e}"))?
+                .label("galvo spot, laser off")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], MAGENTA.mix(0.3)));
+        }
+        if !galvo.lit.is_empty() {
+            chart
+                .draw_series(
+                    galvo
+                        .lit
+                        .iter()
+                        .map(|&p| Circle::new(p, 4, ShapeStyle::from(&MAGENTA).filled())),
+                )
+                .map_err(|e| anyhow!("{e}"))?
+                .label("galvo spot, laser on")
+                .legend(|(x, y)| Circle::new((x + 10, y), 4, MAGENTA.filled()));
+        }
+
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.85))
@@ -156,7 +194,7 @@ mod tests {
             half_cols: 6,
             half_rows: 4,
         };
-        let svg = render_svg(&rec, grid, "test").unwrap();
+        let svg = render_svg(&rec, &GalvoTrace::default(), grid, "test").unwrap();
         assert!(svg.starts_with("<svg"));
         assert!(
             svg.matches("<circle").count() >= 13 * 9,

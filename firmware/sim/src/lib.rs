@@ -15,11 +15,33 @@ pub mod servo_port;
 pub mod usb_host;
 pub mod world;
 
-/// Draws a run: board, grid (default geometry), spot path and dwells.
+/// The galvo spot of a run: its path and where the laser was on (cm).
+pub fn galvo_trace(dac: &dac::DacRecording, galvo: &physics::PhysicalGalvo) -> drawing::GalvoTrace {
+    let mut trace = drawing::GalvoTrace::default();
+    for (_, _, _, sample) in dac.runs() {
+        let Some(spot) = galvo.spot_cm(sample.x_code, sample.y_code) else {
+            continue;
+        };
+        if trace.path.last() != Some(&spot) {
+            trace.path.push(spot);
+        }
+        if sample.laser && trace.lit.last() != Some(&spot) {
+            trace.lit.push(spot);
+        }
+    }
+    // A galvo that never moved is not worth drawing.
+    if trace.path.len() < 2 && trace.lit.is_empty() {
+        trace.path.clear();
+    }
+    trace
+}
+
+/// Draws a run: board, grid (default geometry), both spots and dwells.
 pub fn render(report: &world::SimReport, title: &str) -> anyhow::Result<String> {
     let settings = laser_app::settings::Settings::default();
     drawing::render_svg(
         &report.recording,
+        &galvo_trace(&report.dac, &physics::PhysicalGalvo::default()),
         drawing::GridView {
             pitch_cm: settings.grid_pitch_cm,
             half_cols: i32::from(settings.grid_cols / 2),

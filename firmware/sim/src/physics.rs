@@ -4,7 +4,7 @@
 //! forward kinematics of `kinematics-core` (SPEC §4.3), independent of the
 //! model the firmware aims with.
 
-use kinematics_core::{Gimbal, GimbalModel, JointAngles};
+use kinematics_core::{Galvo, Gimbal, GimbalModel, JointAngles};
 
 /// The physical gimbal: which bus ids drive which joint, and its true
 /// geometry and servo mapping.
@@ -42,6 +42,23 @@ impl PhysicalGimbal {
         };
         let p = self.gimbal.fk(joints).ok()?;
         Some((p.x_cm, p.y_cm))
+    }
+}
+
+/// The physical galvo: the SPEC default geometry and DAC span. The
+/// mirrors follow the DAC ideally (each sample's angle is reached within
+/// the sample: the planner's trajectories respect the drive's limits).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PhysicalGalvo {
+    /// True geometry and DAC mapping.
+    pub galvo: Galvo<f64>,
+}
+
+impl PhysicalGalvo {
+    /// Board point (cm) of the spot for DAC codes `x_code`, `y_code`.
+    pub fn spot_cm(&self, x_code: u16, y_code: u16) -> Option<(f64, f64)> {
+        let p = self.galvo.codes_to_board(x_code, y_code).ok()?;
+        Some((p.x_mm / 10.0, p.y_mm / 10.0))
     }
 }
 

@@ -7,11 +7,15 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use embassy_time::Timer;
+use std::sync::atomic::Ordering;
+
 use laser_app::command::CommandLink;
+use laser_app::galvo::{GalvoConfig, GalvoLink, GalvoLoop};
 use laser_app::sequencer::{LaserSwitch, Sequencer, SettingsStore};
 use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
 use laser_app::status::{Activity, Phase, StatusBoard};
 
+use crate::dac::{DacRecording, SimDac};
 use crate::executor::{self, RunEnd};
 use crate::physics::PhysicalGimbal;
 use crate::recorder::{DwellRecord, Recording, SpotSample};
@@ -19,6 +23,9 @@ use crate::script::Step;
 use crate::servo_model::SimServoBus;
 use crate::servo_port::{BusFaults, PortHandle, SimServoPort};
 use crate::usb_host::{Transcript, UsbHost, script_task, terminal_task};
+
+/// Samples per galvo DAC half buffer (1.28 ms at 100 kHz).
+pub const GALVO_HALF_LEN: usize = 128;
 
 /// How to run a simulation.
 #[derive(Debug, Clone)]
@@ -44,6 +51,9 @@ pub struct SimOptions {
     /// The true gimbal: bus ids, geometry, servo mounting and board pose
     /// (set a pose or zero error to model a real, imperfect build).
     pub physical: PhysicalGimbal,
+    /// Galvo loop compute time charged per DAC sample, ns (0: the loop
+    /// is instant; above the sample period it underruns).
+    pub galvo_cost_ns_per_sample: u64,
 }
 
 impl Default for SimOptions {
@@ -59,6 +69,7 @@ impl Default for SimOptions {
             sample_period_us: 2_000,
             saved_settings: None,
             physical: PhysicalGimbal::default(),
+            galvo_cost_ns_per_sample: 0,
         }
     }
 }
@@ -78,6 +89,10 @@ pub struct SimReport {
     pub idle_at_end: bool,
     /// Settings record saved with `save` during the run, if any.
     pub saved_settings: Option<Vec<u8>>,
+    /// Every galvo DAC sample.
+    pub dac: DacRecording,
+    /// Galvo underruns.
+    pub galvo_underruns: u32,
 }
 
 impl SimReport {
@@ -136,6 +151,8 @@ fn is_idle(status: &StatusBoard) -> bool {
 pub fn run(options: SimOptions) -> SimReport {
     let link: &'static CommandLink = Box::leak(Box::new(CommandLink::new()));
     let servo_link: &'static ServoLink = Box::leak(Box::new(ServoLink::new()));
+    let galvo_link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
+    let dac_recording = Rc::new(RefCell::new(DacRecording::default()));
     let status: &'static StatusBoard = Box::leak(Box::new(StatusBoard::new()));
     let host = Rc::new(UsbHost::new(options.echo));
     let recording = Rc::new(RefCell::new(Recording::default()));
@@ -161,6 +178,7 @@ pub fn run(options: SimOptions) -> SimReport {
             options.script.clone(),
         );
         let until_idle = options.until_idle;
+        let galvo_dac = dac_recording.clone();
         let stop_host = host.clone();
         executor::run(
             options.realtime,
@@ -188,8 +206,23 @@ pub fn run(options: SimOptions) -> SimReport {
                 let store = MemoryStore(flash.clone());
                 executor::spawn(&spawner, async move {
                     let mut sequencer =
-                        Sequencer::new(link, servo_link, status, laser, store).await;
+                        Sequencer::new(link, servo_link, Some(galvo_link), status, laser, store)
+                            .await;
                     sequencer.run().await;
+                });
+                let (dac_recording, cost) = (galvo_dac, options.galvo_cost_ns_per_sample);
+                executor::spawn(&spawner, async move {
+                    let config = GalvoConfig::default();
+                    let mut dac = SimDac::new(
+                        GALVO_HALF_LEN,
+                        (config.sample_period_s * 1e9) as u64,
+                        cost,
+                        dac_recording,
+                    );
+                    match GalvoLoop::new(config) {
+                        Ok(mut galvo) => galvo.run(&mut dac, galvo_link).await,
+                        Err(e) => log::error!("galvo loop not started: {e}"),
+                    }
                 });
                 executor::spawn(
                     &spawner,
@@ -211,6 +244,7 @@ pub fn run(options: SimOptions) -> SimReport {
     let transcript = host.transcript.borrow().clone();
     let recording = recording.borrow().clone();
     let saved_settings = flash.borrow().clone();
+    let dac = dac_recording.borrow().clone();
     SimReport {
         transcript,
         recording,
@@ -218,6 +252,8 @@ pub fn run(options: SimOptions) -> SimReport {
         end_time_us: crate::clock::now_us(),
         idle_at_end: is_idle(status),
         saved_settings,
+        dac,
+        galvo_underruns: galvo_link.underruns.load(Ordering::Relaxed),
     }
 }
 

@@ -2,8 +2,8 @@
 
 use super::args::Args;
 use super::error::{CommandError, word};
-use crate::command::{AimModel, Command, GridPattern, Pattern, PointCm, Rotation};
-use crate::settings::{LaserMode, find_param};
+use crate::command::{Actuator, AimModel, Command, GridPattern, Pattern, PointCm, Rotation};
+use crate::settings::{JumpPlanner, LaserMode, find_param};
 
 /// Largest board coordinate accepted anywhere, cm.
 pub const BOARD_LIMIT_CM: f64 = 200.0;
@@ -32,6 +32,37 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
         Command::Stop
     } else if is("params") {
         Command::Params
+    } else if is("target") {
+        let which = args.word("gimbal|galvo|both")?;
+        Command::Target(
+            [Actuator::Gimbal, Actuator::Galvo, Actuator::Both]
+                .into_iter()
+                .find(|a| a.name().eq_ignore_ascii_case(which))
+                .ok_or(CommandError::InvalidArgument {
+                    expected: "gimbal|galvo|both",
+                    got: word(which),
+                })?,
+        )
+    } else if is("planner") {
+        let which = args.word("optimal|seed")?;
+        Command::Planner(
+            [JumpPlanner::Optimal, JumpPlanner::Seed]
+                .into_iter()
+                .find(|p| p.name().eq_ignore_ascii_case(which))
+                .ok_or(CommandError::InvalidArgument {
+                    expected: "optimal|seed",
+                    got: word(which),
+                })?,
+        )
+    } else if is("galvo") {
+        let what = args.word("status")?;
+        if !what.eq_ignore_ascii_case("status") {
+            return Err(CommandError::InvalidArgument {
+                expected: "status",
+                got: word(what),
+            });
+        }
+        Command::GalvoStatus
     } else if is("save") {
         Command::Save
     } else if is("pattern") {
@@ -178,6 +209,9 @@ pub const HELP_LINES: &[&str] = &[
     "grid <xi> <yi>               aim at a grid point",
     "laser on|off|auto|dwell      laser mode",
     "model exact|seed             gimbal kinematic model",
+    "target gimbal|galvo|both     which actuator draws",
+    "planner optimal|seed         galvo jump planner",
+    "galvo status                 galvo loop state, underruns",
     "set <param> <value>          change a parameter",
     "get <param>                  read a parameter",
     "params                       list parameters",
@@ -322,6 +356,11 @@ mod tests {
         assert_eq!(ok("laser DWELL"), Command::Laser(LaserMode::Dwell));
         assert_eq!(ok("laser on"), Command::Laser(LaserMode::Auto));
         assert_eq!(ok("laser off"), Command::Laser(LaserMode::Off));
+        assert_eq!(ok("target GALVO"), Command::Target(Actuator::Galvo));
+        assert_eq!(ok("planner seed"), Command::Planner(JumpPlanner::Seed));
+        assert_eq!(ok("galvo status"), Command::GalvoStatus);
+        assert!(parse_line("target laser").is_err());
+        assert!(parse_line("galvo go").is_err());
         assert!(parse_line("laser maybe").is_err());
         assert_eq!(ok("model seed"), Command::Model(AimModel::Seed));
         assert!(parse_line("model exactish").is_err());
@@ -351,6 +390,9 @@ mod tests {
             "grid 1 1",
             "laser on",
             "model exact",
+            "target both",
+            "planner seed",
+            "galvo status",
             "set dwell_ms 1",
             "get dwell_ms",
             "params",

@@ -11,18 +11,62 @@
 //! dwell with the laser on, and a laser-off delay. A half the DAC had
 //! already begun to replay is an underrun: counted, reported, laser off.
 //!
-//! Status: the loop body, its DAC interface and the simulated DAC are
-//! done and tested; the sequencer commands (`target galvo`) and the
-//! target's timer-triggered DAC DMA are not wired yet.
+//! The sequencer drives it through [`GalvoLink`] (`target galvo|both`);
+//! the simulator feeds a simulated DAC. Not wired yet: the target's
+//! timer-triggered DAC DMA (see the README's status).
 
 mod scan;
 
+/// Whether this build drives a galvo (cargo feature `galvo`). The
+/// simulator has it; the firmware leaves it out until the DAC output is
+/// wired and fits the flash budget. Without it every galvo code path in
+/// the sequencer is compiled out (`target galvo|both` is refused).
+pub const GALVO_OUTPUT: bool = cfg!(feature = "galvo");
+
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, Phase};
 
-use core::sync::atomic::AtomicU32;
+use core::sync::atomic::{AtomicU8, AtomicU32, Ordering};
+
+use galvo_planner::{Method, RigidParams};
+use kinematics_core::{DacAxis, Galvo, GalvoGeometry};
+
+use crate::settings::{GalvoSettings, JumpPlanner};
+
+/// The loop configuration for the user's galvo parameters.
+pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
+    let dac = |codes_per_rad: f64, offset_code: f64| DacAxis {
+        codes_per_rad: codes_per_rad as f32,
+        offset_code: offset_code as f32,
+    };
+    GalvoConfig {
+        sample_period_s: settings.sample_period_us * 1e-6,
+        galvo: Galvo {
+            geometry: GalvoGeometry {
+                d_mm: settings.d_mm as f32,
+                e_mm: settings.e_mm as f32,
+            },
+            dac_x: dac(settings.x_codes_per_rad, settings.x_offset_code),
+            dac_y: dac(settings.y_codes_per_rad, settings.y_offset_code),
+        },
+        mirrors: RigidParams {
+            kt_nm_per_a: settings.kt_nm_per_a,
+            j_kg_m2: settings.j_kg_m2,
+            l_h: settings.l_h,
+            r_ohm: settings.r_ohm,
+            u_max_v: settings.u_max_v,
+        },
+        method: match settings.planner {
+            JumpPlanner::Optimal => Method::TimeOptimal,
+            JumpPlanner::Seed => Method::SEED,
+        },
+        laser_on_delay_us: settings.laser_on_delay_us as u32,
+        laser_off_delay_us: settings.laser_off_delay_us as u32,
+    }
+}
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
+use embassy_sync::signal::Signal;
 
 /// One DAC sample: both 12-bit codes and the laser enable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -52,6 +96,9 @@ pub trait DacStream {
     /// Samples per half buffer.
     fn half_len(&self) -> usize;
 
+    /// Sets the sample period (s) for the halves written from now on.
+    fn set_sample_period(&mut self, period_s: f64);
+
     /// Waits until the half the DAC is not reading is free, then stores
     /// `samples` (`half_len` of them) in it. `Err` when the DAC had
     /// already started on that half (the loop was late): the samples are
@@ -61,7 +108,6 @@ pub trait DacStream {
 
 /// What the sequencer asks of the galvo loop.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum GalvoRequest {
     /// Jump to a board point (mm, galvo frame) with the laser off, then
     /// dwell there with the laser on.
@@ -99,18 +145,52 @@ pub enum GalvoEvent {
     /// The loop was late; the laser was turned off and queued points
     /// dropped.
     Underrun(Underrun),
+    /// New parameters were refused (the old ones stay).
+    ConfigRefused(GalvoError),
 }
 
 /// Channels and counters between the sequencer and the galvo loop.
 pub struct GalvoLink {
     /// Sequencer → galvo loop.
     pub requests: Channel<CriticalSectionRawMutex, GalvoRequest, 4>,
+    /// New parameters (the latest wins), applied between points, never
+    /// mid-move.
+    pub config: Signal<CriticalSectionRawMutex, GalvoConfig>,
     /// Galvo loop → sequencer.
     pub events: Channel<CriticalSectionRawMutex, GalvoEvent, 4>,
     /// Underruns since boot.
     pub underruns: AtomicU32,
     /// Half buffers written since boot (liveness for the watchdog).
     pub halves: AtomicU32,
+    /// [`Phase`] after the last half buffer.
+    phase: AtomicU8,
+    /// Points queued in the loop after the last half buffer.
+    queued: AtomicU8,
+}
+
+const PHASES: [Phase; 5] = [
+    Phase::Idle,
+    Phase::Jumping,
+    Phase::Settling,
+    Phase::Dwelling,
+    Phase::LaserOffDelay,
+];
+
+impl GalvoLink {
+    /// The loop's phase and queued points after its last half buffer.
+    pub fn state(&self) -> (Phase, usize) {
+        let phase = PHASES
+            .get(usize::from(self.phase.load(Ordering::Relaxed)))
+            .copied()
+            .unwrap_or(Phase::Idle);
+        (phase, usize::from(self.queued.load(Ordering::Relaxed)))
+    }
+
+    fn publish(&self, phase: Phase, queued: usize) {
+        let code = PHASES.iter().position(|p| *p == phase).unwrap_or(0);
+        self.phase.store(code as u8, Ordering::Relaxed);
+        self.queued.store(queued.min(255) as u8, Ordering::Relaxed);
+    }
 }
 
 impl GalvoLink {
@@ -118,9 +198,12 @@ impl GalvoLink {
     pub const fn new() -> Self {
         Self {
             requests: Channel::new(),
+            config: Signal::new(),
             events: Channel::new(),
             underruns: AtomicU32::new(0),
             halves: AtomicU32::new(0),
+            phase: AtomicU8::new(0),
+            queued: AtomicU8::new(0),
         }
     }
 }

@@ -5,6 +5,8 @@ use core::fmt;
 use core::sync::atomic::Ordering;
 
 use galvo_planner::{Discrete, JumpSync, Method, RigidParams, XyStepper, plan_xy_jump};
+
+use crate::settings::GalvoSettings;
 use kinematics_core::{Galvo, MirrorAngles, PointMm};
 
 use super::{DacSample, DacStream, GalvoEvent, GalvoLink, GalvoRequest};
@@ -36,17 +38,11 @@ pub struct GalvoConfig {
 }
 
 impl Default for GalvoConfig {
-    /// 100 kHz, SPEC galvo geometry and DAC span, reference mirror drive,
-    /// time-optimal jumps, 100 µs laser delays.
+    /// The default galvo parameters ([`GalvoSettings::default`]): 100 kHz,
+    /// SPEC geometry and DAC span, reference mirror drive, time-optimal
+    /// jumps, 100 µs laser delays.
     fn default() -> Self {
-        Self {
-            sample_period_s: 10e-6,
-            galvo: Galvo::default(),
-            mirrors: RigidParams::REFERENCE,
-            method: Method::TimeOptimal,
-            laser_on_delay_us: 100,
-            laser_off_delay_us: 100,
-        }
+        super::config_from(&GalvoSettings::default())
     }
 }
 
@@ -95,12 +91,13 @@ pub enum Phase {
     LaserOffDelay,
 }
 
-/// A queued point, in samples.
+/// A queued point (converted to angles when its jump starts, with the
+/// configuration in force then).
 #[derive(Debug, Clone, Copy)]
 struct Point {
     seq: u32,
-    target_rad: [f64; 2],
-    dwell_samples: u32,
+    target_mm: PointMm,
+    dwell_us: u32,
 }
 
 /// The point being visited.
@@ -128,6 +125,8 @@ pub struct GalvoLoop {
     last: DacSample,
     /// Latched by an underrun: points are refused until `Stop`.
     faulted: bool,
+    /// Parameters to apply at the next point boundary.
+    pending_config: Option<GalvoConfig>,
     on_delay_samples: u32,
     off_delay_samples: u32,
 }
@@ -143,17 +142,23 @@ impl GalvoLoop {
     /// Errors: [`GalvoError::Planner`] for an invalid mirror model or
     /// sample period, [`GalvoError::Kinematics`] for invalid geometry.
     pub fn new(config: GalvoConfig) -> Result<Self, GalvoError> {
+        Self::holding_at(config, [0.0, 0.0])
+    }
+
+    /// A loop holding the mirrors at `angles_rad`, laser off.
+    fn holding_at(config: GalvoConfig, angles_rad: [f64; 2]) -> Result<Self, GalvoError> {
         let disc = config
             .mirrors
             .model()
             .and_then(|m| m.discretize(config.sample_period_s))
             .map_err(|_| GalvoError::Planner)?;
-        let mirrors = XyStepper::new(&disc, &disc, [0.0, 0.0]).map_err(|_| GalvoError::Planner)?;
+        let mirrors = XyStepper::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
+        let [x_rad, y_rad] = angles_rad;
         let centre = config
             .galvo
             .angles_to_codes(MirrorAngles {
-                x_rad: 0.0,
-                y_rad: 0.0,
+                x_rad: x_rad as f32,
+                y_rad: y_rad as f32,
             })
             .map_err(|_| GalvoError::Kinematics)?;
         let ts = config.sample_period_s;
@@ -169,6 +174,7 @@ impl GalvoLoop {
                 laser: false,
             },
             faulted: false,
+            pending_config: None,
             on_delay_samples: samples_for(config.laser_on_delay_us, ts),
             off_delay_samples: samples_for(config.laser_off_delay_us, ts),
             config,
@@ -204,7 +210,18 @@ impl GalvoLoop {
                 y_mm,
                 dwell_us,
             } => match self.point(seq, x_mm, y_mm, dwell_us) {
-                Ok(point) => match self.queue.push_back(point) {
+                Ok(_) if self.queue.is_full() => Some(GalvoEvent::Refused {
+                    seq,
+                    error: GalvoError::QueueFull,
+                }),
+                Ok(_) => match self.queue.push_back(Point {
+                    seq,
+                    target_mm: PointMm {
+                        x_mm: f64::from(x_mm),
+                        y_mm: f64::from(y_mm),
+                    },
+                    dwell_us,
+                }) {
                     Ok(()) => None,
                     Err(_) => Some(GalvoEvent::Refused {
                         seq,
@@ -216,12 +233,9 @@ impl GalvoLoop {
         }
     }
 
-    /// Checks a point and converts it to mirror angles (f64, for planning).
-    fn point(&self, seq: u32, x_mm: f32, y_mm: f32, dwell_us: u32) -> Result<Point, GalvoError> {
-        let target = PointMm {
-            x_mm: f64::from(x_mm),
-            y_mm: f64::from(y_mm),
-        };
+    /// Checks a point (mm) and converts it to mirror angles (rad, f64 for
+    /// planning).
+    fn angles_for(&self, target: PointMm) -> Result<[f64; 2], GalvoError> {
         let codes = self
             .planning
             .board_to_codes(target)
@@ -234,11 +248,49 @@ impl GalvoLoop {
             .geometry
             .ik(target)
             .map_err(|_| GalvoError::Kinematics)?;
-        Ok(Point {
-            seq,
-            target_rad: [angles.x_rad, angles.y_rad],
-            dwell_samples: samples_for(dwell_us, self.config.sample_period_s),
+        Ok([angles.x_rad, angles.y_rad])
+    }
+
+    /// Checks a requested point against the current configuration.
+    fn point(&self, _seq: u32, x_mm: f32, y_mm: f32, _dwell_us: u32) -> Result<(), GalvoError> {
+        self.angles_for(PointMm {
+            x_mm: f64::from(x_mm),
+            y_mm: f64::from(y_mm),
         })
+        .map(|_| ())
+    }
+
+    /// New parameters, applied at the next point boundary (a new sample
+    /// period at the next half-buffer boundary with no point running).
+    pub fn configure(&mut self, config: GalvoConfig) {
+        self.pending_config = Some(config);
+    }
+
+    /// Applies new parameters if no point is running (else at the next
+    /// point boundary; a new sample period only at a half-buffer
+    /// boundary, so every half has one period); a refused configuration is
+    /// reported and dropped.
+    fn apply_pending_config(&mut self, at_half_boundary: bool) -> Option<GalvoEvent> {
+        let config = self.pending_config?;
+        if self.active.is_some()
+            || (!at_half_boundary && config.sample_period_s != self.config.sample_period_s)
+        {
+            return None;
+        }
+        self.pending_config = None;
+        if config == self.config {
+            return None;
+        }
+        match Self::holding_at(config, self.mirrors.end_position_rad()) {
+            Ok(mut fresh) => {
+                fresh.queue = core::mem::take(&mut self.queue);
+                fresh.faulted = self.faulted;
+                *self = fresh;
+                log::info!("galvo: new parameters applied");
+                None
+            }
+            Err(error) => Some(GalvoEvent::ConfigRefused(error)),
+        }
     }
 
     /// Drops queued points and turns the laser off from the next sample;
@@ -285,6 +337,9 @@ impl GalvoLoop {
     fn advance(&mut self, on_event: &mut impl FnMut(GalvoEvent)) {
         loop {
             let Some(mut a) = self.active else {
+                if let Some(event) = self.apply_pending_config(false) {
+                    on_event(event);
+                }
                 let Some(point) = self.queue.pop_front() else {
                     return;
                 };
@@ -318,6 +373,16 @@ impl GalvoLoop {
 
     /// Plans and queues the jump to `point`.
     fn start(&mut self, point: Point, on_event: &mut impl FnMut(GalvoEvent)) {
+        let target_rad = match self.angles_for(point.target_mm) {
+            Ok(angles) => angles,
+            Err(error) => {
+                on_event(GalvoEvent::Refused {
+                    seq: point.seq,
+                    error,
+                });
+                return;
+            }
+        };
         let capacity = self
             .mirrors
             .x
@@ -327,7 +392,7 @@ impl GalvoLoop {
             &self.disc,
             &self.disc,
             self.mirrors.end_position_rad(),
-            point.target_rad,
+            target_rad,
             self.config.method,
             JumpSync::Independent,
             capacity,
@@ -339,7 +404,7 @@ impl GalvoLoop {
                     seq: point.seq,
                     phase: Phase::Jumping,
                     samples_left: 0,
-                    dwell_samples: point.dwell_samples,
+                    dwell_samples: samples_for(point.dwell_us, self.config.sample_period_s),
                     cancelled: false,
                 });
             }
@@ -364,17 +429,30 @@ impl GalvoLoop {
     pub async fn run<D: DacStream>(&mut self, dac: &mut D, link: &GalvoLink) -> ! {
         let n = dac.half_len().clamp(1, MAX_HALF_LEN);
         let mut half = [DacSample::default(); MAX_HALF_LEN];
+        let mut period_s = self.config.sample_period_s;
+        dac.set_sample_period(period_s);
         loop {
             while let Ok(request) = link.requests.try_receive() {
                 if let Some(event) = self.request(request) {
                     let _ = link.events.try_send(event);
                 }
             }
+            if let Some(config) = link.config.try_take() {
+                self.configure(config);
+            }
+            if let Some(event) = self.apply_pending_config(true) {
+                let _ = link.events.try_send(event);
+            }
+            if self.config.sample_period_s != period_s {
+                period_s = self.config.sample_period_s;
+                dac.set_sample_period(period_s);
+            }
             let out = &mut half[..n];
             self.fill(out, |event| {
                 let _ = link.events.try_send(event);
             });
             link.halves.fetch_add(1, Ordering::Relaxed);
+            link.publish(self.phase(), self.queue.len());
             if let Err(underrun) = dac.write_half(out).await {
                 link.underruns.fetch_add(underrun.halves, Ordering::Relaxed);
                 log::warning!(

@@ -6,9 +6,11 @@ use super::{LaserSwitch, Phase, Run, Sequencer, SettingsStore};
 use crate::build_info;
 use crate::cli::format::Fixed;
 use crate::cli::parse::HELP_LINES;
+use crate::command::{Actuator, ReplyText, reply_text};
 use crate::command::{AimModel, Command, Pattern, PointCm};
+use crate::galvo::GALVO_OUTPUT;
 use crate::settings::{PARAMS, ParamLine};
-use crate::status::Activity;
+use crate::status::{Activity, Snapshot};
 
 impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     /// Runs one command and sends its reply.
@@ -53,6 +55,31 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 Ok(target) => self.goto(target).await,
                 Err(reason) => link.error(reason).await,
             },
+            Command::Target(actuator)
+                if actuator != Actuator::Gimbal && !(GALVO_OUTPUT && self.galvo.is_some()) =>
+            {
+                link.error("this build has no galvo output").await
+            }
+            Command::Target(actuator) => {
+                // The running pattern or goto stops: it was checked for
+                // the old actuator.
+                self.stop("actuator changed");
+                self.actuator = actuator;
+                self.configure_galvo();
+                link.ok().await;
+            }
+            Command::Planner(_) | Command::GalvoStatus if !GALVO_OUTPUT => {
+                link.error("this build has no galvo output").await
+            }
+            Command::Planner(planner) => {
+                self.settings.galvo.planner = planner;
+                self.configure_galvo();
+                link.ok().await;
+            }
+            Command::GalvoStatus => {
+                self.report_galvo_status().await;
+                link.ok().await;
+            }
             Command::Laser(mode) => {
                 self.settings.laser_mode = mode;
                 link.ok().await;
@@ -69,7 +96,12 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 let before = self.settings;
                 match self.settings.set(param, value) {
                     Ok(()) => match self.check_current_run() {
-                        Ok(()) => link.ok().await,
+                        Ok(()) => {
+                            if GALVO_OUTPUT && before.galvo != self.settings.galvo {
+                                self.configure_galvo();
+                            }
+                            link.ok().await
+                        }
                         Err(reason) => {
                             self.settings = before;
                             link.error(reason).await;
@@ -114,7 +146,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
 
     /// Aims at one target and holds it; refuses unreachable targets.
     async fn goto(&mut self, target: Target) {
-        match targets::check_target(&self.settings, self.model, &target) {
+        match targets::check_target(&self.settings, self.model, self.actuator, &target) {
             Ok(_) => {
                 self.start(Run::new(None, Some(target), true));
                 self.link.ok().await;
@@ -125,7 +157,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
 
     /// Every point of `pattern` must be reachable before it starts.
     fn check_pattern(&self, pattern: &Pattern) -> Result<(), PatternError> {
-        targets::check_pattern(pattern, &self.settings, self.model)
+        targets::check_pattern(pattern, &self.settings, self.model, self.actuator)
     }
 
     /// After a parameter change, the running pattern (if any) must still be
@@ -139,34 +171,44 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             Some(Run {
                 single: Some(target),
                 ..
-            }) => targets::check_target(&self.settings, self.model, &target).map(|_| ()),
+            }) => targets::check_target(&self.settings, self.model, self.actuator, &target),
             _ => Ok(()),
         }
     }
 
     async fn report_status(&self) {
-        let link = self.link;
-        let s = self.status.snapshot();
-        let uptime_ms = self.booted_at.elapsed().as_millis();
-        link.data(format_args!(
-            "uptime: {}.{:03} s",
-            uptime_ms / 1000,
-            uptime_ms % 1000
-        ))
-        .await;
-        link.data(format_args!(
-            "build: {} {} git {} {}",
-            build_info::PRODUCT,
-            build_info::VERSION,
-            build_info::GIT_REV,
-            build_info::PROFILE
-        ))
-        .await;
-        match s.activity {
-            Activity::Idle => link.data(format_args!("state: idle")).await,
-            Activity::Goto => link.data(format_args!("state: goto")).await,
-            Activity::Pattern(p) => {
-                link.data(format_args!(
+        let snapshot = self.status.snapshot();
+        for line in 0..STATUS_LINES {
+            if let Some(text) = self.status_line(&snapshot, line) {
+                self.link.data_line(text).await;
+            }
+        }
+    }
+
+    /// Line `line` of `status` (`None`: not shown now). One formatter and
+    /// one await in the caller keep the task's state machine small.
+    fn status_line(&self, s: &Snapshot, line: usize) -> Option<ReplyText> {
+        let text = |args: core::fmt::Arguments<'_>| Some(reply_text(args));
+        match line {
+            0 => {
+                let uptime_ms = self.booted_at.elapsed().as_millis();
+                text(format_args!(
+                    "uptime: {}.{:03} s",
+                    uptime_ms / 1000,
+                    uptime_ms % 1000
+                ))
+            }
+            1 => text(format_args!(
+                "build: {} {} git {} {}",
+                build_info::PRODUCT,
+                build_info::VERSION,
+                build_info::GIT_REV,
+                build_info::PROFILE
+            )),
+            2 => match s.activity {
+                Activity::Idle => text(format_args!("state: idle")),
+                Activity::Goto => text(format_args!("state: goto")),
+                Activity::Pattern(p) => text(format_args!(
                     "state: pattern {}{} point {} pass {}",
                     p.name(),
                     if self.run.is_some_and(|r| r.once) {
@@ -176,75 +218,78 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                     },
                     s.point_index.unwrap_or(0),
                     s.pass
-                ))
-                .await
-            }
-        }
-        let phase = match s.phase {
-            None => "-",
-            Some(Phase::Moving) => "moving",
-            Some(Phase::Dwelling) => "dwelling",
-            Some(Phase::Holding) => "holding",
-        };
-        link.data(format_args!("phase: {phase}")).await;
-        link.data(format_args!(
-            "model: {}",
-            match self.model {
-                AimModel::Exact => "exact",
-                AimModel::Seed => "seed",
-            }
-        ))
-        .await;
-        if let Some((target, aim)) = s.target {
-            let PointCm { x_cm, y_cm } = target.point;
-            let (x_cm, y_cm) = (Fixed::<3>(x_cm), Fixed::<3>(y_cm));
-            match target.grid {
-                Some((xi, yi)) => {
-                    link.data(format_args!(
-                        "target: ({x_cm}, {y_cm}) cm grid ({xi}, {yi})"
-                    ))
-                    .await
+                )),
+            },
+            3 => text(format_args!(
+                "phase: {}",
+                match s.phase {
+                    None => "-",
+                    Some(Phase::Moving) => "moving",
+                    Some(Phase::Dwelling) => "dwelling",
+                    Some(Phase::Holding) => "holding",
                 }
-                None => link.data(format_args!("target: ({x_cm}, {y_cm}) cm")).await,
+            )),
+            4 => text(format_args!("actuator: {}", self.actuator.name())),
+            5 => text(format_args!(
+                "model: {}",
+                match self.model {
+                    AimModel::Exact => "exact",
+                    AimModel::Seed => "seed",
+                }
+            )),
+            6 => {
+                let (target, _) = s.target?;
+                let PointCm { x_cm, y_cm } = target.point;
+                let (x_cm, y_cm) = (Fixed::<3>(x_cm), Fixed::<3>(y_cm));
+                match target.grid {
+                    Some((xi, yi)) => text(format_args!(
+                        "target: ({x_cm}, {y_cm}) cm grid ({xi}, {yi})"
+                    )),
+                    None => text(format_args!("target: ({x_cm}, {y_cm}) cm")),
+                }
             }
-            link.data(format_args!(
-                "joint: yaw {} deg pitch {} deg",
-                Fixed::<3>(aim.yaw_deg),
-                Fixed::<3>(aim.pitch_deg)
-            ))
-            .await;
-            link.data(format_args!(
-                "servo: yaw {} deg pitch {} deg (wire {} {})",
-                Fixed::<1>(f64::from(aim.yaw_wire) / 10.0),
-                Fixed::<1>(f64::from(aim.pitch_wire) / 10.0),
-                aim.yaw_wire,
-                aim.pitch_wire
-            ))
-            .await;
-        }
-        if let Some((yaw, pitch)) = self.measured {
-            link.data(format_args!(
-                "measured at arrival: yaw {} deg pitch {} deg",
-                Fixed::<1>(f64::from(yaw) / 10.0),
-                Fixed::<1>(f64::from(pitch) / 10.0)
-            ))
-            .await;
-        }
-        link.data(format_args!(
-            "laser: {} (mode {})",
-            if s.laser_on { "on" } else { "off" },
-            self.settings.laser_mode.name()
-        ))
-        .await;
-        match s.faulty_servo {
-            Some(id) => {
-                link.data(format_args!("faults: servo {id} not responding"))
-                    .await
+            7 => {
+                let (_, aim) = s.target?;
+                text(format_args!(
+                    "joint: yaw {} deg pitch {} deg",
+                    Fixed::<3>(aim.yaw_deg),
+                    Fixed::<3>(aim.pitch_deg)
+                ))
             }
-            None => link.data(format_args!("faults: none")).await,
+            8 => {
+                let (_, aim) = s.target?;
+                text(format_args!(
+                    "servo: yaw {} deg pitch {} deg (wire {} {})",
+                    Fixed::<1>(f64::from(aim.yaw_wire) / 10.0),
+                    Fixed::<1>(f64::from(aim.pitch_wire) / 10.0),
+                    aim.yaw_wire,
+                    aim.pitch_wire
+                ))
+            }
+            9 => {
+                let (yaw, pitch) = self.measured?;
+                text(format_args!(
+                    "measured at arrival: yaw {} deg pitch {} deg",
+                    Fixed::<1>(f64::from(yaw) / 10.0),
+                    Fixed::<1>(f64::from(pitch) / 10.0)
+                ))
+            }
+            10 => text(format_args!(
+                "laser: {} (mode {})",
+                if s.laser_on { "on" } else { "off" },
+                self.settings.laser_mode.name()
+            )),
+            11 => match s.faulty_servo {
+                Some(id) => text(format_args!("faults: servo {id} not responding")),
+                None => text(format_args!("faults: none")),
+            },
+            _ => None,
         }
     }
 }
+
+/// Lines [`Sequencer::status_line`] knows.
+const STATUS_LINES: usize = 12;
 
 impl Run {
     pub(super) fn new(pattern: Option<Pattern>, single: Option<Target>, once: bool) -> Self {
@@ -257,6 +302,9 @@ impl Run {
             phase: Phase::Moving,
             seq: 0,
             dwell_until: None,
+            gimbal_busy: false,
+            galvo_busy: false,
+            galvo_seq: 0,
         }
     }
 }

@@ -8,6 +8,7 @@
 //! running pattern immediately, in any phase.
 
 mod commands;
+mod galvo;
 mod laser;
 pub mod targets;
 
@@ -17,7 +18,8 @@ use embassy_time::{Duration, Instant, Timer};
 pub use self::laser::{LaserSwitch, laser_wanted};
 use self::targets::{Aim, Target};
 use crate::cli::format::Fixed;
-use crate::command::{AimModel, CommandLink, Pattern};
+use crate::command::{Actuator, AimModel, CommandLink, Pattern};
+use crate::galvo::GalvoLink;
 use crate::log;
 use crate::servo::task::{ServoLink, ServoOutcome, ServoRequest};
 use crate::settings::{RecordError, Settings};
@@ -42,11 +44,15 @@ const HOUSEKEEPING: Duration = Duration::from_millis(250);
 pub struct Sequencer<'a, L: LaserSwitch, S: SettingsStore> {
     link: &'a CommandLink,
     servo: &'a ServoLink,
+    /// The galvo loop, when this build has one.
+    galvo: Option<&'a GalvoLink>,
     status: &'a StatusBoard,
     laser: L,
     store: S,
     settings: Settings,
     model: AimModel,
+    /// Which actuator(s) draw.
+    actuator: Actuator,
     booted_at: Instant,
     /// Current activity and where it is.
     run: Option<Run>,
@@ -78,6 +84,12 @@ struct Run {
     seq: u32,
     /// End of the dwell.
     dwell_until: Option<Instant>,
+    /// The gimbal has not finished the current point (move + dwell).
+    gimbal_busy: bool,
+    /// The galvo has not reported the current point done.
+    galvo_busy: bool,
+    /// Request number of the galvo point in flight.
+    galvo_seq: u32,
 }
 
 impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
@@ -86,6 +98,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     pub async fn new(
         link: &'a CommandLink,
         servo: &'a ServoLink,
+        galvo: Option<&'a GalvoLink>,
         status: &'a StatusBoard,
         mut laser: L,
         mut store: S,
@@ -108,14 +121,21 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             }
         };
         status.update(|s| s.activity = Activity::Idle);
+        if let Some(galvo) = galvo.filter(|_| crate::galvo::GALVO_OUTPUT) {
+            galvo
+                .config
+                .signal(crate::galvo::config_from(&settings.galvo));
+        }
         Self {
             link,
             servo,
+            galvo,
             status,
             laser,
             store,
             settings,
             model: AimModel::Exact,
+            actuator: Actuator::Gimbal,
             booted_at: Instant::now(),
             run: None,
             next_seq: 0,
@@ -148,11 +168,18 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                     Either::Second(()) => None,
                 }
             };
+            let galvo_link = self.galvo.filter(|_| crate::galvo::GALVO_OUTPUT);
+            let galvo_event = async {
+                match galvo_link {
+                    Some(galvo) => galvo.events.receive().await,
+                    None => core::future::pending().await,
+                }
+            };
             let event = select4(
                 command,
                 self.servo.outcomes.receive(),
                 timer,
-                Timer::at(housekeeping),
+                select(Timer::at(housekeeping), galvo_event),
             )
             .await;
             match event {
@@ -163,10 +190,15 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 Either4::First(None) => self.stop("stop button"),
                 Either4::Second(outcome) => self.handle_outcome(outcome),
                 Either4::Third(()) => self.dwell_finished(),
-                Either4::Fourth(()) => {
+                Either4::Fourth(Either::First(())) => {
                     housekeeping = Instant::now() + HOUSEKEEPING;
                     self.status
                         .update(|s| s.heartbeat = s.heartbeat.wrapping_add(1));
+                }
+                Either4::Fourth(Either::Second(event)) => {
+                    if crate::galvo::GALVO_OUTPUT {
+                        self.handle_galvo_event(event);
+                    }
                 }
             }
             self.apply_laser();
@@ -179,6 +211,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         log::info!("start {} (once={})", name, run.once);
         self.run = Some(run);
         self.faulty_servo = None;
+        if self.actuator.uses_galvo() {
+            // Clears points of an earlier run and an underrun latch.
+            self.send_galvo(crate::galvo::GalvoRequest::Stop);
+        }
         self.begin_point();
     }
 
@@ -187,6 +223,9 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         if let Some(run) = self.run.take() {
             let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
             log::info!("stop {} ({})", name, why);
+            if self.actuator.uses_galvo() {
+                self.send_galvo(crate::galvo::GalvoRequest::Stop);
+            }
         }
         self.publish();
     }
@@ -200,12 +239,34 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         }
     }
 
-    /// Aims at the current point and sends the servo move.
+    /// Sends the current point to the actuator(s).
     fn begin_point(&mut self) {
         let Some(target) = self.current_target() else {
             self.stop("pattern has no points");
             return;
         };
+        let gimbal_started = !self.actuator.uses_gimbal() || self.begin_gimbal_move(target);
+        let galvo_started =
+            gimbal_started && (!self.actuator.uses_galvo() || self.begin_galvo_point(target));
+        if !(gimbal_started && galvo_started) {
+            return;
+        }
+        let holds = self.run.is_some_and(|r| r.pattern.is_none());
+        if let Some(run) = self.run.as_mut() {
+            run.phase = Phase::Moving;
+            run.dwell_until = None;
+            run.gimbal_busy = self.actuator.uses_gimbal();
+            // A goto's galvo holds the point, laser on, until the next
+            // command: nothing to wait for.
+            run.galvo_busy = self.actuator.uses_galvo() && !holds;
+        }
+        self.publish();
+        self.point_finished_if_done();
+    }
+
+    /// Aims the gimbal at `target` and sends the servo move; on an
+    /// unreachable target stops with an error notice.
+    fn begin_gimbal_move(&mut self, target: Target) -> bool {
         let aim = match targets::aim(&self.settings, self.model, target.point) {
             Ok(aim) => aim,
             Err(e) => {
@@ -218,7 +279,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                     why
                 ));
                 self.stop("unreachable target");
-                return;
+                return false;
             }
         };
         let interval_ms = self.move_interval_ms(&aim);
@@ -244,12 +305,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             interval_ms
         );
         if let Some(run) = self.run.as_mut() {
-            run.phase = Phase::Moving;
             run.seq = seq;
-            run.dwell_until = None;
         }
         self.last_aim = Some((target, aim));
-        self.publish();
+        true
     }
 
     /// Travel time for a move at the configured speed, from the largest
@@ -319,8 +378,20 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
 
     /// The dwell on the current point ended: next point, next pass, or done.
     fn dwell_finished(&mut self) {
+        if let Some(run) = self.run.as_mut() {
+            run.dwell_until = None;
+            run.gimbal_busy = false;
+        }
+        self.point_finished_if_done();
+    }
+
+    /// When every actuator is done with the current point: the next
+    /// point, the next pass, the end — or, for a goto, holding.
+    fn point_finished_if_done(&mut self) {
         let Some(mut run) = self.run else { return };
-        run.dwell_until = None;
+        if run.gimbal_busy || run.galvo_busy {
+            return;
+        }
         let Some(pattern) = run.pattern else {
             // A goto holds its point until the next command.
             run.phase = Phase::Holding;
@@ -345,7 +416,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     /// Switches the laser to what the state calls for.
     fn apply_laser(&mut self) {
         let phase = self.run.map(|r| r.phase);
-        let wanted = laser_wanted(self.settings.laser_mode, phase, self.faulty_servo.is_some());
+        // The galvo's laser is switched per sample by the galvo loop; this
+        // is the gimbal's.
+        let wanted = self.actuator.uses_gimbal()
+            && laser_wanted(self.settings.laser_mode, phase, self.faulty_servo.is_some());
         if wanted != self.laser_on {
             self.laser.set(wanted);
             self.laser_on = wanted;

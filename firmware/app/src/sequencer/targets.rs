@@ -8,7 +8,7 @@ use kinematics_core as kc;
 use kinematics_core::{BoardPoint, Criterion, ErrorModel, Gimbal, Grid, GridIndex};
 
 use crate::cli::format::Fixed;
-use crate::command::{AimModel, Pattern, PointCm};
+use crate::command::{Actuator, AimModel, Pattern, PointCm};
 use crate::settings::{AxisSettings, Settings};
 
 /// One point the sequencer visits.
@@ -229,6 +229,20 @@ pub enum PatternError {
         /// Pattern name.
         pattern: &'static str,
     },
+    /// A point is outside the galvo's DAC range.
+    OutsideGalvoRange {
+        /// Pattern name (`goto` for a single target).
+        pattern: &'static str,
+        /// Index of the first bad point.
+        index: usize,
+        /// The point, cm.
+        point: PointCm,
+    },
+    /// Marked paths (line, circle, rect) do not run on the galvo yet.
+    GalvoPath {
+        /// Pattern name.
+        pattern: &'static str,
+    },
 }
 
 impl core::fmt::Display for PatternError {
@@ -247,22 +261,75 @@ impl core::fmt::Display for PatternError {
                 Fixed::<2>(point.y_cm)
             ),
             PatternError::Empty { pattern } => write!(f, "{pattern} has no points on this grid"),
+            PatternError::OutsideGalvoRange {
+                pattern,
+                index,
+                point,
+            } => write!(
+                f,
+                "{pattern} point {index} ({}, {}) cm is outside the galvo's range",
+                Fixed::<2>(point.x_cm),
+                Fixed::<2>(point.y_cm)
+            ),
+            PatternError::GalvoPath { pattern } => {
+                write!(
+                    f,
+                    "{pattern} paths do not run on the galvo yet; use target gimbal"
+                )
+            }
         }
     }
+}
+
+/// Whether the galvo can reach board point `point` (cm) within its DAC
+/// range.
+pub fn galvo_in_range(settings: &Settings, point: PointCm) -> bool {
+    let galvo = crate::galvo::config_from(&settings.galvo)
+        .galvo
+        .cast::<f64>();
+    galvo
+        .board_to_codes(kc::PointMm {
+            x_mm: point.x_cm * 10.0,
+            y_mm: point.y_cm * 10.0,
+        })
+        .is_ok_and(|codes| !codes.clamped())
+}
+
+/// Checks point `index` of `pattern` for every actuator that draws it.
+fn check_point(
+    settings: &Settings,
+    model: AimModel,
+    actuator: Actuator,
+    pattern: &'static str,
+    index: usize,
+    point: PointCm,
+) -> Result<(), PatternError> {
+    if actuator.uses_gimbal() {
+        aim(settings, model, point).map_err(|error| PatternError::Unreachable {
+            pattern,
+            index,
+            point,
+            error,
+        })?;
+    }
+    if actuator.uses_galvo() && !galvo_in_range(settings, point) {
+        return Err(PatternError::OutsideGalvoRange {
+            pattern,
+            index,
+            point,
+        });
+    }
+    Ok(())
 }
 
 /// Checks that a single target can be aimed at.
 pub fn check_target(
     settings: &Settings,
     model: AimModel,
+    actuator: Actuator,
     target: &Target,
-) -> Result<Aim, PatternError> {
-    aim(settings, model, target.point).map_err(|error| PatternError::Unreachable {
-        pattern: "goto",
-        index: 0,
-        point: target.point,
-        error,
-    })
+) -> Result<(), PatternError> {
+    check_point(settings, model, actuator, "goto", 0, target.point)
 }
 
 /// Checks before a pattern starts that it has points and that every one
@@ -271,8 +338,12 @@ pub fn check_pattern(
     pattern: &Pattern,
     settings: &Settings,
     model: AimModel,
+    actuator: Actuator,
 ) -> Result<(), PatternError> {
     let name = pattern.name();
+    if actuator.uses_galvo() && pattern.is_path() {
+        return Err(PatternError::GalvoPath { pattern: name });
+    }
     if let Some(Err(error)) = path_points(pattern, settings) {
         return Err(PatternError::Path {
             pattern: name,
@@ -281,14 +352,7 @@ pub fn check_pattern(
     }
     let mut count = 0usize;
     while let Some(target) = pattern_target(pattern, count, settings) {
-        if let Err(error) = aim(settings, model, target.point) {
-            return Err(PatternError::Unreachable {
-                pattern: name,
-                index: count,
-                point: target.point,
-                error,
-            });
-        }
+        check_point(settings, model, actuator, name, count, target.point)?;
         count += 1;
     }
     if count == 0 {
@@ -408,15 +472,20 @@ mod tests {
                 y_cm: 1.0
             }
         );
-        assert!(check_pattern(&line, &s, AimModel::Exact).is_ok());
+        assert!(check_pattern(&line, &s, AimModel::Exact, Actuator::Gimbal).is_ok());
     }
 
     #[test]
     fn check_pattern_names_the_first_unreachable_point() {
         let mut s = Settings::default();
         s.yaw.min_deg = -10.0;
-        let e =
-            check_pattern(&Pattern::Grid(kc::Pattern::Corner), &s, AimModel::Exact).unwrap_err();
+        let e = check_pattern(
+            &Pattern::Grid(kc::Pattern::Corner),
+            &s,
+            AimModel::Exact,
+            Actuator::Gimbal,
+        )
+        .unwrap_err();
         let text = std::format!("{e}");
         assert!(
             text.starts_with("corner point 1 (11.50, 7.66) cm unreachable"),
@@ -430,6 +499,14 @@ mod tests {
             radius_cm: 0.01,
             rotation: kc::Rotation::Cw,
         };
-        assert!(check_pattern(&tiny, &Settings::default(), AimModel::Exact).is_err());
+        assert!(
+            check_pattern(
+                &tiny,
+                &Settings::default(),
+                AimModel::Exact,
+                Actuator::Gimbal
+            )
+            .is_err()
+        );
     }
 }

@@ -1,0 +1,129 @@
+//! The sequencer's side of the galvo: points to the galvo loop, its
+//! events back, and its status.
+
+use core::sync::atomic::Ordering;
+
+use super::targets::Target;
+use super::{LaserSwitch, Sequencer, SettingsStore};
+use crate::cli::format::Shortest;
+use crate::galvo::{GalvoEvent, GalvoRequest, config_from};
+use crate::log;
+
+/// Dwell of a goto on the galvo: held until the next command, µs.
+const HOLD_US: u32 = u32::MAX;
+
+impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
+    /// Queues a request for the galvo loop; `false` (with an error
+    /// notice) when the loop does not keep up.
+    pub(super) fn send_galvo(&mut self, request: GalvoRequest) -> bool {
+        let Some(galvo) = self.galvo else {
+            return false;
+        };
+        if request == GalvoRequest::Stop {
+            // Stop cancels whatever the loop has not taken yet anyway.
+            while galvo.requests.try_receive().is_ok() {}
+        }
+        if galvo.requests.try_send(request).is_ok() {
+            return true;
+        }
+        log::warning!("galvo: request queue full");
+        self.link
+            .notify(format_args!("error: galvo not responding; stopped"));
+        self.run = None;
+        self.publish();
+        false
+    }
+
+    /// Sends the current point to the galvo (board cm → galvo mm).
+    pub(super) fn begin_galvo_point(&mut self, target: Target) -> bool {
+        let Some(run) = self.run else { return false };
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let seq = self.next_seq;
+        let dwell_us = match run.pattern {
+            None => HOLD_US,
+            Some(p) if p.is_path() => 0,
+            Some(_) => (self.settings.dwell_ms * 1000.0) as u32,
+        };
+        let request = GalvoRequest::Point {
+            seq,
+            x_mm: (target.point.x_cm * 10.0) as f32,
+            y_mm: (target.point.y_cm * 10.0) as f32,
+            dwell_us,
+        };
+        if !self.send_galvo(request) {
+            return false;
+        }
+        if let Some(run) = self.run.as_mut() {
+            run.galvo_seq = seq;
+        }
+        log::info!(
+            "galvo target ({}, {}) cm",
+            target.point.x_cm,
+            target.point.y_cm
+        );
+        true
+    }
+
+    /// Handles an event of the galvo loop.
+    pub(super) fn handle_galvo_event(&mut self, event: GalvoEvent) {
+        match event {
+            GalvoEvent::Done { seq } => {
+                if let Some(run) = self.run.as_mut().filter(|r| r.galvo_seq == seq) {
+                    run.galvo_busy = false;
+                    self.point_finished_if_done();
+                }
+            }
+            GalvoEvent::Refused { seq, error } => {
+                if self.run.is_some_and(|r| r.galvo_seq == seq) {
+                    self.link
+                        .notify(format_args!("error: galvo: {error}; stopped"));
+                    self.stop("galvo refused the point");
+                }
+            }
+            GalvoEvent::Underrun(underrun) => {
+                self.link.notify(format_args!(
+                    "error: galvo underrun ({} half buffers late); stopped, laser off",
+                    underrun.halves
+                ));
+                self.stop("galvo underrun");
+            }
+            GalvoEvent::ConfigRefused(error) => {
+                self.link.notify(format_args!(
+                    "error: galvo parameters refused: {error}; previous ones kept"
+                ));
+            }
+        }
+    }
+
+    /// Sends the galvo parameters to the loop (applied between points).
+    pub(super) fn configure_galvo(&mut self) {
+        if let Some(galvo) = self.galvo {
+            galvo.config.signal(config_from(&self.settings.galvo));
+        }
+    }
+
+    /// `galvo status` lines.
+    pub(super) async fn report_galvo_status(&self) {
+        let link = self.link;
+        let Some(galvo) = self.galvo else {
+            link.data(format_args!("galvo: not in this build")).await;
+            return;
+        };
+        let (phase, queued) = galvo.state();
+        let g = &self.settings.galvo;
+        link.data(format_args!("galvo: {phase:?}, {queued} points queued"))
+            .await;
+        link.data(format_args!(
+            "planner: {}, sample period {} us",
+            g.planner.name(),
+            Shortest(g.sample_period_us)
+        ))
+        .await;
+        link.data(format_args!(
+            "underruns: {}, half buffers: {}",
+            galvo.underruns.load(Ordering::Relaxed),
+            galvo.halves.load(Ordering::Relaxed)
+        ))
+        .await;
+    }
+}
