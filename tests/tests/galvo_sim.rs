@@ -243,7 +243,7 @@ fn switching_pattern_mid_dwell_stops_the_galvo_cleanly() {
 #[test]
 fn galvo_commands_refuse_what_it_cannot_do() {
     let report = run_with(
-        "target galvo\npattern line 0 0 5 5 once\ngoto 30 0\ngalvo status\nstatus\n",
+        "pattern tuning once\ntarget both\npattern line 0 0 5 5 once\ntarget galvo\ngoto 30 0\ngalvo status\nstatus\n",
         SimOptions::default(),
     );
     let errors: Vec<&str> = report
@@ -253,16 +253,21 @@ fn galvo_commands_refuse_what_it_cannot_do() {
         .map(|(_, l)| l.as_str())
         .filter(|l| l.starts_with("error:"))
         .collect();
-    assert_eq!(errors.len(), 2, "{errors:?}");
+    assert_eq!(errors.len(), 3, "{errors:?}");
     assert!(
-        errors[0].contains("do not run on the galvo"),
+        errors[0].contains("tuning: paths run on one actuator"),
         "{}",
         errors[0]
     );
     assert!(
-        errors[1].contains("outside the galvo's range"),
+        errors[1].contains("line: paths run on one actuator"),
         "{}",
         errors[1]
+    );
+    assert!(
+        errors[2].contains("outside the galvo's range"),
+        "{}",
+        errors[2]
     );
     let lines: Vec<&str> = report
         .transcript
@@ -273,6 +278,74 @@ fn galvo_commands_refuse_what_it_cannot_do() {
     assert!(lines.contains(&"galvo: Idle, 0 points queued"), "{lines:?}");
     assert!(lines.contains(&"actuator: galvo"));
     assert!(report.dac.iter().all(|(_, s)| !s.laser));
+}
+
+#[test]
+fn the_galvo_marks_paths_from_the_command_line() {
+    // Circle of 3 cm about (1, -1) cm, counter-clockwise, then the tuning
+    // figure (square of 5 cm with its circle and cross).
+    let report = run_to_idle(
+        "target galvo\npattern circle 1 -1 3 ccw once\nwait 300\npattern tuning 0 0 5 once\nwait 500\n",
+    );
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let samples = samples(&report);
+    let runs = lit_runs(&samples);
+    assert_eq!(runs.len(), 1 + 4, "one circle stroke, four tuning strokes");
+    let (start, len, _) = runs[0];
+    // 188 mm of circumference at ≤ 1 m/s.
+    assert!(len >= 18_800, "{len} samples");
+    for s in &samples[start..start + len] {
+        let (x, y) = spot_mm(s);
+        let r = (x - 10.0).hypot(y + 10.0);
+        assert!(
+            (r - 30.0).abs() < 0.15,
+            "({x:.3}, {y:.3}) is {r:.3} mm from the centre"
+        );
+    }
+    for &(start, len, _) in &runs[1..] {
+        for s in &samples[start..start + len] {
+            let (x, y) = spot_mm(s);
+            let on_square = (x.abs() - 25.0).abs() < 0.15 && y.abs() <= 25.15
+                || (y.abs() - 25.0).abs() < 0.15 && x.abs() <= 25.15;
+            let on_circle = (x.hypot(y) - 25.0).abs() < 0.15;
+            let on_cross = y.abs() < 0.15 || x.abs() < 0.15;
+            assert!(
+                on_square || on_circle || on_cross,
+                "tuning lit at ({x:.3}, {y:.3})"
+            );
+        }
+    }
+}
+
+#[test]
+fn switching_pattern_mid_path_brakes_dark_and_moves_on() {
+    let report = run_to_idle(
+        "target galvo\npattern rect -4 3 4 -3\nwait 20\npattern home once\nwait 1100\n",
+    );
+    assert!(report.succeeded(false));
+    let samples = samples(&report);
+    let runs = lit_runs(&samples);
+    assert_eq!(runs.len(), 2, "the interrupted rectangle, then home");
+    let (_, bound) = planned_jump(
+        (-6.0 * PITCH_MM, 4.0 * PITCH_MM),
+        (6.0 * PITCH_MM, -4.0 * PITCH_MM),
+        Method::TimeOptimal,
+    );
+    let largest = samples
+        .windows(2)
+        .map(|w| {
+            w[0].x_code
+                .abs_diff(w[1].x_code)
+                .max(w[0].y_code.abs_diff(w[1].y_code))
+        })
+        .max()
+        .unwrap_or(0);
+    assert!(
+        largest <= bound,
+        "DAC step {largest} > planned maximum {bound}"
+    );
+    let home = runs[1].2;
+    assert!(home.0.abs() < 0.1 && home.1.abs() < 0.1, "{home:?}");
 }
 
 #[test]

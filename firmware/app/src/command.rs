@@ -63,6 +63,13 @@ pub enum Pattern {
         /// The opposite corner, cm.
         b: PointCm,
     },
+    /// Galvo tuning figure: square, inscribed circle and cross.
+    Tuning {
+        /// Centre, cm.
+        centre: PointCm,
+        /// Side of the square, cm.
+        size_cm: f64,
+    },
 }
 
 impl Pattern {
@@ -73,6 +80,7 @@ impl Pattern {
             Pattern::Line { .. } => "line",
             Pattern::Circle { .. } => "circle",
             Pattern::Rect { .. } => "rect",
+            Pattern::Tuning { .. } => "tuning",
         }
     }
 
@@ -81,7 +89,10 @@ impl Pattern {
     pub fn is_path(&self) -> bool {
         matches!(
             self,
-            Pattern::Line { .. } | Pattern::Circle { .. } | Pattern::Rect { .. }
+            Pattern::Line { .. }
+                | Pattern::Circle { .. }
+                | Pattern::Rect { .. }
+                | Pattern::Tuning { .. }
         )
     }
 }
@@ -226,6 +237,10 @@ impl fmt::Display for Pattern {
                     Rotation::Ccw => "ccw",
                 };
                 write!(f, "circle {x} {y} {} {turn}", Shortest(radius_cm))
+            }
+            Pattern::Tuning { centre, size_cm } => {
+                let (x, y) = cm(centre);
+                write!(f, "tuning {x} {y} {}", Shortest(size_cm))
             }
             _ => f.write_str(self.name()),
         }

@@ -118,6 +118,10 @@ pub struct GalvoSettings {
     pub laser_on_delay_us: f64,
     /// Hold after the laser turns off before the next jump, µs.
     pub laser_off_delay_us: f64,
+    /// Marking speed of paths, mm/s.
+    pub mark_speed_mm_s: f64,
+    /// Marking acceleration of paths (and braking on stop), mm/s².
+    pub mark_accel_mm_s2: f64,
 }
 
 impl Default for GalvoSettings {
@@ -143,6 +147,8 @@ impl Default for GalvoSettings {
             planner: JumpPlanner::Optimal,
             laser_on_delay_us: 100.0,
             laser_off_delay_us: 100.0,
+            mark_speed_mm_s: 1000.0,
+            mark_accel_mm_s2: 1.0e5,
         }
     }
 }
@@ -556,6 +562,22 @@ pub const PARAMS: &[ParamSpec] = &[
         10_000.0,
         "galvo hold after laser off before a jump, us",
         |s| s.galvo.laser_off_delay_us
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.mark_speed_mm_s",
+        1.0,
+        20_000.0,
+        "galvo marking speed of paths, mm/s",
+        |s| s.galvo.mark_speed_mm_s
+    ),
+    #[cfg(feature = "galvo")]
+    real!(
+        "galvo.mark_accel_mm_s2",
+        100.0,
+        1.0e8,
+        "galvo marking acceleration, mm/s^2",
+        |s| s.galvo.mark_accel_mm_s2
     ),
 ];
 

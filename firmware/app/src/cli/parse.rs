@@ -157,6 +157,22 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
             from: point(&mut args, "x0_cm", "y0_cm")?,
             to: point(&mut args, "x1_cm", "y1_cm")?,
         }
+    } else if is("tuning") {
+        // Optional centre and size; defaults: a 4 cm figure at the origin.
+        let mut peek = args.clone();
+        match peek.next_word() {
+            Some(w) if !w.eq_ignore_ascii_case("once") => Pattern::Tuning {
+                centre: point(&mut args, "cx_cm", "cy_cm")?,
+                size_cm: args.number("size_cm", 0.1, BOARD_LIMIT_CM)?,
+            },
+            _ => Pattern::Tuning {
+                centre: PointCm {
+                    x_cm: 0.0,
+                    y_cm: 0.0,
+                },
+                size_cm: 4.0,
+            },
+        }
     } else if is("rect") {
         Pattern::Rect {
             a: point(&mut args, "x0_cm", "y0_cm")?,
@@ -184,7 +200,7 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
         }
     } else {
         return Err(CommandError::InvalidArgument {
-            expected: "home|corner|horizontal|vertical|visit-all|grid-full|line|circle|rect",
+            expected: "home|corner|horizontal|vertical|visit-all|grid-full|line|circle|rect|tuning",
             got: word(name),
         });
     };
@@ -204,6 +220,7 @@ pub const HELP_LINES: &[&str] = &[
     "pattern line <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
     "pattern circle <cx_cm> <cy_cm> <radius_cm> [cw|ccw] [once]",
     "pattern rect <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
+    "pattern tuning [<cx_cm> <cy_cm> <size_cm>] [once]   (galvo)",
     "stop                         stop the pattern, laser off",
     "goto <x_cm> <y_cm>           aim at a board point",
     "grid <xi> <yi>               aim at a grid point",
@@ -385,6 +402,7 @@ mod tests {
             "pattern line 0 0 1 1 once",
             "pattern circle 0 0 1 cw once",
             "pattern rect 0 0 1 1 once",
+            "pattern tuning once",
             "stop",
             "goto 1 1",
             "grid 1 1",

@@ -15,6 +15,7 @@
 //! the simulator feeds a simulated DAC. Not wired yet: the target's
 //! timer-triggered DAC DMA (see the README's status).
 
+mod path;
 mod scan;
 
 /// Whether this build drives a galvo (cargo feature `galvo`). The
@@ -23,6 +24,7 @@ mod scan;
 /// the sequencer is compiled out (`target galvo|both` is refused).
 pub const GALVO_OUTPUT: bool = cfg!(feature = "galvo");
 
+pub use path::GalvoPath;
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, Phase};
 
 use core::sync::atomic::{AtomicU8, AtomicU32, Ordering};
@@ -61,6 +63,8 @@ pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
         },
         laser_on_delay_us: settings.laser_on_delay_us as u32,
         laser_off_delay_us: settings.laser_off_delay_us as u32,
+        mark_speed_mm_s: settings.mark_speed_mm_s,
+        mark_accel_mm_s2: settings.mark_accel_mm_s2,
     }
 }
 
@@ -121,8 +125,17 @@ pub enum GalvoRequest {
         /// Laser-on time at the point, µs (0: just go there).
         dwell_us: u32,
     },
-    /// Drop queued points, laser off at once; the mirrors finish the
-    /// jump in flight (a jump is rest to rest) and hold.
+    /// Mark a path: jump (laser off) to each stroke's start, settle,
+    /// mark it with the laser on at the marking speed, laser-off delay.
+    Path {
+        /// Request number.
+        seq: u32,
+        /// What to draw.
+        path: GalvoPath,
+    },
+    /// Drop queued jobs, laser off at once; the mirrors finish the jump in
+    /// flight (a jump is rest to rest) or brake along the stroke being
+    /// marked, and hold.
     Stop,
 }
 
@@ -168,11 +181,13 @@ pub struct GalvoLink {
     queued: AtomicU8,
 }
 
-const PHASES: [Phase; 5] = [
+const PHASES: [Phase; 7] = [
     Phase::Idle,
     Phase::Jumping,
     Phase::Settling,
     Phase::Dwelling,
+    Phase::Marking,
+    Phase::Braking,
     Phase::LaserOffDelay,
 ];
 

@@ -1,24 +1,31 @@
-//! The loop body: point queue, jump planning, per-sample state update,
-//! laser timing and DAC mapping.
+//! The loop body: job queue (points and marked paths), jump planning,
+//! per-sample state update, marking, laser timing and DAC mapping.
 
 use core::fmt;
 use core::sync::atomic::Ordering;
 
-use galvo_planner::{Discrete, JumpSync, Method, RigidParams, XyStepper, plan_xy_jump};
-
-use crate::settings::GalvoSettings;
+use galvo_planner::{
+    Discrete, JumpSync, MarkLimits, MarkSample, Method, PathPlanner, RigidParams, XyStepper,
+    plan_xy_jump,
+};
 use kinematics_core::{Galvo, MirrorAngles, PointMm};
 
+use super::path::{GalvoPath, Segment};
 use super::{DacSample, DacStream, GalvoEvent, GalvoLink, GalvoRequest};
 use crate::log;
+use crate::settings::GalvoSettings;
 
 /// Jump input samples the stepper holds per axis (10.24 ms at 100 kHz,
 /// longer than any full-range time-optimal jump of the reference galvo).
 pub const STEPPER_CAPACITY: usize = 1024;
 /// Longest half buffer the loop fills, samples.
 pub const MAX_HALF_LEN: usize = 512;
-/// Points queued inside the loop (beyond the request channel).
-const POINT_QUEUE: usize = 4;
+/// Jobs queued inside the loop (beyond the request channel).
+const JOB_QUEUE: usize = 4;
+/// Look-ahead blocks of the path planner (a stroke has at most 4).
+const MARK_BLOCKS: usize = 16;
+/// GRBL's default junction deviation, mm.
+const JUNCTION_DEVIATION_MM: f64 = 0.01;
 
 /// Galvo loop parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,29 +42,33 @@ pub struct GalvoConfig {
     pub laser_on_delay_us: u32,
     /// Hold after the laser turns off, before the next jump, µs.
     pub laser_off_delay_us: u32,
+    /// Marking speed, mm/s.
+    pub mark_speed_mm_s: f64,
+    /// Marking acceleration (and braking on stop), mm/s².
+    pub mark_accel_mm_s2: f64,
 }
 
 impl Default for GalvoConfig {
     /// The default galvo parameters ([`GalvoSettings::default`]): 100 kHz,
     /// SPEC geometry and DAC span, reference mirror drive, time-optimal
-    /// jumps, 100 µs laser delays.
+    /// jumps, 100 µs laser delays, marking at 1 m/s.
     fn default() -> Self {
         super::config_from(&GalvoSettings::default())
     }
 }
 
-/// Why the loop cannot be built or a point cannot be visited.
+/// Why the loop cannot be built or a job cannot run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum GalvoError {
     /// Galvo kinematics refused the point (non-finite, invalid geometry).
     Kinematics,
-    /// The point is outside the DAC's range.
+    /// The point or path is outside the DAC's range.
     OutOfRange,
-    /// The jump planner refused (invalid model, jump too long for the
-    /// stepper's buffer).
+    /// The jump or path planner refused (invalid model or limits, jump
+    /// too long for the stepper's buffer, path too short).
     Planner,
-    /// More points than the loop queues.
+    /// More jobs than the loop queues.
     QueueFull,
     /// An underrun latched the laser off; a `Stop` clears it.
     Faulted,
@@ -67,9 +78,9 @@ impl fmt::Display for GalvoError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
             GalvoError::Kinematics => "galvo kinematics refused the point",
-            GalvoError::OutOfRange => "point is outside the galvo's DAC range",
-            GalvoError::Planner => "jump planner refused the move",
-            GalvoError::QueueFull => "galvo point queue is full",
+            GalvoError::OutOfRange => "outside the galvo's DAC range",
+            GalvoError::Planner => "galvo planner refused the move",
+            GalvoError::QueueFull => "galvo job queue is full",
             GalvoError::Faulted => "galvo underrun: send stop before new points",
         })
     }
@@ -81,35 +92,49 @@ impl fmt::Display for GalvoError {
 pub enum Phase {
     /// Holding, laser off, nothing queued.
     Idle,
-    /// Jumping to the point, laser off.
+    /// Jumping to a point or stroke start, laser off.
     Jumping,
     /// Landed; laser-on delay.
     Settling,
-    /// Laser on at the point.
+    /// Laser on at a point.
     Dwelling,
+    /// Laser on, marking a stroke of a path.
+    Marking,
+    /// Stopped while marking: decelerating along the path, laser off.
+    Braking,
     /// Laser off; laser-off delay before the next jump.
     LaserOffDelay,
 }
 
-/// A queued point (converted to angles when its jump starts, with the
-/// configuration in force then).
-#[derive(Debug, Clone, Copy)]
-struct Point {
-    seq: u32,
-    target_mm: PointMm,
-    dwell_us: u32,
+/// A queued job.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Job {
+    /// Jump to a point and dwell there (µs).
+    Point { target_mm: PointMm, dwell_us: u32 },
+    /// Mark a path, stroke by stroke.
+    Path(GalvoPath),
 }
 
-/// The point being visited.
+/// The job being run.
 #[derive(Debug, Clone, Copy)]
 struct Active {
     seq: u32,
+    job: Job,
+    /// Stroke of a path being drawn.
+    stroke: usize,
     phase: Phase,
     /// Samples left in a timed phase.
     samples_left: u32,
-    dwell_samples: u32,
-    /// `stop` arrived during the jump: hold after landing, no dwell.
+    /// `stop` arrived: finish the jump (or brake) and hold, dark.
     cancelled: bool,
+}
+
+/// The spot while marking or braking: position (mm) and its change over
+/// the last sample (mm per sample).
+#[derive(Debug, Clone, Copy, Default)]
+struct Motion {
+    position_mm: [f32; 2],
+    step_mm: [f32; 2],
 }
 
 /// The galvo loop's state. Build with [`GalvoLoop::new`], then
@@ -120,12 +145,14 @@ pub struct GalvoLoop {
     planning: Galvo<f64>,
     disc: Discrete<3>,
     mirrors: XyStepper<3, STEPPER_CAPACITY>,
-    queue: heapless::Deque<Point, POINT_QUEUE>,
+    marker: Option<PathPlanner<MARK_BLOCKS>>,
+    motion: Motion,
+    queue: heapless::Deque<(u32, Job), JOB_QUEUE>,
     active: Option<Active>,
     last: DacSample,
-    /// Latched by an underrun: points are refused until `Stop`.
+    /// Latched by an underrun: jobs are refused until `Stop`.
     faulted: bool,
-    /// Parameters to apply at the next point boundary.
+    /// Parameters to apply at the next job boundary.
     pending_config: Option<GalvoConfig>,
     on_delay_samples: u32,
     off_delay_samples: u32,
@@ -154,7 +181,7 @@ impl GalvoLoop {
             .map_err(|_| GalvoError::Planner)?;
         let mirrors = XyStepper::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
         let [x_rad, y_rad] = angles_rad;
-        let centre = config
+        let codes = config
             .galvo
             .angles_to_codes(MirrorAngles {
                 x_rad: x_rad as f32,
@@ -166,11 +193,13 @@ impl GalvoLoop {
             planning: config.galvo.cast(),
             disc,
             mirrors,
+            marker: None,
+            motion: Motion::default(),
             queue: heapless::Deque::new(),
             active: None,
             last: DacSample {
-                x_code: centre.x.code,
-                y_code: centre.y.code,
+                x_code: codes.x.code,
+                y_code: codes.y.code,
                 laser: false,
             },
             faulted: false,
@@ -186,55 +215,66 @@ impl GalvoLoop {
         self.active.map_or(Phase::Idle, |a| a.phase)
     }
 
-    /// Points waiting behind the current one.
+    /// Jobs waiting behind the current one.
     pub fn queued_points(&self) -> usize {
         self.queue.len()
     }
 
-    /// Takes a request (between half buffers). A refused point is
-    /// returned as its [`GalvoEvent::Refused`].
+    /// Takes a request (between half buffers). A refused job is returned
+    /// as its [`GalvoEvent::Refused`].
     pub fn request(&mut self, request: GalvoRequest) -> Option<GalvoEvent> {
-        match request {
+        let (seq, job) = match request {
             GalvoRequest::Stop => {
                 self.stop();
                 self.faulted = false;
-                None
+                return None;
             }
-            GalvoRequest::Point { seq, .. } if self.faulted => Some(GalvoEvent::Refused {
-                seq,
-                error: GalvoError::Faulted,
-            }),
             GalvoRequest::Point {
                 seq,
                 x_mm,
                 y_mm,
                 dwell_us,
-            } => match self.point(seq, x_mm, y_mm, dwell_us) {
-                Ok(_) if self.queue.is_full() => Some(GalvoEvent::Refused {
-                    seq,
-                    error: GalvoError::QueueFull,
-                }),
-                Ok(_) => match self.queue.push_back(Point {
-                    seq,
+            } => (
+                seq,
+                Job::Point {
                     target_mm: PointMm {
                         x_mm: f64::from(x_mm),
                         y_mm: f64::from(y_mm),
                     },
                     dwell_us,
-                }) {
-                    Ok(()) => None,
-                    Err(_) => Some(GalvoEvent::Refused {
-                        seq,
-                        error: GalvoError::QueueFull,
-                    }),
                 },
-                Err(error) => Some(GalvoEvent::Refused { seq, error }),
-            },
+            ),
+            GalvoRequest::Path { seq, path } => (seq, Job::Path(path)),
+        };
+        let checked = if self.faulted {
+            Err(GalvoError::Faulted)
+        } else {
+            self.check(&job)
+        };
+        match checked.and_then(|()| {
+            self.queue
+                .push_back((seq, job))
+                .map_err(|_| GalvoError::QueueFull)
+        }) {
+            Ok(()) => None,
+            Err(error) => Some(GalvoEvent::Refused { seq, error }),
         }
     }
 
-    /// Checks a point (mm) and converts it to mirror angles (rad, f64 for
-    /// planning).
+    /// Checks a job against the current configuration.
+    fn check(&self, job: &Job) -> Result<(), GalvoError> {
+        match job {
+            Job::Point { target_mm, .. } => self.angles_for(*target_mm).map(|_| ()),
+            Job::Path(path) => {
+                for [x_mm, y_mm] in path.bounds_mm() {
+                    self.angles_for(PointMm { x_mm, y_mm })?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Mirror angles (rad, f64 for planning) of a board point (mm).
     fn angles_for(&self, target: PointMm) -> Result<[f64; 2], GalvoError> {
         let codes = self
             .planning
@@ -251,25 +291,14 @@ impl GalvoLoop {
         Ok([angles.x_rad, angles.y_rad])
     }
 
-    /// Checks a requested point against the current configuration.
-    fn point(&self, _seq: u32, x_mm: f32, y_mm: f32, _dwell_us: u32) -> Result<(), GalvoError> {
-        self.angles_for(PointMm {
-            x_mm: f64::from(x_mm),
-            y_mm: f64::from(y_mm),
-        })
-        .map(|_| ())
-    }
-
-    /// New parameters, applied at the next point boundary (a new sample
-    /// period at the next half-buffer boundary with no point running).
+    /// New parameters, applied at the next job boundary (a new sample
+    /// period at the next half-buffer boundary with no job running).
     pub fn configure(&mut self, config: GalvoConfig) {
         self.pending_config = Some(config);
     }
 
-    /// Applies new parameters if no point is running (else at the next
-    /// point boundary; a new sample period only at a half-buffer
-    /// boundary, so every half has one period); a refused configuration is
-    /// reported and dropped.
+    /// Applies new parameters if no job is running; a refused
+    /// configuration is reported and dropped.
     fn apply_pending_config(&mut self, at_half_boundary: bool) -> Option<GalvoEvent> {
         let config = self.pending_config?;
         if self.active.is_some()
@@ -293,8 +322,9 @@ impl GalvoLoop {
         }
     }
 
-    /// Drops queued points and turns the laser off from the next sample;
-    /// a jump in flight lands and holds.
+    /// Drops queued jobs and turns the laser off from the next sample; a
+    /// jump in flight lands, a stroke being marked brakes along the path,
+    /// and the mirrors hold.
     pub fn stop(&mut self) {
         self.queue.clear();
         self.active = match self.active {
@@ -302,33 +332,136 @@ impl GalvoLoop {
                 cancelled: true,
                 ..a
             }),
+            Some(a) if matches!(a.phase, Phase::Marking | Phase::Braking) => {
+                self.marker = None;
+                Some(Active {
+                    cancelled: true,
+                    phase: Phase::Braking,
+                    ..a
+                })
+            }
             _ => None,
         };
     }
 
-    /// Fills `out` with the next samples; `on_event` gets each point's
-    /// `Done` (or `Refused`, when its jump cannot be planned).
+    /// Latches an underrun: laser off, jobs dropped and refused until the
+    /// next `Stop`.
+    pub fn underrun(&mut self) {
+        self.stop();
+        self.faulted = true;
+    }
+
+    /// Fills `out` with the next samples; `on_event` gets each job's
+    /// `Done` (or `Refused`, when it cannot be planned).
     pub fn fill(&mut self, out: &mut [DacSample], mut on_event: impl FnMut(GalvoEvent)) {
         for slot in out.iter_mut() {
             self.advance(&mut on_event);
-            let [x_rad, y_rad] = self.mirrors.step();
-            let laser = self.phase() == Phase::Dwelling;
-            // The stepper's angles stay between planned rest points, all
-            // inside the DAC range; on a conversion error hold the last
-            // codes rather than output garbage.
-            if let Ok(codes) = self
-                .config
-                .galvo
-                .angles_to_codes(MirrorAngles { x_rad, y_rad })
-            {
-                self.last.x_code = codes.x.code;
-                self.last.y_code = codes.y.code;
+            let codes = match self.phase() {
+                Phase::Marking => self.mark_sample(&mut on_event),
+                Phase::Braking => self.brake_sample(),
+                _ => {
+                    let [x_rad, y_rad] = self.mirrors.step();
+                    self.config
+                        .galvo
+                        .angles_to_codes(MirrorAngles { x_rad, y_rad })
+                        .ok()
+                        .map(|c| (c.x.code, c.y.code))
+                }
+            };
+            // Angles and marked positions stay inside the checked range;
+            // on a conversion error hold the last codes rather than output
+            // garbage.
+            if let Some((x_code, y_code)) = codes {
+                self.last.x_code = x_code;
+                self.last.y_code = y_code;
             }
-            self.last.laser = laser;
+            self.last.laser = matches!(self.phase(), Phase::Dwelling | Phase::Marking);
             *slot = self.last;
             if let Some(a) = self.active.as_mut() {
                 a.samples_left = a.samples_left.saturating_sub(1);
             }
+        }
+    }
+
+    /// DAC codes of a board position (mm).
+    fn codes_at(&self, position_mm: [f32; 2]) -> Option<(u16, u16)> {
+        let [x_mm, y_mm] = position_mm;
+        self.config
+            .galvo
+            .board_to_codes(PointMm { x_mm, y_mm })
+            .ok()
+            .map(|c| (c.x.code, c.y.code))
+    }
+
+    /// The next marking sample; at the end of the stroke the mirrors hold
+    /// there and the laser-off delay starts.
+    fn mark_sample(&mut self, on_event: &mut impl FnMut(GalvoEvent)) -> Option<(u16, u16)> {
+        let sample = self.marker.as_mut().map(|m| m.next_sample());
+        if let Some(MarkSample::Mark { x_mm, y_mm, .. }) = sample {
+            let [px, py] = self.motion.position_mm;
+            self.motion = Motion {
+                position_mm: [x_mm, y_mm],
+                step_mm: [x_mm - px, y_mm - py],
+            };
+            return self.codes_at([x_mm, y_mm]);
+        }
+        // Stroke done (planner idle): hold at its end, laser off.
+        self.marker = None;
+        self.hold_at_motion(on_event);
+        if let Some(a) = self.active.as_mut() {
+            a.enter(Phase::LaserOffDelay, self.off_delay_samples);
+        }
+        self.codes_at(self.motion.position_mm)
+    }
+
+    /// One braking sample: along the last direction, slowing at the
+    /// marking acceleration; at rest the mirrors hold and the job ends.
+    fn brake_sample(&mut self) -> Option<(u16, u16)> {
+        let [sx, sy] = self.motion.step_mm;
+        let speed = libm::hypotf(sx, sy);
+        let ts = self.config.sample_period_s as f32;
+        let slow_by = self.config.mark_accel_mm_s2 as f32 * ts * ts;
+        let scale = if speed > slow_by {
+            (speed - slow_by) / speed
+        } else {
+            0.0
+        };
+        let step = [sx * scale, sy * scale];
+        let [px, py] = self.motion.position_mm;
+        let next = [px + step[0], py + step[1]];
+        match self.codes_at(next) {
+            Some(codes) if scale > 0.0 => {
+                self.motion = Motion {
+                    position_mm: next,
+                    step_mm: step,
+                };
+                Some(codes)
+            }
+            // At rest, or the next step would leave the DAC range: hold.
+            _ => {
+                self.hold_at_motion(&mut |_| {});
+                self.active = None;
+                self.codes_at(self.motion.position_mm)
+            }
+        }
+    }
+
+    /// Re-seats the (idle) jump stepper at rest where marking left the
+    /// spot, so the next jump starts there.
+    fn hold_at_motion(&mut self, on_event: &mut impl FnMut(GalvoEvent)) {
+        let [x, y] = self.motion.position_mm;
+        let seated = self
+            .angles_for(PointMm {
+                x_mm: f64::from(x),
+                y_mm: f64::from(y),
+            })
+            .and_then(|angles| {
+                self.mirrors
+                    .hold_at(angles)
+                    .map_err(|_| GalvoError::Planner)
+            });
+        if let (Err(error), Some(a)) = (seated, self.active) {
+            on_event(GalvoEvent::Refused { seq: a.seq, error });
         }
     }
 
@@ -340,13 +473,24 @@ impl GalvoLoop {
                 if let Some(event) = self.apply_pending_config(false) {
                     on_event(event);
                 }
-                let Some(point) = self.queue.pop_front() else {
+                let Some((seq, job)) = self.queue.pop_front() else {
                     return;
                 };
-                self.start(point, on_event);
+                self.active = Some(Active {
+                    seq,
+                    job,
+                    stroke: 0,
+                    phase: Phase::Idle,
+                    samples_left: 0,
+                    cancelled: false,
+                });
+                if !self.jump_to_job_start(on_event) {
+                    self.active = None;
+                }
                 continue;
             };
             match a.phase {
+                Phase::Marking | Phase::Braking => return,
                 Phase::Jumping if !self.mirrors.is_idle() => return,
                 Phase::Jumping if a.cancelled => {
                     self.active = None;
@@ -354,16 +498,40 @@ impl GalvoLoop {
                 }
                 Phase::Jumping => a.enter(Phase::Settling, self.on_delay_samples),
                 _ if a.samples_left > 0 => return,
-                Phase::Settling if a.dwell_samples == 0 => {
-                    on_event(GalvoEvent::Done { seq: a.seq });
-                    self.active = None;
-                    continue;
-                }
-                Phase::Settling => a.enter(Phase::Dwelling, a.dwell_samples),
+                Phase::Settling => match a.job {
+                    Job::Point { dwell_us: 0, .. } => {
+                        on_event(GalvoEvent::Done { seq: a.seq });
+                        self.active = None;
+                        continue;
+                    }
+                    Job::Point { dwell_us, .. } => a.enter(
+                        Phase::Dwelling,
+                        samples_for(dwell_us, self.config.sample_period_s),
+                    ),
+                    Job::Path(path) => {
+                        self.active = Some(a);
+                        if !self.start_marking(path, a.stroke, on_event) {
+                            self.active = None;
+                        }
+                        continue;
+                    }
+                },
                 Phase::Dwelling => a.enter(Phase::LaserOffDelay, self.off_delay_samples),
                 Phase::LaserOffDelay | Phase::Idle => {
-                    on_event(GalvoEvent::Done { seq: a.seq });
-                    self.active = None;
+                    let next_stroke = match a.job {
+                        Job::Path(path) => path.stroke(a.stroke + 1).map(|_| a.stroke + 1),
+                        Job::Point { .. } => None,
+                    };
+                    let Some(stroke) = next_stroke else {
+                        on_event(GalvoEvent::Done { seq: a.seq });
+                        self.active = None;
+                        continue;
+                    };
+                    a.stroke = stroke;
+                    self.active = Some(a);
+                    if !self.jump_to_job_start(on_event) {
+                        self.active = None;
+                    }
                     continue;
                 }
             }
@@ -371,60 +539,101 @@ impl GalvoLoop {
         }
     }
 
-    /// Plans and queues the jump to `point`.
-    fn start(&mut self, point: Point, on_event: &mut impl FnMut(GalvoEvent)) {
-        let target_rad = match self.angles_for(point.target_mm) {
-            Ok(angles) => angles,
-            Err(error) => {
-                on_event(GalvoEvent::Refused {
-                    seq: point.seq,
-                    error,
-                });
-                return;
-            }
+    /// Plans and queues the jump to the active job's point or stroke
+    /// start; `false` (with `Refused`) when it cannot be planned.
+    fn jump_to_job_start(&mut self, on_event: &mut impl FnMut(GalvoEvent)) -> bool {
+        let Some(a) = self.active else { return false };
+        let target_mm = match a.job {
+            Job::Point { target_mm, .. } => target_mm,
+            Job::Path(path) => match path.stroke(a.stroke) {
+                Some(([x_mm, y_mm], _)) => PointMm { x_mm, y_mm },
+                None => return false,
+            },
         };
         let capacity = self
             .mirrors
             .x
             .free_samples()
             .min(self.mirrors.y.free_samples());
-        let planned = plan_xy_jump(
-            &self.disc,
-            &self.disc,
-            self.mirrors.end_position_rad(),
-            target_rad,
-            self.config.method,
-            JumpSync::Independent,
-            capacity,
-        )
-        .and_then(|jump| self.mirrors.queue_jump(&jump));
+        let planned = self.angles_for(target_mm).and_then(|target_rad| {
+            plan_xy_jump(
+                &self.disc,
+                &self.disc,
+                self.mirrors.end_position_rad(),
+                target_rad,
+                self.config.method,
+                JumpSync::Independent,
+                capacity,
+            )
+            .and_then(|jump| self.mirrors.queue_jump(&jump))
+            .map_err(|_| GalvoError::Planner)
+        });
         match planned {
             Ok(()) => {
-                self.active = Some(Active {
-                    seq: point.seq,
-                    phase: Phase::Jumping,
-                    samples_left: 0,
-                    dwell_samples: samples_for(point.dwell_us, self.config.sample_period_s),
-                    cancelled: false,
-                });
+                if let Some(a) = self.active.as_mut() {
+                    a.enter(Phase::Jumping, 0);
+                }
+                true
             }
-            Err(_) => on_event(GalvoEvent::Refused {
-                seq: point.seq,
-                error: GalvoError::Planner,
-            }),
+            Err(error) => {
+                on_event(GalvoEvent::Refused { seq: a.seq, error });
+                false
+            }
         }
     }
 
-    /// Latches an underrun: laser off, points dropped and refused until
-    /// the next `Stop`.
-    pub fn underrun(&mut self) {
-        self.stop();
-        self.faulted = true;
+    /// Loads stroke `stroke` of `path` into the path planner and starts
+    /// marking; `false` (with `Refused`) when the planner refuses it.
+    fn start_marking(
+        &mut self,
+        path: GalvoPath,
+        stroke: usize,
+        on_event: &mut impl FnMut(GalvoEvent),
+    ) -> bool {
+        let Some(a) = self.active else { return false };
+        let Some((start, segments)) = path.stroke(stroke) else {
+            return false;
+        };
+        let limits = MarkLimits {
+            speed_mm_s: self.config.mark_speed_mm_s,
+            accel_mm_s2: self.config.mark_accel_mm_s2,
+            junction_deviation_mm: JUNCTION_DEVIATION_MM,
+            ts_s: self.config.sample_period_s,
+        };
+        let loaded = PathPlanner::new(limits, start).and_then(|mut planner| {
+            for segment in &segments {
+                match *segment {
+                    Segment::Line(to) => planner.line_to(to)?,
+                    Segment::Arc { end, centre, ccw } => planner.arc_to(end, centre, ccw)?,
+                }
+            }
+            Ok(planner)
+        });
+        match loaded {
+            Ok(planner) => {
+                self.marker = Some(planner);
+                self.motion = Motion {
+                    position_mm: [start[0] as f32, start[1] as f32],
+                    step_mm: [0.0, 0.0],
+                };
+                if let Some(a) = self.active.as_mut() {
+                    a.enter(Phase::Marking, 0);
+                }
+                true
+            }
+            Err(_) => {
+                on_event(GalvoEvent::Refused {
+                    seq: a.seq,
+                    error: GalvoError::Planner,
+                });
+                false
+            }
+        }
     }
 
     /// Runs the loop forever: requests between half buffers, one half per
-    /// wake-up. An underrun turns the laser off, drops the queued points
-    /// (also those still in the request channel) and is reported; points
+    /// wake-up. An underrun turns the laser off, drops the queued jobs
+    /// (also those still in the request channel) and is reported; jobs
     /// are refused until the next `Stop`.
     pub async fn run<D: DacStream>(&mut self, dac: &mut D, link: &GalvoLink) -> ! {
         let n = dac.half_len().clamp(1, MAX_HALF_LEN);

@@ -3,8 +3,8 @@
 
 use core::sync::atomic::Ordering;
 
-use super::targets::Target;
-use super::{LaserSwitch, Sequencer, SettingsStore};
+use super::targets::{self, Target};
+use super::{LaserSwitch, Phase, Sequencer, SettingsStore};
 use crate::cli::format::Shortest;
 use crate::galvo::{GalvoEvent, GalvoRequest, config_from};
 use crate::log;
@@ -62,6 +62,32 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             target.point.y_cm
         );
         true
+    }
+
+    /// Sends the running path pattern to the galvo as one job.
+    pub(super) fn begin_galvo_path(&mut self) {
+        let path = self
+            .run
+            .and_then(|r| r.pattern)
+            .and_then(|p| targets::galvo_path(&p));
+        let Some(path) = path else {
+            self.stop("not a path");
+            return;
+        };
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let seq = self.next_seq;
+        if !self.send_galvo(GalvoRequest::Path { seq, path }) {
+            return;
+        }
+        if let Some(run) = self.run.as_mut() {
+            run.galvo_seq = seq;
+            run.galvo_busy = true;
+            run.gimbal_busy = false;
+            run.phase = Phase::Moving;
+            run.dwell_until = None;
+        }
+        log::info!("galvo marks the path");
+        self.publish();
     }
 
     /// Handles an event of the galvo loop.

@@ -239,8 +239,22 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         }
     }
 
+    /// Whether the run is a path marked by the galvo alone (one job per
+    /// pass instead of point by point).
+    fn is_galvo_path_run(&self) -> bool {
+        self.actuator.uses_galvo()
+            && !self.actuator.uses_gimbal()
+            && self
+                .run
+                .is_some_and(|r| r.pattern.is_some_and(|p| p.is_path()))
+    }
+
     /// Sends the current point to the actuator(s).
     fn begin_point(&mut self) {
+        if self.is_galvo_path_run() {
+            self.begin_galvo_path();
+            return;
+        }
         let Some(target) = self.current_target() else {
             self.stop("pattern has no points");
             return;
@@ -400,7 +414,9 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             return;
         };
         run.index += 1;
-        if targets::pattern_target(&pattern, run.index, &self.settings).is_none() {
+        if self.is_galvo_path_run()
+            || targets::pattern_target(&pattern, run.index, &self.settings).is_none()
+        {
             run.pass += 1;
             run.index = 0;
             if run.once {

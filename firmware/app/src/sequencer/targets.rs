@@ -9,6 +9,7 @@ use kinematics_core::{BoardPoint, Criterion, ErrorModel, Gimbal, Grid, GridIndex
 
 use crate::cli::format::Fixed;
 use crate::command::{Actuator, AimModel, Pattern, PointCm};
+use crate::galvo::GalvoPath;
 use crate::settings::{AxisSettings, Settings};
 
 /// One point the sequencer visits.
@@ -131,8 +132,40 @@ pub fn grid_point(settings: &Settings, xi: i8, yi: i8) -> Result<Target, kc::Err
 fn grid_pattern(pattern: &Pattern) -> Option<kc::Pattern> {
     match pattern {
         Pattern::Grid(grid) => Some(*grid),
-        Pattern::Line { .. } | Pattern::Circle { .. } | Pattern::Rect { .. } => None,
+        Pattern::Line { .. }
+        | Pattern::Circle { .. }
+        | Pattern::Rect { .. }
+        | Pattern::Tuning { .. } => None,
     }
+}
+
+/// The galvo path (mm) of a path pattern (cm).
+pub fn galvo_path(pattern: &Pattern) -> Option<GalvoPath> {
+    let mm = |p: PointCm| [(p.x_cm * 10.0) as f32, (p.y_cm * 10.0) as f32];
+    Some(match *pattern {
+        Pattern::Line { from, to } => GalvoPath::Line {
+            from_mm: mm(from),
+            to_mm: mm(to),
+        },
+        Pattern::Circle {
+            centre,
+            radius_cm,
+            rotation,
+        } => GalvoPath::Circle {
+            centre_mm: mm(centre),
+            radius_mm: (radius_cm * 10.0) as f32,
+            ccw: rotation == kc::Rotation::Ccw,
+        },
+        Pattern::Rect { a, b } => GalvoPath::Rect {
+            a_mm: mm(a),
+            b_mm: mm(b),
+        },
+        Pattern::Tuning { centre, size_cm } => GalvoPath::Tuning {
+            centre_mm: mm(centre),
+            half_size_mm: (size_cm * 5.0) as f32,
+        },
+        Pattern::Grid(_) => return None,
+    })
 }
 
 /// The points of a path pattern, interpolated point by point (midpoint
@@ -238,8 +271,9 @@ pub enum PatternError {
         /// The point, cm.
         point: PointCm,
     },
-    /// Marked paths (line, circle, rect) do not run on the galvo yet.
-    GalvoPath {
+    /// A path cannot be drawn by the selected actuator(s): paths run on
+    /// one actuator at a time, and the tuning figure only on the galvo.
+    PathActuator {
         /// Pattern name.
         pattern: &'static str,
     },
@@ -271,12 +305,10 @@ impl core::fmt::Display for PatternError {
                 Fixed::<2>(point.x_cm),
                 Fixed::<2>(point.y_cm)
             ),
-            PatternError::GalvoPath { pattern } => {
-                write!(
-                    f,
-                    "{pattern} paths do not run on the galvo yet; use target gimbal"
-                )
-            }
+            PatternError::PathActuator { pattern } => write!(
+                f,
+                "{pattern}: paths run on one actuator at a time (tuning: galvo only); use target gimbal or galvo"
+            ),
         }
     }
 }
@@ -341,8 +373,29 @@ pub fn check_pattern(
     actuator: Actuator,
 ) -> Result<(), PatternError> {
     let name = pattern.name();
-    if actuator.uses_galvo() && pattern.is_path() {
-        return Err(PatternError::GalvoPath { pattern: name });
+    if pattern.is_path() && actuator.uses_galvo() {
+        if actuator.uses_gimbal() {
+            return Err(PatternError::PathActuator { pattern: name });
+        }
+        // The galvo marks the path itself: its corners must be in range.
+        let path = galvo_path(pattern).ok_or(PatternError::Empty { pattern: name })?;
+        for (index, [x_mm, y_mm]) in path.bounds_mm().into_iter().enumerate() {
+            let point = PointCm {
+                x_cm: x_mm / 10.0,
+                y_cm: y_mm / 10.0,
+            };
+            if !galvo_in_range(settings, point) {
+                return Err(PatternError::OutsideGalvoRange {
+                    pattern: name,
+                    index,
+                    point,
+                });
+            }
+        }
+        return Ok(());
+    }
+    if matches!(pattern, Pattern::Tuning { .. }) {
+        return Err(PatternError::PathActuator { pattern: name });
     }
     if let Some(Err(error)) = path_points(pattern, settings) {
         return Err(PatternError::Path {

@@ -250,3 +250,143 @@ fn an_underrun_latches_the_laser_off_until_stop() {
     assert_eq!(galvo.request(GalvoRequest::Stop), None);
     assert_eq!(galvo.request(point(3, 0.0, 0.0, 100)), None);
 }
+
+fn path(seq: u32, path: GalvoPath) -> GalvoRequest {
+    GalvoRequest::Path { seq, path }
+}
+
+/// Distance (mm) from `p` to the border of the axis-aligned rectangle.
+fn off_rect(p: PointMm, lo: [f64; 2], hi: [f64; 2]) -> f64 {
+    let inside_x = p.x_mm.clamp(lo[0], hi[0]);
+    let inside_y = p.y_mm.clamp(lo[1], hi[1]);
+    let outside = (p.x_mm - inside_x).hypot(p.y_mm - inside_y);
+    let inside = (p.x_mm - lo[0])
+        .abs()
+        .min((p.x_mm - hi[0]).abs())
+        .min((p.y_mm - lo[1]).abs())
+        .min((p.y_mm - hi[1]).abs());
+    if outside > 0.0 { outside } else { inside }
+}
+
+/// Largest DAC step between consecutive samples.
+fn largest_step(samples: &[DacSample]) -> u16 {
+    samples
+        .windows(2)
+        .map(|w| {
+            w[0].x_code
+                .abs_diff(w[1].x_code)
+                .max(w[0].y_code.abs_diff(w[1].y_code))
+        })
+        .max()
+        .unwrap_or(0)
+}
+
+#[test]
+fn a_rectangle_is_marked_on_its_border_at_the_marking_speed() {
+    let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
+    let rect = GalvoPath::Rect {
+        a_mm: [-40.0, 30.0],
+        b_mm: [40.0, -30.0],
+    };
+    assert_eq!(galvo.request(path(1, rect)), None);
+    let (samples, events) = run(&mut galvo, done(1));
+    assert_eq!(events.len(), 1);
+    let lit: Vec<&DacSample> = samples.iter().filter(|s| s.laser).collect();
+    // 280 mm of border at ≤ 1 m/s: at least 28 ms of marking.
+    assert!(lit.len() >= 2800, "{} lit samples", lit.len());
+    for s in &lit {
+        let p = spot_mm(s);
+        // DAC quantisation: one LSB is ~0.085 mm here.
+        assert!(off_rect(p, [-40.0, -30.0], [40.0, 30.0]) < 0.15, "{p:?}");
+    }
+    // Marking never outruns 1000 mm/s (10 µs samples: 0.01 mm + 1 LSB).
+    let mut prev: Option<PointMm> = None;
+    for s in samples.iter() {
+        let p = spot_mm(s);
+        if let (Some(q), true) = (prev, s.laser) {
+            assert!((p.x_mm - q.x_mm).hypot(p.y_mm - q.y_mm) < 0.01 + 0.13);
+        }
+        prev = Some(p);
+    }
+    // One unbroken lit run that starts and ends at corner a.
+    let first = samples.iter().position(|s| s.laser).unwrap();
+    let last = samples.iter().rposition(|s| s.laser).unwrap();
+    assert!(samples[first..=last].iter().all(|s| s.laser));
+    for k in [first, last] {
+        let p = spot_mm(&samples[k]);
+        assert!(
+            (p.x_mm + 40.0).abs() < 0.15 && (p.y_mm - 30.0).abs() < 0.15,
+            "{p:?}"
+        );
+    }
+}
+
+#[test]
+fn the_tuning_figure_is_four_strokes_with_jumps_between() {
+    let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
+    let figure = GalvoPath::Tuning {
+        centre_mm: [10.0, -5.0],
+        half_size_mm: 25.0,
+    };
+    galvo.request(path(1, figure));
+    let (samples, _) = run(&mut galvo, done(1));
+    let switches_on = samples
+        .windows(2)
+        .filter(|w| !w[0].laser && w[1].laser)
+        .count();
+    assert_eq!(switches_on, 4, "square, circle, horizontal, vertical");
+    for s in samples.iter().filter(|s| s.laser) {
+        let p = spot_mm(s);
+        let (dx, dy) = (p.x_mm - 10.0, p.y_mm + 5.0);
+        let on_square = off_rect(p, [-15.0, -30.0], [35.0, 20.0]) < 0.15;
+        let on_circle = (dx.hypot(dy) - 25.0).abs() < 0.15;
+        let on_cross =
+            (dy.abs() < 0.15 && dx.abs() <= 25.15) || (dx.abs() < 0.15 && dy.abs() <= 25.15);
+        assert!(
+            on_square || on_circle || on_cross,
+            "lit off the figure at {p:?}"
+        );
+    }
+}
+
+#[test]
+fn stop_while_marking_brakes_dark_without_a_jump() {
+    let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
+    galvo.request(path(
+        1,
+        GalvoPath::Line {
+            from_mm: [-60.0, 0.0],
+            to_mm: [60.0, 0.0],
+        },
+    ));
+    let mut half = [DacSample::default(); 128];
+    let mut samples = Vec::new();
+    // Mark until the spot is at full speed, well into the line.
+    while samples.iter().filter(|s: &&DacSample| s.laser).count() < 3000 {
+        galvo.fill(&mut half, |_| {});
+        samples.extend_from_slice(&half);
+    }
+    assert_eq!(galvo.phase(), Phase::Marking);
+    let marking_step = largest_step(&samples[samples.len() - 128..]);
+    galvo.stop();
+    let (after, events) = run(&mut galvo, |_| false);
+    assert!(events.is_empty());
+    assert!(after.iter().all(|s| !s.laser), "dark from the next sample");
+    assert_eq!(galvo.phase(), Phase::Idle);
+    let mut joined = samples[samples.len() - 1..].to_vec();
+    joined.extend_from_slice(&after);
+    assert!(
+        largest_step(&joined) <= marking_step,
+        "no jump when stopping"
+    );
+    // It kept moving forward while braking (1 m/s at 1e5 mm/s²: 5 mm).
+    let (before, end) = (spot_mm(&joined[0]), spot_mm(after.last().unwrap()));
+    assert!(
+        end.x_mm - before.x_mm > 3.0 && end.x_mm - before.x_mm < 7.0,
+        "{before:?} → {end:?}"
+    );
+    // And it can jump again from there.
+    galvo.request(point(2, 0.0, 0.0, 100));
+    let (_, events) = run(&mut galvo, done(2));
+    assert_eq!(events.len(), 1);
+}
