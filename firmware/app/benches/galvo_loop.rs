@@ -7,7 +7,7 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
-use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoRequest};
+use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoPath, GalvoRequest, Phase};
 
 const HALF: usize = 128;
 
@@ -52,6 +52,30 @@ fn galvo_loop(c: &mut Criterion) {
             );
         });
     }
+    group.bench_function("marking a line (path planner + galvo IK + DAC)", |b| {
+        b.iter_batched(
+            || {
+                let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default config");
+                galvo.request(GalvoRequest::Path {
+                    seq: 1,
+                    path: GalvoPath::Line {
+                        from_mm: [-80.0, 10.0],
+                        to_mm: [80.0, -10.0],
+                    },
+                });
+                let mut half = [DacSample::default(); HALF];
+                while galvo.phase() != Phase::Marking {
+                    galvo.fill(&mut half, |_| {});
+                }
+                (galvo, half)
+            },
+            |(mut galvo, mut half)| {
+                galvo.fill(black_box(&mut half), |_| {});
+                half
+            },
+            BatchSize::SmallInput,
+        );
+    });
     group.finish();
 }
 

@@ -25,7 +25,9 @@ pub fn galvo_trace(dac: &dac::DacRecording, galvo: &physics::PhysicalGalvo) -> d
         if trace.path.last() != Some(&spot) {
             trace.path.push(spot);
         }
-        if sample.laser && trace.lit.last() != Some(&spot) {
+        // Lit spots closer than 0.2 mm to the last one drawn add nothing.
+        let near = |p: &(f64, f64)| (p.0 - spot.0).hypot(p.1 - spot.1) < 0.02;
+        if sample.laser && !trace.lit.last().is_some_and(near) {
             trace.lit.push(spot);
         }
     }

@@ -41,7 +41,12 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
 
 /// The script `cargo xtask sim` runs without arguments.
 pub const DEMO_SCRIPT: &str = "\
-# Demo: the four corners once, then the whole grid once (serpentine).
+# Demo: the galvo marks its tuning figure (square, circle, cross), then the
+# gimbal visits the four corners once and the whole grid once (serpentine).
+target galvo
+pattern tuning 0 0 8 once
+wait 1500
+target gimbal
 set dwell_ms 200
 pattern corner once
 wait 3000
