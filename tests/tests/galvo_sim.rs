@@ -145,6 +145,29 @@ fn planned_jump(from_mm: (f64, f64), to_mm: (f64, f64), method: Method) -> (usiz
     (jump.samples(), max_step)
 }
 
+/// No DAC step larger than the planner's own largest step on the longest
+/// jump of the grid (corner to opposite corner): the output never jumps.
+fn assert_no_step_beyond_a_planned_jump(samples: &[DacSample]) {
+    let (_, bound) = planned_jump(
+        (-6.0 * PITCH_MM, 4.0 * PITCH_MM),
+        (6.0 * PITCH_MM, -4.0 * PITCH_MM),
+        Method::TimeOptimal,
+    );
+    let largest = samples
+        .windows(2)
+        .map(|w| {
+            w[0].x_code
+                .abs_diff(w[1].x_code)
+                .max(w[0].y_code.abs_diff(w[1].y_code))
+        })
+        .max()
+        .unwrap_or(0);
+    assert!(
+        largest <= bound,
+        "DAC step {largest} > planned maximum {bound}"
+    );
+}
+
 #[test]
 fn jumps_take_the_planned_time_with_either_planner() {
     let corner = (-6.0 * PITCH_MM, 4.0 * PITCH_MM);
@@ -212,26 +235,7 @@ fn switching_pattern_mid_dwell_stops_the_galvo_cleanly() {
         run_to_idle("target galvo\npattern visit-all\nwait 2500\npattern home once\nwait 1010\n");
     assert!(report.succeeded(false));
     let samples = samples(&report);
-    // No DAC step larger than the planner's own largest step (the
-    // longest jump here: across the grid).
-    let (_, bound) = planned_jump(
-        (-6.0 * PITCH_MM, 4.0 * PITCH_MM),
-        (6.0 * PITCH_MM, -4.0 * PITCH_MM),
-        Method::TimeOptimal,
-    );
-    let largest = samples
-        .windows(2)
-        .map(|w| {
-            w[0].x_code
-                .abs_diff(w[1].x_code)
-                .max(w[0].y_code.abs_diff(w[1].y_code))
-        })
-        .max()
-        .unwrap_or(0);
-    assert!(
-        largest <= bound,
-        "DAC step {largest} > planned maximum {bound}"
-    );
+    assert_no_step_beyond_a_planned_jump(&samples);
     let last_lit = lit_runs(&samples).last().map(|r| r.2).expect("lit");
     assert!(
         last_lit.0.abs() < 0.1 && last_lit.1.abs() < 0.1,
@@ -326,24 +330,7 @@ fn switching_pattern_mid_path_brakes_dark_and_moves_on() {
     let samples = samples(&report);
     let runs = lit_runs(&samples);
     assert_eq!(runs.len(), 2, "the interrupted rectangle, then home");
-    let (_, bound) = planned_jump(
-        (-6.0 * PITCH_MM, 4.0 * PITCH_MM),
-        (6.0 * PITCH_MM, -4.0 * PITCH_MM),
-        Method::TimeOptimal,
-    );
-    let largest = samples
-        .windows(2)
-        .map(|w| {
-            w[0].x_code
-                .abs_diff(w[1].x_code)
-                .max(w[0].y_code.abs_diff(w[1].y_code))
-        })
-        .max()
-        .unwrap_or(0);
-    assert!(
-        largest <= bound,
-        "DAC step {largest} > planned maximum {bound}"
-    );
+    assert_no_step_beyond_a_planned_jump(&samples);
     let home = runs[1].2;
     assert!(home.0.abs() < 0.1 && home.1.abs() < 0.1, "{home:?}");
 }
