@@ -137,6 +137,20 @@ impl fmt::Display for Error {
 
 impl core::error::Error for Error {}
 
+/// `v` limited to `[lo, hi]`; NaN stays NaN (so solvers still see a
+/// diverged iterate). Unlike `f64::clamp` it cannot panic, and it links no
+/// float formatting into the firmware (`f64::clamp`'s panic message
+/// formats its bounds).
+pub(crate) fn clamp<F: PartialOrd>(v: F, lo: F, hi: F) -> F {
+    if v < lo {
+        lo
+    } else if v > hi {
+        hi
+    } else {
+        v
+    }
+}
+
 /// Checks that `value` is finite; names it in the error otherwise.
 pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, Error> {
     if value.is_finite() {
@@ -161,6 +175,16 @@ mod tests {
     extern crate std;
     use super::*;
     use std::string::ToString;
+
+    #[test]
+    fn clamp_keeps_nan_and_never_panics() {
+        assert_eq!(clamp(5.0, 0.0, 1.0), 1.0);
+        assert_eq!(clamp(-5.0f32, 0.0, 1.0), 0.0);
+        assert_eq!(clamp(0.25, 0.0, 1.0), 0.25);
+        assert!(clamp(f64::NAN, 0.0, 1.0).is_nan());
+        // Misordered bounds (f64::clamp would panic): no panic.
+        assert_eq!(clamp(0.5, 1.0, 0.0), 1.0);
+    }
 
     #[test]
     fn display_names_the_value() {

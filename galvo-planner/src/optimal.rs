@@ -34,7 +34,7 @@
 //! 20° move takes ~5 continuation stages of a few Newton steps plus 1–2
 //! sampled solves (≈ 17–25 µs on a desktop core, see the README).
 
-use crate::error::{Error, finite};
+use crate::error::{Error, clamp, finite};
 use crate::jump::{InputLaw, JumpPlan, MethodKind, PlanInfo};
 use crate::linalg::{Matrix, Vector, at, expm_and_integral, mat_vec, solve};
 use crate::min_energy::{SeedConfig, min_energy_at};
@@ -417,8 +417,8 @@ fn continuous_optimum(
         };
         let project = |x: Vector<3>| -> Vector<3> {
             let t = x[2].max(1e-12);
-            let t1 = x[0].clamp(0.0, t);
-            let t2 = x[1].clamp(t1, t);
+            let t1 = clamp(x[0], 0.0, t);
+            let t2 = clamp(x[1], t1, t);
             [t1, t2, t]
         };
         let nudge = |x: Vector<3>| -> Vector<3> { [x[0] * 0.9, x[1], x[2] * 1.05] };
@@ -480,7 +480,7 @@ fn sampled_bang_bang(
     // R(s): response at sample n of an averaged unit step starting at s,
     // and its derivative −g_q.
     let r_of = |s: f64| -> (Vector<3>, Vector<3>) {
-        let m = libm::floor(s).clamp(0.0, (n - 1) as f64);
+        let m = clamp(libm::floor(s), 0.0, (n - 1) as f64);
         let f = s - m;
         let q = n - 1 - m as usize;
         let (hi, lo) = (big_s(q + 1), big_s(q));
@@ -512,8 +512,8 @@ fn sampled_bang_bang(
         (r, jac)
     };
     let project = |x: Vector<3>| -> Vector<3> {
-        let s1 = x[0].clamp(0.0, last);
-        let s2 = x[1].clamp(s1, last);
+        let s1 = clamp(x[0], 0.0, last);
+        let s2 = clamp(x[1], s1, last);
         [s1, s2, x[2]]
     };
     // Singular when both switches share a sample: push the second one into
@@ -531,7 +531,7 @@ fn sampled_bang_bang(
         tol: 1e-12,
         max_iter: 60,
     };
-    let g = (guess.0.clamp(0.0, last), guess.1.clamp(0.0, last));
+    let g = (clamp(guess.0, 0.0, last), clamp(guess.1, 0.0, last));
     let x = newton.solve([g.0, g.1, 0.0], eval, project, nudge)?;
     if libm::fabs(x[2]) <= u_max {
         Some(x)

@@ -27,7 +27,7 @@
 //! The planner works in board coordinates only; converting them to mirror
 //! angles is the caller's job (galvo kinematics live in another crate).
 
-use crate::error::{Error, finite, positive};
+use crate::error::{Error, clamp, finite, positive};
 
 /// Limits and sample period of the path planner.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -680,7 +680,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
                 e.v1 + e.accel * r,
             )
         };
-        let s = s.clamp(0.0, e.length);
+        let s = clamp(s, 0.0, e.length);
         let p = if e.arc {
             let ang = e.angle0 + e.dir * s / e.radius;
             [
@@ -804,7 +804,7 @@ fn trapezoid(v0: f64, v1: f64, vn: f64, a: f64, l: f64) -> (f64, f64, f64, f64, 
         let vp = libm::sqrt(0.5 * (2.0 * a * l + v0 * v0 + v1 * v1))
             .max(v0)
             .max(v1);
-        let d_acc = ((vp * vp - v0 * v0) / (2.0 * a)).clamp(0.0, l);
+        let d_acc = clamp((vp * vp - v0 * v0) / (2.0 * a), 0.0, l);
         (vp, d_acc, (vp - v0) / a, 0.0, (vp - v1) / a)
     }
 }
