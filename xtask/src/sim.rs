@@ -46,12 +46,17 @@ pub struct SimArgs {
     /// With --until-idle: `error:` replies do not fail the run.
     #[arg(long)]
     allow_errors: bool,
-    /// Pace with the wall clock (interactive use) instead of virtual time.
+    /// Pace with the wall clock instead of virtual time.
     #[arg(long)]
     realtime: bool,
-    /// Stop after this much simulated time, s.
-    #[arg(long, default_value_t = 600.0)]
-    max_time_s: f64,
+    /// Type commands on stdin as the simulation runs in real time, like a
+    /// serial terminal on the board (end with Ctrl-D). Implies --realtime.
+    #[arg(long, conflicts_with = "script")]
+    interactive: bool,
+    /// Stop after this much simulated time, s (default 600; no limit with
+    /// --interactive).
+    #[arg(long)]
+    max_time_s: Option<f64>,
     /// Log level of the firmware logs on stderr (error, warn, info, debug, trace, off).
     #[arg(long, default_value = "info")]
     log: String,
@@ -137,6 +142,7 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
     })?;
     laser_sim::logger::init(level);
     let script_text = match &args.script {
+        _ if args.interactive => String::new(),
         Some(path) if path.as_os_str() == "-" => read_stdin()?,
         Some(path) => std::fs::read_to_string(path)
             .with_context(|| format!("cannot read script {}", path.display()))?,
@@ -144,7 +150,7 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         None if std::io::IsTerminal::is_terminal(&std::io::stdin()) => String::new(),
         None => read_stdin()?,
     };
-    let demo = args.script.is_none() && script_text.trim().is_empty();
+    let demo = !args.interactive && args.script.is_none() && script_text.trim().is_empty();
     let script_text = if demo {
         DEMO_SCRIPT.to_owned()
     } else {
@@ -157,19 +163,27 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         .clone()
         .or_else(|| demo.then(|| PathBuf::from("sim.svg")));
     let until_idle = args.until_idle || demo;
-    if !(args.max_time_s.is_finite() && args.max_time_s > 0.0) {
-        bail!("--max-time-s must be positive");
+    let max_time_s = match args.max_time_s {
+        Some(s) if s.is_finite() && s > 0.0 => s,
+        Some(_) => bail!("--max-time-s must be positive"),
+        // A year of simulated time: no limit in practice.
+        None if args.interactive => 3.2e7,
+        None => 600.0,
+    };
+    if args.interactive {
+        eprintln!("xtask sim: type commands (help lists them); Ctrl-D ends the simulation");
     }
     if demo {
         eprintln!("xtask sim: no script given, running the demo:\n{DEMO_SCRIPT}");
     }
     let report = run(SimOptions {
         script,
-        realtime: args.realtime,
+        realtime: args.realtime || args.interactive,
+        interactive: args.interactive,
         until_idle,
         faults,
         slow_factor,
-        max_time_ms: (args.max_time_s * 1000.0) as u64,
+        max_time_ms: (max_time_s * 1000.0) as u64,
         echo: true,
         galvo_cost_ns_per_sample: args.galvo_cost_ns,
         ..SimOptions::default()

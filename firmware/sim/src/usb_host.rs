@@ -72,15 +72,39 @@ pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>) {
     for step in steps {
         match step {
             Step::WaitMs(ms) => Timer::after_millis(ms).await,
-            Step::Send(line) => {
-                host.record(format!("> {line}"));
-                host.to_device.write_all(line.as_bytes()).await;
-                host.to_device.write_all(b"\r\n").await;
-                host.finals.receive().await;
-            }
+            Step::Send(line) => send_line(&host, &line).await,
         }
     }
     host.transcript.borrow_mut().script_done = true;
+}
+
+/// Types lines as they come from `lines` (a terminal, read on another
+/// thread), checking every 20 ms; the end of input ends the script. For
+/// interactive use in real time.
+pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc<UsbHost>) {
+    loop {
+        match lines.try_recv() {
+            Ok(line) => {
+                for step in crate::script::parse_script(&line).unwrap_or_default() {
+                    match step {
+                        Step::WaitMs(ms) => Timer::after_millis(ms).await,
+                        Step::Send(line) => send_line(&host, &line).await,
+                    }
+                }
+            }
+            Err(std::sync::mpsc::TryRecvError::Empty) => Timer::after_millis(20).await,
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => break,
+        }
+    }
+    host.transcript.borrow_mut().script_done = true;
+}
+
+/// Types one command line and waits for its closing reply.
+async fn send_line(host: &UsbHost, line: &str) {
+    host.record(format!("> {line}"));
+    host.to_device.write_all(line.as_bytes()).await;
+    host.to_device.write_all(b"\r\n").await;
+    host.finals.receive().await;
 }
 
 /// Reads the device's output line by line.
@@ -107,5 +131,49 @@ pub async fn terminal_task(host: Rc<UsbHost>) {
                 host.finals.send(is_ok).await;
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::executor;
+
+    /// A device that answers every line with `ok`.
+    async fn echo_ok_device(host: Rc<UsbHost>) {
+        let mut buf = [0u8; 64];
+        loop {
+            let n = host.to_device.read(&mut buf).await;
+            for _ in buf[..n].iter().filter(|&&b| b == b'\n') {
+                host.from_device.write_all(b"ok\r\n").await;
+            }
+        }
+    }
+
+    #[test]
+    fn interactive_lines_are_typed_in_order_until_the_input_ends() {
+        let host = Rc::new(UsbHost::new(false));
+        let (send, lines) = std::sync::mpsc::channel();
+        for line in ["status", "# a comment", "wait 100", "goto 1 2"] {
+            send.send(line.to_owned()).unwrap();
+        }
+        drop(send);
+        let (h1, h2, h3, stop) = (host.clone(), host.clone(), host.clone(), host.clone());
+        let end = executor::run(
+            false,
+            10_000_000,
+            move |spawner| {
+                executor::spawn(&spawner, interactive_task(lines, h1));
+                executor::spawn(&spawner, terminal_task(h2));
+                executor::spawn(&spawner, echo_ok_device(h3));
+            },
+            move || stop.transcript.borrow().script_done,
+        );
+        assert_eq!(end, executor::RunEnd::Stopped);
+        let transcript = host.transcript.borrow();
+        let lines: Vec<&str> = transcript.lines.iter().map(|(_, l)| l.as_str()).collect();
+        assert_eq!(lines, ["> status", "ok", "> goto 1 2", "ok"]);
+        let goto_at = transcript.lines[2].0;
+        assert!(goto_at >= 100_000, "the wait line waited: {goto_at} µs");
     }
 }

@@ -22,7 +22,7 @@ use crate::recorder::{DwellRecord, Recording, SpotSample};
 use crate::script::Step;
 use crate::servo_model::SimServoBus;
 use crate::servo_port::{BusFaults, PortHandle, SimServoPort};
-use crate::usb_host::{Transcript, UsbHost, script_task, terminal_task};
+use crate::usb_host::{Transcript, UsbHost, interactive_task, script_task, terminal_task};
 
 /// Samples per galvo DAC half buffer (1.28 ms at 100 kHz).
 pub const GALVO_HALF_LEN: usize = 128;
@@ -32,6 +32,9 @@ pub const GALVO_HALF_LEN: usize = 128;
 pub struct SimOptions {
     /// The command lines to type (and waits).
     pub script: Vec<Step>,
+    /// Type what the user types on stdin instead of `script` (real time,
+    /// until end of input).
+    pub interactive: bool,
     /// Pace with the wall clock instead of jumping over idle time.
     pub realtime: bool,
     /// Keep running after the script until the sequencer is idle.
@@ -60,6 +63,7 @@ impl Default for SimOptions {
     fn default() -> Self {
         Self {
             script: Vec::new(),
+            interactive: false,
             realtime: false,
             until_idle: false,
             faults: BusFaults::default(),
@@ -177,6 +181,7 @@ pub fn run(options: SimOptions) -> SimReport {
             bus.clone(),
             options.script.clone(),
         );
+        let interactive = options.interactive;
         let until_idle = options.until_idle;
         let galvo_dac = dac_recording.clone();
         let stop_host = host.clone();
@@ -190,7 +195,19 @@ pub fn run(options: SimOptions) -> SimReport {
                     let mut tx = &console_host.from_device;
                     laser_app::usb::run_console(&mut rx, &mut tx, link).await;
                 });
-                executor::spawn(&spawner, script_task(script, host.clone()));
+                if interactive {
+                    let (send, lines) = std::sync::mpsc::channel();
+                    std::thread::spawn(move || {
+                        for line in std::io::stdin().lines().map_while(Result::ok) {
+                            if send.send(line).is_err() {
+                                break;
+                            }
+                        }
+                    });
+                    executor::spawn(&spawner, interactive_task(lines, host.clone()));
+                } else {
+                    executor::spawn(&spawner, script_task(script, host.clone()));
+                }
                 executor::spawn(&spawner, terminal_task(host.clone()));
                 let servo_port = port.clone();
                 executor::spawn(&spawner, async move {
