@@ -356,3 +356,30 @@ fn a_galvo_loop_too_slow_for_the_sample_rate_is_reported_and_stopped() {
     );
     assert!(report.idle_at_end, "the pattern stopped");
 }
+
+#[test]
+fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
+    let report = run_to_idle("target galvo\ngoto 2 1\nwait 50\nstatus\nstop\nwait 10\n");
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let lines: Vec<&str> = report
+        .transcript
+        .lines
+        .iter()
+        .map(|(_, l)| l.as_str())
+        .collect();
+    assert!(
+        lines.contains(&"state: goto") && lines.contains(&"phase: holding"),
+        "{lines:?}"
+    );
+    let samples = samples(&report);
+    let runs = lit_runs(&samples);
+    assert_eq!(runs.len(), 1);
+    let (start, len, spot) = runs[0];
+    assert!(
+        (spot.0 - 20.0).abs() < 0.1 && (spot.1 - 10.0).abs() < 0.1,
+        "{spot:?}"
+    );
+    // Lit from landing until `stop` (~50 ms later), then dark to the end.
+    assert!(len >= 4_500, "{len} samples lit");
+    assert!(samples[start + len..].iter().all(|s| !s.laser));
+}
