@@ -5,7 +5,7 @@
 //! deg/s). Integer parameters (ids, counts, directions) are checked to be
 //! whole numbers.
 //!
-//! [`params`] holds the table, [`record`] the saved form.
+//! `params.rs` holds the table, `record.rs` the saved form.
 
 mod params;
 mod record;
