@@ -20,6 +20,16 @@ pub fn run_with(script: &str, options: SimOptions) -> SimReport {
     })
 }
 
+/// Every line of the terminal transcript (`> command` for what was sent).
+pub fn terminal_lines(report: &SimReport) -> Vec<&str> {
+    report
+        .transcript
+        .lines
+        .iter()
+        .map(|(_, l)| l.as_str())
+        .collect()
+}
+
 /// Simulated time at which the terminal sent `line`, µs.
 pub fn sent_at(report: &SimReport, line: &str) -> u64 {
     report

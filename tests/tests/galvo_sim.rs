@@ -6,7 +6,7 @@ use galvo_planner::{JumpSync, Method, RigidParams, XyStepper, plan_xy_jump};
 use kinematics_core::{Galvo, PointMm};
 use laser_app::galvo::DacSample;
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::{run_to_idle, run_with, spec_patterns};
+use system_tests::{run_to_idle, run_with, spec_patterns, terminal_lines};
 
 /// SPEC grid pitch, mm.
 const PITCH_MM: f64 = 19.16;
@@ -273,12 +273,7 @@ fn galvo_commands_refuse_what_it_cannot_do() {
         "{}",
         errors[2]
     );
-    let lines: Vec<&str> = report
-        .transcript
-        .lines
-        .iter()
-        .map(|(_, l)| l.as_str())
-        .collect();
+    let lines = terminal_lines(&report);
     assert!(lines.contains(&"galvo: Idle, 0 points queued"), "{lines:?}");
     assert!(lines.contains(&"actuator: galvo"));
     assert!(report.dac.iter().all(|(_, s)| !s.laser));
@@ -361,12 +356,7 @@ fn a_galvo_loop_too_slow_for_the_sample_rate_is_reported_and_stopped() {
 fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
     let report = run_to_idle("target galvo\ngoto 2 1\nwait 50\nstatus\nstop\nwait 10\n");
     assert!(report.succeeded(false), "{:?}", report.transcript);
-    let lines: Vec<&str> = report
-        .transcript
-        .lines
-        .iter()
-        .map(|(_, l)| l.as_str())
-        .collect();
+    let lines = terminal_lines(&report);
     assert!(
         lines.contains(&"state: goto") && lines.contains(&"phase: holding"),
         "{lines:?}"

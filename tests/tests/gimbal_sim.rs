@@ -4,7 +4,7 @@
 use laser_sim::recorder::Direction;
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::SimOptions;
-use system_tests::{run_to_idle, run_with, sent_at, spec_patterns};
+use system_tests::{run_to_idle, run_with, sent_at, spec_patterns, terminal_lines};
 
 /// Pointing tolerance of the exact model, cm (0.5 mm).
 const TOLERANCE_CM: f64 = 0.05;
@@ -315,12 +315,7 @@ fn saved_settings_survive_a_reboot_and_a_corrupt_record_falls_back_to_defaults()
             ..SimOptions::default()
         },
     );
-    let lines: Vec<&str> = rebooted
-        .transcript
-        .lines
-        .iter()
-        .map(|(_, l)| l.as_str())
-        .collect();
+    let lines = terminal_lines(&rebooted);
     assert!(
         lines.iter().any(|l| l.starts_with("dwell_ms = 123")),
         "{lines:?}"
