@@ -250,11 +250,8 @@ fn galvo_commands_refuse_what_it_cannot_do() {
         "pattern tuning once\ntarget both\npattern line 0 0 5 5 once\ntarget galvo\ngoto 30 0\ngalvo status\nstatus\n",
         SimOptions::default(),
     );
-    let errors: Vec<&str> = report
-        .transcript
-        .lines
-        .iter()
-        .map(|(_, l)| l.as_str())
+    let errors: Vec<&str> = terminal_lines(&report)
+        .into_iter()
         .filter(|l| l.starts_with("error:"))
         .collect();
     assert_eq!(errors.len(), 3, "{errors:?}");
