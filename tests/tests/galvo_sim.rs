@@ -370,3 +370,86 @@ fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
     assert!(len >= 4_500, "{len} samples lit");
     assert!(samples[start + len..].iter().all(|s| !s.laser));
 }
+
+#[test]
+fn random_command_sequences_keep_every_safety_invariant() {
+    // Meaningful commands in random order and timing: actuators, planners,
+    // patterns (grid and paths), gotos, stops, parameter changes.
+    let templates: &[&dyn Fn(u64) -> String] = &[
+        &|_| "target galvo".into(),
+        &|_| "target gimbal".into(),
+        &|_| "target both".into(),
+        &|r| format!("planner {}", if r % 2 == 0 { "optimal" } else { "seed" }),
+        &|r| {
+            format!(
+                "pattern {} once",
+                ["corner", "home", "horizontal", "vertical"][(r % 4) as usize]
+            )
+        },
+        &|_| "pattern tuning 1 -1 5".into(),
+        &|_| "pattern circle -3 2 2.5 ccw".into(),
+        &|_| "pattern rect -4 3 4 -3 once".into(),
+        &|r| format!("goto {} {}", (r % 17) as f64 - 8.0, (r % 11) as f64 - 5.0),
+        &|_| "stop".into(),
+        &|r| format!("set dwell_ms {}", r % 120),
+        &|r| format!("set galvo.mark_speed_mm_s {}", 200 + r % 3000),
+        &|r| format!("set galvo.laser_on_delay_us {}", r % 400),
+        &|r| format!("wait {}", r % 80),
+    ];
+    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let mut script = String::new();
+    for _ in 0..1000 {
+        let pick = (next() % templates.len() as u64) as usize;
+        script.push_str(&templates[pick](next()));
+        script.push('\n');
+    }
+    script.push_str("stop\nwait 20\nstatus\ngalvo status\n");
+    let report = run_with(&script, SimOptions::default());
+    assert!(report.transcript.script_done, "every line got its reply");
+    assert_ne!(report.end, laser_sim::executor::RunEnd::Livelock);
+    eprintln!(
+        "random commands: {:.2} s simulated, {} DAC samples ({} lit), {} gimbal dwells, {} error replies",
+        report.end_time_us as f64 * 1e-6,
+        report.dac.len(),
+        report.dac.iter().filter(|(_, s)| s.laser).count(),
+        report.recording.dwells.len(),
+        report.transcript.error_replies
+    );
+    let lines = terminal_lines(&report);
+    let sent = lines.iter().filter(|l| l.starts_with("> ")).count();
+    let finals = lines
+        .iter()
+        .filter(|l| **l == "ok" || l.starts_with("error:"))
+        .count();
+    assert_eq!(sent, finals, "exactly one closing reply per line");
+    assert_eq!(report.galvo_underruns, 0);
+    // The galvo's laser is never on while its mirrors move.
+    let samples = samples(&report);
+    for w in samples.windows(2) {
+        if (w[0].x_code, w[0].y_code) != (w[1].x_code, w[1].y_code) && w[0].laser && w[1].laser {
+            // Marking moves with the laser on, in steps of at most the
+            // marking speed (≤ 3.2 m/s here: 0.032 mm per sample + 1 LSB).
+            let (p, q) = (spot_mm(&w[0]), spot_mm(&w[1]));
+            assert!((p.0 - q.0).hypot(p.1 - q.1) < 0.2, "lit jump {p:?} → {q:?}");
+        }
+    }
+    assert!(
+        !samples.last().expect("samples").laser,
+        "galvo dark after stop"
+    );
+    assert!(
+        !report.recording.laser_events.last().is_some_and(|e| e.1),
+        "gimbal laser off after stop"
+    );
+    assert!(
+        lines.contains(&"state: idle"),
+        "{:?}",
+        &lines[lines.len().saturating_sub(20)..]
+    );
+}
