@@ -33,36 +33,26 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
     } else if is("params") {
         Command::Params
     } else if is("target") {
-        let which = args.word("gimbal|galvo|both")?;
-        Command::Target(
-            [Actuator::Gimbal, Actuator::Galvo, Actuator::Both]
-                .into_iter()
-                .find(|a| a.name().eq_ignore_ascii_case(which))
-                .ok_or(CommandError::InvalidArgument {
-                    expected: "gimbal|galvo|both",
-                    got: word(which),
-                })?,
-        )
+        Command::Target(keyword(
+            &mut args,
+            "gimbal|galvo|both",
+            &[
+                ("gimbal", Actuator::Gimbal),
+                ("galvo", Actuator::Galvo),
+                ("both", Actuator::Both),
+            ],
+        )?)
     } else if is("planner") {
-        let which = args.word("optimal|seed")?;
-        Command::Planner(
-            [JumpPlanner::Optimal, JumpPlanner::Seed]
-                .into_iter()
-                .find(|p| p.name().eq_ignore_ascii_case(which))
-                .ok_or(CommandError::InvalidArgument {
-                    expected: "optimal|seed",
-                    got: word(which),
-                })?,
-        )
+        Command::Planner(keyword(
+            &mut args,
+            "optimal|seed",
+            &[
+                ("optimal", JumpPlanner::Optimal),
+                ("seed", JumpPlanner::Seed),
+            ],
+        )?)
     } else if is("galvo") {
-        let what = args.word("status")?;
-        if !what.eq_ignore_ascii_case("status") {
-            return Err(CommandError::InvalidArgument {
-                expected: "status",
-                got: word(what),
-            });
-        }
-        Command::GalvoStatus
+        keyword(&mut args, "status", &[("status", Command::GalvoStatus)])?
     } else if is("save") {
         Command::Save
     } else if is("pattern") {
@@ -74,35 +64,24 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
         let yi = args.integer("yi", -GRID_INDEX_LIMIT, GRID_INDEX_LIMIT)? as i8;
         Command::Grid { xi, yi }
     } else if is("laser") {
-        let mode = args.word("on|off|auto|dwell")?;
         // `on` enables the laser for runs: SPEC §9 keeps it off whenever no
         // pattern or goto is active, so `on` is `auto`.
-        let mode = if mode.eq_ignore_ascii_case("on") {
-            "auto"
-        } else {
-            mode
-        };
-        Command::Laser(
-            [LaserMode::Off, LaserMode::Auto, LaserMode::Dwell]
-                .into_iter()
-                .find(|m| m.name().eq_ignore_ascii_case(mode))
-                .ok_or(CommandError::InvalidArgument {
-                    expected: "on|off|auto|dwell",
-                    got: word(mode),
-                })?,
-        )
+        Command::Laser(keyword(
+            &mut args,
+            "on|off|auto|dwell",
+            &[
+                ("on", LaserMode::Auto),
+                ("off", LaserMode::Off),
+                ("auto", LaserMode::Auto),
+                ("dwell", LaserMode::Dwell),
+            ],
+        )?)
     } else if is("model") {
-        let model = args.word("exact|seed")?;
-        Command::Model(if model.eq_ignore_ascii_case("exact") {
-            AimModel::Exact
-        } else if model.eq_ignore_ascii_case("seed") {
-            AimModel::Seed
-        } else {
-            return Err(CommandError::InvalidArgument {
-                expected: "exact|seed",
-                got: word(model),
-            });
-        })
+        Command::Model(keyword(
+            &mut args,
+            "exact|seed",
+            &[("exact", AimModel::Exact), ("seed", AimModel::Seed)],
+        )?)
     } else if is("set") {
         let name = args.word("parameter name")?;
         let param = find_param(name).ok_or(CommandError::InvalidArgument {
@@ -211,6 +190,24 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
     };
     args.finish()?;
     Ok(Command::Pattern { pattern, once })
+}
+
+/// The next word as one of `choices` (ASCII case-insensitive); `expected`
+/// names them in the error.
+fn keyword<T: Copy>(
+    args: &mut Args<'_>,
+    expected: &'static str,
+    choices: &[(&str, T)],
+) -> Result<T, CommandError> {
+    let given = args.word(expected)?;
+    choices
+        .iter()
+        .find(|(name, _)| name.eq_ignore_ascii_case(given))
+        .map(|&(_, value)| value)
+        .ok_or(CommandError::InvalidArgument {
+            expected,
+            got: word(given),
+        })
 }
 
 /// One line per command for `help`.
