@@ -34,27 +34,36 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
         false
     }
 
-    /// Sends the current point to the galvo (board cm → galvo mm).
-    pub(super) fn begin_galvo_point(&mut self, target: Target) -> bool {
-        let Some(run) = self.run else { return false };
+    /// Sends the galvo job built for the next request number and makes
+    /// it the run's job in flight.
+    fn send_galvo_job(&mut self, job: impl FnOnce(u32) -> GalvoRequest) -> bool {
         self.next_seq = self.next_seq.wrapping_add(1);
         let seq = self.next_seq;
-        let dwell_us = match run.pattern {
-            None => HOLD_US,
-            Some(p) if p.is_path() => 0,
-            Some(_) => (self.settings.dwell_ms * 1000.0) as u32,
-        };
-        let request = GalvoRequest::Point {
-            seq,
-            x_mm: (target.point.x_cm * 10.0) as f32,
-            y_mm: (target.point.y_cm * 10.0) as f32,
-            dwell_us,
-        };
-        if !self.send_galvo(request) {
+        if !self.send_galvo(job(seq)) {
             return false;
         }
         if let Some(run) = self.run.as_mut() {
             run.galvo_seq = seq;
+        }
+        true
+    }
+
+    /// Sends the current grid or goto point to the galvo (board cm →
+    /// galvo mm). Paths go whole, through [`Self::begin_galvo_path`].
+    pub(super) fn begin_galvo_point(&mut self, target: Target) -> bool {
+        let Some(run) = self.run else { return false };
+        let dwell_us = match run.pattern {
+            None => HOLD_US,
+            Some(_) => (self.settings.dwell_ms * 1000.0) as u32,
+        };
+        let sent = self.send_galvo_job(|seq| GalvoRequest::Point {
+            seq,
+            x_mm: (target.point.x_cm * 10.0) as f32,
+            y_mm: (target.point.y_cm * 10.0) as f32,
+            dwell_us,
+        });
+        if !sent {
+            return false;
         }
         log::info!(
             "galvo target ({}, {}) cm",
@@ -74,13 +83,10 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             self.stop("not a path");
             return;
         };
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
-        if !self.send_galvo(GalvoRequest::Path { seq, path }) {
+        if !self.send_galvo_job(|seq| GalvoRequest::Path { seq, path }) {
             return;
         }
         if let Some(run) = self.run.as_mut() {
-            run.galvo_seq = seq;
             run.galvo_busy = true;
             run.gimbal_busy = false;
             run.phase = Phase::Moving;
