@@ -386,7 +386,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 ));
                 self.stop("servo fault");
             }
-            ServoOutcome::Present { .. } | ServoOutcome::Superseded { .. } => {}
+            ServoOutcome::Superseded { .. } => {}
         }
     }
 

@@ -76,18 +76,13 @@ pub enum ServoRequest {
         /// Arrival deadband, 0.1° (used from now on).
         deadband_tenths: u16,
     },
-    /// Ping both servos and report whether they answer.
-    Probe {
-        /// Request number.
-        seq: u32,
-    },
 }
 
 impl ServoRequest {
     /// The request number.
     pub fn seq(&self) -> u32 {
         match self {
-            ServoRequest::Move { seq, .. } | ServoRequest::Probe { seq } => *seq,
+            ServoRequest::Move { seq, .. } => *seq,
         }
     }
 }
@@ -122,11 +117,6 @@ pub enum ServoOutcome {
         yaw_tenths: i16,
         /// Measured pitch angle, 0.1°.
         pitch_tenths: i16,
-    },
-    /// Both servos answered the `Probe` `seq`.
-    Present {
-        /// Request number.
-        seq: u32,
     },
     /// Request `seq` failed because servo `id` is faulty.
     Fault {
@@ -244,9 +234,7 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                     continue;
                 }
             };
-            if let ServoRequest::Move { seq, .. } = request {
-                last_move = Some(seq);
-            }
+            last_move = Some(request.seq());
             next_health_check = Instant::now() + health_period;
             let outcome = self.serve(request, link).await;
             match outcome {
@@ -254,7 +242,7 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                     log::warning!("servo {}: fault {:?}", id, fault);
                     self.set_faulty(id, true);
                 }
-                ServoOutcome::Arrived { .. } | ServoOutcome::Present { .. } => {
+                ServoOutcome::Arrived { .. } => {
                     self.faulty = [false; 2];
                 }
                 _ => {}
@@ -306,14 +294,6 @@ impl<R: Read, W: Write> ServoBus<R, W> {
 
     async fn serve(&mut self, request: ServoRequest, link: &ServoLink) -> ServoOutcome {
         match request {
-            ServoRequest::Probe { seq } => {
-                for id in [self.config.yaw_id, self.config.pitch_id] {
-                    if let Err(fault) = self.transact(Request::Ping { id }, id).await {
-                        return ServoOutcome::Fault { seq, id, fault };
-                    }
-                }
-                ServoOutcome::Present { seq }
-            }
             ServoRequest::Move {
                 seq,
                 yaw_tenths,
