@@ -5,13 +5,15 @@
 //! deg/s). Integer parameters (ids, counts, directions) are checked to be
 //! whole numbers.
 //!
-//! `params.rs` holds the table, `record.rs` the saved form.
+//! `params.rs` holds the table, `record.rs` the saved form, `store.rs` where
+//! it is kept (two flash sectors, power-fail safe).
 
 mod params;
 mod record;
+pub mod store;
 
 pub use params::{PARAMS, ParamLine, ParamSpec, find_param};
-pub use record::{RECORD_LEN, RECORD_VERSION, RecordError, crc32};
+pub use record::{RECORD_LEN, RECORD_VERSION, RecordError, crc32, intact_record_len};
 
 use params::{Slot, check_value};
 
