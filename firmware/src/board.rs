@@ -10,9 +10,12 @@
 //! | laser enable        | PB0 (active high) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
+//!
+//! Flash: the image in sectors 0–5 (≤ 256 KiB), the saved settings in
+//! sectors 10 and 11 (`settings_flash`, `memory.x`).
 
 use embassy_stm32::exti::ExtiInput;
-use embassy_stm32::flash::Flash;
+use embassy_stm32::flash::{self, Flash};
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::mode::Async;
 use embassy_stm32::peripherals::IWDG;
@@ -23,7 +26,7 @@ use embassy_usb::UsbDevice;
 use embassy_usb::class::cdc_acm::{BufferedReceiver, CdcAcmClass, Sender, State};
 use static_cell::StaticCell;
 
-use crate::settings_flash::FlashSettings;
+use crate::settings_flash::{FlashSettings, settings_store};
 use crate::tasks::{LaserPin, UsbDriver};
 
 bind_interrupts!(struct Irqs {
@@ -32,6 +35,7 @@ bind_interrupts!(struct Irqs {
     DMA1_STREAM5 => dma::InterruptHandler<peripherals::DMA1_CH5>;
     DMA1_STREAM6 => dma::InterruptHandler<peripherals::DMA1_CH6>;
     EXTI0 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI0>;
+    FLASH => flash::InterruptHandler;
 });
 
 /// USB full-speed bulk packet size, bytes.
@@ -89,7 +93,7 @@ pub struct Board {
     pub fault_led: Output<'static>,
     /// User button (PA0).
     pub button: ExtiInput<'static, Async>,
-    /// Settings flash sector.
+    /// Settings store (flash sectors 10 and 11).
     pub settings: FlashSettings,
     /// Independent watchdog.
     pub iwdg: Peri<'static, IWDG>,
@@ -170,7 +174,7 @@ pub fn init() -> Board {
     let laser_led = Output::new(p.PD13, Level::Low, Speed::Low);
     let fault_led = Output::new(p.PD14, Level::Low, Speed::Low);
     let button = ExtiInput::new(p.PA0, p.EXTI0, Pull::Down, Irqs);
-    let settings = FlashSettings::new(Flash::new_blocking(p.FLASH));
+    let settings = settings_store(Flash::new(p.FLASH, Irqs));
 
     Board {
         laser,

@@ -128,8 +128,9 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 }
                 link.ok().await;
             }
-            // Erasing the flash sector stalls the CPU for about a second on
-            // the target: not while the laser draws.
+            // A save may erase a flash sector (when one fills up), which
+            // stalls the CPU for 1-2 s on the target: not while the laser
+            // draws.
             Command::Save if self.run.is_some() => {
                 link.error("stop the running pattern or goto before save")
                     .await;

@@ -25,8 +25,9 @@ use crate::servo::task::{ServoLink, ServoOutcome, ServoRequest};
 use crate::settings::{RecordError, Settings};
 use crate::status::{Activity, Phase, StatusBoard};
 
-/// Where settings are saved (a flash sector on the target, memory or a file
-/// in the simulator).
+/// Where settings are saved: [`crate::settings::store::FlashSettingsStore`]
+/// over the target's flash sectors 10 and 11, or over the simulator's model
+/// of them.
 #[allow(async_fn_in_trait)]
 pub trait SettingsStore {
     /// Reads the saved record into `buf`; returns the bytes read (0 when
