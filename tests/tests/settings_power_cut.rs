@@ -224,15 +224,17 @@ fn a_record_of_the_earlier_layout_loads_and_migrates_without_a_window_of_loss() 
     let mut raw = old.clone();
     raw.resize(old.len().next_multiple_of(4), 0xFF);
     // Sector 10 as shipped (erased) or holding anything.
+    let mut cuts = 0;
     for sector10 in [0xFF, 0x00, 0x5A] {
         let image = legacy_image(&raw, sector10);
         assert_eq!(boot(image.clone()), old, "first boot loads the old record");
-        check_every_cut(&image, &old, &record(8));
+        cuts += check_every_cut(&image, &old, &record(8));
         // Migrated: later saves go through the map and the old record
         // never comes back.
         let image = saved(image, &[record(8), record(9), record(10), record(11)]);
         assert_eq!(boot(image), record(11));
     }
+    eprintln!("migrations: {cuts} cut points (step x tear)");
     // A record the old firmware only half wrote was lost then already: the
     // store starts afresh and takes a save.
     let mut torn = erased();
