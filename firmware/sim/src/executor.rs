@@ -2,8 +2,10 @@
 //! clock: poll until every task waits, then jump (or, in real-time mode,
 //! sleep) to the next timer.
 
+use std::cell::Cell;
 use std::future::Future;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use embassy_executor::Spawner;
 use embassy_executor::raw::{Executor, TaskStorage};
@@ -44,6 +46,19 @@ pub enum RunEnd {
     Livelock,
 }
 
+thread_local! {
+    /// Longest host time one executor poll took in this thread's last run.
+    static LONGEST_POLL: Cell<Duration> = const { Cell::new(Duration::ZERO) };
+}
+
+/// Host (wall-clock) time of the longest single executor poll of the last
+/// run on this thread: how long one step of the task bodies held the
+/// executor, every other task waiting. Virtual time stands still during a
+/// poll, so this is the only measure of work done in one step.
+pub fn longest_poll() -> Duration {
+    LONGEST_POLL.with(Cell::get)
+}
+
 /// Polls at one instant after which a run counts as livelocked.
 pub const MAX_POLLS_PER_INSTANT: u32 = 1_000_000;
 
@@ -56,6 +71,7 @@ pub fn run(
     mut stop: impl FnMut() -> bool,
 ) -> RunEnd {
     clock::reset(realtime);
+    LONGEST_POLL.with(|l| l.set(Duration::ZERO));
     let pending: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(true)));
     let executor: &'static Executor = Box::leak(Box::new(Executor::new(
         pending as *const AtomicBool as *mut (),
@@ -69,9 +85,12 @@ pub fn run(
                 if polls > MAX_POLLS_PER_INSTANT {
                     return RunEnd::Livelock;
                 }
+                let started = Instant::now();
                 // SAFETY: poll is only ever called from this loop, never
                 // re-entrantly (the pender only sets a flag).
                 unsafe { executor.poll() };
+                let took = started.elapsed();
+                LONGEST_POLL.with(|l| l.set(l.get().max(took)));
             }
             if clock::fire_due() == 0 && !pending.load(Ordering::SeqCst) {
                 break;
