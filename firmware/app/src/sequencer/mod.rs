@@ -309,8 +309,14 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             Err(e) => {
                 let why = crate::command::reply_text(format_args!("{e}"));
                 log::warning!("target unreachable: {}", why.as_str());
+                // What happened first: the reason may be cut at the
+                // reply line length.
+                let name = self
+                    .run
+                    .and_then(|r| r.pattern)
+                    .map_or("goto", |p| p.name());
                 self.link.notify(format_args!(
-                    "error: target ({}, {}) cm unreachable: {}; stopped, laser off",
+                    "error: {name} stopped, laser off: point ({}, {}) cm unreachable: {}",
                     Fixed::<2>(target.point.x_cm),
                     Fixed::<2>(target.point.y_cm),
                     why
