@@ -414,3 +414,68 @@ proptest! {
         prop_assert_eq!(report.recording.laser_events.last().map(|e| e.1), Some(false));
     }
 }
+
+/// Galvo spot of a DAC sample, mm.
+fn galvo_spot_mm(s: &laser_app::galvo::DacSample) -> (f64, f64) {
+    let p = kinematics_core::Galvo::<f64>::default()
+        .codes_to_board(s.x_code, s.y_code)
+        .expect("codes in range");
+    (p.x_mm, p.y_mm)
+}
+
+#[test]
+fn galvo_travel_between_figures_strokes_and_passes_is_dark() {
+    // A goto, the tuning figure (four strokes) repeated, then a line
+    // repeated: every lit stretch starts on a stroke's start and, unless a
+    // command cut it, ends on that stroke's end.
+    let report = run_with(
+        "target galvo\ngoto 8 6\nwait 30\npattern tuning 1 -1 5\nwait 1600\n\
+         pattern line -3 -2 4 3\nwait 400\nstop\nwait 10\n",
+        SimOptions::default(),
+    );
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let near = |p: (f64, f64), q: (f64, f64)| (p.0 - q.0).hypot(p.1 - q.1) < 0.15;
+    // (figure, stroke start, stroke end), mm: centre (10, −10), half side 25.
+    let strokes = [
+        ("goto", (80.0, 60.0), (80.0, 60.0)),
+        ("tuning", (-15.0, 15.0), (-15.0, 15.0)),
+        ("tuning", (10.0, 15.0), (10.0, 15.0)),
+        ("tuning", (-15.0, -10.0), (35.0, -10.0)),
+        ("tuning", (10.0, 15.0), (10.0, -35.0)),
+        ("line", (-30.0, -20.0), (40.0, 30.0)),
+    ];
+    let samples: Vec<_> = report.dac.iter().map(|(_, s)| s).collect();
+    let mut runs: Vec<(&str, (f64, f64), (f64, f64))> = Vec::new();
+    let mut k = 0;
+    while k < samples.len() {
+        if !samples[k].laser {
+            k += 1;
+            continue;
+        }
+        let first = galvo_spot_mm(&samples[k]);
+        while k < samples.len() && samples[k].laser {
+            k += 1;
+        }
+        let last = galvo_spot_mm(&samples[k - 1]);
+        let figure = strokes
+            .iter()
+            .find(|(_, start, _)| near(first, *start))
+            .map(|(f, _, _)| *f)
+            .unwrap_or_else(|| panic!("a lit stretch starts at {first:?}, no stroke's start"));
+        runs.push((figure, first, last));
+    }
+    let count = |name: &str| runs.iter().filter(|r| r.0 == name).count();
+    assert_eq!(count("goto"), 1);
+    assert!(count("tuning") >= 8, "two passes of four strokes: {runs:?}");
+    assert!(count("line") >= 2, "two passes of the line: {runs:?}");
+    for (i, (figure, first, last)) in runs.iter().enumerate() {
+        let cut_by_a_command = runs.get(i + 1).is_none_or(|next| next.0 != *figure);
+        let ends_a_stroke = strokes
+            .iter()
+            .any(|(f, start, end)| f == figure && near(*first, *start) && near(*last, *end));
+        assert!(
+            cut_by_a_command || ends_a_stroke,
+            "{figure} lit from {first:?} to {last:?}: not one stroke"
+        );
+    }
+}
