@@ -445,7 +445,9 @@ fn galvo_travel_between_figures_strokes_and_passes_is_dark() {
         ("line", (-30.0, -20.0), (40.0, 30.0)),
     ];
     let samples: Vec<_> = report.dac.iter().map(|(_, s)| s).collect();
-    let mut runs: Vec<(&str, (f64, f64), (f64, f64))> = Vec::new();
+    // (figure, first lit spot, last lit spot), mm.
+    type LitStretch<'a> = (&'a str, (f64, f64), (f64, f64));
+    let mut runs: Vec<LitStretch> = Vec::new();
     let mut k = 0;
     while k < samples.len() {
         if !samples[k].laser {

@@ -867,8 +867,10 @@ mod tests {
 
     #[test]
     fn a_path_cursor_steps_through_the_interpolated_points() {
-        let mut s = Settings::default();
-        s.path_step_cm = 0.3;
+        let s = Settings {
+            path_step_cm: 0.3,
+            ..Settings::default()
+        };
         let circle = Pattern::Circle {
             centre: PointCm {
                 x_cm: 1.0,
@@ -910,8 +912,10 @@ mod tests {
 
     #[test]
     fn a_long_path_is_checked_at_a_bounded_number_of_points() {
-        let mut s = Settings::default();
-        s.path_step_cm = 0.01;
+        let s = Settings {
+            path_step_cm: 0.01,
+            ..Settings::default()
+        };
         // 40 000 interpolated points.
         let long = line(-200.0, 0.0, 200.0, 0.0);
         let mut check = PatternCheck::new(&long, &s, Actuator::Gimbal).unwrap();
