@@ -336,6 +336,51 @@ fn the_reported_approach_from_home_is_dark() {
     assert!(report.recording.spot.iter().any(|s| s.laser));
 }
 
+#[test]
+fn passes_of_a_closed_figure_stay_lit_and_the_way_back_to_an_open_one_is_dark() {
+    // A circle's passes start where the last one ended: no travel, lit
+    // throughout. A line's next pass starts back at its start: dark.
+    let circle = run_with(
+        "pattern circle 1 1 1.5 ccw\nwait 6000\nstatus\nstop\n",
+        SimOptions::default(),
+    );
+    let stop = sent_at(&circle, "stop");
+    let events = &circle.recording.laser_events;
+    let first_on = events
+        .iter()
+        .position(|(_, on)| *on)
+        .expect("the circle was lit");
+    let later: Vec<_> = events[first_on + 1..]
+        .iter()
+        .filter(|(t, _)| *t < stop)
+        .collect();
+    assert!(later.is_empty(), "dark between passes: {later:?}");
+    let lines = terminal_lines(&circle);
+    let pass: u32 = lines
+        .iter()
+        .find_map(|l| l.strip_prefix("state: pattern circle point "))
+        .and_then(|rest| rest.split(" pass ").nth(1)?.parse().ok())
+        .unwrap_or_else(|| panic!("{lines:?}"));
+    assert!(pass >= 2, "{pass} passes");
+    let figure = Figure::Line((-3.0, -1.0), (2.0, 2.0));
+    let line = run_with(
+        &format!("pattern {}\nwait 6000\nstop\n", figure.command()),
+        SimOptions::default(),
+    );
+    let ons = line
+        .recording
+        .laser_events
+        .iter()
+        .filter(|(_, on)| *on)
+        .count();
+    assert!(
+        ons >= 2,
+        "dark between passes: {:?}",
+        line.recording.laser_events
+    );
+    assert!(stray_lit_cm(&line, &figure, 0, ON_FIGURE_CM) < 0.05);
+}
+
 /// How far from the figure a lit spot may be, cm. Half a step of
 /// interpolation, joint-space chords between points and the servos' 0.1°
 /// resolution give 1.5 mm on smooth figures; at a corner the next point

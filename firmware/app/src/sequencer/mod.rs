@@ -276,6 +276,13 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             self.stop("pattern has no points");
             return;
         };
+        // Travel to the first point of a pass (or to a goto target) is off
+        // the figure: dark in every laser mode. A later pass of a closed
+        // figure starts where the last one ended (arrived there): no travel.
+        let approach = self.run.is_some_and(|r| {
+            let closed = r.pass > 0 && self.last_aim.is_some_and(|(t, _)| t.point == target.point);
+            r.pattern.is_none() || (r.index == 0 && !closed)
+        });
         let gimbal_started = !self.actuator.uses_gimbal() || self.begin_gimbal_move(target);
         let galvo_started =
             gimbal_started && (!self.actuator.uses_galvo() || self.begin_galvo_point(target));
@@ -284,9 +291,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         }
         let holds = self.run.is_some_and(|r| r.pattern.is_none());
         if let Some(run) = self.run.as_mut() {
-            // Travel to the first point of a pass (or to a goto target) is
-            // off the figure: dark in every laser mode.
-            run.phase = if holds || run.index == 0 {
+            run.phase = if approach {
                 Phase::Approaching
             } else {
                 Phase::Moving
