@@ -2,8 +2,10 @@
 //! clock: poll until every task waits, then jump (or, in real-time mode,
 //! sleep) to the next timer.
 
+use std::cell::Cell;
 use std::future::Future;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
 
 use embassy_executor::Spawner;
 use embassy_executor::raw::{Executor, TaskStorage};
@@ -44,6 +46,47 @@ pub enum RunEnd {
     Livelock,
 }
 
+thread_local! {
+    /// Longest host CPU time one executor poll took in this thread's last
+    /// run.
+    static LONGEST_POLL: Cell<Duration> = const { Cell::new(Duration::ZERO) };
+}
+
+/// Host CPU time of the longest single executor poll of the last run on
+/// this thread: how long one step of the task bodies held the executor,
+/// every other task waiting. Virtual time stands still during a poll, so
+/// this is the measure of the work done in one step. It is the thread's
+/// CPU time (time the OS gave other processes is not counted) where the
+/// platform has it, else wall-clock time.
+pub fn longest_poll() -> Duration {
+    LONGEST_POLL.with(Cell::get)
+}
+
+/// This thread's CPU time.
+#[cfg(unix)]
+fn cpu_time() -> Duration {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the call only writes it.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    if rc != 0 {
+        return Duration::ZERO;
+    }
+    Duration::new(
+        u64::try_from(ts.tv_sec).unwrap_or(0),
+        u32::try_from(ts.tv_nsec).unwrap_or(0),
+    )
+}
+
+/// Wall-clock time since the first call (no thread CPU clock here).
+#[cfg(not(unix))]
+fn cpu_time() -> Duration {
+    static ORIGIN: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+    ORIGIN.get_or_init(std::time::Instant::now).elapsed()
+}
+
 /// Polls at one instant after which a run counts as livelocked.
 pub const MAX_POLLS_PER_INSTANT: u32 = 1_000_000;
 
@@ -56,6 +99,7 @@ pub fn run(
     mut stop: impl FnMut() -> bool,
 ) -> RunEnd {
     clock::reset(realtime);
+    LONGEST_POLL.with(|l| l.set(Duration::ZERO));
     let pending: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(true)));
     let executor: &'static Executor = Box::leak(Box::new(Executor::new(
         pending as *const AtomicBool as *mut (),
@@ -69,9 +113,12 @@ pub fn run(
                 if polls > MAX_POLLS_PER_INSTANT {
                     return RunEnd::Livelock;
                 }
+                let started = cpu_time();
                 // SAFETY: poll is only ever called from this loop, never
                 // re-entrantly (the pender only sets a flag).
                 unsafe { executor.poll() };
+                let took = cpu_time().saturating_sub(started);
+                LONGEST_POLL.with(|l| l.set(l.get().max(took)));
             }
             if clock::fire_due() == 0 && !pending.load(Ordering::SeqCst) {
                 break;

@@ -16,7 +16,7 @@ use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::laser::{LaserSwitch, laser_wanted};
-use self::targets::{Aim, Target};
+use self::targets::{Aim, PathCursor, Target};
 use crate::cli::format::Fixed;
 use crate::command::{Actuator, AimModel, CommandLink, Pattern};
 use crate::galvo::GalvoLink;
@@ -78,6 +78,10 @@ struct Run {
     once: bool,
     /// Index of the current point within the pass.
     index: usize,
+    /// A path's interpolation state in the current pass (next point in
+    /// O(1)); `None` for grid patterns (looked up by index in O(1)), a
+    /// goto, and paths the galvo marks itself.
+    path: Option<PathCursor>,
     /// Completed passes.
     pass: u32,
     phase: Phase,
@@ -207,9 +211,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     }
 
     /// Starts `run` at its first point.
-    fn start(&mut self, run: Run) {
+    fn start(&mut self, mut run: Run) {
         let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
         log::info!("start {} (once={})", name, run.once);
+        run.path = self.path_cursor(run.pattern);
         self.run = Some(run);
         self.faulty_servo = None;
         if self.actuator.uses_galvo() {
@@ -234,10 +239,22 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     /// The target of the current point of the run.
     fn current_target(&self) -> Option<Target> {
         let run = self.run?;
-        match run.pattern {
-            Some(pattern) => targets::pattern_target(&pattern, run.index, &self.settings),
-            None => run.single,
+        match (run.pattern, run.path) {
+            (Some(_), Some(path)) => Some(path.target()),
+            (Some(pattern), None) => targets::grid_target(&pattern, run.index, &self.settings),
+            (None, _) => run.single,
         }
+    }
+
+    /// The cursor at the first point of a pass of `pattern` when the
+    /// gimbal draws it point by point (`None` otherwise, or when the path
+    /// cannot be interpolated: the run then has no points and stops).
+    fn path_cursor(&self, pattern: Option<Pattern>) -> Option<PathCursor> {
+        let pattern = pattern?;
+        if self.actuator.uses_galvo() {
+            return None;
+        }
+        PathCursor::start(&pattern, &self.settings)?.ok()
     }
 
     /// Whether the run is a path marked by the galvo alone (one job per
@@ -260,6 +277,13 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             self.stop("pattern has no points");
             return;
         };
+        // Travel to the first point of a pass (or to a goto target) is off
+        // the figure: dark in every laser mode. A later pass of a closed
+        // figure starts where the last one ended (arrived there): no travel.
+        let approach = self.run.is_some_and(|r| {
+            let closed = r.pass > 0 && self.last_aim.is_some_and(|(t, _)| t.point == target.point);
+            r.pattern.is_none() || (r.index == 0 && !closed)
+        });
         let gimbal_started = !self.actuator.uses_gimbal() || self.begin_gimbal_move(target);
         let galvo_started =
             gimbal_started && (!self.actuator.uses_galvo() || self.begin_galvo_point(target));
@@ -268,7 +292,11 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         }
         let holds = self.run.is_some_and(|r| r.pattern.is_none());
         if let Some(run) = self.run.as_mut() {
-            run.phase = Phase::Moving;
+            run.phase = if approach {
+                Phase::Approaching
+            } else {
+                Phase::Moving
+            };
             run.dwell_until = None;
             run.gimbal_busy = self.actuator.uses_gimbal();
             // A goto's galvo holds the point, laser on, until the next
@@ -287,8 +315,14 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             Err(e) => {
                 let why = crate::command::reply_text(format_args!("{e}"));
                 log::warning!("target unreachable: {}", why.as_str());
+                // What happened first: the reason may be cut at the
+                // reply line length.
+                let name = self
+                    .run
+                    .and_then(|r| r.pattern)
+                    .map_or("goto", |p| p.name());
                 self.link.notify(format_args!(
-                    "error: target ({}, {}) cm unreachable: {}; stopped, laser off",
+                    "error: {name} stopped, laser off: point ({}, {}) cm unreachable: {}",
                     Fixed::<2>(target.point.x_cm),
                     Fixed::<2>(target.point.y_cm),
                     why
@@ -377,7 +411,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 // health check while dwelling or idle) stops everything.
                 if self
                     .run
-                    .is_some_and(|r| r.seq != seq && r.phase == Phase::Moving)
+                    .is_some_and(|r| r.seq != seq && r.phase.is_travel())
                 {
                     return;
                 }
@@ -415,9 +449,14 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             return;
         };
         run.index += 1;
-        if self.is_galvo_path_run()
-            || targets::pattern_target(&pattern, run.index, &self.settings).is_none()
-        {
+        let more = match run.path.as_mut() {
+            Some(path) => path.advance(),
+            None => {
+                !self.is_galvo_path_run()
+                    && targets::grid_target(&pattern, run.index, &self.settings).is_some()
+            }
+        };
+        if !more {
             run.pass += 1;
             run.index = 0;
             if run.once {
@@ -425,6 +464,8 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 self.stop("pattern complete");
                 return;
             }
+            // A new pass takes the path parameters as they are now.
+            run.path = self.path_cursor(Some(pattern));
         }
         self.run = Some(run);
         self.begin_point();
