@@ -6,8 +6,7 @@ use core::panic::PanicInfo;
 
 use embassy_stm32::pac;
 
-/// Bit of the laser-enable pin in GPIOB (PB0; see `board`).
-const LASER_PIN_BIT: usize = 0;
+use crate::board::LASER_PIN_BIT;
 
 #[panic_handler]
 fn panic(info: &PanicInfo<'_>) -> ! {

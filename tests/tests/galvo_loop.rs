@@ -33,6 +33,7 @@ fn run(compute_ns_per_sample: u64) -> Run {
     let recording = Rc::new(RefCell::new(DacRecording::default()));
     let events: Rc<RefCell<Vec<GalvoEvent>>> = Rc::default();
     let finished = Rc::new(RefCell::new(false));
+    let gate = laser_sim::laser::recorded_gate(&recording);
     let (rec, ev, fin) = (recording.clone(), events.clone(), finished.clone());
     let end = executor::run(
         false,
@@ -41,7 +42,7 @@ fn run(compute_ns_per_sample: u64) -> Run {
             executor::spawn(&spawner, async move {
                 let mut dac = SimDac::new(128, 10_000, compute_ns_per_sample, rec);
                 let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
-                galvo.run(&mut dac, link).await;
+                galvo.run(&mut dac, link, gate).await;
             });
             executor::spawn(&spawner, async move {
                 for (i, &(x_mm, y_mm)) in POINTS.iter().enumerate() {

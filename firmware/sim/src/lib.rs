@@ -6,6 +6,7 @@ pub mod clock;
 pub mod dac;
 pub mod drawing;
 pub mod executor;
+pub mod laser;
 pub mod logger;
 pub mod physics;
 pub mod recorder;
