@@ -238,3 +238,63 @@ fn an_underrun_mid_dwell_replays_dark_and_the_laser_is_dark_at_once() {
     assert!(late.is_empty(), "idle underruns: {late:?}");
     assert!(samples.last().expect("samples").0 > quiet_from + 100_000_000);
 }
+
+#[test]
+fn closing_the_gate_stops_the_loop_even_when_no_stop_request_gets_through() {
+    // A full job queue of long dwells; then only the gate closes (no
+    // `Stop` request): the loop drops everything, and nothing it had
+    // handed to the DAC lights after the close.
+    let link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
+    let recording = Rc::new(RefCell::new(DacRecording::default()));
+    let gate = laser_sim::laser::recorded_gate(&recording);
+    let closed_at = Rc::new(RefCell::new(None));
+    let finished = Rc::new(RefCell::new(false));
+    let (fin, closed) = (finished.clone(), closed_at.clone());
+    let rec = recording.clone();
+    let end = executor::run(
+        false,
+        5_000_000,
+        move |spawner| {
+            executor::spawn(&spawner, async move {
+                let mut dac = SimDac::new(128, 10_000, 0, rec);
+                let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
+                galvo.run(&mut dac, link, gate).await;
+            });
+            executor::spawn(&spawner, async move {
+                for seq in 0..5 {
+                    link.requests
+                        .send(GalvoRequest::Point {
+                            seq,
+                            x_mm: 8.0 * seq as f32,
+                            y_mm: -5.0,
+                            dwell_us: 500_000,
+                        })
+                        .await;
+                }
+                while link.state().1 < 4 {
+                    embassy_time::Timer::after_millis(1).await;
+                }
+                embassy_time::Timer::after_millis(20).await;
+                *closed.borrow_mut() = Some(embassy_time::Instant::now().as_micros() * 1000);
+                gate.close();
+                embassy_time::Timer::after_millis(2000).await;
+                *fin.borrow_mut() = true;
+            });
+        },
+        move || *finished.borrow(),
+    );
+    assert_eq!(end, RunEnd::Stopped);
+    assert_eq!(link.state(), (laser_app::galvo::Phase::Idle, 0));
+    let closed_ns = closed_at.borrow().expect("closed");
+    let recording = recording.borrow().clone();
+    let samples: Vec<(u64, DacSample)> = recording.iter().collect();
+    assert!(samples.iter().any(|(t, s)| *t < closed_ns && s.laser));
+    assert!(samples.iter().all(|(t, s)| *t < closed_ns || !s.laser));
+    // The loop itself stopped (not only the gate): its stream is dark
+    // from the next half it computed.
+    assert!(
+        recording
+            .stream_runs()
+            .all(|(t, _, _, s, _)| t < closed_ns + 3 * 1_280_000 || !s.laser)
+    );
+}
