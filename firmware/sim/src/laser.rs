@@ -90,7 +90,7 @@ impl Output {
             if rec.spot.last().is_some_and(|s| s.t_us == t_us) {
                 rec.spot.pop();
             }
-            if rec.laser_events.last().map_or(false, |e| e.1) == lit {
+            if rec.laser_events.last().is_some_and(|e| e.1) == lit {
                 return;
             }
         }
