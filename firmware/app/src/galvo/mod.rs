@@ -167,7 +167,9 @@ pub enum GalvoRequest {
     },
     /// Drop queued jobs, laser off at once; the mirrors finish the jump in
     /// flight (a jump is rest to rest) or brake along the stroke being
-    /// marked, and hold.
+    /// marked, and hold. Also clears an underrun latch. (Closing the
+    /// [`LaserGate`](crate::laser_gate::LaserGate) stops the loop the same
+    /// way, without the latch, and cannot get lost in a full channel.)
     Stop,
 }
 
@@ -175,7 +177,8 @@ pub enum GalvoRequest {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum GalvoEvent {
-    /// Point `seq` is done (jump, settle, dwell, laser-off delay).
+    /// Point `seq` is done (jump, settle, dwell, laser-off delay) and the
+    /// DAC has output its last sample.
     Done {
         /// Request number.
         seq: u32,
