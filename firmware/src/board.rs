@@ -21,9 +21,10 @@ use embassy_stm32::mode::Async;
 use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
-use embassy_stm32::{Peri, bind_interrupts, dma, exti, peripherals, usb};
+use embassy_stm32::{Peri, bind_interrupts, dma, exti, pac, peripherals, usb};
 use embassy_usb::UsbDevice;
 use embassy_usb::class::cdc_acm::{BufferedReceiver, CdcAcmClass, Sender, State};
+use laser_app::laser_gate::{GateState, LaserGate};
 use static_cell::StaticCell;
 
 use crate::settings_flash::{FlashSettings, settings_store};
@@ -71,6 +72,24 @@ pub fn clock_config() -> embassy_stm32::Config {
     config
 }
 
+/// Bit of the laser-enable pin in GPIOB (PB0).
+pub const LASER_PIN_BIT: usize = 0;
+
+/// The master laser gate (see `laser_app::laser_gate`): the sequencer
+/// closes it on every stop, fault and button press, the galvo loop on an
+/// underrun; closing pulls PB0 low at once.
+pub static LASER_GATE: LaserGate = LaserGate::with_hook(laser_gate_changed);
+
+/// The gate's hook: when it closes, PB0 goes low straight through the
+/// GPIO's set/reset register (one atomic store, safe from any task or
+/// interrupt), whoever holds the pin. (The galvo's laser stream is not
+/// wired on this board yet; when it is, closing also stops that stream.)
+pub fn laser_gate_changed(state: GateState) {
+    if !state.open {
+        pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
+    }
+}
+
 /// Everything the tasks need, configured.
 pub struct Board {
     /// Laser enable (PB0), low.
@@ -103,7 +122,10 @@ pub struct Board {
 pub fn init() -> Board {
     let p = embassy_stm32::init(clock_config());
     // Laser off before anything else can run.
-    let laser = LaserPin(Output::new(p.PB0, Level::Low, Speed::Low));
+    let laser = LaserPin {
+        pin: Output::new(p.PB0, Level::Low, Speed::Low),
+        gate: &LASER_GATE,
+    };
     defmt::info!(
         "{} {} (git {}) booting at {} MHz",
         laser_app::build_info::PRODUCT,

@@ -13,8 +13,6 @@ use core::sync::atomic::{AtomicBool, Ordering};
 
 use embassy_stm32::pac;
 
-/// Bit of the laser-enable pin in GPIOB (PB0; see `board`).
-const LASER_PIN_BIT: usize = 0;
 /// Address of GPIOB's bit set/reset register (RM0090 §8.4.7), for the
 /// HardFault handler's assembly.
 const GPIOB_BSRR: u32 = 0x4002_0418;
@@ -30,6 +28,7 @@ static PANICKED: AtomicBool = AtomicBool::new(false);
 fn laser_off_now() {
     pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
 }
+use crate::board::LASER_PIN_BIT;
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo<'_>) -> ! {

@@ -7,6 +7,7 @@ pub mod dac;
 pub mod drawing;
 pub mod executor;
 pub mod flash;
+pub mod laser;
 pub mod logger;
 pub mod physics;
 pub mod recorder;

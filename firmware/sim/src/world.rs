@@ -11,7 +11,7 @@ use std::sync::atomic::Ordering;
 
 use laser_app::command::CommandLink;
 use laser_app::galvo::{GalvoConfig, GalvoLink, GalvoLoop};
-use laser_app::sequencer::{LaserSwitch, Sequencer, SettingsStore};
+use laser_app::sequencer::{Sequencer, SettingsStore};
 use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::status::{Activity, Phase, StatusBoard};
@@ -20,6 +20,7 @@ use sequential_storage::map::MapConfig;
 use crate::dac::{DacRecording, SimDac};
 use crate::executor::{self, RunEnd};
 use crate::flash::{FlashStats, FlashTiming, PowerCut, SimFlash};
+use crate::laser::{GatedLaserPin, recorded_gate};
 use crate::physics::PhysicalGimbal;
 use crate::recorder::{DwellRecord, Recording, SpotSample};
 use crate::script::Step;
@@ -159,16 +160,6 @@ impl SimReport {
     }
 }
 
-/// The laser output: records every switch with its time.
-struct RecordingLaser(Rc<RefCell<Recording>>);
-
-impl LaserSwitch for RecordingLaser {
-    fn set(&mut self, on: bool) {
-        let t = crate::clock::now_us();
-        self.0.borrow_mut().laser_events.push((t, on));
-    }
-}
-
 fn is_idle(status: &StatusBoard) -> bool {
     let s = status.snapshot();
     match s.activity {
@@ -185,6 +176,7 @@ pub fn run(options: SimOptions) -> SimReport {
     let servo_link: &'static ServoLink = Box::leak(Box::new(ServoLink::new()));
     let galvo_link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
     let dac_recording = Rc::new(RefCell::new(DacRecording::default()));
+    let gate = recorded_gate(&dac_recording);
     let status: &'static StatusBoard = Box::leak(Box::new(StatusBoard::new()));
     let host = Rc::new(UsbHost::new(options.echo));
     let recording = Rc::new(RefCell::new(Recording::default()));
@@ -247,12 +239,23 @@ pub fn run(options: SimOptions) -> SimReport {
                     .run(servo_link)
                     .await;
                 });
-                let laser = RecordingLaser(recording.clone());
+                let spot_bus = bus.clone();
+                let laser = GatedLaserPin::new(
+                    recording.clone(),
+                    Box::new(move |t_us| gimbal_spot_cm(&spot_bus, gimbal, t_us)),
+                );
                 let store = settings_store(flash.clone());
                 executor::spawn(&spawner, async move {
-                    let mut sequencer =
-                        Sequencer::new(link, servo_link, Some(galvo_link), status, laser, store)
-                            .await;
+                    let mut sequencer = Sequencer::new(
+                        link,
+                        servo_link,
+                        Some(galvo_link),
+                        status,
+                        laser,
+                        gate,
+                        store,
+                    )
+                    .await;
                     sequencer.run().await;
                 });
                 let (dac_recording, cost) = (galvo_dac, options.galvo_cost_ns_per_sample);
@@ -265,7 +268,7 @@ pub fn run(options: SimOptions) -> SimReport {
                         dac_recording,
                     );
                     match GalvoLoop::new(config) {
-                        Ok(mut galvo) => galvo.run(&mut dac, galvo_link).await,
+                        Ok(mut galvo) => galvo.run(&mut dac, galvo_link, gate).await,
                         Err(e) => log::error!("galvo loop not started: {e}"),
                     }
                 });
@@ -287,6 +290,22 @@ pub fn run(options: SimOptions) -> SimReport {
         )
     };
     let transcript = host.transcript.borrow().clone();
+    let end_time_us = crate::clock::now_us();
+    {
+        // The trace ends with the laser's final state at the end time.
+        let mut rec = recording.borrow_mut();
+        if rec.spot.last().is_none_or(|s| s.t_us < end_time_us)
+            && let Some((x_cm, y_cm)) = gimbal_spot_cm(&bus, gimbal, end_time_us)
+        {
+            let laser = crate::laser::gimbal_lit();
+            rec.spot.push(SpotSample {
+                t_us: end_time_us,
+                x_cm,
+                y_cm,
+                laser,
+            });
+        }
+    }
     let recording = recording.borrow().clone();
     let settings_flash = flash.image();
     let settings_flash_stats = flash.stats();
@@ -296,7 +315,7 @@ pub fn run(options: SimOptions) -> SimReport {
         transcript,
         recording,
         end,
-        end_time_us: crate::clock::now_us(),
+        end_time_us,
         idle_at_end: is_idle(status),
         saved_settings,
         settings_flash,
@@ -328,6 +347,19 @@ fn boot_settings_flash(options: &SimOptions) -> SettingsFlash {
         .with_timing(FlashTiming::Virtual)
 }
 
+/// Where the gimbal spot is at `t_us` (from the simulated servos' true
+/// angles through the exact forward kinematics), board cm.
+fn gimbal_spot_cm(
+    bus: &Rc<RefCell<SimServoBus>>,
+    gimbal: PhysicalGimbal,
+    t_us: u64,
+) -> Option<(f64, f64)> {
+    let bus = bus.borrow();
+    let yaw_deg = bus.angle_deg(gimbal.yaw_id, t_us).unwrap_or(0.0);
+    let pitch_deg = bus.angle_deg(gimbal.pitch_id, t_us).unwrap_or(0.0);
+    gimbal.spot_cm(yaw_deg, pitch_deg)
+}
+
 /// Samples the spot from the simulated servos' true angles, and records
 /// where it was at the end of each dwell.
 async fn spot_sampler(
@@ -340,17 +372,10 @@ async fn spot_sampler(
     let mut open_dwell: Option<(DwellKey, usize)> = None;
     loop {
         let t_us = crate::clock::now_us();
-        let (yaw_deg, pitch_deg) = {
-            let bus = bus.borrow();
-            (
-                bus.angle_deg(gimbal.yaw_id, t_us).unwrap_or(0.0),
-                bus.angle_deg(gimbal.pitch_id, t_us).unwrap_or(0.0),
-            )
-        };
+        let spot = gimbal_spot_cm(&bus, gimbal, t_us);
         {
             let mut rec = recording.borrow_mut();
             let laser = rec.laser_at(t_us);
-            let spot = gimbal.spot_cm(yaw_deg, pitch_deg);
             if let Some((x_cm, y_cm)) = spot {
                 rec.spot.push(SpotSample {
                     t_us,

@@ -9,7 +9,11 @@
 //! Each requested point is a jump (laser off, planned by `galvo-planner`,
 //! time-optimal or the patent's bisection method), a settling delay, a
 //! dwell with the laser on, and a laser-off delay. A half the DAC had
-//! already begun to replay is an underrun: counted, reported, laser off.
+//! already begun to replay is an underrun: counted, reported, laser off
+//! (the master [`LaserGate`](crate::laser_gate::LaserGate) closes).
+//! While nothing runs the loop holds: it lets the DAC replay the dark
+//! hold both halves already hold instead of recomputing it, so an idle
+//! loop cannot underrun.
 //!
 //! The sequencer drives it through [`GalvoLink`] (`target galvo|both`);
 //! the simulator feeds a simulated DAC. Not wired yet: the target's
@@ -93,8 +97,26 @@ pub struct Underrun {
     pub halves: u32,
 }
 
+/// One half buffer handed to the DAC.
+#[derive(Debug, Clone, Copy)]
+pub struct Half<'a> {
+    /// The samples (`half_len` of them).
+    pub samples: &'a [DacSample],
+    /// [`LaserGate`](crate::laser_gate::LaserGate) generation the samples
+    /// were computed under: their laser bits shine only while the gate is
+    /// open at this generation (a half computed before a stop stays dark).
+    pub generation: u32,
+    /// Samples the loop actually computed; the rest repeat a hold sample
+    /// (the simulated DAC charges loop time per computed sample).
+    pub computed: usize,
+}
+
 /// A hardware-timed DAC fed from a double buffer: a timer-triggered DMA
 /// on the target, a simulated DAC with the same deadlines on the host.
+///
+/// The DAC's laser output is the samples' laser bit AND the master
+/// [`LaserGate`](crate::laser_gate::LaserGate) at the half's generation;
+/// a half the DAC replays because the loop was late is output dark.
 #[allow(async_fn_in_trait)]
 pub trait DacStream {
     /// Samples per half buffer.
@@ -103,11 +125,21 @@ pub trait DacStream {
     /// Sets the sample period (s) for the halves written from now on.
     fn set_sample_period(&mut self, period_s: f64);
 
+    /// Whether both halves already hold nothing but `sample` (then
+    /// [`Self::repeat_half`] outputs the same as writing it again).
+    fn holds(&self, sample: DacSample) -> bool;
+
     /// Waits until the half the DAC is not reading is free, then stores
-    /// `samples` (`half_len` of them) in it. `Err` when the DAC had
-    /// already started on that half (the loop was late): the samples are
-    /// then output one half late.
-    async fn write_half(&mut self, samples: &[DacSample]) -> Result<(), Underrun>;
+    /// `half` in it. `Err` when the DAC had already started on that half
+    /// (the loop was late): it replayed that half dark and outputs these
+    /// samples one half late.
+    async fn write_half(&mut self, half: Half<'_>) -> Result<(), Underrun>;
+
+    /// Waits like [`Self::write_half`] but leaves the next half as the
+    /// DAC holds it. Only when [`Self::holds`] the same sample: replaying
+    /// an identical hold is the intended output, so this is never an
+    /// underrun, however late.
+    async fn repeat_half(&mut self);
 }
 
 /// What the sequencer asks of the galvo loop.
@@ -135,7 +167,9 @@ pub enum GalvoRequest {
     },
     /// Drop queued jobs, laser off at once; the mirrors finish the jump in
     /// flight (a jump is rest to rest) or brake along the stroke being
-    /// marked, and hold.
+    /// marked, and hold. Also clears an underrun latch. (Closing the
+    /// [`LaserGate`](crate::laser_gate::LaserGate) stops the loop the same
+    /// way, without the latch, and cannot get lost in a full channel.)
     Stop,
 }
 
@@ -143,7 +177,8 @@ pub enum GalvoRequest {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum GalvoEvent {
-    /// Point `seq` is done (jump, settle, dwell, laser-off delay).
+    /// Point `seq` is done (jump, settle, dwell, laser-off delay) and the
+    /// DAC has output its last sample.
     Done {
         /// Request number.
         seq: u32,

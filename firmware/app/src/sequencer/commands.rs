@@ -86,8 +86,13 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             }
             Command::Model(model) => {
                 self.model = model;
-                // Re-aim the current point with the new model.
+                // Re-aim the current point with the new model; on the
+                // galvo the new job replaces the one running (a dwell or
+                // a hold), it does not queue behind it.
                 if self.run.is_some() {
+                    if self.actuator.uses_galvo() {
+                        self.stop_galvo();
+                    }
                     self.begin_point();
                 }
                 link.ok().await;

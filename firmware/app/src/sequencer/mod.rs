@@ -20,6 +20,7 @@ use self::targets::{Aim, PathCursor, Target};
 use crate::cli::format::Fixed;
 use crate::command::{Actuator, AimModel, CommandLink, Pattern};
 use crate::galvo::GalvoLink;
+use crate::laser_gate::LaserGate;
 use crate::log;
 use crate::servo::task::{ServoLink, ServoOutcome, ServoRequest};
 use crate::settings::{RecordError, Settings};
@@ -49,6 +50,12 @@ pub struct Sequencer<'a, L: LaserSwitch, S: SettingsStore> {
     galvo: Option<&'a GalvoLink>,
     status: &'a StatusBoard,
     laser: L,
+    /// The master laser gate: closed at once by every stop, opened only
+    /// for a run that draws.
+    gate: &'a LaserGate,
+    /// Gate generation of the current run (since the last close): the
+    /// gimbal laser opens the gate only for it.
+    gate_generation: u32,
     store: S,
     settings: Settings,
     model: AimModel,
@@ -99,16 +106,19 @@ struct Run {
 
 impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     /// A sequencer with settings loaded from `store` (defaults, with a
-    /// warning, when the record is missing, old or corrupt).
+    /// warning, when the record is missing, old or corrupt). `gate` is the
+    /// master laser gate shared with the galvo loop and the laser pin.
     pub async fn new(
         link: &'a CommandLink,
         servo: &'a ServoLink,
         galvo: Option<&'a GalvoLink>,
         status: &'a StatusBoard,
         mut laser: L,
+        gate: &'a LaserGate,
         mut store: S,
     ) -> Self {
         laser.set(false);
+        let gate_generation = gate.close();
         let mut record = [0u8; crate::settings::RECORD_LEN];
         let n = store.load(&mut record).await;
         let settings = match Settings::from_record(record.get(..n).unwrap_or(&[])) {
@@ -137,6 +147,8 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             galvo,
             status,
             laser,
+            gate,
+            gate_generation,
             store,
             settings,
             model: AimModel::Exact,
@@ -215,25 +227,31 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
         log::info!("start {} (once={})", name, run.once);
         run.path = self.path_cursor(run.pattern);
+        // Nothing of an earlier run may shine: a new gate generation, and
+        // the galvo drops its points and an underrun latch.
+        self.close_gate();
         self.run = Some(run);
         self.faulty_servo = None;
-        if self.actuator.uses_galvo() {
-            // Clears points of an earlier run and an underrun latch.
-            self.send_galvo(crate::galvo::GalvoRequest::Stop);
-        }
         self.begin_point();
     }
 
-    /// Stops whatever runs.
+    /// Stops whatever runs — and, whatever the sequencer thinks runs, the
+    /// laser and the galvo loop: the gate closes at once and the loop gets
+    /// `Stop`.
     fn stop(&mut self, why: &str) {
+        self.close_gate();
         if let Some(run) = self.run.take() {
             let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
             log::info!("stop {} ({})", name, why);
-            if self.actuator.uses_galvo() {
-                self.send_galvo(crate::galvo::GalvoRequest::Stop);
-            }
         }
         self.publish();
+    }
+
+    /// Closes the master laser gate (laser dark from now on, also samples
+    /// the galvo DAC already holds) and stops the galvo loop.
+    fn close_gate(&mut self) {
+        self.gate_generation = self.gate.close();
+        self.stop_galvo();
     }
 
     /// The target of the current point of the run.
@@ -477,7 +495,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         // The galvo's laser is switched per sample by the galvo loop; this
         // is the gimbal's.
         let wanted = self.actuator.uses_gimbal()
-            && laser_wanted(self.settings.laser_mode, phase, self.faulty_servo.is_some());
+            && laser_wanted(self.settings.laser_mode, phase, self.faulty_servo.is_some())
+            // Refused when the gate was closed since the run began (a
+            // galvo underrun): dark until the run is stopped or restarted.
+            && self.gate.open(self.gate_generation);
         if wanted != self.laser_on {
             self.laser.set(wanted);
             self.laser_on = wanted;
