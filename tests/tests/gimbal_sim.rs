@@ -370,9 +370,12 @@ fn servo_ids_from_the_settings_are_used_on_the_bus() {
         tx_ids.contains(&7),
         "angle queries went to servo 7: {tx_ids:?}"
     );
-    assert_eq!(
+    // Dark at the end (travel to a goto is dark, so it may never have lit).
+    assert_ne!(
         report.recording.laser_events.last().map(|e| e.1),
-        Some(false)
+        Some(true),
+        "{:?}",
+        report.recording.laser_events
     );
 }
 
