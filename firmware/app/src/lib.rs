@@ -15,6 +15,7 @@ pub mod cli;
 pub mod command;
 pub mod galvo;
 mod log;
+pub mod outbound;
 pub mod sequencer;
 pub mod servo;
 pub mod settings;
