@@ -202,7 +202,9 @@ pub mod console {
             ..ReplyAudit::default()
         };
         for s in &sent {
-            let reply = expected.get(*s).ok_or(format!("no expected reply for {s:?}"))?;
+            let reply = expected
+                .get(*s)
+                .ok_or(format!("no expected reply for {s:?}"))?;
             audit.data_lines_expected += reply.data.len();
         }
         let (mut reply_index, mut cursor) = (0usize, 0usize);

@@ -124,9 +124,7 @@ impl Dropped {
             LineKind::Notice => self.notices = self.notices.saturating_add(1),
             // Closers always have room (see the module doc); should one
             // ever be refused it is counted with the data lines.
-            LineKind::Ok | LineKind::Error => {
-                self.data_lines = self.data_lines.saturating_add(1)
-            }
+            LineKind::Ok | LineKind::Error => self.data_lines = self.data_lines.saturating_add(1),
         }
     }
 }

@@ -53,7 +53,11 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
         match words.next() {
             Some("wait") => steps.push(Step::WaitMs(ms_argument("wait", words, number)?)),
             Some("@stall-read") => {
-                steps.push(Step::StallReadMs(ms_argument("@stall-read", words, number)?));
+                steps.push(Step::StallReadMs(ms_argument(
+                    "@stall-read",
+                    words,
+                    number,
+                )?));
             }
             Some("@type-ahead") => {
                 let typed = line.trim_start_matches("@type-ahead").trim();
@@ -124,8 +128,16 @@ mod tests {
                 Step::Send("params".into())
             ]
         );
-        for bad in ["@stall-read", "@stall-read 1 2", "@stall-read -5", "@type-ahead", "@stall 5"] {
-            let err = parse_script(&format!("stop\n{bad}\n")).unwrap_err().to_string();
+        for bad in [
+            "@stall-read",
+            "@stall-read 1 2",
+            "@stall-read -5",
+            "@type-ahead",
+            "@stall 5",
+        ] {
+            let err = parse_script(&format!("stop\n{bad}\n"))
+                .unwrap_err()
+                .to_string();
             assert!(err.contains("line 2"), "{bad}: {err}");
         }
     }

@@ -252,7 +252,10 @@ mod tests {
         let lines: Vec<&str> = transcript.lines.iter().map(|(_, l)| l.as_str()).collect();
         assert_eq!(lines, ["> a", "> b", "ok", "ok", "> c", "ok"]);
         let first_ok = transcript.lines[2].0;
-        assert!(first_ok >= 500_000, "read during the stall at {first_ok} µs");
+        assert!(
+            first_ok >= 500_000,
+            "read during the stall at {first_ok} µs"
+        );
         assert!(transcript.lines[1].0 < 1_000, "typed during the stall");
         assert!(transcript.unterminated.is_empty());
     }
