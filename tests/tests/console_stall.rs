@@ -103,8 +103,14 @@ fn a_host_that_stops_reading_delays_no_fault_shutdown_and_gets_whole_replies() {
                   get dwell_ms\nbogus\nversion\nwait 300\n";
     let report = run_with(script, silent_servo_at(1020));
     let dark_us = dark_after(&report, 1_020_000);
-    eprintln!("silent servo -> laser off during a host stall: {dark_us} µs");
+    let quiet = run_with("pattern visit-all\nwait 2000\n", silent_servo_at(1020));
+    let quiet_dark_us = dark_after(&quiet, 1_020_000);
+    eprintln!(
+        "silent servo -> laser off: {dark_us} µs during a host stall, \
+         {quiet_dark_us} µs with a host that reads"
+    );
     assert!(dark_us < 200_000, "laser off {dark_us} µs after the fault");
+    assert!(dark_us <= quiet_dark_us, "the stall delayed the shutdown");
 
     let audit = audit(&report);
     assert!(

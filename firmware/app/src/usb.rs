@@ -37,8 +37,8 @@ use crate::outbound::{LineKind, OutLine, Outbound};
 /// counted). Commands without data lines (`stop`, `goto`, …) never wait.
 pub const HOST_STALL: Duration = Duration::from_millis(250);
 
-/// Longest line on the wire: `error: ` + text + CR LF, bytes.
-const WIRE_LINE_MAX: usize = 7 + REPLY_LINE_LEN + 2;
+/// Longest line on the wire without its line end: `error: ` + text, bytes.
+const WIRE_LINE_MAX: usize = 7 + REPLY_LINE_LEN;
 
 /// Why the console stopped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -133,8 +133,12 @@ async fn write_lines<W: Write>(tx: &mut W, out: &Outbound) -> ConsoleEnd {
     }
 }
 
-/// Writes one line with its decoration (`error: `, `[…]`) and CR LF in one
-/// piece, then flushes.
+/// Writes one line with its decoration (`error: `, `[…]`), then CR LF,
+/// then flushes; never abandoned part way (only a failed write ends it).
+/// The line end goes in a write of its own so the line always ends in a
+/// short USB packet, which makes the host deliver it at once (a line
+/// ending exactly on a full packet would wait for the next one: the
+/// CDC-ACM class sends no zero-length packet).
 async fn write_line<W: Write>(tx: &mut W, line: &OutLine) -> Result<(), W::Error> {
     let (prefix, suffix): (&[u8], &[u8]) = match line.kind {
         LineKind::Data => (b"", b""),
@@ -147,10 +151,11 @@ async fn write_line<W: Write>(tx: &mut W, line: &OutLine) -> Result<(), W::Error
         _ => line.text.as_bytes(),
     };
     let mut wire = heapless::Vec::<u8, WIRE_LINE_MAX>::new();
-    for part in [prefix, text, suffix, b"\r\n"] {
+    for part in [prefix, text, suffix] {
         // Fits: the text is at most REPLY_LINE_LEN bytes.
         let _ = wire.extend_from_slice(part);
     }
     tx.write_all(&wire).await?;
+    tx.write_all(b"\r\n").await?;
     tx.flush().await
 }
