@@ -248,3 +248,15 @@ proptest! {
         prop_assert_eq!(tail_received, tail);
     }
 }
+
+#[test]
+fn a_host_that_reads_gets_every_line_even_when_it_types_ahead() {
+    // Pasting several commands at once: nothing dropped, all in order.
+    let script = "pattern visit-all\nwait 500\n@type-ahead help\n@type-ahead params\n\
+                  @type-ahead bogus\n@type-ahead params\nversion\nwait 100\n";
+    let report = run_with(script, SimOptions::default());
+    let audit = audit(&report);
+    assert_eq!(audit.dropped_lines_reported, 0, "{:?}", audit.notices);
+    assert_eq!(audit.data_lines, audit.data_lines_expected);
+    assert!(audit.data_lines > 100);
+}

@@ -20,7 +20,7 @@
 //! bracketed notice once the host reads again.
 
 use core::cell::RefCell;
-use core::fmt::{self, Write as _};
+use core::fmt;
 
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
@@ -192,8 +192,12 @@ impl Queue {
     /// Queues `text` as a `kind` line, after a drop marker if lines were
     /// dropped before it; counts it as dropped when its share is full.
     fn push(&mut self, kind: LineKind, text: &str) -> bool {
-        let text = text.as_bytes();
-        let text = text.get(..REPLY_LINE_LEN).unwrap_or(text);
+        // At most REPLY_LINE_LEN bytes, cut on a character boundary.
+        let mut end = text.len().min(REPLY_LINE_LEN);
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        let text = text.as_bytes().get(..end).unwrap_or(&[]);
         let marker = if self.dropped.is_empty() {
             0
         } else {
@@ -309,11 +313,7 @@ impl Outbound {
 
     /// Queues a line formatted from `args` (cut at [`REPLY_LINE_LEN`]).
     pub fn push_fmt(&self, kind: LineKind, args: fmt::Arguments<'_>) -> bool {
-        let mut text = ReplyText::new();
-        if text.write_fmt(args).is_err() {
-            text = reply_text(args);
-        }
-        self.push(kind, &text)
+        self.push(kind, &reply_text(args))
     }
 
     /// Takes the next line to write (drop reports included), if any.
@@ -472,6 +472,16 @@ mod tests {
         let last = lines.last().map(|l| l.text.as_str()).unwrap_or("");
         assert!(last.contains("and 1 reply line dropped"), "{last}");
         assert!(out.take().is_none());
+    }
+
+    #[test]
+    fn long_text_is_cut_on_a_character_boundary() {
+        let out = Outbound::new();
+        let text = String::from("é").repeat(REPLY_LINE_LEN);
+        assert!(out.push(LineKind::Data, &text));
+        let line = out.take().expect("queued");
+        assert_eq!(line.text.len(), REPLY_LINE_LEN);
+        assert!(line.text.chars().all(|c| c == 'é'));
     }
 
     #[test]
