@@ -14,7 +14,9 @@ use laser_sim::world::{SimOptions, run};
 /// Options of `cargo xtask sim`.
 #[derive(clap::Args, Debug)]
 pub struct SimArgs {
-    /// Script of command lines (`wait <ms>` pauses; `#` comments); `-`
+    /// Script of command lines (`wait <ms>` pauses; `#` comments;
+    /// `@stall-read <ms>` stops the host reading replies for a while,
+    /// `@type-ahead <line>` types without waiting for the reply); `-`
     /// reads it from stdin. Without it, piped stdin is the script, and a
     /// terminal or empty stdin runs the demo (writing sim.svg).
     #[arg(long)]

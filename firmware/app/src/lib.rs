@@ -17,6 +17,7 @@ pub mod command;
 pub mod galvo;
 pub mod laser_gate;
 mod log;
+pub mod outbound;
 pub mod sequencer;
 pub mod servo;
 pub mod settings;

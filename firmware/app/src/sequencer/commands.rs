@@ -19,9 +19,9 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
         match command {
             Command::Help => {
                 for line in HELP_LINES {
-                    link.data(format_args!("{line}")).await;
+                    link.data(format_args!("{line}"));
                 }
-                link.ok().await;
+                link.ok();
             }
             Command::Version => {
                 link.data(format_args!(
@@ -31,34 +31,33 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                     build_info::GIT_REV,
                     build_info::PROFILE,
                     build_info::TARGET
-                ))
-                .await;
-                link.ok().await;
+                ));
+                link.ok();
             }
             Command::Status => {
-                self.report_status().await;
-                link.ok().await;
+                self.report_status();
+                link.ok();
             }
             Command::Stop => {
                 self.stop("stop command");
-                link.ok().await;
+                link.ok();
             }
             Command::Pattern { pattern, once } => match self.check_pattern(&pattern).await {
                 Ok(()) => {
                     self.start(Run::new(Some(pattern), None, once));
-                    link.ok().await;
+                    link.ok();
                 }
-                Err(reason) => link.error(reason).await,
+                Err(reason) => link.error(reason),
             },
-            Command::Goto(point) => self.goto(Target { point, grid: None }).await,
+            Command::Goto(point) => self.goto(Target { point, grid: None }),
             Command::Grid { xi, yi } => match targets::grid_point(&self.settings, xi, yi) {
-                Ok(target) => self.goto(target).await,
-                Err(reason) => link.error(reason).await,
+                Ok(target) => self.goto(target),
+                Err(reason) => link.error(reason),
             },
             Command::Target(actuator)
                 if actuator != Actuator::Gimbal && !(GALVO_OUTPUT && self.galvo.is_some()) =>
             {
-                link.error("this build has no galvo output").await
+                link.error("this build has no galvo output")
             }
             Command::Target(actuator) => {
                 // The running pattern or goto stops: it was checked for
@@ -66,23 +65,23 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 self.stop("actuator changed");
                 self.actuator = actuator;
                 self.configure_galvo();
-                link.ok().await;
+                link.ok();
             }
             Command::Planner(_) | Command::GalvoStatus if !GALVO_OUTPUT => {
-                link.error("this build has no galvo output").await
+                link.error("this build has no galvo output")
             }
             Command::Planner(planner) => {
                 self.settings.galvo.planner = planner;
                 self.configure_galvo();
-                link.ok().await;
+                link.ok();
             }
             Command::GalvoStatus => {
-                self.report_galvo_status().await;
-                link.ok().await;
+                self.report_galvo_status();
+                link.ok();
             }
             Command::Laser(mode) => {
                 self.settings.laser_mode = mode;
-                link.ok().await;
+                link.ok();
             }
             Command::Model(model) => {
                 self.model = model;
@@ -95,7 +94,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                     }
                     self.begin_point();
                 }
-                link.ok().await;
+                link.ok();
             }
             Command::Set { param, value } => {
                 let before = self.settings;
@@ -105,59 +104,56 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                             if GALVO_OUTPUT && before.galvo != self.settings.galvo {
                                 self.configure_galvo();
                             }
-                            link.ok().await
+                            link.ok()
                         }
                         Err(reason) => {
                             self.settings = before;
-                            link.error(reason).await;
+                            link.error(reason);
                         }
                     },
-                    Err(e) => link.error(e).await,
+                    Err(e) => link.error(e),
                 }
             }
             Command::Get(param) => {
                 link.data(format_args!(
                     "{}",
                     ParamLine(param, self.settings.get(param))
-                ))
-                .await;
-                link.ok().await;
+                ));
+                link.ok();
             }
             Command::Params => {
                 for param in PARAMS {
                     link.data(format_args!(
                         "{}",
                         ParamLine(param, self.settings.get(param))
-                    ))
-                    .await;
+                    ));
                 }
-                link.ok().await;
+                link.ok();
             }
             // A save may erase a flash sector (when one fills up), which
             // stalls the CPU for 1-2 s on the target: not while the laser
             // draws.
             Command::Save if self.run.is_some() => {
-                link.error("stop the running pattern or goto before save")
-                    .await;
+                link.error("stop the running pattern or goto before save");
             }
             Command::Save => {
                 let record = self.settings.to_record();
                 match self.store.save(&record).await {
-                    Ok(()) => link.ok().await,
-                    Err(reason) => link.error(reason).await,
+                    Ok(()) => link.ok(),
+                    Err(reason) => link.error(reason),
                 }
             }
         }
     }
 
     /// Aims at one target and holds it; refuses unreachable targets.
-    async fn goto(&mut self, target: Target) {
+    fn goto(&mut self, target: Target) {
         match targets::check_target(&self.settings, self.model, self.actuator, &target) {
             Ok(_) => {
                 self.start(Run::new(None, Some(target), true));
-                self.link.ok().await;
+                self.link.ok();
             }
-            Err(e) => self.link.error(e).await,
+            Err(e) => self.link.error(e),
         }
     }
 
@@ -190,17 +186,17 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
         }
     }
 
-    async fn report_status(&self) {
+    fn report_status(&self) {
         let snapshot = self.status.snapshot();
         for line in 0..STATUS_LINES {
             if let Some(text) = self.status_line(&snapshot, line) {
-                self.link.data_line(text).await;
+                self.link.data_line(text);
             }
         }
     }
 
     /// Line `line` of `status` (`None`: not shown now). One formatter and
-    /// one await in the caller keep the task's state machine small.
+    /// one queueing call in the caller keep the code small.
     fn status_line(&self, s: &Snapshot, line: usize) -> Option<ReplyText> {
         let text = |args: core::fmt::Arguments<'_>| Some(reply_text(args));
         match line {

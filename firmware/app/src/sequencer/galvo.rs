@@ -140,27 +140,24 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     }
 
     /// `galvo status` lines.
-    pub(super) async fn report_galvo_status(&self) {
+    pub(super) fn report_galvo_status(&self) {
         let link = self.link;
         let Some(galvo) = self.galvo else {
-            link.data(format_args!("galvo: not in this build")).await;
+            link.data(format_args!("galvo: not in this build"));
             return;
         };
         let (phase, queued) = galvo.state();
         let g = &self.settings.galvo;
-        link.data(format_args!("galvo: {phase:?}, {queued} points queued"))
-            .await;
+        link.data(format_args!("galvo: {phase:?}, {queued} points queued"));
         link.data(format_args!(
             "planner: {}, sample period {} us",
             g.planner.name(),
             Shortest(g.sample_period_us)
-        ))
-        .await;
+        ));
         link.data(format_args!(
             "underruns: {}, half buffers: {}",
             galvo.underruns.load(Ordering::Relaxed),
             galvo.halves.load(Ordering::Relaxed)
-        ))
-        .await;
+        ));
     }
 }
