@@ -6,7 +6,7 @@ use galvo_planner::{JumpSync, Method, RigidParams, XyStepper, plan_xy_jump};
 use kinematics_core::{Galvo, PointMm};
 use laser_app::galvo::DacSample;
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::{run_to_idle, run_with, spec_patterns, terminal_lines};
+use system_tests::{run_to_idle, run_with, sent_at, spec_patterns, terminal_lines};
 
 /// SPEC grid pitch, mm.
 const PITCH_MM: f64 = 19.16;
@@ -716,5 +716,52 @@ fn a_galvo_underrun_replays_dark_and_the_laser_is_dark_at_once() {
     assert!(
         samples.iter().all(|(t, s)| *t < t0 + 1_000_000 || !s.laser),
         "dark from 1 ms after the underrun on"
+    );
+}
+
+#[test]
+fn laser_off_keeps_the_galvo_dark_while_it_still_draws() {
+    // From the start: the galvo visits every corner, never lit.
+    let report =
+        run_to_idle("target galvo\nlaser off\nset dwell_ms 20\npattern corner once\nwait 150\n");
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let samples = samples(&report);
+    assert!(samples.iter().all(|s| !s.laser), "lit with laser off");
+    let corner = (-6.0 * PITCH_MM, 4.0 * PITCH_MM);
+    assert!(
+        samples.iter().any(|s| {
+            let p = spot_mm(s);
+            (p.0 - corner.0).abs() <= 0.1 && (p.1 - corner.1).abs() <= 0.1
+        }),
+        "the mirrors still went to the first corner"
+    );
+
+    // Mid-run: dark from three half buffers (the two already handed to
+    // the DAC and the one computed and waiting for its slot: 3.84 ms at
+    // 100 kHz) after the line is processed; lit again after `laser auto`.
+    let report = run_to_idle(
+        "target galvo\nset dwell_ms 200\npattern corner once\nwait 100\nlaser off\nwait 400\nlaser auto\nwait 400\n",
+    );
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let off_ns = sent_at(&report, "laser off") * 1000;
+    let auto_ns = sent_at(&report, "laser auto") * 1000;
+    let lit: Vec<u64> = report
+        .dac
+        .iter()
+        .filter(|(_, s)| s.laser)
+        .map(|(t, _)| t)
+        .collect();
+    assert!(lit.iter().any(|&t| t < off_ns), "lit before laser off");
+    assert!(
+        lit.iter().all(|&t| t < off_ns + 3_850_000 || t > auto_ns),
+        "lit between laser off ({off_ns} ns) and laser auto: {:?}",
+        lit.iter()
+            .filter(|&&t| t >= off_ns + 3_850_000 && t <= auto_ns)
+            .take(3)
+            .collect::<Vec<_>>()
+    );
+    assert!(
+        lit.iter().any(|&t| t > auto_ns),
+        "lit again after laser auto"
     );
 }

@@ -31,7 +31,7 @@ pub const GALVO_OUTPUT: bool = cfg!(feature = "galvo");
 pub use path::GalvoPath;
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, Phase};
 
-use core::sync::atomic::{AtomicU8, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 
 use galvo_planner::{Method, RigidParams};
 use kinematics_core::{DacAxis, Galvo, GalvoGeometry};
@@ -210,6 +210,9 @@ pub struct GalvoLink {
     pub underruns: AtomicU32,
     /// Half buffers written since boot (liveness for the watchdog).
     pub halves: AtomicU32,
+    /// Whether the laser mode lets the galvo light at all (`laser off`
+    /// clears it); applied to every half buffer computed from then on.
+    laser_allowed: AtomicBool,
     /// [`Phase`] after the last half buffer.
     phase: AtomicU8,
     /// Points queued in the loop after the last half buffer.
@@ -227,6 +230,19 @@ const PHASES: [Phase; 7] = [
 ];
 
 impl GalvoLink {
+    /// Lets the galvo light its dwells and strokes (`true`, laser modes
+    /// `auto` and `dwell`) or keeps every sample it computes from now on
+    /// dark (`false`, `laser off`). The master gate still decides whether
+    /// an allowed sample shines.
+    pub fn allow_laser(&self, allowed: bool) {
+        self.laser_allowed.store(allowed, Ordering::Relaxed);
+    }
+
+    /// Whether the laser mode lets the galvo light (see [`Self::allow_laser`]).
+    pub fn laser_allowed(&self) -> bool {
+        self.laser_allowed.load(Ordering::Relaxed)
+    }
+
     /// The loop's phase and queued points after its last half buffer.
     pub fn state(&self) -> (Phase, usize) {
         let phase = PHASES
@@ -252,6 +268,7 @@ impl GalvoLink {
             events: Channel::new(),
             underruns: AtomicU32::new(0),
             halves: AtomicU32::new(0),
+            laser_allowed: AtomicBool::new(true),
             phase: AtomicU8::new(0),
             queued: AtomicU8::new(0),
         }

@@ -603,6 +603,10 @@ impl GalvoLoop {
                 }
             });
             link.publish(self.phase(), self.queue.len());
+            if !link.laser_allowed() {
+                // `laser off`: the mirrors still move, dark.
+                out.iter_mut().for_each(|s| s.laser = false);
+            }
             if out.iter().any(|s| s.laser) {
                 // Refused (the half stays dark) when the gate closed since.
                 gate.open(generation);

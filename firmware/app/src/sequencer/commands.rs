@@ -81,6 +81,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             }
             Command::Laser(mode) => {
                 self.settings.laser_mode = mode;
+                self.allow_galvo_laser();
                 link.ok();
             }
             Command::Model(model) => {

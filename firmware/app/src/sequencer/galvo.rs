@@ -8,6 +8,7 @@ use super::{LaserSwitch, Phase, Sequencer, SettingsStore};
 use crate::cli::format::Shortest;
 use crate::galvo::{GALVO_OUTPUT, GalvoEvent, GalvoRequest, config_from};
 use crate::log;
+use crate::settings::LaserMode;
 
 /// Dwell of a goto on the galvo: held until the next command, µs.
 const HOLD_US: u32 = u32::MAX;
@@ -136,6 +137,15 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     pub(super) fn configure_galvo(&mut self) {
         if let Some(galvo) = self.galvo {
             galvo.config.signal(config_from(&self.settings.galvo));
+        }
+        self.allow_galvo_laser();
+    }
+
+    /// Tells the galvo loop whether the laser mode lets it light (`laser
+    /// off`: it still moves, dark).
+    pub(super) fn allow_galvo_laser(&self) {
+        if let Some(galvo) = self.galvo {
+            galvo.allow_laser(self.settings.laser_mode != LaserMode::Off);
         }
     }
 

@@ -140,6 +140,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             galvo
                 .config
                 .signal(crate::galvo::config_from(&settings.galvo));
+            galvo.allow_laser(settings.laser_mode != crate::settings::LaserMode::Off);
         }
         Self {
             link,
