@@ -5,6 +5,7 @@ use core::fmt;
 use super::{LaserMode, Settings};
 use crate::cli::error::CommandError;
 use crate::cli::format::Shortest;
+use kinematics_core::error_model::COEF_LIMITS;
 
 /// How a parameter's value is stored.
 #[derive(Clone, Copy)]
@@ -101,31 +102,13 @@ macro_rules! choice {
 }
 
 /// Error-model coefficients (SPEC §5): `Δ = c0 + c1·x + c2·y + c3·x² +
-/// c4·x·y + c5·y²` with x, y, Δ in mm. Ranges: c0 ±100 mm (a 10 cm
-/// offset is already a mis-mounted board), c1/c2 ±1 mm/mm (100 % scale
-/// error), c3..c5 ±0.01 1/mm (100 mm of error at 100 mm from the centre).
+/// c4·x·y + c5·y²` with x, y, Δ in mm. Ranges from
+/// [`kinematics_core::error_model::COEF_LIMITS`] (shared with `cargo xtask
+/// calib fit`): c0 ±100 mm, c1/c2 ±1 mm/mm, c3..c5 ±0.01 1/mm.
 macro_rules! err_coef {
-    ($name:literal, $axis:ident, 0) => {
-        real!($name, -100.0, 100.0, "error-model constant c0, mm", |s| s
-            .$axis[0])
-    };
-    ($name:literal, $axis:ident, $i:literal, linear) => {
-        real!(
-            $name,
-            -1.0,
-            1.0,
-            "error-model linear coefficient, mm/mm",
-            |s| s.$axis[$i]
-        )
-    };
-    ($name:literal, $axis:ident, $i:literal, quadratic) => {
-        real!(
-            $name,
-            -0.01,
-            0.01,
-            "error-model quadratic coefficient, 1/mm",
-            |s| s.$axis[$i]
-        )
+    ($name:literal, $axis:ident, $i:literal, $help:literal) => {
+        real!($name, -COEF_LIMITS[$i], COEF_LIMITS[$i], $help, |s| s.$axis
+            [$i])
     };
 }
 
@@ -274,18 +257,68 @@ pub const PARAMS: &[ParamSpec] = &[
         "0 auto, 1 dwell, 2 off",
         Slot::Laser
     ),
-    err_coef!("err.dx.c0", err_dx, 0),
-    err_coef!("err.dx.c1", err_dx, 1, linear),
-    err_coef!("err.dx.c2", err_dx, 2, linear),
-    err_coef!("err.dx.c3", err_dx, 3, quadratic),
-    err_coef!("err.dx.c4", err_dx, 4, quadratic),
-    err_coef!("err.dx.c5", err_dx, 5, quadratic),
-    err_coef!("err.dy.c0", err_dy, 0),
-    err_coef!("err.dy.c1", err_dy, 1, linear),
-    err_coef!("err.dy.c2", err_dy, 2, linear),
-    err_coef!("err.dy.c3", err_dy, 3, quadratic),
-    err_coef!("err.dy.c4", err_dy, 4, quadratic),
-    err_coef!("err.dy.c5", err_dy, 5, quadratic),
+    err_coef!("err.dx.c0", err_dx, 0, "error-model constant c0, mm"),
+    err_coef!(
+        "err.dx.c1",
+        err_dx,
+        1,
+        "error-model coefficient c1 of x, mm/mm"
+    ),
+    err_coef!(
+        "err.dx.c2",
+        err_dx,
+        2,
+        "error-model coefficient c2 of y, mm/mm"
+    ),
+    err_coef!(
+        "err.dx.c3",
+        err_dx,
+        3,
+        "error-model coefficient c3 of x^2, 1/mm"
+    ),
+    err_coef!(
+        "err.dx.c4",
+        err_dx,
+        4,
+        "error-model coefficient c4 of x*y, 1/mm"
+    ),
+    err_coef!(
+        "err.dx.c5",
+        err_dx,
+        5,
+        "error-model coefficient c5 of y^2, 1/mm"
+    ),
+    err_coef!("err.dy.c0", err_dy, 0, "error-model constant c0, mm"),
+    err_coef!(
+        "err.dy.c1",
+        err_dy,
+        1,
+        "error-model coefficient c1 of x, mm/mm"
+    ),
+    err_coef!(
+        "err.dy.c2",
+        err_dy,
+        2,
+        "error-model coefficient c2 of y, mm/mm"
+    ),
+    err_coef!(
+        "err.dy.c3",
+        err_dy,
+        3,
+        "error-model coefficient c3 of x^2, 1/mm"
+    ),
+    err_coef!(
+        "err.dy.c4",
+        err_dy,
+        4,
+        "error-model coefficient c4 of x*y, 1/mm"
+    ),
+    err_coef!(
+        "err.dy.c5",
+        err_dy,
+        5,
+        "error-model coefficient c5 of y^2, 1/mm"
+    ),
     #[cfg(feature = "galvo")]
     real!(
         "galvo.d_mm",
