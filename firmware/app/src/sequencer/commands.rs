@@ -16,6 +16,10 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     /// Runs one command and sends its reply.
     pub(super) async fn handle_command(&mut self, command: Command) {
         let link = self.link;
+        if let Some(reason) = self.refusal_for_dead_servo(&command) {
+            link.error(reason).await;
+            return;
+        }
         match command {
             Command::Help => {
                 for line in HELP_LINES {
