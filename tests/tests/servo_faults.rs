@@ -292,7 +292,7 @@ fn last_reading(report: &SimReport, id: u8, t_us: u64) -> Option<(u64, i16, i16)
                 .map_or(Some(received), |c| decode(&c.sent))?;
             Some((f.t_us, received, sent))
         })
-        .last()
+        .next_back()
 }
 
 /// Runs 100 random short gotos per seed with the given bus faults and

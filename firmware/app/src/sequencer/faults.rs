@@ -74,7 +74,7 @@ impl ServoFaults {
 pub(super) fn servo_ranges_tenths(settings: &Settings) -> [(i16, i16); 2] {
     // The limits are within ±180° (their parameter ranges): the casts are
     // exact.
-    let tenths = |deg: f64| (deg * 10.0).round() as i16;
+    let tenths = |deg: f64| libm::round(deg * 10.0) as i16;
     [
         (tenths(settings.yaw.min_deg), tenths(settings.yaw.max_deg)),
         (

@@ -79,8 +79,10 @@ pub struct ReadingFilter {
     range_tenths: (i16, i16),
     /// Last accepted reading and when it was taken.
     last_good: Option<(i16, Instant)>,
-    /// Last reading not accepted (candidate for confirmation).
-    candidate: Option<(i16, Instant)>,
+    /// The last two in-envelope readings not accepted, newest first
+    /// (candidates for confirmation; two, so that one corrupted reading
+    /// cannot displace the good one before it).
+    candidates: [Option<(i16, Instant)>; 2],
     /// Implausible readings in a row.
     run: u8,
 }
@@ -91,7 +93,7 @@ impl ReadingFilter {
         Self {
             range_tenths,
             last_good: None,
-            candidate: None,
+            candidates: [None; 2],
             run: 0,
         }
     }
@@ -129,10 +131,10 @@ impl ReadingFilter {
     /// Judges `reading` taken at `now`.
     ///
     /// Accepted when inside the envelope and within the physical jump of
-    /// the last accepted reading, or of the reading just before it (that
-    /// one was not accepted: two readings in a row that agree outvote a
-    /// reference that was itself a corrupted reading, and confirm the
-    /// first reading when there is no recent reference).
+    /// the last accepted reading, or of one of the last two readings that
+    /// were not accepted (two readings that agree outvote a reference that
+    /// was itself a corrupted reading, and confirm the first reading when
+    /// there is no recent reference).
     pub fn judge(&mut self, reading: i16, now: Instant) -> Verdict {
         let recent = |from: Option<(i16, Instant)>| {
             from.filter(|(_, at)| !reference_expired(now.saturating_duration_since(*at)))
@@ -142,17 +144,21 @@ impl ReadingFilter {
             jump <= max_jump_tenths(now.saturating_duration_since(from.1))
         };
         let reference = recent(self.last_good);
-        let candidate = recent(self.candidate);
+        let candidates = self.candidates.map(recent);
         let in_envelope = self.in_envelope(reading);
-        if in_envelope && (reference.is_some_and(within) || candidate.is_some_and(within)) {
+        let confirmed = candidates.iter().flatten().any(|c| within(*c));
+        if in_envelope && (reference.is_some_and(within) || confirmed) {
             self.last_good = Some((reading, now));
-            self.candidate = None;
+            self.candidates = [None; 2];
             self.run = 0;
             return Verdict::Accepted(reading);
         }
-        self.candidate = Some((reading, now));
-        if in_envelope && reference.is_none() && candidate.is_none() {
-            return Verdict::Unconfirmed;
+        if in_envelope {
+            let [newest, _] = self.candidates;
+            self.candidates = [Some((reading, now)), newest];
+            if reference.is_none() && candidates.iter().all(Option::is_none) {
+                return Verdict::Unconfirmed;
+            }
         }
         self.run = self.run.saturating_add(1);
         Verdict::Implausible { run: self.run }
@@ -322,6 +328,8 @@ mod tests {
             let mut last_accepted: Option<(i16, u64)> = None;
             // Previous decoded reading: value, time, corrupted, accepted.
             let mut previous: Option<(i16, u64, bool, bool)> = None;
+            // The last two in-envelope readings not accepted, newest first.
+            let mut unaccepted: [Option<(i16, u64)>; 2] = [None; 2];
             let mut run_of_rejects = 0;
             for (i, &(dt, speed, hold)) in steps.iter().enumerate() {
                 now += dt;
@@ -355,7 +363,7 @@ mod tests {
                     };
                     prop_assert!(
                         last_accepted.is_some_and(jump_ok)
-                            || previous.is_some_and(|(r, t, _, acc)| !acc && jump_ok((r, t))),
+                            || unaccepted.iter().flatten().any(|c| jump_ok(*c)),
                         "accepted {} without a physically consistent reading before it", a
                     );
                     if corrupted && previous.is_some_and(|(_, _, c, acc)| !c && acc) {
@@ -367,8 +375,12 @@ mod tests {
                         );
                     }
                     last_accepted = Some((a, now));
+                    unaccepted = [None; 2];
                     run_of_rejects = 0;
                 } else {
+                    if f.in_envelope(reading) {
+                        unaccepted = [Some((reading, now)), unaccepted[0]];
+                    }
                     run_of_rejects += 1;
                 }
                 // Isolated corruption never makes a run that faults.
