@@ -297,10 +297,12 @@ fn last_reading(report: &SimReport, id: u8, t_us: u64) -> Option<(u64, i16, i16)
 
 /// Runs 100 random short gotos per seed with the given bus faults and
 /// checks every declared arrival against what the servos really sent.
-/// Returns (arrivals checked, corrupted frames that passed the checksum).
-fn arrivals_on_real_readings_only(faults: impl Fn(u64) -> BusFaults) -> (usize, usize) {
+/// Returns (arrivals checked, corrupted frames that passed the checksum,
+/// readings the firmware rejected as implausible per its `status`).
+fn arrivals_on_real_readings_only(faults: impl Fn(u64) -> BusFaults) -> (usize, usize, u64) {
     let mut passed_checksum = 0;
     let mut dwells = 0;
+    let mut rejected = 0;
     for seed in 1..=12u64 {
         let options = SimOptions {
             faults: faults(seed),
@@ -318,7 +320,16 @@ fn arrivals_on_real_readings_only(faults: impl Fn(u64) -> BusFaults) -> (usize, 
                 rng.below(9) as i64 - 4
             ));
         }
+        script.push_str("status\n");
         let report = run_with(&script, options);
+        rejected += report
+            .transcript
+            .lines
+            .iter()
+            .rev()
+            .find_map(|(_, l)| l.strip_prefix("servo readings rejected as implausible: "))
+            .and_then(|n| n.parse::<u64>().ok())
+            .expect("status counts rejected readings");
         // Frames that were corrupted on the wire yet decode as a valid
         // angle response with another angle.
         for c in &report.recording.clean_rx {
@@ -353,12 +364,12 @@ fn arrivals_on_real_readings_only(faults: impl Fn(u64) -> BusFaults) -> (usize, 
             }
         }
     }
-    (dwells, passed_checksum)
+    (dwells, passed_checksum, rejected)
 }
 
 #[test]
 fn at_ten_percent_byte_corruption_no_arrival_is_declared_on_a_corrupted_reading() {
-    let (dwells, passed) = arrivals_on_real_readings_only(|seed| BusFaults {
+    let (dwells, passed, _) = arrivals_on_real_readings_only(|seed| BusFaults {
         corrupt_probability: 0.1,
         seed: seed.wrapping_mul(0x2545_f491),
         ..BusFaults::default()
@@ -374,12 +385,16 @@ fn at_ten_percent_byte_corruption_no_arrival_is_declared_on_a_corrupted_reading(
 #[test]
 fn wrong_angles_the_checksum_cannot_catch_never_declare_an_arrival() {
     // One angle response in five is wrong with a valid checksum.
-    let (dwells, passed) = arrivals_on_real_readings_only(|seed| BusFaults {
+    let (dwells, passed, rejected) = arrivals_on_real_readings_only(|seed| BusFaults {
         forge_probability: 0.2,
         seed: seed.wrapping_mul(0x2545_f491),
         ..BusFaults::default()
     });
-    eprintln!("{dwells} arrivals checked, {passed} forged frames");
+    eprintln!("{dwells} arrivals checked, {passed} forged frames, {rejected} rejected");
+    assert!(
+        rejected >= 100,
+        "{rejected} readings rejected as implausible"
+    );
     assert!(dwells >= 300, "{dwells} arrivals checked");
     assert!(passed >= 1_000, "{passed} forged frames");
 }

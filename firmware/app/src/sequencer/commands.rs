@@ -287,13 +287,19 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 Some(id) => text(format_args!("faults: servo {id} not responding")),
                 None => text(format_args!("faults: none")),
             },
+            12 => text(format_args!(
+                "servo readings rejected as implausible: {}",
+                self.servo
+                    .implausible_readings
+                    .load(core::sync::atomic::Ordering::Relaxed)
+            )),
             _ => None,
         }
     }
 }
 
 /// Lines [`Sequencer::status_line`] knows.
-const STATUS_LINES: usize = 12;
+const STATUS_LINES: usize = 13;
 
 impl Run {
     pub(super) fn new(pattern: Option<Pattern>, single: Option<Target>, once: bool) -> Self {
