@@ -461,6 +461,29 @@ mod tests {
     }
 
     #[test]
+    fn params_lines_show_the_range_and_fit_a_reply_line() {
+        use core::fmt::Write as _;
+        let d = Settings::default();
+        // The default and in-range values with all 17 digits.
+        for (p, value) in PARAMS.iter().flat_map(|p| {
+            [
+                (p, d.get(p)),
+                (p, p.min * 0.987_654_321_098_765_4),
+                (p, p.max * 0.123_456_789_012_345_67),
+            ]
+        }) {
+            let mut line: heapless::String<256> = heapless::String::new();
+            write!(line, "{}", ParamLine(p, value)).unwrap();
+            assert!(
+                line.len() <= crate::command::REPLY_LINE_LEN,
+                "{} bytes: {line}",
+                line.len()
+            );
+            assert!(line.ends_with(']') && line.contains(" # "), "{line}");
+        }
+    }
+
+    #[test]
     fn a_galvo_scale_too_close_to_zero_is_refused() {
         for name in ["galvo.x_codes_per_rad", "galvo.y_codes_per_rad"] {
             let mut s = Settings::default();

@@ -344,7 +344,7 @@ pub const PARAMS: &[ParamSpec] = &[
         max: MAX_CODES_PER_RAD,
         min_magnitude: MIN_CODES_PER_RAD,
         precision: Precision::F32,
-        help: "galvo X DAC codes per rad, |1000..120000| (sign = direction)",
+        help: "galvo X DAC codes/rad, |v| >= 1000, sign = direction",
         slot: Slot::Real(|s| &mut s.galvo.x_codes_per_rad),
     },
     #[cfg(feature = "galvo")]
@@ -363,7 +363,7 @@ pub const PARAMS: &[ParamSpec] = &[
         max: MAX_CODES_PER_RAD,
         min_magnitude: MIN_CODES_PER_RAD,
         precision: Precision::F32,
-        help: "galvo Y DAC codes per rad, |1000..120000| (sign = direction)",
+        help: "galvo Y DAC codes/rad, |v| >= 1000, sign = direction",
         slot: Slot::Real(|s| &mut s.galvo.y_codes_per_rad),
     },
     #[cfg(feature = "galvo")]
@@ -510,17 +510,19 @@ pub(super) fn survives_f32(value: f64) -> bool {
     narrow.is_finite() && (narrow != 0.0 || value == 0.0)
 }
 
-/// Format of `get`/`params` lines: `name = value  # help`.
+/// Format of `get`/`params` lines: `name = value  # help [min, max]`.
 pub struct ParamLine<'a>(pub &'a ParamSpec, pub f64);
 
 impl fmt::Display for ParamLine<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} = {}  # {}",
+            "{} = {}  # {} [{}, {}]",
             self.0.name,
             Shortest(self.1),
-            self.0.help
+            self.0.help,
+            Shortest(self.0.min),
+            Shortest(self.0.max)
         )
     }
 }
