@@ -52,6 +52,17 @@ pub struct FrameRecord {
     pub bytes: Vec<u8>,
 }
 
+/// A response frame the fault injection corrupted on the wire.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CorruptedFrame {
+    /// When its first byte went on the wire, µs (as in [`FrameRecord`]).
+    pub t_us: u64,
+    /// The bytes as the servo sent them.
+    pub sent: Vec<u8>,
+    /// The bytes as the firmware received them.
+    pub received: Vec<u8>,
+}
+
 /// Everything recorded during a run.
 #[derive(Debug, Default, Clone)]
 pub struct Recording {
@@ -63,6 +74,9 @@ pub struct Recording {
     pub laser_events: Vec<(u64, bool)>,
     /// Servo-bus frames.
     pub frames: Vec<FrameRecord>,
+    /// Response frames corrupted by the fault injection (their clean
+    /// bytes), in order.
+    pub clean_rx: Vec<CorruptedFrame>,
 }
 
 impl Recording {

@@ -16,6 +16,10 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     /// Runs one command and sends its reply.
     pub(super) async fn handle_command(&mut self, command: Command) {
         let link = self.link;
+        if let Some(reason) = self.refusal_for_dead_servo(&command) {
+            link.error(reason);
+            return;
+        }
         match command {
             Command::Help => {
                 for line in HELP_LINES {
@@ -295,6 +299,12 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 Some(id) => text(format_args!("faults: servo {id} not responding")),
                 None => text(format_args!("faults: none")),
             },
+            12 => text(format_args!(
+                "servo readings rejected as implausible: {}",
+                self.servo
+                    .implausible_readings
+                    .load(core::sync::atomic::Ordering::Relaxed)
+            )),
             _ => None,
         }
     }
@@ -306,7 +316,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
 const CHECKS_PER_STEP: usize = 3;
 
 /// Lines [`Sequencer::status_line`] knows.
-const STATUS_LINES: usize = 12;
+const STATUS_LINES: usize = 13;
 
 impl Run {
     pub(super) fn new(pattern: Option<Pattern>, single: Option<Target>, once: bool) -> Self {

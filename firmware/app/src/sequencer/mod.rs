@@ -8,6 +8,7 @@
 //! running pattern immediately, in any phase.
 
 mod commands;
+mod faults;
 mod galvo;
 mod laser;
 pub mod targets;
@@ -66,8 +67,9 @@ pub struct Sequencer<'a, L: LaserSwitch, S: SettingsStore> {
     run: Option<Run>,
     /// Request number of the servo move in flight.
     next_seq: u32,
-    /// Servo ids currently faulty.
-    faulty_servo: Option<u8>,
+    /// Servos known dead (faulted, not yet answering again), and whether
+    /// the gimbal laser waits for a confirmed arrival after a fault.
+    faults: faults::ServoFaults,
     /// Last aim sent to the servos.
     last_aim: Option<(Target, Aim)>,
     /// Last measured servo angles, 0.1°.
@@ -157,7 +159,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             booted_at: Instant::now(),
             run: None,
             next_seq: 0,
-            faulty_servo: None,
+            faults: faults::ServoFaults::default(),
             last_aim: None,
             measured: None,
             laser_on: false,
@@ -232,7 +234,6 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         // the galvo drops its points and an underrun latch.
         self.close_gate();
         self.run = Some(run);
-        self.faulty_servo = None;
         self.begin_point();
     }
 
@@ -360,6 +361,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             interval_ms,
             ids: (self.settings.yaw.id, self.settings.pitch.id),
             deadband_tenths: (self.settings.deadband_deg * 10.0) as u16,
+            ranges_tenths: faults::servo_ranges_tenths(&self.settings),
         };
         // Newest request wins: drop one the servo task has not taken yet.
         let _ = self.servo.requests.try_receive();
@@ -396,20 +398,16 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
 
     fn handle_outcome(&mut self, outcome: ServoOutcome) {
         match outcome {
-            ServoOutcome::Recovered { id } => {
-                if self.faulty_servo == Some(id) {
-                    self.faulty_servo = None;
-                }
-                self.link
-                    .notify(format_args!("info: servo {id} answering again"));
-                self.publish();
-            }
+            ServoOutcome::Recovered { id } => self.servo_recovered(id),
             ServoOutcome::Arrived {
                 seq,
                 yaw_tenths,
                 pitch_tenths,
             } => {
                 self.measured = Some((yaw_tenths, pitch_tenths));
+                // Both servos answered and arrived: they are alive.
+                self.faults
+                    .arrived(self.settings.yaw.id, self.settings.pitch.id);
                 let Some(run) = self.run.as_mut().filter(|r| r.seq == seq) else {
                     return;
                 };
@@ -424,22 +422,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 log::info!("arrived (servo {} {})", yaw_tenths, pitch_tenths);
                 self.publish();
             }
-            ServoOutcome::Fault { seq, id, fault } => {
-                // A fault of an older, superseded move is stale; any other
-                // fault (of the current move, or found by the servo task's
-                // health check while dwelling or idle) stops everything.
-                if self
-                    .run
-                    .is_some_and(|r| r.seq != seq && r.phase.is_travel())
-                {
-                    return;
-                }
-                self.faulty_servo = Some(id);
-                self.link.notify(format_args!(
-                    "error: servo {id} fault ({fault:?}); pattern stopped, laser off"
-                ));
-                self.stop("servo fault");
-            }
+            ServoOutcome::Fault { seq, id, fault } => self.servo_fault(seq, id, fault),
             ServoOutcome::Superseded { .. } => {}
         }
     }
@@ -496,7 +479,15 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         // The galvo's laser is switched per sample by the galvo loop; this
         // is the gimbal's.
         let wanted = self.actuator.uses_gimbal()
-            && laser_wanted(self.settings.laser_mode, phase, self.faulty_servo.is_some())
+            && laser_wanted(
+                self.settings.laser_mode,
+                phase,
+                self.faults.gimbal_laser_blocked(
+                    self.settings.yaw.id,
+                    self.settings.pitch.id,
+                    phase,
+                ),
+            )
             // Refused when the gate was closed since the run began (a
             // galvo underrun): dark until the run is stopped or restarted.
             && self.gate.open(self.gate_generation);
@@ -513,7 +504,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         let run = self.run;
         let aim = self.last_aim;
         let laser = self.laser_on;
-        let fault = self.faulty_servo;
+        let fault = self.faults.first_dead();
         self.status.update(|s| {
             s.activity = match run {
                 None => Activity::Idle,
