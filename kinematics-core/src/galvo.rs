@@ -159,30 +159,38 @@ impl<F: Real> DacAxis<F> {
     }
 
     /// DAC code for mechanical angle `theta_rad`, clamped to 0..=4095 (and
-    /// flagged) when outside the range.
+    /// flagged) when outside the range. Rounds half away from zero.
+    ///
+    /// The conversion stays in `F`: the code value is truncated to an
+    /// integer (one `VCVT` in `f32`) and the remainder, exact in `F`,
+    /// decides the rounding, so the `f32` path never widens to `f64`.
     ///
     /// Errors: [`Error::NonFinite`] (angle or mapping).
     #[inline]
     pub fn angle_to_code(&self, theta_rad: F) -> Result<DacCode, Error> {
-        let code = (self.offset_code + self.codes_per_rad * theta_rad).round();
-        if !code.is_finite() {
+        let value = self.offset_code + self.codes_per_rad * theta_rad;
+        if !value.is_finite() {
             return Err(Error::NonFinite { what: "DAC code" });
         }
-        let max = F::from_f64(f64::from(DAC_MAX_CODE));
-        Ok(if code < F::ZERO {
+        // round(value) < 0 ⇔ value ≤ −½; round(value) > 4095 ⇔ value ≥ 4095½.
+        let top = F::from_u16(DAC_MAX_CODE) + F::HALF;
+        Ok(if value <= -F::HALF {
             DacCode {
                 code: 0,
                 clamped: true,
             }
-        } else if code > max {
+        } else if value >= top {
             DacCode {
                 code: DAC_MAX_CODE,
                 clamped: true,
             }
         } else {
+            // value ∈ (−½, 4095½): −½ < value < 0 truncates to 0 and
+            // rounds to 0; otherwise value − trunc(value) is exact.
+            let whole = value.trunc_to_u16();
+            let up = value - F::from_u16(whole) >= F::HALF;
             DacCode {
-                // Whole and within 0..=4095: the cast is exact.
-                code: code.to_f64() as u16,
+                code: whole + u16::from(up),
                 clamped: false,
             }
         })
