@@ -8,7 +8,7 @@
 //! The `f32` path stays on the M4F's single-precision FPU: square root is
 //! the `VSQRT.F32` instruction ([`sqrt_f32`]; libm's `sqrtf` is a software
 //! routine there), float → integer goes straight through `VCVT`
-//! ([`Real::trunc_to_u16`]) instead of via `f64`, and nothing here widens
+//! ([`Real::trunc_to_u32`]) instead of via `f64`, and nothing here widens
 //! to `f64` (every `f64` operation is a library call on the M4F).
 
 use core::fmt::Debug;
@@ -55,8 +55,10 @@ pub trait Real:
     fn atan(self) -> Self;
     /// Rounds half away from zero.
     fn round(self) -> Self;
-    /// Toward zero to an integer, saturating at 0 and 65535 (NaN → 0).
-    fn trunc_to_u16(self) -> u16;
+    /// Toward zero to an integer, saturating at 0 and `u32::MAX` (NaN →
+    /// 0): exactly what the M4F's `VCVT.U32.F32` does, so in `f32` it is
+    /// that one instruction.
+    fn trunc_to_u32(self) -> u32;
     /// The value of `v` (exact in both types).
     fn from_u16(v: u16) -> Self;
     /// Absolute value.
@@ -89,6 +91,7 @@ impl Real for f32 {
     }
     #[inline]
     fn atan(self) -> Self {
+        // libm's atanf computes in f32 (unlike its sinf/cosf).
         libm::atanf(self)
     }
     #[inline]
@@ -96,9 +99,8 @@ impl Real for f32 {
         libm::roundf(self)
     }
     #[inline]
-    fn trunc_to_u16(self) -> u16 {
-        // Saturating cast: one VCVT on the M4F.
-        self as u16
+    fn trunc_to_u32(self) -> u32 {
+        self as u32
     }
     #[inline]
     fn from_u16(v: u16) -> Self {
@@ -145,8 +147,8 @@ impl Real for f64 {
         libm::round(self)
     }
     #[inline]
-    fn trunc_to_u16(self) -> u16 {
-        self as u16
+    fn trunc_to_u32(self) -> u32 {
+        self as u32
     }
     #[inline]
     fn from_u16(v: u16) -> Self {
@@ -227,10 +229,10 @@ mod tests {
         assert!(!F::from_f64(f64::NAN).is_finite());
         assert!(!F::from_f64(f64::INFINITY).is_finite());
         assert!(F::HALF.is_finite());
-        assert_eq!(F::from_f64(4095.9).trunc_to_u16(), 4095);
-        assert_eq!(F::from_f64(-3.0).trunc_to_u16(), 0);
-        assert_eq!(F::from_f64(1e9).trunc_to_u16(), u16::MAX);
-        assert_eq!(F::from_f64(f64::NAN).trunc_to_u16(), 0);
+        assert_eq!(F::from_f64(4095.9).trunc_to_u32(), 4095);
+        assert_eq!(F::from_f64(-3.0).trunc_to_u32(), 0);
+        assert_eq!(F::from_f64(1e12).trunc_to_u32(), u32::MAX);
+        assert_eq!(F::from_f64(f64::NAN).trunc_to_u32(), 0);
         assert_eq!(F::from_u16(4095).to_f64(), 4095.0);
     }
 

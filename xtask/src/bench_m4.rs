@@ -170,6 +170,18 @@ pub const ROWS: &[Row] = &[
         budget: None,
     },
     Row {
+        id: "galvo.sample_map.board_to_codes",
+        what: "per-sample map: galvo IK + DAC, f32",
+        unit: "point",
+        budget: None,
+    },
+    Row {
+        id: "galvo.sample_map.angles_to_codes",
+        what: "per-sample map: DAC, both axes, f32",
+        unit: "point",
+        budget: None,
+    },
+    Row {
         id: "galvo.ik.f32",
         what: "galvo IK, f32",
         unit: "point",

@@ -125,6 +125,7 @@ fn main() -> ! {
     let _ = writeln!(b.out, "empty {empty} 64");
     b.out.flush();
 
+    self_checks(&mut b);
     kinematics(&mut b);
     stepper_and_path(&mut b);
     loop_halves(&mut b);
@@ -133,6 +134,51 @@ fn main() -> ! {
     let _ = writeln!(b.out, "done {}", b.failures);
     b.out.flush();
     semihosting::exit(b.failures == 0)
+}
+
+/// What only the target can check: the FPU square root (`VSQRT.F32` in
+/// `asm!`, the host runs the libm fallback) against `libm::sqrtf` bit for
+/// bit, and the f32 DAC conversion against the f64 one on the target's
+/// code path.
+fn self_checks(b: &mut Bench) {
+    let mut checked = 0u32;
+    let mut x = 1.0e-38f32;
+    while x < 3.0e38 {
+        for k in 0..16u8 {
+            let v = x * (1.0 + f32::from(k) * 0.0625);
+            let (hw, sw) = (kinematics_core::sqrt_f32(v), libm::sqrtf(v));
+            if hw.to_bits() != sw.to_bits() {
+                return b.fail("check.sqrt", (v, hw, sw));
+            }
+            checked += 1;
+        }
+        x *= 1.5;
+    }
+    for v in [0.0f32, -0.0, f32::INFINITY, f32::MIN_POSITIVE, 1.0e-45] {
+        if kinematics_core::sqrt_f32(v).to_bits() != libm::sqrtf(v).to_bits() {
+            return b.fail("check.sqrt", v);
+        }
+    }
+    if !kinematics_core::sqrt_f32(-1.0).is_nan() {
+        return b.fail("check.sqrt", -1.0f32);
+    }
+    let (d32, d64) = (DacAxis::<f32>::default(), DacAxis::<f64>::default());
+    for i in 0..=20_000u32 {
+        let theta = (i as f32 / 10_000.0 - 1.0) * 0.25;
+        let (c32, c64) = (
+            d32.angle_to_code(theta),
+            d64.angle_to_code(f64::from(theta)),
+        );
+        let close = match (c32, c64) {
+            (Ok(a), Ok(b)) => a.clamped == b.clamped && a.code.abs_diff(b.code) <= 1,
+            _ => false,
+        };
+        if !close {
+            return b.fail("check.dac", theta);
+        }
+    }
+    let _ = writeln!(b.out, "check sqrt+dac ok {checked}");
+    b.out.flush();
 }
 
 /// Galvo IK and DAC mapping per sample, gimbal IK and compensation per
@@ -158,6 +204,26 @@ fn kinematics(b: &mut Bench) {
         move || {
             i += 1;
             g32.board_to_codes(black_box(p32(i)))
+        }
+    });
+    let map = match kinematics_core::SampleMap::new(&g32) {
+        Ok(m) => m,
+        Err(e) => return b.fail("galvo.sample_map", e),
+    };
+    b.repeat("galvo.sample_map.board_to_codes", N, {
+        let mut i = 0;
+        move || {
+            i += 1;
+            let p = black_box(p32(i));
+            map.board_to_codes(p.x_mm, p.y_mm)
+        }
+    });
+    b.repeat("galvo.sample_map.angles_to_codes", N, {
+        let mut i = 0u32;
+        move || {
+            i += 1;
+            let t = (i % 89) as f32 * 0.004 - 0.18;
+            map.angles_to_codes(black_box(t), black_box(-t))
         }
     });
     b.repeat("galvo.angles_to_codes.f32", N, {

@@ -427,7 +427,11 @@ fn arc_rotor_follows_the_f64_angle_over_a_long_arc() {
     // A full circle (the longest arc block) sampled at 100 kHz at 1 m/s
     // after the acceleration, in f32 as the sampler produces it, turned as
     // the sampler does: by (s − s_prev)·(dir / r) per sample.
-    for (r, dir, a0) in [(40.0f64, 1.0f64, 1.2f64), (250.0, -1.0, -2.9), (0.5, 1.0, 0.0)] {
+    for (r, dir, a0) in [
+        (40.0f64, 1.0f64, 1.2f64),
+        (250.0, -1.0, -2.9),
+        (0.5, 1.0, 0.0),
+    ] {
         let mut rotor = ArcRotor::at_angle(a0);
         let turn_per_mm = (dir / r) as f32;
         let (ts, v, acc) = (1e-5f32, 1000.0f32, 1e5f32);

@@ -21,10 +21,8 @@ impl GalvoLoop {
     /// DAC codes of a board position (mm).
     fn codes_at(&self, position_mm: [f32; 2]) -> Option<(u16, u16)> {
         let [x_mm, y_mm] = position_mm;
-        self.config
-            .galvo
-            .board_to_codes(PointMm { x_mm, y_mm })
-            .ok()
+        self.sample_map
+            .board_to_codes(x_mm, y_mm)
             .map(|c| (c.x.code, c.y.code))
     }
 
@@ -56,7 +54,8 @@ impl GalvoLoop {
     /// marking acceleration; at rest the mirrors hold and the job ends.
     pub(super) fn brake_sample(&mut self) -> Option<(u16, u16)> {
         let [sx, sy] = self.motion.step_mm;
-        let speed = libm::hypotf(sx, sy);
+        // libm's hypotf computes in f64: √ on the FPU instead.
+        let speed = kinematics_core::sqrt_f32(sx * sx + sy * sy);
         let ts = self.config.sample_period_s as f32;
         let slow_by = self.config.mark_accel_mm_s2 as f32 * ts * ts;
         let scale = if speed > slow_by {
