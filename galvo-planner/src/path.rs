@@ -200,6 +200,8 @@ struct Exec {
     accel: f32,
     d_acc: f32,
     t_dec: f32,
+    /// Sample period, s (f32 copy: no f64 per sample).
+    ts: f32,
     /// `base` as f32 (acceleration phase times are small).
     base: f32,
     /// First sample index in the cruise / deceleration phase / after the end.
@@ -225,6 +227,7 @@ const IDLE_EXEC: Exec = Exec {
     arc: false,
     p0: [0.0; 2],
     unit: [0.0; 2],
+    ts: 0.0,
     radius: 0.0,
     turn_per_mm: 0.0,
     rotor: ArcRotor::UNIT_X,
@@ -640,6 +643,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
         }
         e.end = [b.end[0] as f32, b.end[1] as f32];
         e.length = l as f32;
+        e.ts = ts as f32;
         e.v0 = v0 as f32;
         e.vp = vp as f32;
         e.v1 = v1 as f32;
@@ -676,7 +680,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
     /// called for j = 1, 2, … in turn (an arc's rotor advances).
     fn eval_exec(&mut self, j: u32) -> ([f32; 2], f32) {
         let e = &mut self.exec;
-        let ts = self.limits.ts_s as f32;
+        let ts = e.ts;
         let (s, v) = if j < e.j_cruise {
             let tau = e.base + j as f32 * ts;
             (e.v0 * tau + 0.5 * e.accel * tau * tau, e.v0 + e.accel * tau)

@@ -15,6 +15,8 @@ use crate::galvo::path::{GalvoPath, Segment};
 pub(super) struct Motion {
     pub(super) position_mm: [f32; 2],
     pub(super) step_mm: [f32; 2],
+    /// Speed lost per braking sample, mm per sample (accel · Ts²).
+    pub(super) brake_mm: f32,
 }
 
 impl GalvoLoop {
@@ -38,6 +40,7 @@ impl GalvoLoop {
             self.motion = Motion {
                 position_mm: [x_mm, y_mm],
                 step_mm: [x_mm - px, y_mm - py],
+                ..self.motion
             };
             return self.codes_at([x_mm, y_mm]);
         }
@@ -56,8 +59,7 @@ impl GalvoLoop {
         let [sx, sy] = self.motion.step_mm;
         // libm's hypotf computes in f64: √ on the FPU instead.
         let speed = kinematics_core::sqrt_f32(sx * sx + sy * sy);
-        let ts = self.config.sample_period_s as f32;
-        let slow_by = self.config.mark_accel_mm_s2 as f32 * ts * ts;
+        let slow_by = self.motion.brake_mm;
         let scale = if speed > slow_by {
             (speed - slow_by) / speed
         } else {
@@ -71,6 +73,7 @@ impl GalvoLoop {
                 self.motion = Motion {
                     position_mm: next,
                     step_mm: step,
+                    ..self.motion
                 };
                 Some(codes)
             }
@@ -132,9 +135,11 @@ impl GalvoLoop {
         match loaded {
             Ok(planner) => {
                 self.marker = Some(planner);
+                let ts = self.config.sample_period_s;
                 self.motion = Motion {
                     position_mm: [start[0] as f32, start[1] as f32],
                     step_mm: [0.0, 0.0],
+                    brake_mm: (self.config.mark_accel_mm_s2 * ts * ts) as f32,
                 };
                 if let Some(a) = self.active.as_mut() {
                     a.enter(Phase::Marking, 0);
