@@ -850,7 +850,7 @@ impl ArcRotor {
 fn cos_sin_small(delta: f32) -> (f32, f32) {
     let mut d = delta;
     let mut halvings = 0u32;
-    while (d > ROTOR_DIRECT_MAX_RAD || d < -ROTOR_DIRECT_MAX_RAD) && halvings < 64 {
+    while !(-ROTOR_DIRECT_MAX_RAD..=ROTOR_DIRECT_MAX_RAD).contains(&d) && halvings < 64 {
         d *= 0.5;
         halvings += 1;
     }
