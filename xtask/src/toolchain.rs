@@ -84,7 +84,8 @@ fn package_args<'a>(packages: &[&'a str]) -> Vec<&'a str> {
     packages.iter().flat_map(|p| ["-p", *p]).collect()
 }
 
-/// `cargo xtask test`: the whole gate, in the order a reviewer would run it.
+/// `cargo xtask test`: the whole gate, in the order a reviewer would run it
+/// (ends with `bench-m4`, the M4 budgets on QEMU).
 pub fn test() -> Result<()> {
     ensure_toolchain()?;
     run("cargo", &["fmt", "--all", "--check"])?;
@@ -94,7 +95,16 @@ pub fn test() -> Result<()> {
     clippy_host.extend(["--", "-D", "warnings"]);
     run("cargo", &clippy_host)?;
 
-    let mut clippy_target = vec!["clippy", "--target", TARGET, "--release", "-p", "firmware"];
+    let mut clippy_target = vec![
+        "clippy",
+        "--target",
+        TARGET,
+        "--release",
+        "-p",
+        "firmware",
+        "-p",
+        "bench-m4",
+    ];
     clippy_target.extend(package_args(&TARGET_LIBRARIES));
     clippy_target.extend(["--", "-D", "warnings"]);
     run("cargo", &clippy_target)?;
@@ -112,7 +122,10 @@ pub fn test() -> Result<()> {
     run("cargo", &tests)?;
 
     build_firmware()?;
-    size()
+    size()?;
+
+    // The per-sample and refill budgets on the target's instruction set.
+    crate::bench_m4::bench_m4()
 }
 
 /// Installs flip-link, the firmware's linker wrapper (`.cargo/config.toml`:

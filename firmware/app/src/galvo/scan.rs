@@ -7,7 +7,7 @@ use core::sync::atomic::Ordering;
 use galvo_planner::{
     Discrete, JumpSync, Method, PathPlanner, RigidParams, XyStepper, plan_xy_jump,
 };
-use kinematics_core::{Galvo, MirrorAngles, PointMm};
+use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
 use super::path::GalvoPath;
@@ -135,6 +135,8 @@ struct Active {
 /// [`GalvoLoop::fill`] directly).
 pub struct GalvoLoop {
     config: GalvoConfig,
+    /// `config.galvo` checked once for the per-sample f32 path.
+    sample_map: SampleMap,
     planning: Galvo<f64>,
     disc: Discrete<3>,
     mirrors: XyStepper<3, STEPPER_CAPACITY>,
@@ -174,15 +176,13 @@ impl GalvoLoop {
             .map_err(|_| GalvoError::Planner)?;
         let mirrors = XyStepper::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
         let [x_rad, y_rad] = angles_rad;
-        let codes = config
-            .galvo
-            .angles_to_codes(MirrorAngles {
-                x_rad: x_rad as f32,
-                y_rad: y_rad as f32,
-            })
-            .map_err(|_| GalvoError::Kinematics)?;
+        let sample_map = SampleMap::new(&config.galvo).map_err(|_| GalvoError::Kinematics)?;
+        let codes = sample_map
+            .angles_to_codes(x_rad as f32, y_rad as f32)
+            .ok_or(GalvoError::Kinematics)?;
         let ts = config.sample_period_s;
         Ok(Self {
+            sample_map,
             planning: config.galvo.cast(),
             disc,
             mirrors,
@@ -358,9 +358,8 @@ impl GalvoLoop {
         // An idle stepper returns its rest position and does not change.
         let [x_rad, y_rad] = self.mirrors.step();
         let (x_code, y_code) = self
-            .config
-            .galvo
-            .angles_to_codes(MirrorAngles { x_rad, y_rad })
+            .sample_map
+            .angles_to_codes(x_rad, y_rad)
             .map_or((self.last.x_code, self.last.y_code), |c| {
                 (c.x.code, c.y.code)
             });
@@ -387,10 +386,8 @@ impl GalvoLoop {
                 Phase::Braking => self.brake_sample(),
                 _ => {
                     let [x_rad, y_rad] = self.mirrors.step();
-                    self.config
-                        .galvo
-                        .angles_to_codes(MirrorAngles { x_rad, y_rad })
-                        .ok()
+                    self.sample_map
+                        .angles_to_codes(x_rad, y_rad)
                         .map(|c| (c.x.code, c.y.code))
                 }
             };
