@@ -15,7 +15,7 @@ pub mod targets;
 use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
-pub use self::laser::{LaserSwitch, laser_wanted};
+pub use self::laser::{LaserEvent, LaserSwitch, laser_wanted};
 use self::targets::{Aim, Target};
 use crate::cli::format::Fixed;
 use crate::command::{Actuator, AimModel, CommandLink, Pattern};
@@ -209,6 +209,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     fn start(&mut self, run: Run) {
         let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
         log::info!("start {} (once={})", name, run.once);
+        self.laser.note(laser::LaserEvent::RunStarted);
         self.run = Some(run);
         self.faulty_servo = None;
         if self.actuator.uses_galvo() {
@@ -220,6 +221,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
 
     /// Stops whatever runs.
     fn stop(&mut self, why: &str) {
+        self.laser.note(laser::LaserEvent::Stopped { why });
         if let Some(run) = self.run.take() {
             let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
             log::info!("stop {} ({})", name, why);
@@ -310,6 +312,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         // Newest request wins: drop one the servo task has not taken yet.
         let _ = self.servo.requests.try_receive();
         let _ = self.servo.requests.try_send(request);
+        self.laser.note(laser::LaserEvent::GimbalMoveSent);
         log::info!(
             "target ({}, {}) cm -> servo {} {} (0.1 deg) over {} ms",
             target.point.x_cm,
@@ -360,6 +363,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                     return;
                 };
                 run.phase = Phase::Dwelling;
+                self.laser.note(laser::LaserEvent::GimbalArrived);
                 let dwell = if run.pattern.is_some_and(|p| p.is_path()) {
                     0.0
                 } else {
