@@ -1,6 +1,7 @@
 //! Shared helpers for the integration tests in `tests/tests/`: run a script
 //! through the simulator and read what happened.
 
+use laser_sim::safety::{Violation, ViolationKind, check, report_text};
 use laser_sim::script::parse_script;
 use laser_sim::world::{SimOptions, SimReport, run};
 
@@ -18,6 +19,28 @@ pub fn run_with(script: &str, options: SimOptions) -> SimReport {
         until_idle: true,
         ..options
     })
+}
+
+/// Runs `script` to idle with `options` under the safety checker: panics
+/// listing every violated invariant (`laser_sim::safety`).
+pub fn run_checked(script: &str, options: SimOptions) -> SimReport {
+    let report = run_with(script, options);
+    assert_safe(&report);
+    report
+}
+
+/// Panics listing every safety violation of a finished run.
+pub fn assert_safe(report: &SimReport) {
+    let violations = check(report);
+    assert!(violations.is_empty(), "{}", report_text(&violations));
+}
+
+/// The safety violations of `kind` in a finished run.
+pub fn violations_of(report: &SimReport, kind: ViolationKind) -> Vec<Violation> {
+    check(report)
+        .into_iter()
+        .filter(|v| v.kind == kind)
+        .collect()
 }
 
 /// Every line of the terminal transcript (`> command` for what was sent).

@@ -26,6 +26,26 @@ pub struct DacRecording {
     /// `(first sample index, halves)` of each underrun: where stale
     /// samples were replayed.
     pub underruns: Vec<(usize, u32)>,
+    /// When the loop learned of each underrun (its `write_half` returned
+    /// the error), ns.
+    pub underrun_detected_ns: Vec<u64>,
+    /// Every half buffer output, in order.
+    pub halves: Vec<HalfRecord>,
+}
+
+/// One half buffer as the DAC output it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HalfRecord {
+    /// Index of its first sample in the recording.
+    pub first_sample: usize,
+    /// When its first sample was output, ns.
+    pub start_ns: u64,
+    /// When the loop computed the content output (it calls `write_half`
+    /// right after filling the half; for a stale replay: the earlier
+    /// content the buffer still held), ns.
+    pub computed_ns: u64,
+    /// Replayed stale content (the loop was late).
+    pub stale: bool,
 }
 
 /// `count` equal samples from `start_ns`, one per `period_ns`.
@@ -77,7 +97,20 @@ impl DacRecording {
         out
     }
 
-    fn push_half(&mut self, start_ns: u64, period_ns: u64, half: &[DacSample]) {
+    fn push_half(
+        &mut self,
+        start_ns: u64,
+        period_ns: u64,
+        half: &[DacSample],
+        computed_ns: u64,
+        stale: bool,
+    ) {
+        self.halves.push(HalfRecord {
+            first_sample: self.len,
+            start_ns,
+            computed_ns,
+            stale,
+        });
         for (i, &sample) in half.iter().enumerate() {
             let t_ns = start_ns + i as u64 * period_ns;
             self.len += 1;
@@ -111,8 +144,8 @@ pub struct SimDac {
     free_from_ns: u64,
     /// Index of the next half (selects the physical buffer).
     next_half: u64,
-    /// Content and period (ns) of the two physical halves.
-    buffers: [(Vec<DacSample>, u64); 2],
+    /// Content, period (ns) and compute time (ns) of the two physical halves.
+    buffers: [(Vec<DacSample>, u64, u64); 2],
     compute_ns_per_sample: u64,
     recording: Rc<RefCell<DacRecording>>,
 }
@@ -137,8 +170,8 @@ impl SimDac {
             free_from_ns: now_ns,
             next_half: 0,
             buffers: [
-                (vec![DacSample::default(); half_len], period_ns),
-                (vec![DacSample::default(); half_len], period_ns),
+                (vec![DacSample::default(); half_len], period_ns, now_ns),
+                (vec![DacSample::default(); half_len], period_ns, now_ns),
             ],
             compute_ns_per_sample,
             recording,
@@ -151,20 +184,25 @@ impl SimDac {
 
     /// The DAC moves on past the half at `next_start_ns` with the content
     /// its buffer holds.
-    fn advance(&mut self, written: Option<&[DacSample]>) {
+    fn advance(&mut self, written: Option<(&[DacSample], u64)>) {
         let slot = Self::physical(self.next_half);
-        if let Some(samples) = written {
+        if let Some((samples, computed_ns)) = written {
             let buffer = &mut self.buffers[slot];
             buffer.0.clear();
             buffer.0.extend(samples.iter().copied().take(self.half_len));
             let last = samples.last().copied().unwrap_or_default();
             buffer.0.resize(self.half_len, last);
             buffer.1 = self.period_ns;
+            buffer.2 = computed_ns;
         }
-        let (content, period_ns) = &self.buffers[slot];
-        self.recording
-            .borrow_mut()
-            .push_half(self.next_start_ns, *period_ns, content);
+        let (content, period_ns, computed_ns) = &self.buffers[slot];
+        self.recording.borrow_mut().push_half(
+            self.next_start_ns,
+            *period_ns,
+            content,
+            *computed_ns,
+            written.is_none(),
+        );
         self.free_from_ns = self.next_start_ns;
         self.next_start_ns += self.half_len as u64 * period_ns;
         self.next_half += 1;
@@ -183,6 +221,7 @@ impl DacStream for SimDac {
     }
 
     async fn write_half(&mut self, samples: &[DacSample]) -> Result<(), Underrun> {
+        let computed_ns = Instant::now().as_micros() * 1000;
         let compute_ns = self.compute_ns_per_sample * samples.len() as u64;
         Timer::after_micros(compute_ns.div_ceil(1000)).await;
         let now_ns = Instant::now().as_micros() * 1000;
@@ -203,8 +242,13 @@ impl DacStream for SimDac {
         } else if now_ns < self.free_from_ns {
             Timer::at(Instant::from_micros(self.free_from_ns.div_ceil(1000))).await;
         }
-        self.advance(Some(samples));
+        self.advance(Some((samples, computed_ns)));
         if halves > 0 {
+            let detected_ns = Instant::now().as_micros() * 1000;
+            self.recording
+                .borrow_mut()
+                .underrun_detected_ns
+                .push(detected_ns);
             Err(Underrun { halves })
         } else {
             Ok(())

@@ -1,5 +1,6 @@
 //! Simulator scripts: one command line per line, `wait <ms>` pauses in
-//! simulated time, blank lines and `#` comments are skipped.
+//! simulated time, `button` presses the board's stop button, blank lines
+//! and `#` comments are skipped.
 
 use anyhow::{Context, Result, bail};
 
@@ -10,6 +11,8 @@ pub enum Step {
     Send(String),
     /// Let simulated time pass, ms.
     WaitMs(u64),
+    /// Press the board's stop button (stop, laser off, no reply).
+    StopButton,
 }
 
 /// Parses a script; `wait` needs a whole number of milliseconds.
@@ -32,6 +35,8 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
                 bail!("script line {}: `wait <ms>` takes one argument", number + 1);
             }
             steps.push(Step::WaitMs(ms));
+        } else if line == "button" {
+            steps.push(Step::StopButton);
         } else {
             steps.push(Step::Send(line.to_owned()));
         }
@@ -59,13 +64,14 @@ mod tests {
 
     #[test]
     fn parses_commands_waits_and_skips_comments() {
-        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\n").unwrap();
+        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\nbutton\n").unwrap();
         assert_eq!(
             steps,
             vec![
                 Step::Send("pattern corner".into()),
                 Step::WaitMs(250),
-                Step::Send("stop".into())
+                Step::Send("stop".into()),
+                Step::StopButton,
             ]
         );
     }

@@ -11,6 +11,7 @@ use embassy_sync::pipe::Pipe;
 use embassy_time::Timer;
 
 use crate::script::Step;
+use laser_app::command::CommandLink;
 
 /// Host → firmware bytes.
 pub type ToDevice = Pipe<CriticalSectionRawMutex, 256>;
@@ -67,12 +68,14 @@ impl UsbHost {
     }
 }
 
-/// Types the script: each command line, then waits for its closing reply.
-pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>) {
+/// Types the script: each command line, then waits for its closing reply;
+/// `button` steps press the board's stop button (`link`'s stop request).
+pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, link: &CommandLink) {
     for step in steps {
         match step {
             Step::WaitMs(ms) => Timer::after_millis(ms).await,
             Step::Send(line) => send_line(&host, &line).await,
+            Step::StopButton => link.stop_request.signal(()),
         }
     }
     host.transcript.borrow_mut().script_done = true;
@@ -89,6 +92,8 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
                     match step {
                         Step::WaitMs(ms) => Timer::after_millis(ms).await,
                         Step::Send(line) => send_line(&host, &line).await,
+                        // The terminal has no stop button.
+                        Step::StopButton => {}
                     }
                 }
             }

@@ -11,14 +11,17 @@ use std::sync::atomic::Ordering;
 
 use laser_app::command::CommandLink;
 use laser_app::galvo::{GalvoConfig, GalvoLink, GalvoLoop};
-use laser_app::sequencer::{LaserSwitch, Sequencer, SettingsStore};
+use laser_app::sequencer::{LaserEvent, LaserSwitch, Sequencer, SettingsStore};
 use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
 use laser_app::status::{Activity, Phase, StatusBoard};
 
 use crate::dac::{DacRecording, SimDac};
+use crate::executor::TaskKind;
 use crate::executor::{self, RunEnd};
 use crate::physics::PhysicalGimbal;
-use crate::recorder::{DwellRecord, Recording, SpotSample};
+use crate::recorder::{
+    DwellRecord, EventRecord, Recording, SequencerEvent, ServoSample, ServoState, SpotSample,
+};
 use crate::script::Step;
 use crate::servo_model::SimServoBus;
 use crate::servo_port::{BusFaults, PortHandle, SimServoPort};
@@ -97,6 +100,8 @@ pub struct SimReport {
     pub dac: DacRecording,
     /// Galvo underruns.
     pub galvo_underruns: u32,
+    /// CPU-time accounting of every task's steps (polls).
+    pub task_steps: Vec<executor::TaskSteps>,
 }
 
 impl SimReport {
@@ -110,13 +115,59 @@ impl SimReport {
     }
 }
 
-/// The laser output: records every switch with its time.
-struct RecordingLaser(Rc<RefCell<Recording>>);
+/// The laser output: records every switch and every sequencer event with
+/// its time, and the servos' true state at that moment.
+struct RecordingLaser {
+    recording: Rc<RefCell<Recording>>,
+    bus: Rc<RefCell<SimServoBus>>,
+    gimbal: PhysicalGimbal,
+}
+
+impl RecordingLaser {
+    fn record_servos(&self, rec: &mut Recording, t_us: u64) {
+        let laser = rec.laser_at(t_us);
+        rec.servos
+            .push(servo_sample(&self.bus.borrow(), self.gimbal, t_us, laser));
+    }
+}
 
 impl LaserSwitch for RecordingLaser {
     fn set(&mut self, on: bool) {
         let t = crate::clock::now_us();
-        self.0.borrow_mut().laser_events.push((t, on));
+        let mut rec = self.recording.borrow_mut();
+        rec.laser_events.push((t, on));
+        self.record_servos(&mut rec, t);
+    }
+
+    fn note(&mut self, event: LaserEvent<'_>) {
+        let t_us = crate::clock::now_us();
+        let event = match event {
+            LaserEvent::Stopped { why } => SequencerEvent::Stopped {
+                why: why.to_owned(),
+            },
+            LaserEvent::RunStarted => SequencerEvent::RunStarted,
+            LaserEvent::GimbalMoveSent => SequencerEvent::GimbalMoveSent,
+            LaserEvent::GimbalArrived => SequencerEvent::GimbalArrived,
+        };
+        let mut rec = self.recording.borrow_mut();
+        rec.events.push(EventRecord { t_us, event });
+        self.record_servos(&mut rec, t_us);
+    }
+}
+
+/// The gimbal servos' true angles and targets at `t_us`.
+fn servo_sample(bus: &SimServoBus, gimbal: PhysicalGimbal, t_us: u64, laser: bool) -> ServoSample {
+    let state = |id| {
+        bus.servo(id).map(|s| ServoState {
+            angle_deg: s.angle_deg(t_us),
+            target_deg: f64::from(s.target_tenths()) / 10.0,
+        })
+    };
+    ServoSample {
+        t_us,
+        yaw: state(gimbal.yaw_id),
+        pitch: state(gimbal.pitch_id),
+        laser,
     }
 }
 
@@ -190,7 +241,7 @@ pub fn run(options: SimOptions) -> SimReport {
             options.max_time_ms * 1000,
             move |spawner| {
                 let console_host = host.clone();
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "console", TaskKind::Firmware, async move {
                     let mut rx = &console_host.to_device;
                     let mut tx = &console_host.from_device;
                     laser_app::usb::run_console(&mut rx, &mut tx, link).await;
@@ -204,13 +255,28 @@ pub fn run(options: SimOptions) -> SimReport {
                             }
                         }
                     });
-                    executor::spawn(&spawner, interactive_task(lines, host.clone()));
+                    executor::spawn_task(
+                        &spawner,
+                        "host (interactive)",
+                        TaskKind::Simulator,
+                        interactive_task(lines, host.clone()),
+                    );
                 } else {
-                    executor::spawn(&spawner, script_task(script, host.clone()));
+                    executor::spawn_task(
+                        &spawner,
+                        "host (script)",
+                        TaskKind::Simulator,
+                        script_task(script, host.clone(), link),
+                    );
                 }
-                executor::spawn(&spawner, terminal_task(host.clone()));
+                executor::spawn_task(
+                    &spawner,
+                    "host (terminal)",
+                    TaskKind::Simulator,
+                    terminal_task(host.clone()),
+                );
                 let servo_port = port.clone();
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "servo", TaskKind::Firmware, async move {
                     ServoBus::new(
                         PortHandle(servo_port.clone()),
                         PortHandle(servo_port),
@@ -219,16 +285,20 @@ pub fn run(options: SimOptions) -> SimReport {
                     .run(servo_link)
                     .await;
                 });
-                let laser = RecordingLaser(recording.clone());
+                let laser = RecordingLaser {
+                    recording: recording.clone(),
+                    bus: bus.clone(),
+                    gimbal,
+                };
                 let store = MemoryStore(flash.clone());
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "sequencer", TaskKind::Firmware, async move {
                     let mut sequencer =
                         Sequencer::new(link, servo_link, Some(galvo_link), status, laser, store)
                             .await;
                     sequencer.run().await;
                 });
                 let (dac_recording, cost) = (galvo_dac, options.galvo_cost_ns_per_sample);
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "galvo", TaskKind::Firmware, async move {
                     let config = GalvoConfig::default();
                     let mut dac = SimDac::new(
                         GALVO_HALF_LEN,
@@ -241,8 +311,10 @@ pub fn run(options: SimOptions) -> SimReport {
                         Err(e) => log::error!("galvo loop not started: {e}"),
                     }
                 });
-                executor::spawn(
+                executor::spawn_task(
                     &spawner,
+                    "spot sampler",
+                    TaskKind::Simulator,
                     spot_sampler(
                         bus.clone(),
                         recording.clone(),
@@ -271,6 +343,7 @@ pub fn run(options: SimOptions) -> SimReport {
         saved_settings,
         dac,
         galvo_underruns: galvo_link.underruns.load(Ordering::Relaxed),
+        task_steps: executor::task_steps(),
     }
 }
 
@@ -296,6 +369,8 @@ async fn spot_sampler(
         {
             let mut rec = recording.borrow_mut();
             let laser = rec.laser_at(t_us);
+            rec.servos
+                .push(servo_sample(&bus.borrow(), gimbal, t_us, laser));
             let spot = gimbal.spot_cm(yaw_deg, pitch_deg);
             if let Some((x_cm, y_cm)) = spot {
                 rec.spot.push(SpotSample {
