@@ -373,43 +373,9 @@ fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
 
 #[test]
 fn random_command_sequences_keep_every_safety_invariant() {
-    // Meaningful commands in random order and timing: actuators, planners,
-    // patterns (grid and paths), gotos, stops, parameter changes.
-    let templates: &[&dyn Fn(u64) -> String] = &[
-        &|_| "target galvo".into(),
-        &|_| "target gimbal".into(),
-        &|_| "target both".into(),
-        &|r| format!("planner {}", if r % 2 == 0 { "optimal" } else { "seed" }),
-        &|r| {
-            format!(
-                "pattern {} once",
-                ["corner", "home", "horizontal", "vertical"][(r % 4) as usize]
-            )
-        },
-        &|_| "pattern tuning 1 -1 5".into(),
-        &|_| "pattern circle -3 2 2.5 ccw".into(),
-        &|_| "pattern rect -4 3 4 -3 once".into(),
-        &|r| format!("goto {} {}", (r % 17) as f64 - 8.0, (r % 11) as f64 - 5.0),
-        &|_| "stop".into(),
-        &|r| format!("set dwell_ms {}", r % 120),
-        &|r| format!("set galvo.mark_speed_mm_s {}", 200 + r % 3000),
-        &|r| format!("set galvo.laser_on_delay_us {}", r % 400),
-        &|r| format!("wait {}", r % 80),
-    ];
-    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
-    let mut next = || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
-    let mut script = String::new();
-    for _ in 0..1000 {
-        let pick = (next() % templates.len() as u64) as usize;
-        script.push_str(&templates[pick](next()));
-        script.push('\n');
-    }
-    script.push_str("stop\nwait 20\nstatus\ngalvo status\n");
+    // Meaningful commands in random order and timing (the same script runs
+    // under the safety checker in `safety_campaign.rs`).
+    let script = system_tests::random_meaningful_commands();
     let report = run_with(&script, SimOptions::default());
     assert!(report.transcript.script_done, "every line got its reply");
     assert_ne!(report.end, laser_sim::executor::RunEnd::Livelock);

@@ -185,6 +185,11 @@ impl SimDac {
     /// The DAC moves on past the half at `next_start_ns` with the content
     /// its buffer holds.
     fn advance(&mut self, written: Option<(&[DacSample], u64)>) {
+        // The DAC and its recording: not firmware work.
+        crate::executor::simulator_work(|| self.advance_now(written));
+    }
+
+    fn advance_now(&mut self, written: Option<(&[DacSample], u64)>) {
         let slot = Self::physical(self.next_half);
         if let Some((samples, computed_ns)) = written {
             let buffer = &mut self.buffers[slot];

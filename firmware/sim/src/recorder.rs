@@ -77,6 +77,9 @@ pub struct EventRecord {
     pub t_us: u64,
     /// What happened.
     pub event: SequencerEvent,
+    /// Laser switches (`Recording::laser_events`) recorded before it: the
+    /// order of events and switches within one instant.
+    pub laser_switches_before: usize,
 }
 
 /// One gimbal servo's true state.

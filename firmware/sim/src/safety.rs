@@ -333,19 +333,18 @@ impl SettingsTimeline {
     }
 
     /// Whether `laser dwell` mode is certainly in force at `t_us`: the
-    /// last accepted mode change replied by then set it, and no change
-    /// sent since is still in flight.
+    /// last accepted change replied before then set it, and a change in
+    /// flight at `t_us` (sent by then, replied at or after it: the
+    /// transcript cannot order it against what happened in that instant)
+    /// keeps it.
     fn certainly_dwell_mode(&self, t_us: u64) -> bool {
         let mut mode = Settings::default().laser_mode;
         for (sent, replied, s) in &self.changes {
             if *sent > t_us {
                 break;
             }
-            if *replied > t_us {
-                if s.laser_mode != LaserMode::Dwell {
-                    return false;
-                }
-                continue;
+            if *replied >= t_us && (mode != LaserMode::Dwell || s.laser_mode != LaserMode::Dwell) {
+                return false;
             }
             mode = s.laser_mode;
         }
@@ -419,20 +418,29 @@ fn dark_after_stops(inputs: &SafetyInputs<'_>) -> Vec<Violation> {
             .get(i + 1)
             .map_or(u64::MAX, |(s, _)| (s.t_us + DARK_WITHIN_US) * 1000);
         let computed_before_ns = next_start.map_or(u64::MAX, |t| t * 1000);
+        // A later window starting as early includes this one's rule.
+        if from_ns >= until_ns {
+            continue;
+        }
         let begin = galvo.partition_point(|s| s.last_ns() < from_ns);
         let mut lit: Option<(u64, u64, u64)> = None; // first ns, last ns, samples
         for s in galvo[begin..].iter().take_while(|s| s.start_ns < until_ns) {
             if !s.laser || s.computed_ns >= computed_before_ns {
                 continue;
             }
+            // Samples output in [from_ns, until_ns).
             let skip = from_ns.saturating_sub(s.start_ns).div_ceil(s.period_ns);
-            if skip >= s.count {
+            let end = until_ns
+                .saturating_sub(s.start_ns)
+                .div_ceil(s.period_ns)
+                .min(s.count);
+            if skip >= end {
                 continue;
             }
             let first_ns = s.start_ns + skip * s.period_ns;
             let entry = lit.get_or_insert((first_ns, first_ns, 0));
-            entry.1 = s.last_ns().min(until_ns);
-            entry.2 += s.count - skip;
+            entry.1 = s.start_ns + (end - 1) * s.period_ns;
+            entry.2 += end - skip;
         }
         if let Some((first_ns, last_ns, samples)) = lit {
             found.push(Violation {
@@ -606,24 +614,25 @@ fn gimbal_travel_dark(inputs: &SafetyInputs<'_>) -> Vec<Violation> {
 /// within the deadband (+0.15° for quantisation) of their targets.
 fn gimbal_dwell_mode(inputs: &SafetyInputs<'_>, timeline: &SettingsTimeline) -> Vec<Violation> {
     let mut found = Vec::new();
-    // Arrival state changes: (t, arrived).
-    let mut arrival: Vec<(u64, bool)> = Vec::new();
-    for e in inputs.events {
-        let arrived = match e.event {
-            SequencerEvent::GimbalArrived => true,
-            SequencerEvent::GimbalMoveSent
-            | SequencerEvent::RunStarted
-            | SequencerEvent::Stopped { .. } => false,
-        };
-        arrival.push((e.t_us, arrived));
-    }
-    let arrived_at = |t: u64| {
-        let n = arrival.partition_point(|(at, _)| *at <= t);
-        n > 0 && arrival[n - 1].1
-    };
-    // Laser switched on without a confirmed arrival.
-    for &(t, on) in inputs.gimbal_laser {
-        if on && timeline.certainly_dwell_mode(t) && !arrived_at(t) {
+    // Laser switched on without a confirmed arrival: the arrival state
+    // after the events processed before the switch.
+    let events = inputs.events;
+    for (j, &(t, on)) in inputs.gimbal_laser.iter().enumerate() {
+        if !on || !timeline.certainly_dwell_mode(t) {
+            continue;
+        }
+        let before = events.partition_point(|e| e.laser_switches_before <= j);
+        let arrived = events[..before]
+            .iter()
+            .rev()
+            .find_map(|e| match e.event {
+                SequencerEvent::GimbalArrived => Some(true),
+                SequencerEvent::GimbalMoveSent
+                | SequencerEvent::RunStarted
+                | SequencerEvent::Stopped { .. } => Some(false),
+            })
+            .unwrap_or(false);
+        if !arrived {
             found.push(Violation {
                 kind: ViolationKind::LitWithoutArrival,
                 t_us: t,

@@ -133,13 +133,21 @@ impl RecordingLaser {
 
 impl LaserSwitch for RecordingLaser {
     fn set(&mut self, on: bool) {
-        let t = crate::clock::now_us();
-        let mut rec = self.recording.borrow_mut();
-        rec.laser_events.push((t, on));
-        self.record_servos(&mut rec, t);
+        crate::executor::simulator_work(|| {
+            let t = crate::clock::now_us();
+            let mut rec = self.recording.borrow_mut();
+            rec.laser_events.push((t, on));
+            self.record_servos(&mut rec, t);
+        });
     }
 
     fn note(&mut self, event: LaserEvent<'_>) {
+        crate::executor::simulator_work(|| self.record_event(event));
+    }
+}
+
+impl RecordingLaser {
+    fn record_event(&self, event: LaserEvent<'_>) {
         let t_us = crate::clock::now_us();
         let event = match event {
             LaserEvent::Stopped { why } => SequencerEvent::Stopped {
@@ -150,7 +158,12 @@ impl LaserSwitch for RecordingLaser {
             LaserEvent::GimbalArrived => SequencerEvent::GimbalArrived,
         };
         let mut rec = self.recording.borrow_mut();
-        rec.events.push(EventRecord { t_us, event });
+        let laser_switches_before = rec.laser_events.len();
+        rec.events.push(EventRecord {
+            t_us,
+            event,
+            laser_switches_before,
+        });
         self.record_servos(&mut rec, t_us);
     }
 }
