@@ -65,6 +65,13 @@ pub fn assert_safe_allowing(report: &SimReport, open: &[ViolationKind]) {
 /// checked completely.
 pub const UNTIL_TRAVEL_FIX: &[ViolationKind] = &[ViolationKind::LitTravel];
 
+/// Task steps over 1 ms of CPU time: issue 9 item 5's O(n²) path checks
+/// (fixed on another branch) and the galvo loop planning a long
+/// time-optimal jump inside one step (up to 1.4 ms here in the dev profile;
+/// the README already says jumps must be planned ahead on the target).
+/// **After both are fixed, make this `&[]`.**
+pub const UNTIL_STEP_FIXES: &[ViolationKind] = &[ViolationKind::LongStep];
+
 /// Violation kinds of issue 9 items 1–3 (galvo laser lit after stop: no
 /// master gate, stop not reaching the loop, lit underrun replays), fixed
 /// on the galvo-gate branch. **After merging it, make this `&[]`.**

@@ -286,6 +286,7 @@ fn a_gimbal_pattern_in_dwell_mode_holds_every_invariant() {
 
 #[test]
 fn a_galvo_pattern_that_completes_holds_every_invariant() {
+    // Short jumps: far inside the 1 ms step limit.
     assert_safe(&run_with(
         "target galvo\nset dwell_ms 20\npattern visit-all once\nwait 900\npattern tuning 0 0 5 once\nwait 500\n",
         SimOptions::default(),
