@@ -260,3 +260,78 @@ impl DacStream for SimDac {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::executor;
+    use crate::safety::galvo_stretches;
+
+    fn lit(x_code: u16) -> DacSample {
+        DacSample {
+            x_code,
+            y_code: 0,
+            laser: true,
+        }
+    }
+
+    #[test]
+    fn each_half_records_when_it_was_computed_and_late_halves_replay_stale() {
+        let recording = Rc::new(RefCell::new(DacRecording::default()));
+        let dac_recording = recording.clone();
+        executor::run(
+            false,
+            1_000_000,
+            move |spawner| {
+                executor::spawn(&spawner, async move {
+                    // 4 samples of 10 µs per half: each half lasts 40 µs.
+                    let mut dac = SimDac::new(4, 10_000, 0, dac_recording);
+                    for code in [1, 2] {
+                        let _ = dac.write_half(&[lit(code); 4]).await;
+                    }
+                    // The second write waited for its buffer until 40 µs;
+                    // the third comes at 140 µs, after its half began at
+                    // 120 µs: the DAC replays what that buffer holds.
+                    Timer::after_micros(100).await;
+                    let late = dac.write_half(&[lit(3); 4]).await;
+                    assert!(late.is_err());
+                });
+            },
+            || false,
+        );
+        let rec = recording.borrow();
+        let halves: Vec<(u64, u64, bool)> = rec
+            .halves
+            .iter()
+            .map(|h| (h.start_ns, h.computed_ns, h.stale))
+            .collect();
+        // Halves 0 and 1 from 40 and 80 µs (both computed at 0), half 2
+        // replays half 0's content (computed at 0) from 120 µs, then the
+        // late half (computed at 140 µs) from 160 µs.
+        assert_eq!(
+            halves,
+            [
+                (40_000, 0, false),
+                (80_000, 0, false),
+                (120_000, 0, true),
+                (160_000, 140_000, false),
+            ]
+        );
+        assert_eq!(rec.underrun_detected_ns, [140_000]);
+        let stretches = galvo_stretches(&rec);
+        let codes: Vec<(u64, u16, u64)> = stretches
+            .iter()
+            .map(|s| (s.start_ns, s.x_code, s.count))
+            .collect();
+        assert_eq!(
+            codes,
+            [
+                (40_000, 1, 4),
+                (80_000, 2, 4),
+                (120_000, 1, 4),
+                (160_000, 3, 4)
+            ]
+        );
+        assert_eq!(stretches[3].computed_ns, 140_000);
+    }
+}
