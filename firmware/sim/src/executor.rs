@@ -168,6 +168,20 @@ pub fn task_steps() -> Vec<TaskSteps> {
     STEPS.with(|s| s.borrow().clone())
 }
 
+/// The longest step (poll) of any firmware task in this thread's last (or
+/// current) run, in thread CPU time.
+pub fn longest_poll() -> std::time::Duration {
+    let ns = STEPS.with(|s| {
+        s.borrow()
+            .iter()
+            .filter(|t| t.kind == TaskKind::Firmware)
+            .map(|t| t.max_cpu_ns)
+            .max()
+            .unwrap_or(0)
+    });
+    std::time::Duration::from_nanos(ns)
+}
+
 /// CPU time this thread has used, ns.
 #[cfg(unix)]
 fn thread_cpu_ns() -> u64 {
@@ -376,6 +390,10 @@ mod tests {
         let sleeper = &steps[1];
         assert_eq!(sleeper.polls, 2);
         assert!(sleeper.max_cpu_ns < LONG_STEP_NS, "{sleeper:?}");
+        assert_eq!(
+            longest_poll(),
+            std::time::Duration::from_nanos(spinner.max_cpu_ns)
+        );
     }
 
     #[test]
