@@ -60,7 +60,7 @@ fn random_session(seed: u64) -> (String, SimOptions) {
             4 | 5 => format!(
                 "pattern {}{}",
                 ["corner", "home", "horizontal", "vertical", "visit-all"][(r % 5) as usize],
-                if r % 3 == 0 { "" } else { " once" }
+                if r.is_multiple_of(3) { "" } else { " once" }
             ),
             6 => format!(
                 "pattern line {} {} {} {}{}",
@@ -68,7 +68,7 @@ fn random_session(seed: u64) -> (String, SimOptions) {
                 (r % 7) as f64 - 3.0,
                 ((r >> 8) % 9) as f64 - 4.0,
                 ((r >> 16) % 7) as f64 - 3.5,
-                if r % 2 == 0 { " once" } else { "" }
+                if r.is_multiple_of(2) { " once" } else { "" }
             ),
             7 => format!(
                 "pattern circle {} {} 2.5 ccw once",

@@ -622,16 +622,10 @@ fn gimbal_dwell_mode(inputs: &SafetyInputs<'_>, timeline: &SettingsTimeline) -> 
             continue;
         }
         let before = events.partition_point(|e| e.laser_switches_before <= j);
+        // Every event but an arrival means the gimbal left its point.
         let arrived = events[..before]
-            .iter()
-            .rev()
-            .find_map(|e| match e.event {
-                SequencerEvent::GimbalArrived => Some(true),
-                SequencerEvent::GimbalMoveSent
-                | SequencerEvent::RunStarted
-                | SequencerEvent::Stopped { .. } => Some(false),
-            })
-            .unwrap_or(false);
+            .last()
+            .is_some_and(|e| e.event == SequencerEvent::GimbalArrived);
         if !arrived {
             found.push(Violation {
                 kind: ViolationKind::LitWithoutArrival,
