@@ -150,9 +150,8 @@ fn holds_after_the_master_laser_gate_on_a_servo_fault() {
     assert_safe(&servo_fault_while_the_galvo_dwells());
 }
 
-// Item 3: an underrun replays stale halves lit (and lit across a jump
-// when the loop is far too slow); the laser stays lit ~2.5 ms after the
-// loop learned of it.
+// Item 3: an underrun replays stale halves lit; the laser stays lit
+// ~2.5 ms after the loop learned of it.
 
 fn slow_galvo_loop(cost_ns_per_sample: u64) -> SimReport {
     run_with(
@@ -166,15 +165,15 @@ fn slow_galvo_loop(cost_ns_per_sample: u64) -> SimReport {
 
 #[test]
 fn detects_lit_underrun_replays() {
-    let report = slow_galvo_loop(12_000);
-    assert!(report.galvo_underruns > 0);
-    assert_reported(
-        &report,
-        ViolationKind::LitAfterStop,
-        &["galvo laser", "galvo underrun"],
-    );
-    let far_too_slow = slow_galvo_loop(20_000);
-    assert_reported(&far_too_slow, ViolationKind::LitGalvoJump, &["jumped"]);
+    for cost_ns_per_sample in [12_000, 20_000] {
+        let report = slow_galvo_loop(cost_ns_per_sample);
+        assert!(report.galvo_underruns > 0);
+        assert_reported(
+            &report,
+            ViolationKind::LitAfterStop,
+            &["galvo laser", "galvo underrun"],
+        );
+    }
 }
 
 #[test]

@@ -490,7 +490,8 @@ fn gimbal_laser_at(switches: &[(u64, bool)], t_us: u64) -> bool {
 
 /// (b) The galvo laser is dark whenever the DAC codes step by more than
 /// marking allows (marking speed in force × sample period × 1.5 + 0.2 mm
-/// for code quantisation).
+/// for code quantisation): a sample that steps that far must be dark (the
+/// mirrors move to it during its sample period, with its laser state).
 fn galvo_jumps_dark(inputs: &SafetyInputs<'_>, timeline: &SettingsTimeline) -> Vec<Violation> {
     let mut found = Vec::new();
     // (first µs, last µs, steps, largest mm) of the current lit jump.
@@ -509,7 +510,9 @@ fn galvo_jumps_dark(inputs: &SafetyInputs<'_>, timeline: &SettingsTimeline) -> V
     };
     for w in inputs.galvo.windows(2) {
         let (a, b) = (&w[0], &w[1]);
-        if (a.x_code, a.y_code) == (b.x_code, b.y_code) || !(a.laser || b.laser) {
+        // The mirrors move from `a`'s codes to `b`'s during `b`'s sample,
+        // with `b`'s laser state (the DAC and the laser switch together).
+        if (a.x_code, a.y_code) == (b.x_code, b.y_code) || !b.laser {
             continue;
         }
         let (Some(p), Some(q)) = (
@@ -943,7 +946,17 @@ mod tests {
         ];
         let found = galvo_jumps_dark(&inputs(&t, &[], &[], jump.clone()), &timeline);
         assert_eq!(kinds(&found), [ViolationKind::LitGalvoJump]);
-        assert!(found[0].detail.contains("2 steps"), "{found:?}");
+        assert!(found[0].detail.contains("1 steps"), "{found:?}");
+        assert_eq!(found[0].t_us, 10);
+        // Leaving a lit point dark: the laser is off while the mirrors move.
+        let leaving = vec![
+            stretch(0, 2000, true, 0).with_count(1),
+            stretch(10, 2100, false, 0).with_count(1),
+        ];
+        assert_eq!(
+            galvo_jumps_dark(&inputs(&t, &[], &[], leaving), &timeline),
+            []
+        );
         // At the fastest marking `set` accepts (20 m/s: 0.5 mm per
         // sample), 100 codes (~9 mm) per sample are still a jump.
         let fast = transcript(&[(0, "> set galvo.mark_speed_mm_s 20000"), (0, "ok")]);
