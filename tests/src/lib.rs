@@ -65,11 +65,15 @@ pub fn assert_safe_allowing(report: &SimReport, open: &[ViolationKind]) {
 /// checked completely.
 pub const UNTIL_TRAVEL_FIX: &[ViolationKind] = &[ViolationKind::LitTravel];
 
-/// Task steps over 1 ms of CPU time: issue 9 item 5's O(n²) path checks
-/// (fixed on another branch) and the galvo loop planning a long
-/// time-optimal jump inside one step (up to 1.4 ms here in the dev profile;
-/// the README already says jumps must be planned ahead on the target).
-/// **After both are fixed, make this `&[]`.**
+/// Task steps over 1 ms of CPU time. Open: issue 9 item 5's O(n²) path
+/// checks (fixed on another branch) and the galvo loop planning a long
+/// time-optimal jump inside one step (0.9–1.4 ms of host CPU in the dev
+/// profile; the README already says jumps must be planned ahead on the
+/// target). Also, on a loaded machine under memory pressure a single poll
+/// can show several ms of CPU time (page-fault handling counts), so the
+/// integration tests tolerate long steps; `safety_checker.rs` checks them
+/// on a 12 ms step. **After both fixes, make this `&[]`** (or keep it for
+/// noisy CI machines).
 pub const UNTIL_STEP_FIXES: &[ViolationKind] = &[ViolationKind::LongStep];
 
 /// Violation kinds of issue 9 items 1–3 (galvo laser lit after stop: no

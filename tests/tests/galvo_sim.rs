@@ -6,9 +6,6 @@ use galvo_planner::{JumpSync, Method, RigidParams, XyStepper, plan_xy_jump};
 use kinematics_core::{Galvo, PointMm};
 use laser_app::galvo::DacSample;
 use laser_sim::world::{SimOptions, SimReport};
-// The galvo loop plans time-optimal jumps inside a step: up to 0.97 ms of
-// host CPU here, too close to the 1 ms limit to check reliably
-// (`UNTIL_STEP_FIXES`).
 use system_tests::{
     UNTIL_GALVO_GATE, UNTIL_STEP_FIXES, UNTIL_TRAVEL_FIX, assert_safe_allowing, run_to_idle,
     run_with, spec_patterns, terminal_lines,
