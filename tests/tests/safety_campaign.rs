@@ -84,7 +84,7 @@ fn random_session(seed: u64) -> (String, SimOptions) {
             ),
             11 => format!("grid {} {}", (r % 13) as i64 - 6, ((r >> 8) % 9) as i64 - 4),
             12 | 13 => "stop".to_owned(),
-            14 => "button".to_owned(),
+            14 => "@button".to_owned(),
             15 => format!("set dwell_ms {}", r % 150),
             16 => format!("set servo.speed_deg_s {}", 60 + r % 300),
             17 => format!(

@@ -100,7 +100,7 @@ fn detects_buffered_half_buffers_lit_after_stop() {
     for (period_us, stop, why) in [
         (10, "stop", "stop command"),
         (1000, "stop", "stop command"),
-        (10, "button", "stop button"),
+        (10, "@button", "stop button"),
         (10, "target gimbal", "actuator changed"),
     ] {
         let report = galvo_stopped_mid_dwell(period_us, stop);
@@ -115,7 +115,7 @@ fn holds_after_the_master_laser_gate() {
     for (period_us, stop) in [
         (10, "stop"),
         (1000, "stop"),
-        (10, "button"),
+        (10, "@button"),
         (10, "target gimbal"),
     ] {
         assert_safe_allowing(&galvo_stopped_mid_dwell(period_us, stop), UNTIL_STEP_FIXES);
@@ -285,7 +285,7 @@ fn holds_after_dark_travel() {
 fn a_gimbal_pattern_in_dwell_mode_is_safe() {
     assert_safe_allowing(
         &run_with(
-            "laser dwell\nset dwell_ms 50\npattern corner once\nwait 1000\nbutton\nwait 100\nstatus\n",
+            "laser dwell\nset dwell_ms 50\npattern corner once\nwait 1000\n@button\nwait 100\nstatus\n",
             SimOptions::default(),
         ),
         UNTIL_STEP_FIXES,

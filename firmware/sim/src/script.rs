@@ -1,5 +1,5 @@
 //! Simulator scripts: one command line per line, `wait <ms>` pauses in
-//! simulated time, `button` presses the board's stop button, blank lines
+//! simulated time, `@button` presses the board's stop button, blank lines
 //! and `#` comments are skipped.
 
 use anyhow::{Context, Result, bail};
@@ -35,7 +35,7 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
                 bail!("script line {}: `wait <ms>` takes one argument", number + 1);
             }
             steps.push(Step::WaitMs(ms));
-        } else if line == "button" {
+        } else if line == "@button" {
             steps.push(Step::StopButton);
         } else {
             steps.push(Step::Send(line.to_owned()));
@@ -64,7 +64,7 @@ mod tests {
 
     #[test]
     fn parses_commands_waits_and_skips_comments() {
-        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\nbutton\n").unwrap();
+        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\n@button\n").unwrap();
         assert_eq!(
             steps,
             vec![

@@ -69,7 +69,7 @@ impl UsbHost {
 }
 
 /// Types the script: each command line, then waits for its closing reply;
-/// `button` steps press the board's stop button (`link`'s stop request).
+/// `@button` steps press the board's stop button (`link`'s stop request).
 pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, link: &CommandLink) {
     for step in steps {
         match step {
