@@ -385,9 +385,12 @@ fn servo_ids_from_the_settings_are_used_on_the_bus() {
         tx_ids.contains(&7),
         "angle queries went to servo 7: {tx_ids:?}"
     );
-    assert_eq!(
+    // Dark at the end (travel to a goto is dark, so it may never have lit).
+    assert_ne!(
         report.recording.laser_events.last().map(|e| e.1),
-        Some(false)
+        Some(true),
+        "{:?}",
+        report.recording.laser_events
     );
 }
 
@@ -493,5 +496,55 @@ fn laser_stays_off_while_idle_and_in_dwell_mode_lights_only_the_points() {
             "lit {:.2} cm from the nearest corner",
             nearest
         );
+    }
+}
+
+#[test]
+fn the_trace_has_a_row_at_every_laser_change_and_ends_in_the_final_state() {
+    for script in [
+        "pattern corner once\n",
+        "laser dwell\npattern home once\n",
+        "goto 3 2\nwait 300\nstop\nwait 7\n",
+    ] {
+        let report = run_to_idle(script);
+        let csv = report.recording.trace_csv();
+        let rows: Vec<(u64, bool)> = csv
+            .lines()
+            .skip(1)
+            .map(|line| {
+                let f: Vec<&str> = line.split(',').collect();
+                let t_ms: f64 = f[0].parse().expect("t_ms");
+                ((t_ms * 1000.0).round() as u64, f[3] == "1")
+            })
+            .collect();
+        let events = &report.recording.laser_events;
+        assert!(events.iter().any(|e| e.1), "{script}: the laser was used");
+        for &(t_us, on) in events {
+            assert!(
+                rows.contains(&(t_us, on)),
+                "{script}: no trace row for the laser turning {} at {t_us} µs",
+                if on { "on" } else { "off" }
+            );
+        }
+        // Rows in time order; the last row of each instant has the state
+        // the laser was left in at that instant.
+        assert!(rows.windows(2).all(|w| w[0].0 <= w[1].0));
+        for (i, &(t_us, laser)) in rows.iter().enumerate() {
+            if rows.get(i + 1).is_some_and(|next| next.0 == t_us) {
+                continue;
+            }
+            assert_eq!(
+                laser,
+                report.recording.laser_at(t_us),
+                "{script}: row at {t_us} µs"
+            );
+        }
+        let &(last_t, last_laser) = rows.last().expect("rows");
+        assert_eq!(
+            last_t, report.end_time_us,
+            "{script}: the trace reaches the end"
+        );
+        assert!(!last_laser, "{script}: ends dark");
+        assert_eq!(Some(last_laser), events.last().map(|e| e.1));
     }
 }

@@ -14,7 +14,9 @@ use laser_sim::world::{SimOptions, run};
 /// Options of `cargo xtask sim`.
 #[derive(clap::Args, Debug)]
 pub struct SimArgs {
-    /// Script of command lines (`wait <ms>` pauses; `#` comments); `-`
+    /// Script of command lines (`wait <ms>` pauses; `#` comments;
+    /// `@stall-read <ms>` stops the host reading replies for a while,
+    /// `@type-ahead <line>` types without waiting for the reply); `-`
     /// reads it from stdin. Without it, piped stdin is the script, and a
     /// terminal or empty stdin runs the demo (writing sim.svg).
     #[arg(long)]
@@ -35,8 +37,9 @@ pub struct SimArgs {
     /// above the 10 µs sample period the loop underruns).
     #[arg(long, default_value_t = 0)]
     galvo_cost_ns: u64,
-    /// Inject a fault: `servo-silent:<id>@<t_ms>[-<end_ms>]`, `servo-corrupt:<probability>`,
-    /// `servo-slow:<factor>` (repeatable).
+    /// Inject a fault: `servo-silent:<id>@<t_ms>[-<end_ms>]`, `servo-corrupt:<probability>`
+    /// (per response byte), `servo-forge:<probability>` (per angle response: a wrong angle
+    /// with a valid checksum), `servo-slow:<factor>` (repeatable).
     #[arg(long = "fault")]
     faults: Vec<String>,
     /// Run until the script has ended and the sequencer is idle; exit 1 if
@@ -104,14 +107,18 @@ pub fn parse_faults(specs: &[String]) -> Result<(BusFaults, f64)> {
                     until_ms,
                 });
             }
-            "servo-corrupt" => {
+            "servo-corrupt" | "servo-forge" => {
                 let p: f64 = value
                     .parse()
                     .with_context(|| format!("fault {spec:?}: bad probability"))?;
                 if !(0.0..=1.0).contains(&p) {
                     bail!("fault {spec:?}: probability must be in [0, 1]");
                 }
-                faults.corrupt_probability = p;
+                if kind == "servo-forge" {
+                    faults.forge_probability = p;
+                } else {
+                    faults.corrupt_probability = p;
+                }
             }
             "servo-slow" => {
                 let f: f64 = value
@@ -123,7 +130,9 @@ pub fn parse_faults(specs: &[String]) -> Result<(BusFaults, f64)> {
                 slow = f;
             }
             other => {
-                bail!("unknown fault kind {other:?} (servo-silent, servo-corrupt, servo-slow)")
+                bail!(
+                    "unknown fault kind {other:?} (servo-silent, servo-corrupt, servo-forge, servo-slow)"
+                )
             }
         }
     }
@@ -265,6 +274,7 @@ mod tests {
             "servo-silent:1@2500".to_owned(),
             "servo-silent:0@100-400".to_owned(),
             "servo-corrupt:0.05".to_owned(),
+            "servo-forge:0.2".to_owned(),
             "servo-slow:3".to_owned(),
         ];
         let (faults, slow) = parse_faults(&specs).unwrap();
@@ -284,12 +294,14 @@ mod tests {
             ]
         );
         assert_eq!(faults.corrupt_probability, 0.05);
+        assert_eq!(faults.forge_probability, 0.2);
         assert_eq!(slow, 3.0);
         for bad in [
             "servo-silent:1",
             "servo-silent:1@500-400",
             "servo-silent:1@5-x",
             "servo-corrupt:2",
+            "servo-forge:-1",
             "servo-slow:0.5",
             "gremlins:1",
             "x",

@@ -115,9 +115,28 @@ pub fn test() -> Result<()> {
     size()
 }
 
+/// Installs flip-link, the firmware's linker wrapper (`.cargo/config.toml`:
+/// stack below `.data`/`.bss`, so an overflow faults instead of corrupting
+/// them), with `cargo install flip-link --locked` when it is not on `PATH`.
+pub fn ensure_flip_link() -> Result<()> {
+    // flip-link has no `--version`; whether it starts at all is the test.
+    match Command::new("flip-link").output() {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            println!(
+                "flip-link (the firmware's stack-overflow-protecting linker) is not installed: \
+                 installing it with `cargo install flip-link --locked`"
+            );
+            run("cargo", &["install", "flip-link", "--locked"])
+        }
+        Err(e) => Err(e).context("could not start `flip-link`"),
+        Ok(_) => Ok(()),
+    }
+}
+
 /// Builds the release firmware and returns the path of the ELF image.
 pub fn build_firmware() -> Result<PathBuf> {
     ensure_toolchain()?;
+    ensure_flip_link()?;
     run(
         "cargo",
         &["build", "--release", "--target", TARGET, "-p", "firmware"],

@@ -6,6 +6,8 @@ pub mod clock;
 pub mod dac;
 pub mod drawing;
 pub mod executor;
+pub mod flash;
+pub mod laser;
 pub mod logger;
 pub mod physics;
 pub mod recorder;

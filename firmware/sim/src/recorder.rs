@@ -103,6 +103,15 @@ pub struct ServoSample {
     pub pitch: Option<ServoState>,
     /// Gimbal laser output at that time (after any switch at `t_us`).
     pub laser: bool,
+/// A response frame the fault injection corrupted on the wire.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CorruptedFrame {
+    /// When its first byte went on the wire, µs (as in [`FrameRecord`]).
+    pub t_us: u64,
+    /// The bytes as the servo sent them.
+    pub sent: Vec<u8>,
+    /// The bytes as the firmware received them.
+    pub received: Vec<u8>,
 }
 
 /// Everything recorded during a run.
@@ -121,6 +130,9 @@ pub struct Recording {
     /// Servo angles and targets: every spot sample period and at every
     /// gimbal laser switch and sequencer event.
     pub servos: Vec<ServoSample>,
+    /// Response frames corrupted by the fault injection (their clean
+    /// bytes), in order.
+    pub clean_rx: Vec<CorruptedFrame>,
 }
 
 impl Recording {
