@@ -16,7 +16,8 @@ use laser_sim::world::{SimOptions, run};
 pub struct SimArgs {
     /// Script of command lines (`wait <ms>` pauses; `#` comments;
     /// `@stall-read <ms>` stops the host reading replies for a while,
-    /// `@type-ahead <line>` types without waiting for the reply); `-`
+    /// `@type-ahead <line>` types without waiting for the reply, `@button`
+    /// presses the stop button); `-`
     /// reads it from stdin. Without it, piped stdin is the script, and a
     /// terminal or empty stdin runs the demo (writing sim.svg).
     #[arg(long)]

@@ -103,6 +103,8 @@ pub struct ServoSample {
     pub pitch: Option<ServoState>,
     /// Gimbal laser output at that time (after any switch at `t_us`).
     pub laser: bool,
+}
+
 /// A response frame the fault injection corrupted on the wire.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CorruptedFrame {

@@ -19,8 +19,8 @@
 //!   ([`ViolationKind::LitWithoutArrival`]).
 //! * **(c) one reply per line** ([`ViolationKind::Replies`]): each line
 //!   the host sent gets exactly one `ok` / `error: …`, after its data
-//!   lines and before the next line; bracketed notices are not replies
-//!   but must be whole lines.
+//!   lines, in the order the lines were sent; bracketed notices are not
+//!   replies but must be whole lines.
 //! * **(d) short task steps** ([`ViolationKind::LongStep`]): no poll of a
 //!   firmware task takes more than 1 ms of thread CPU time (see
 //!   [`crate::executor`] for what that measures).
@@ -30,6 +30,7 @@
 //! the executor's step accounting. The galvo laser is read in one place,
 //! [`galvo_stretches`]: the **effective** laser state of each sample.
 
+use std::collections::VecDeque;
 use std::fmt;
 
 use laser_app::cli::parse::parse_line;
@@ -679,18 +680,14 @@ fn one_reply_per_line(transcript: &Transcript) -> Vec<Violation> {
             detail,
         })
     };
-    // The line awaiting its reply: (sent µs, text, closing replies seen).
-    let mut pending: Option<(u64, &str, u32)> = None;
-    let check_closed = |pending: Option<(u64, &str, u32)>, add: &mut dyn FnMut(u64, String)| {
-        if let Some((t, line, 0)) = pending {
-            add(t, format!("{line:?} got no closing reply"));
-        }
-    };
+    // Lines awaiting their closing reply, oldest first (a host may type
+    // ahead), and the line closed last.
+    let mut pending: VecDeque<(u64, &str)> = VecDeque::new();
+    let mut last_closed: Option<&str> = None;
     for (t, line) in &transcript.lines {
         let t = *t;
         if let Some(sent) = line.strip_prefix("> ") {
-            check_closed(pending.take(), &mut add);
-            pending = Some((t, sent, 0));
+            pending.push_back((t, sent));
             continue;
         }
         if line.starts_with('[') {
@@ -699,26 +696,25 @@ fn one_reply_per_line(transcript: &Transcript) -> Vec<Violation> {
             }
             continue;
         }
-        if line.contains("[error:") || line.contains("[info:") {
-            add(t, format!("notice glued into a line: {line:?}"));
-        }
         let closing = line == "ok" || line.starts_with("error:");
-        match pending.as_mut() {
-            Some((_, sent, n)) if closing => {
-                *n += 1;
-                if *n == 2 {
-                    add(t, format!("{sent:?} got a second closing reply {line:?}"));
-                }
-            }
-            Some((_, sent, n)) if *n > 0 => add(
-                t,
-                format!("line {line:?} after the closing reply of {sent:?}"),
-            ),
-            Some(_) => {}
-            None => add(t, format!("{line:?} before any command line")),
+        if closing && let Some((_, sent)) = pending.pop_front() {
+            last_closed = Some(sent);
+            continue;
         }
+        if !pending.is_empty() {
+            // A data line of the oldest line awaiting its reply.
+            continue;
+        }
+        let detail = match (closing, last_closed) {
+            (true, Some(sent)) => format!("{sent:?} got a second closing reply {line:?}"),
+            (false, Some(sent)) => format!("line {line:?} after the closing reply of {sent:?}"),
+            (_, None) => format!("{line:?} before any command line"),
+        };
+        add(t, detail);
     }
-    check_closed(pending, &mut add);
+    for (t, sent) in pending {
+        add(t, format!("{sent:?} got no closing reply"));
+    }
     found
 }
 
@@ -826,6 +822,16 @@ mod tests {
             (10, "error: dwell_ms out of range [0, 60000]"),
         ]);
         assert_eq!(one_reply_per_line(&good), []);
+        // A host typing ahead gets the replies in order.
+        let ahead = transcript(&[
+            (0, "> get dwell_ms"),
+            (0, "> status"),
+            (1, "dwell_ms = 1000"),
+            (1, "ok"),
+            (1, "uptime: 1.000 s"),
+            (1, "ok"),
+        ]);
+        assert_eq!(one_reply_per_line(&ahead), []);
         let cases: &[(&[(u64, &str)], &str)] = &[
             (
                 &[(0, "> params"), (1, "oq_cm = 25")],
@@ -840,13 +846,15 @@ mod tests {
                 "after the closing reply",
             ),
             (&[(0, "ok")], "before any command line"),
+            // A reply glued onto a cut line: its closer is not a line.
             (
                 &[
                     (0, "> params"),
-                    (1, "oq_cm = 2[error: servo 1 fault"),
+                    (1, "oq_cm = 2ok"),
+                    (2, "> stop"),
                     (2, "ok"),
                 ],
-                "glued",
+                "got no closing reply",
             ),
             (
                 &[(0, "> params"), (1, "[error: servo 1 fauok"), (2, "ok")],

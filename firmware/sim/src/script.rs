@@ -102,8 +102,7 @@ mod tests {
 
     #[test]
     fn parses_commands_waits_and_skips_comments() {
-        let steps =
-            parse_script("# hi\n\npattern corner\n  wait 250 \nstop\n@button\n").unwrap();
+        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\n@button\n").unwrap();
         assert_eq!(
             steps,
             vec![

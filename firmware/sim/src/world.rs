@@ -11,7 +11,7 @@ use std::sync::atomic::Ordering;
 
 use laser_app::command::CommandLink;
 use laser_app::galvo::{GalvoConfig, GalvoLink, GalvoLoop};
-use laser_app::sequencer::{LaserEvent, LaserSwitch, Sequencer};
+use laser_app::sequencer::{LaserEvent, LaserSwitch, Sequencer, SettingsStore};
 use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::status::{Activity, Phase, StatusBoard};
