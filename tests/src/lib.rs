@@ -1,6 +1,7 @@
 //! Shared helpers for the integration tests in `tests/tests/`: run a script
 //! through the simulator and read what happened.
 
+use laser_sim::safety::{Violation, ViolationKind, check, report_text};
 use laser_sim::script::parse_script;
 use laser_sim::world::{SimOptions, SimReport, run};
 
@@ -19,6 +20,52 @@ pub fn run_with(script: &str, options: SimOptions) -> SimReport {
         ..options
     })
 }
+
+/// Runs `script` to idle with `options` under the safety checker
+/// (`laser_sim::safety`): panics listing every violated invariant.
+pub fn run_checked(script: &str, options: SimOptions) -> SimReport {
+    run_checked_allowing(script, options, &[])
+}
+
+/// Like [`run_checked`], but violations of the `open` kinds (see
+/// [`UNTIL_STEP_FIXES`]) only print.
+pub fn run_checked_allowing(
+    script: &str,
+    options: SimOptions,
+    open: &[ViolationKind],
+) -> SimReport {
+    let report = run_with(script, options);
+    assert_safe_allowing(&report, open);
+    report
+}
+
+/// Panics listing every safety violation of a finished run.
+pub fn assert_safe(report: &SimReport) {
+    assert_safe_allowing(report, &[]);
+}
+
+/// Panics listing every safety violation of a finished run except those
+/// of the `open` kinds, which are printed on stderr.
+pub fn assert_safe_allowing(report: &SimReport, open: &[ViolationKind]) {
+    let (tolerated, violations): (Vec<Violation>, Vec<Violation>) = check(report)
+        .into_iter()
+        .partition(|v| open.contains(&v.kind));
+    if !tolerated.is_empty() {
+        eprint!(
+            "known open defects, tolerated here: {}",
+            report_text(&tolerated)
+        );
+    }
+    assert!(violations.is_empty(), "{}", report_text(&violations));
+}
+
+/// Task steps over 1 ms of CPU time, tolerated where they are not the
+/// point: the galvo loop plans a long time-optimal jump inside one step
+/// (0.9–1.5 ms of host CPU in the dev profile; on the target jumps must be
+/// planned ahead, see the README), and on a loaded machine under memory
+/// pressure a single poll can show several ms of CPU time (page-fault
+/// handling counts). `safety_checker.rs` checks the path checks' steps.
+pub const UNTIL_STEP_FIXES: &[ViolationKind] = &[ViolationKind::LongStep];
 
 /// Every line of the terminal transcript (`> command` for what was sent).
 pub fn terminal_lines(report: &SimReport) -> Vec<&str> {
@@ -85,6 +132,64 @@ pub mod spec_patterns {
             })
             .collect()
     }
+}
+
+/// A xorshift64 random number generator: fixed seeds make reproducible
+/// random campaigns without a dependency.
+#[derive(Debug, Clone)]
+pub struct XorShift(pub u64);
+
+impl XorShift {
+    /// The next pseudo-random number (never 0 for a non-zero seed).
+    pub fn next_u64(&mut self) -> u64 {
+        let mut x = self.0;
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        self.0 = x;
+        x
+    }
+
+    /// A number in `0..n` (`n` > 0).
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n.max(1)
+    }
+}
+
+/// The 1000 meaningful commands in random order and timing of
+/// `galvo_sim.rs`'s random test (actuators, planners, grid and path
+/// patterns, gotos, stops, parameter changes), then `stop` and the status.
+pub fn random_meaningful_commands() -> String {
+    let templates: &[&dyn Fn(u64) -> String] = &[
+        &|_| "target galvo".into(),
+        &|_| "target gimbal".into(),
+        &|_| "target both".into(),
+        &|r| format!("planner {}", if r % 2 == 0 { "optimal" } else { "seed" }),
+        &|r| {
+            format!(
+                "pattern {} once",
+                ["corner", "home", "horizontal", "vertical"][(r % 4) as usize]
+            )
+        },
+        &|_| "pattern tuning 1 -1 5".into(),
+        &|_| "pattern circle -3 2 2.5 ccw".into(),
+        &|_| "pattern rect -4 3 4 -3 once".into(),
+        &|r| format!("goto {} {}", (r % 17) as f64 - 8.0, (r % 11) as f64 - 5.0),
+        &|_| "stop".into(),
+        &|r| format!("set dwell_ms {}", r % 120),
+        &|r| format!("set galvo.mark_speed_mm_s {}", 200 + r % 3000),
+        &|r| format!("set galvo.laser_on_delay_us {}", r % 400),
+        &|r| format!("wait {}", r % 80),
+    ];
+    let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+    let mut script = String::new();
+    for _ in 0..1000 {
+        let pick = (rng.next_u64() % templates.len() as u64) as usize;
+        script.push_str(&templates[pick](rng.next_u64()));
+        script.push('\n');
+    }
+    script.push_str("stop\nwait 20\nstatus\ngalvo status\n");
+    script
 }
 
 /// Checks of the console protocol as a host sees it: whole lines, replies

@@ -6,7 +6,10 @@ use galvo_planner::{JumpSync, Method, RigidParams, XyStepper, plan_xy_jump};
 use kinematics_core::{Galvo, PointMm};
 use laser_app::galvo::DacSample;
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::{run_to_idle, run_with, sent_at, spec_patterns, terminal_lines};
+use system_tests::{
+    UNTIL_STEP_FIXES, assert_safe_allowing, run_to_idle, run_with, sent_at, spec_patterns,
+    terminal_lines,
+};
 
 /// SPEC grid pitch, mm.
 const PITCH_MM: f64 = 19.16;
@@ -47,6 +50,7 @@ fn check_galvo_pattern(name: &str, expected: Vec<(i8, i8)>) {
     let report = run_to_idle(&format!(
         "target galvo\nset dwell_ms 20\npattern {name} once\nwait {wait_ms}\n"
     ));
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{name}: {:?}", report.transcript);
     assert_eq!(report.galvo_underruns, 0);
     let samples = samples(&report);
@@ -175,6 +179,7 @@ fn jumps_take_the_planned_time_with_either_planner() {
         let report = run_to_idle(&format!(
             "target galvo\nplanner {planner}\nset dwell_ms 5\npattern home once\nwait 20\npattern corner once\nwait 40\n"
         ));
+        assert_safe_allowing(&report, UNTIL_STEP_FIXES);
         assert!(report.succeeded(false));
         let samples = samples(&report);
         let runs = lit_runs(&samples);
@@ -210,6 +215,7 @@ fn jumps_take_the_planned_time_with_either_planner() {
 #[test]
 fn both_actuators_visit_the_same_points_together() {
     let report = run_to_idle("target both\nset dwell_ms 50\npattern corner once\nwait 1500\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);
     let gimbal: Vec<(i8, i8)> = report
         .recording
@@ -233,6 +239,7 @@ fn both_actuators_visit_the_same_points_together() {
 fn switching_pattern_mid_dwell_stops_the_galvo_cleanly() {
     let report =
         run_to_idle("target galvo\npattern visit-all\nwait 2500\npattern home once\nwait 1010\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false));
     let samples = samples(&report);
     assert_no_step_beyond_a_planned_jump(&samples);
@@ -250,6 +257,7 @@ fn galvo_commands_refuse_what_it_cannot_do() {
         "pattern tuning once\ntarget both\npattern line 0 0 5 5 once\ntarget galvo\ngoto 30 0\ngalvo status\nstatus\n",
         SimOptions::default(),
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     let errors: Vec<&str> = terminal_lines(&report)
         .into_iter()
         .filter(|l| l.starts_with("error:"))
@@ -283,6 +291,7 @@ fn the_galvo_marks_paths_from_the_command_line() {
     let report = run_to_idle(
         "target galvo\npattern circle 1 -1 3 ccw once\nwait 300\npattern tuning 0 0 5 once\nwait 500\n",
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);
     let samples = samples(&report);
     let runs = lit_runs(&samples);
@@ -318,6 +327,7 @@ fn switching_pattern_mid_path_brakes_dark_and_moves_on() {
     let report = run_to_idle(
         "target galvo\npattern rect -4 3 4 -3\nwait 20\npattern home once\nwait 1100\n",
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false));
     let samples = samples(&report);
     let runs = lit_runs(&samples);
@@ -336,6 +346,7 @@ fn a_galvo_loop_too_slow_for_the_sample_rate_is_reported_and_stopped() {
             ..SimOptions::default()
         },
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.galvo_underruns > 0);
     assert!(
         report
@@ -352,6 +363,7 @@ fn a_galvo_loop_too_slow_for_the_sample_rate_is_reported_and_stopped() {
 #[test]
 fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
     let report = run_to_idle("target galvo\ngoto 2 1\nwait 50\nstatus\nstop\nwait 10\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);
     let lines = terminal_lines(&report);
     assert!(
@@ -373,43 +385,9 @@ fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
 
 #[test]
 fn random_command_sequences_keep_every_safety_invariant() {
-    // Meaningful commands in random order and timing: actuators, planners,
-    // patterns (grid and paths), gotos, stops, parameter changes.
-    let templates: &[&dyn Fn(u64) -> String] = &[
-        &|_| "target galvo".into(),
-        &|_| "target gimbal".into(),
-        &|_| "target both".into(),
-        &|r| format!("planner {}", if r % 2 == 0 { "optimal" } else { "seed" }),
-        &|r| {
-            format!(
-                "pattern {} once",
-                ["corner", "home", "horizontal", "vertical"][(r % 4) as usize]
-            )
-        },
-        &|_| "pattern tuning 1 -1 5".into(),
-        &|_| "pattern circle -3 2 2.5 ccw".into(),
-        &|_| "pattern rect -4 3 4 -3 once".into(),
-        &|r| format!("goto {} {}", (r % 17) as f64 - 8.0, (r % 11) as f64 - 5.0),
-        &|_| "stop".into(),
-        &|r| format!("set dwell_ms {}", r % 120),
-        &|r| format!("set galvo.mark_speed_mm_s {}", 200 + r % 3000),
-        &|r| format!("set galvo.laser_on_delay_us {}", r % 400),
-        &|r| format!("wait {}", r % 80),
-    ];
-    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
-    let mut next = || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
-    let mut script = String::new();
-    for _ in 0..1000 {
-        let pick = (next() % templates.len() as u64) as usize;
-        script.push_str(&templates[pick](next()));
-        script.push('\n');
-    }
-    script.push_str("stop\nwait 20\nstatus\ngalvo status\n");
+    // Meaningful commands in random order and timing (the same script runs
+    // under the safety checker in `safety_campaign.rs`).
+    let script = system_tests::random_meaningful_commands();
     let report = run_with(&script, SimOptions::default());
     assert!(report.transcript.script_done, "every line got its reply");
     assert_ne!(report.end, laser_sim::executor::RunEnd::Livelock);

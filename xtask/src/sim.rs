@@ -16,7 +16,8 @@ use laser_sim::world::{SimOptions, run};
 pub struct SimArgs {
     /// Script of command lines (`wait <ms>` pauses; `#` comments;
     /// `@stall-read <ms>` stops the host reading replies for a while,
-    /// `@type-ahead <line>` types without waiting for the reply); `-`
+    /// `@type-ahead <line>` types without waiting for the reply, `@button`
+    /// presses the stop button); `-`
     /// reads it from stdin. Without it, piped stdin is the script, and a
     /// terminal or empty stdin runs the demo (writing sim.svg).
     #[arg(long)]
@@ -60,6 +61,12 @@ pub struct SimArgs {
     /// --interactive).
     #[arg(long)]
     max_time_s: Option<f64>,
+    /// Check the safety invariants after the run (laser dark within 1 ms
+    /// of stop/fault/button/underrun, never lit while moving, one reply
+    /// per line, no task step over 1 ms of CPU time); print every
+    /// violation and exit 1 on any.
+    #[arg(long)]
+    check_safety: bool,
     /// Log level of the firmware logs on stderr (error, warn, info, debug, trace, off).
     #[arg(long, default_value = "info")]
     log: String,
@@ -225,6 +232,21 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         report.galvo_underruns,
         report.transcript.error_replies
     );
+    let mut unsafe_run = false;
+    if args.check_safety {
+        let violations = laser_sim::safety::check(&report);
+        eprint!("xtask sim: {}", laser_sim::safety::report_text(&violations));
+        for task in &report.task_steps {
+            eprintln!(
+                "xtask sim:   {:<18} {:>9} steps, longest {:.3} ms CPU at {:.3} ms",
+                task.name,
+                task.polls,
+                task.max_cpu_ns as f64 / 1e6,
+                task.max_at_us as f64 / 1000.0
+            );
+        }
+        unsafe_run = !violations.is_empty();
+    }
     if report.end == RunEnd::Livelock {
         eprintln!(
             "xtask sim: a task kept running without letting time pass (busy loop); run stopped"
@@ -235,6 +257,9 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         if !report.idle_at_end {
             eprintln!("xtask sim: the sequencer was still busy when the run ended");
         }
+        return Ok(ExitCode::FAILURE);
+    }
+    if unsafe_run {
         return Ok(ExitCode::FAILURE);
     }
     Ok(ExitCode::SUCCESS)

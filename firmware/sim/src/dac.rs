@@ -45,6 +45,10 @@ pub struct DacRecording {
     /// order. Empty: the gate was never recorded (see
     /// [`crate::laser::recorded_gate`]), and no sample is lit.
     pub gate: Vec<(u64, GateState)>,
+    /// When the loop learned of each underrun, ns.
+    pub underrun_detected_ns: Vec<u64>,
+    /// Every half buffer output, in order.
+    pub halves: Vec<HalfRecord>,
 }
 
 /// `count` equal samples from `start_ns`, one per `period_ns`, computed
@@ -206,6 +210,19 @@ impl DacRecording {
     }
 }
 
+/// One half buffer as the DAC output it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HalfRecord {
+    /// Index of its first sample in the recording.
+    pub first_sample: usize,
+    /// When its first sample was output, ns.
+    pub start_ns: u64,
+    /// When the loop computed the content (or chose to repeat a hold), ns.
+    pub computed_ns: u64,
+    /// Replayed stale content (the loop was late).
+    pub stale: bool,
+}
+
 /// A physical half buffer: content, sample period (ns), and the gate
 /// generation it was computed under.
 #[derive(Debug, Clone)]
@@ -213,6 +230,8 @@ struct Buffer {
     samples: Vec<DacSample>,
     period_ns: u64,
     generation: u32,
+    /// When the loop computed it, ns.
+    computed_ns: u64,
 }
 
 /// How the DAC comes to output a half.
@@ -261,6 +280,7 @@ impl SimDac {
             samples: vec![DacSample::default(); half_len],
             period_ns,
             generation: 0,
+            computed_ns: 0,
         };
         Self {
             half_len,
@@ -289,7 +309,7 @@ impl SimDac {
         self.primed >= 2
     }
 
-    fn store(&mut self, slot: usize, half: &Half<'_>) {
+    fn store(&mut self, slot: usize, half: &Half<'_>, computed_ns: u64) {
         let buffer = &mut self.buffers[slot];
         buffer.samples.clear();
         buffer
@@ -299,16 +319,29 @@ impl SimDac {
         buffer.samples.resize(self.half_len, last);
         buffer.period_ns = self.period_ns;
         buffer.generation = half.generation;
+        buffer.computed_ns = computed_ns;
     }
 
     /// The DAC moves on past the half at `next_start_ns` with the content
     /// its buffer holds.
     fn advance(&mut self, output: Output) {
+        // The DAC and its recording: not firmware work.
+        crate::executor::simulator_work(|| self.advance_now(output));
+    }
+
+    fn advance_now(&mut self, output: Output) {
         let buffer = &self.buffers[Self::physical(self.next_half)];
         let generation = match output {
             Output::Fresh => Some(buffer.generation),
             Output::Stale => None,
         };
+        let first_sample = self.recording.borrow().len();
+        self.recording.borrow_mut().halves.push(HalfRecord {
+            first_sample,
+            start_ns: self.next_start_ns,
+            computed_ns: buffer.computed_ns,
+            stale: generation.is_none(),
+        });
         self.recording.borrow_mut().push_half(
             self.next_start_ns,
             buffer.period_ns,
@@ -363,12 +396,14 @@ impl DacStream for SimDac {
     }
 
     async fn write_half(&mut self, half: Half<'_>) -> Result<(), Underrun> {
+        // The loop computed the half just before handing it over.
+        let computed_ns = now_ns();
         let computed = half.computed.min(half.samples.len()) as u64;
         let compute_ns = self.compute_ns_per_sample.get() * computed;
         Timer::after_micros(compute_ns.div_ceil(1000)).await;
         if !self.started() {
             // Priming: the DAC starts once both halves are written.
-            self.store(self.primed, &half);
+            self.store(self.primed, &half, computed_ns);
             self.primed += 1;
             if self.started() {
                 self.next_start_ns = now_ns();
@@ -382,10 +417,14 @@ impl DacStream for SimDac {
         if halves > 0 {
             // The DAC reached these halves before they were written.
             self.recording.borrow_mut().underruns.push((at, halves));
+            self.recording
+                .borrow_mut()
+                .underrun_detected_ns
+                .push(now_ns());
         } else {
             self.wait_until_free().await;
         }
-        self.store(Self::physical(self.next_half), &half);
+        self.store(Self::physical(self.next_half), &half, computed_ns);
         self.advance(Output::Fresh);
         if halves > 0 {
             Err(Underrun { halves })
@@ -403,6 +442,9 @@ impl DacStream for SimDac {
         if self.catch_up(now_ns(), || Output::Fresh) == 0 {
             self.wait_until_free().await;
         }
+        // The loop chose now to output its hold again.
+        let slot = Self::physical(self.next_half);
+        self.buffers[slot].computed_ns = now_ns();
         self.advance(Output::Fresh);
     }
 }

@@ -11,6 +11,7 @@ pub mod laser;
 pub mod logger;
 pub mod physics;
 pub mod recorder;
+pub mod safety;
 pub mod script;
 pub mod servo_model;
 pub mod servo_port;

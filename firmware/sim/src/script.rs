@@ -2,8 +2,9 @@
 //! simulated time, blank lines and `#` comments are skipped. Lines starting
 //! with `@` direct the simulated host instead of being typed:
 //! `@stall-read <ms>` makes it stop reading the device's output for that
-//! long (the script goes on, so lines can be typed during the stall), and
-//! `@type-ahead <line>` types a line without waiting for its reply.
+//! long (the script goes on, so lines can be typed during the stall),
+//! `@type-ahead <line>` types a line without waiting for its reply, and
+//! `@button` presses the board's stop button.
 
 use anyhow::{Context, Result, bail};
 
@@ -20,6 +21,8 @@ pub enum Step {
     /// Send this line without waiting for its reply (the next `Send`, and
     /// the end of the script, wait for every reply outstanding).
     SendAhead(String),
+    /// Press the board's stop button (stop, laser off, no reply).
+    StopButton,
 }
 
 /// A whole number of milliseconds: the only argument of `word`.
@@ -66,10 +69,11 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
                 }
                 steps.push(Step::SendAhead(typed.to_owned()));
             }
+            Some("@button") if line == "@button" => steps.push(Step::StopButton),
             Some(directive) if directive.starts_with('@') => {
                 bail!(
                     "script line {number}: unknown directive {directive:?} \
-                     (@stall-read <ms>, @type-ahead <line>)"
+                     (@stall-read <ms>, @type-ahead <line>, @button)"
                 );
             }
             _ => steps.push(Step::Send(line.to_owned())),
@@ -98,13 +102,14 @@ mod tests {
 
     #[test]
     fn parses_commands_waits_and_skips_comments() {
-        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\n").unwrap();
+        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\n@button\n").unwrap();
         assert_eq!(
             steps,
             vec![
                 Step::Send("pattern corner".into()),
                 Step::WaitMs(250),
-                Step::Send("stop".into())
+                Step::Send("stop".into()),
+                Step::StopButton,
             ]
         );
     }

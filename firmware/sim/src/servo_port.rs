@@ -104,11 +104,9 @@ impl SimServoPort {
         }
     }
 
-    async fn write_bytes(&self, bytes: &[u8]) {
-        let start = Instant::now().as_micros();
-        // The bytes are on the wire for their transmission time.
-        Timer::after_micros(BYTE_TIME_US * bytes.len() as u64).await;
-        let done = Instant::now().as_micros();
+    /// Records a frame sent from `start` to `done` (µs), lets the servos
+    /// act on it and queues their responses.
+    fn deliver(&self, start: u64, done: u64, bytes: &[u8]) {
         self.recording.borrow_mut().frames.push(FrameRecord {
             t_us: start,
             direction: Direction::Tx,
@@ -149,6 +147,15 @@ impl SimServoPort {
                 incoming.push_back((ready_at_us + BYTE_TIME_US * (i as u64 + 1), byte));
             }
         }
+    }
+
+    async fn write_bytes(&self, bytes: &[u8]) {
+        let start = Instant::now().as_micros();
+        // The bytes are on the wire for their transmission time.
+        Timer::after_micros(BYTE_TIME_US * bytes.len() as u64).await;
+        let done = Instant::now().as_micros();
+        // The simulated bus and servos: not firmware work.
+        crate::executor::simulator_work(|| self.deliver(start, done, bytes));
         self.arrived.signal(());
     }
 

@@ -17,6 +17,7 @@ use embassy_sync::signal::Signal;
 use embassy_time::Timer;
 
 use crate::script::Step;
+use laser_app::command::CommandLink;
 
 /// Host → firmware bytes.
 pub type ToDevice = Pipe<CriticalSectionRawMutex, 256>;
@@ -100,9 +101,15 @@ impl UsbHost {
     }
 }
 
-/// Runs one script step.
-async fn run_step(host: &UsbHost, step: Step) {
+/// Runs one script step; `@button` presses `button`'s stop request (the
+/// interactive terminal has no button).
+async fn run_step(host: &UsbHost, step: Step, button: Option<&CommandLink>) {
     match step {
+        Step::StopButton => {
+            if let Some(link) = button {
+                link.stop_request.signal(());
+            }
+        }
         Step::WaitMs(ms) => Timer::after_millis(ms).await,
         Step::Send(line) => {
             type_line(host, &line).await;
@@ -113,10 +120,11 @@ async fn run_step(host: &UsbHost, step: Step) {
     }
 }
 
-/// Types the script: each command line, then waits for its closing reply.
-pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>) {
+/// Types the script: each command line, then waits for its closing reply;
+/// `@button` steps press the board's stop button (`link`'s stop request).
+pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, link: &CommandLink) {
     for step in steps {
-        run_step(&host, step).await;
+        run_step(&host, step, Some(link)).await;
     }
     host.replies_read().await;
     host.transcript.borrow_mut().script_done = true;
@@ -130,7 +138,7 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
         match lines.try_recv() {
             Ok(line) => {
                 for step in crate::script::parse_script(&line).unwrap_or_default() {
-                    run_step(&host, step).await;
+                    run_step(&host, step, None).await;
                 }
             }
             Err(std::sync::mpsc::TryRecvError::Empty) => Timer::after_millis(20).await,
@@ -241,7 +249,8 @@ mod tests {
             false,
             10_000_000,
             move |spawner| {
-                executor::spawn(&spawner, script_task(steps, h1));
+                let link: &'static CommandLink = Box::leak(Box::new(CommandLink::new()));
+                executor::spawn(&spawner, script_task(steps, h1, link));
                 executor::spawn(&spawner, terminal_task(h2));
                 executor::spawn(&spawner, echo_ok_device(h3));
             },

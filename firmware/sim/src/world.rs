@@ -11,18 +11,21 @@ use std::sync::atomic::Ordering;
 
 use laser_app::command::CommandLink;
 use laser_app::galvo::{GalvoConfig, GalvoLink, GalvoLoop};
-use laser_app::sequencer::{Sequencer, SettingsStore};
+use laser_app::sequencer::{LaserEvent, LaserSwitch, Sequencer, SettingsStore};
 use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::status::{Activity, Phase, StatusBoard};
 use sequential_storage::map::MapConfig;
 
 use crate::dac::{DacRecording, SimDac};
+use crate::executor::TaskKind;
 use crate::executor::{self, RunEnd};
 use crate::flash::{FlashStats, FlashTiming, PowerCut, SimFlash};
 use crate::laser::{GatedLaserPin, recorded_gate};
 use crate::physics::PhysicalGimbal;
-use crate::recorder::{DwellRecord, Recording, SpotSample};
+use crate::recorder::{
+    DwellRecord, EventRecord, Recording, SequencerEvent, ServoSample, ServoState, SpotSample,
+};
 use crate::script::Step;
 use crate::servo_model::SimServoBus;
 use crate::servo_port::{BusFaults, PortHandle, SimServoPort};
@@ -147,6 +150,8 @@ pub struct SimReport {
     pub dac: DacRecording,
     /// Galvo underruns.
     pub galvo_underruns: u32,
+    /// CPU-time accounting of every task's steps (polls).
+    pub task_steps: Vec<executor::TaskSteps>,
 }
 
 impl SimReport {
@@ -157,6 +162,78 @@ impl SimReport {
             && self.transcript.script_done
             && self.idle_at_end
             && (allow_errors || self.transcript.error_replies == 0)
+    }
+}
+
+/// The gimbal laser output: the gated pin (which records the effective
+/// laser), plus every sequencer event with its time and the servos' true
+/// state at each switch and event (for the safety checker).
+struct RecordingLaser {
+    /// The gated pin that records the effective gimbal laser.
+    pin: GatedLaserPin,
+    recording: Rc<RefCell<Recording>>,
+    bus: Rc<RefCell<SimServoBus>>,
+    gimbal: PhysicalGimbal,
+}
+
+impl RecordingLaser {
+    fn record_servos(&self, rec: &mut Recording, t_us: u64) {
+        let laser = rec.laser_at(t_us);
+        rec.servos
+            .push(servo_sample(&self.bus.borrow(), self.gimbal, t_us, laser));
+    }
+}
+
+impl LaserSwitch for RecordingLaser {
+    fn set(&mut self, on: bool) {
+        self.pin.set(on);
+        crate::executor::simulator_work(|| {
+            let t = crate::clock::now_us();
+            let mut rec = self.recording.borrow_mut();
+            self.record_servos(&mut rec, t);
+        });
+    }
+
+    fn note(&mut self, event: LaserEvent<'_>) {
+        crate::executor::simulator_work(|| self.record_event(event));
+    }
+}
+
+impl RecordingLaser {
+    fn record_event(&self, event: LaserEvent<'_>) {
+        let t_us = crate::clock::now_us();
+        let event = match event {
+            LaserEvent::Stopped { why } => SequencerEvent::Stopped {
+                why: why.to_owned(),
+            },
+            LaserEvent::RunStarted => SequencerEvent::RunStarted,
+            LaserEvent::GimbalMoveSent => SequencerEvent::GimbalMoveSent,
+            LaserEvent::GimbalArrived => SequencerEvent::GimbalArrived,
+        };
+        let mut rec = self.recording.borrow_mut();
+        let laser_switches_before = rec.laser_events.len();
+        rec.events.push(EventRecord {
+            t_us,
+            event,
+            laser_switches_before,
+        });
+        self.record_servos(&mut rec, t_us);
+    }
+}
+
+/// The gimbal servos' true angles and targets at `t_us`.
+fn servo_sample(bus: &SimServoBus, gimbal: PhysicalGimbal, t_us: u64, laser: bool) -> ServoSample {
+    let state = |id| {
+        bus.servo(id).map(|s| ServoState {
+            angle_deg: s.angle_deg(t_us),
+            target_deg: f64::from(s.target_tenths()) / 10.0,
+        })
+    };
+    ServoSample {
+        t_us,
+        yaw: state(gimbal.yaw_id),
+        pitch: state(gimbal.pitch_id),
+        laser,
     }
 }
 
@@ -210,7 +287,7 @@ pub fn run(options: SimOptions) -> SimReport {
             options.max_time_ms * 1000,
             move |spawner| {
                 let console_host = host.clone();
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "console", TaskKind::Firmware, async move {
                     let mut rx = &console_host.to_device;
                     let mut tx = &console_host.from_device;
                     laser_app::usb::run_console(&mut rx, &mut tx, link).await;
@@ -224,13 +301,28 @@ pub fn run(options: SimOptions) -> SimReport {
                             }
                         }
                     });
-                    executor::spawn(&spawner, interactive_task(lines, host.clone()));
+                    executor::spawn_task(
+                        &spawner,
+                        "host (interactive)",
+                        TaskKind::Simulator,
+                        interactive_task(lines, host.clone()),
+                    );
                 } else {
-                    executor::spawn(&spawner, script_task(script, host.clone()));
+                    executor::spawn_task(
+                        &spawner,
+                        "host (script)",
+                        TaskKind::Simulator,
+                        script_task(script, host.clone(), link),
+                    );
                 }
-                executor::spawn(&spawner, terminal_task(host.clone()));
+                executor::spawn_task(
+                    &spawner,
+                    "host (terminal)",
+                    TaskKind::Simulator,
+                    terminal_task(host.clone()),
+                );
                 let servo_port = port.clone();
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "servo", TaskKind::Firmware, async move {
                     ServoBus::new(
                         PortHandle(servo_port.clone()),
                         PortHandle(servo_port),
@@ -240,12 +332,17 @@ pub fn run(options: SimOptions) -> SimReport {
                     .await;
                 });
                 let spot_bus = bus.clone();
-                let laser = GatedLaserPin::new(
-                    recording.clone(),
-                    Box::new(move |t_us| gimbal_spot_cm(&spot_bus, gimbal, t_us)),
-                );
+                let laser = RecordingLaser {
+                    pin: GatedLaserPin::new(
+                        recording.clone(),
+                        Box::new(move |t_us| gimbal_spot_cm(&spot_bus, gimbal, t_us)),
+                    ),
+                    recording: recording.clone(),
+                    bus: bus.clone(),
+                    gimbal,
+                };
                 let store = settings_store(flash.clone());
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "sequencer", TaskKind::Firmware, async move {
                     let mut sequencer = Sequencer::new(
                         link,
                         servo_link,
@@ -259,7 +356,7 @@ pub fn run(options: SimOptions) -> SimReport {
                     sequencer.run().await;
                 });
                 let (dac_recording, cost) = (galvo_dac, options.galvo_cost_ns_per_sample);
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "galvo", TaskKind::Firmware, async move {
                     let config = GalvoConfig::default();
                     let mut dac = SimDac::new(
                         GALVO_HALF_LEN,
@@ -272,8 +369,10 @@ pub fn run(options: SimOptions) -> SimReport {
                         Err(e) => log::error!("galvo loop not started: {e}"),
                     }
                 });
-                executor::spawn(
+                executor::spawn_task(
                     &spawner,
+                    "spot sampler",
+                    TaskKind::Simulator,
                     spot_sampler(
                         bus.clone(),
                         recording.clone(),
@@ -322,6 +421,7 @@ pub fn run(options: SimOptions) -> SimReport {
         settings_flash_stats,
         dac,
         galvo_underruns: galvo_link.underruns.load(Ordering::Relaxed),
+        task_steps: executor::task_steps(),
     }
 }
 
@@ -376,6 +476,8 @@ async fn spot_sampler(
         {
             let mut rec = recording.borrow_mut();
             let laser = rec.laser_at(t_us);
+            rec.servos
+                .push(servo_sample(&bus.borrow(), gimbal, t_us, laser));
             if let Some((x_cm, y_cm)) = spot {
                 rec.spot.push(SpotSample {
                     t_us,

@@ -8,6 +8,33 @@ use crate::status::Phase;
 pub trait LaserSwitch {
     /// Turns the laser on or off.
     fn set(&mut self, on: bool);
+
+    /// Told when the sequencer processes an event that decides whether a
+    /// laser may be lit ([`LaserEvent`]). Only for recorders: the
+    /// simulator timestamps these for its safety checker. The default
+    /// (the target's pin) ignores them; it never changes what the
+    /// firmware does.
+    fn note(&mut self, _event: LaserEvent<'_>) {}
+}
+
+/// Sequencer events that decide when a laser may be lit (see
+/// [`LaserSwitch::note`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LaserEvent<'a> {
+    /// The sequencer stopped (`stop` command, stop button, servo fault,
+    /// galvo underrun, actuator change, pattern complete, …): every laser
+    /// must be dark from now on. `why` is the reason as logged.
+    Stopped {
+        /// Why, as in the log (`"stop command"`, `"servo fault"`, …).
+        why: &'a str,
+    },
+    /// A pattern or goto started (lights are allowed again, per the
+    /// laser mode).
+    RunStarted,
+    /// A servo move was sent: the gimbal has left its point.
+    GimbalMoveSent,
+    /// The servo task confirmed the gimbal's arrival at the current point.
+    GimbalArrived,
 }
 
 /// Whether the laser should be on, given the mode, the phase of the active

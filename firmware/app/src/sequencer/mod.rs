@@ -16,7 +16,7 @@ pub mod targets;
 use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
-pub use self::laser::{LaserSwitch, laser_wanted};
+pub use self::laser::{LaserEvent, LaserSwitch, laser_wanted};
 use self::targets::{Aim, PathCursor, Target};
 use crate::cli::format::Fixed;
 use crate::command::{Actuator, AimModel, CommandLink, Pattern};
@@ -229,6 +229,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     fn start(&mut self, mut run: Run) {
         let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
         log::info!("start {} (once={})", name, run.once);
+        self.laser.note(laser::LaserEvent::RunStarted);
         run.path = self.path_cursor(run.pattern);
         // Nothing of an earlier run may shine: a new gate generation, and
         // the galvo drops its points and an underrun latch.
@@ -241,6 +242,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     /// laser and the galvo loop: the gate closes at once and the loop gets
     /// `Stop`.
     fn stop(&mut self, why: &str) {
+        self.laser.note(laser::LaserEvent::Stopped { why });
         self.close_gate();
         if let Some(run) = self.run.take() {
             let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
@@ -366,6 +368,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         // Newest request wins: drop one the servo task has not taken yet.
         let _ = self.servo.requests.try_receive();
         let _ = self.servo.requests.try_send(request);
+        self.laser.note(laser::LaserEvent::GimbalMoveSent);
         log::info!(
             "target ({}, {}) cm -> servo {} {} (0.1 deg) over {} ms",
             target.point.x_cm,
@@ -412,6 +415,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                     return;
                 };
                 run.phase = Phase::Dwelling;
+                self.laser.note(laser::LaserEvent::GimbalArrived);
                 let dwell = if run.pattern.is_some_and(|p| p.is_path()) {
                     0.0
                 } else {
