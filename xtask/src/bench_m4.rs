@@ -623,17 +623,22 @@ mod tests {
         let r = parse(&out).unwrap();
         let err = check(&r).unwrap_err().to_string();
         assert!(err.contains("loop.holding.refill"), "{err}");
-        // A budget not yet met is reported, not failed.
-        let steady = OUT.replace(
+        // Holding per sample is enforced too: 1000 ticks for 128 samples,
+        // 312.5 instructions (2.4 µs) each, over its 0.5 µs.
+        let holding = OUT.replace(
             "bench loop.holding.steady 40 128",
             "bench loop.holding.steady 1000 128",
         );
-        let r = parse(&steady).unwrap();
-        let m = r
-            .rows
-            .iter()
-            .find(|m| m.id == "loop.holding.steady")
-            .unwrap();
+        let err = check(&parse(&holding).unwrap()).unwrap_err().to_string();
+        assert!(err.contains("loop.holding.steady"), "{err}");
+        // A budget not yet met is reported, not failed: 1000 ticks for 40
+        // jump samples, 1000 instructions (7.7 µs) each, over its 1 µs.
+        let jumping = OUT.replace(
+            "bench loop.jump.steady 10 40",
+            "bench loop.jump.steady 1000 40",
+        );
+        let r = parse(&jumping).unwrap();
+        let m = r.rows.iter().find(|m| m.id == "loop.jump.steady").unwrap();
         assert!(m.share.unwrap() > 1.0 && !m.over_budget);
         assert!(
             m.status
