@@ -1,7 +1,10 @@
 //! Link setup for the MPS2 AN386 board: this crate's `memory.x` for
 //! cortex-m-rt's `link.x`, and an empty `defmt.x` because the workspace's
 //! `.cargo/config.toml` passes `-Tdefmt.x` for every thumbv7em binary and
-//! the bench does not use defmt.
+//! the bench does not use defmt. (The linker and flip-link look in the
+//! current directory before the search path; cargo links this crate, a
+//! workspace of its own, in its directory, so they find this `memory.x`
+//! there too, not the workspace root's STM32F407 one.)
 use std::{env, fs, path::PathBuf};
 
 fn main() {

@@ -89,25 +89,27 @@ fn package_args<'a>(packages: &[&'a str]) -> Vec<&'a str> {
 pub fn test() -> Result<()> {
     ensure_toolchain()?;
     run("cargo", &["fmt", "--all", "--check"])?;
+    crate::bench_m4::cargo(&["fmt", "--check"])?;
 
     let mut clippy_host = vec!["clippy", "--all-targets"];
     clippy_host.extend(package_args(&HOST_PACKAGES));
     clippy_host.extend(["--", "-D", "warnings"]);
     run("cargo", &clippy_host)?;
 
-    let mut clippy_target = vec![
+    let mut clippy_target = vec!["clippy", "--target", TARGET, "--release", "-p", "firmware"];
+    clippy_target.extend(package_args(&TARGET_LIBRARIES));
+    clippy_target.extend(["--", "-D", "warnings"]);
+    run("cargo", &clippy_target)?;
+    // bench-m4 is a workspace of its own (see its Cargo.toml).
+    crate::bench_m4::cargo(&[
         "clippy",
         "--target",
         TARGET,
         "--release",
-        "-p",
-        "firmware",
-        "-p",
-        "bench-m4",
-    ];
-    clippy_target.extend(package_args(&TARGET_LIBRARIES));
-    clippy_target.extend(["--", "-D", "warnings"]);
-    run("cargo", &clippy_target)?;
+        "--",
+        "-D",
+        "warnings",
+    ])?;
 
     // The libraries for the target, laser-app with its galvo output (the
     // firmware leaves that out for now, the target build must not rot).

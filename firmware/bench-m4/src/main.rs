@@ -457,6 +457,14 @@ mod heapless_name {
     }
 }
 
+/// `DacStream::holds` as the simulated DAC answers it (firmware/sim's
+/// `dac.rs`; the target's DAC driver is not written yet): both halves hold
+/// nothing but `sample`.
+#[inline(never)]
+fn dac_holds(buffers: &[[DacSample; HALF]; 2], sample: DacSample) -> bool {
+    buffers.iter().all(|h| h.iter().all(|s| *s == sample))
+}
+
 /// The galvo loop's half-buffer fills: holding, marking a line, marking a
 /// circle (r = 40 mm), jumping; `GalvoLoop::new`.
 fn loop_halves(b: &mut Bench) {
@@ -469,16 +477,45 @@ fn loop_halves(b: &mut Bench) {
     };
     let mut half = [DacSample::default(); HALF];
 
-    // Holding.
-    for _ in 0..4 {
-        galvo.fill(&mut half, |_| {});
-    }
+    // Holding, as `GalvoLoop::run` does it. The first two halves after the
+    // loop goes idle are filled: one hold sample computed and copied into
+    // the half (`loop.holding.refill`, the dearest holding half). From then
+    // on both DAC halves hold it and every wake-up only computes the hold
+    // sample and asks the DAC whether both halves hold it, then writes
+    // nothing (`loop.holding.steady`, per sample of the half).
     let mut worst = 0u32;
     for _ in 0..16 {
-        worst = worst.max(window(|| galvo.fill(&mut half, |_| {})));
+        let mut computed = 0;
+        worst = worst.max(window(|| computed = galvo.fill(&mut half, |_| {})));
+        if computed != 1 {
+            return b.fail("loop.holding.refill", ("computed", computed));
+        }
+    }
+    b.report("loop.holding.refill", worst, 1);
+    // The DAC's double buffer after those two halves.
+    let buffers = [half, half];
+    let mut worst = 0u32;
+    for _ in 0..16 {
+        let mut repeated = false;
+        worst = worst.max(window(|| {
+            repeated = galvo
+                .hold_sample()
+                .is_some_and(|hold| dac_holds(black_box(&buffers), hold));
+        }));
+        if !repeated {
+            return b.fail(
+                "loop.holding.steady",
+                "the DAC does not hold the hold sample",
+            );
+        }
     }
     b.report("loop.holding.steady", worst, HALF as u32);
-    b.report("loop.holding.refill", worst, 1);
+    let ticks = window(|| {
+        for _ in 0..64 {
+            black_box(galvo.hold_sample());
+        }
+    });
+    b.report("loop.hold_sample", ticks, 64);
 
     // Marking: first go to the stroke start (not measured), so the job's
     // own jump is zero-length and its halves hold marking only.
