@@ -41,3 +41,44 @@ fn a_galvo_jump_is_planned_without_holding_the_executor_at_any_sample_period() {
         worst.1
     );
 }
+
+#[test]
+fn laser_off_darkens_the_galvo_at_once_at_any_sample_period() {
+    // `laser off` used to reach only the halves computed after it: the
+    // two already handed to the DAC and the one waiting for its slot kept
+    // the galvo lit for up to three half buffers (2.7 ms at 10 µs per
+    // sample, 31 ms at 100 µs, 324 ms at 1 ms). The mirrors still draw,
+    // dark; `laser auto` lights the run again.
+    for ts_us in [10, 100, 1000] {
+        let script = format!(
+            "target galvo\nset galvo.ts_us {ts_us}\nset dwell_ms 2000\npattern corner once\n\
+             wait 700\nlaser off\nwait 1000\nlaser auto\nwait 3000\nstop\n"
+        );
+        let report = run_with(&script, SimOptions::default());
+        assert!(report.succeeded(false), "{:?}", report.transcript);
+        let off_ns = system_tests::sent_at(&report, "laser off") * 1000;
+        let auto_ns = system_tests::sent_at(&report, "laser auto") * 1000;
+        let lit: Vec<u64> = report
+            .dac
+            .iter()
+            .filter(|(_, s)| s.laser)
+            .map(|(t, _)| t)
+            .collect();
+        assert!(lit.iter().any(|&t| t < off_ns), "ts {ts_us}: lit before");
+        let late: Vec<u64> = lit
+            .iter()
+            .filter(|&&t| t >= off_ns && t < auto_ns)
+            .map(|t| (t - off_ns) / 1000)
+            .collect();
+        assert!(
+            late.is_empty(),
+            "ts {ts_us} µs: {} lit samples after `laser off`, the last {} µs after it",
+            late.len(),
+            late.last().unwrap_or(&0)
+        );
+        assert!(
+            lit.iter().any(|&t| t > auto_ns),
+            "ts {ts_us}: lit again after laser auto"
+        );
+    }
+}

@@ -142,10 +142,17 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     }
 
     /// Tells the galvo loop whether the laser mode lets it light (`laser
-    /// off`: it still moves, dark).
+    /// off`: it still moves, dark). `laser off` also shuts the gate, so
+    /// the halves the loop computed before it (up to three, 384 ms at
+    /// 1 ms per sample) go dark at once too; the run goes on and lights
+    /// again after `laser auto`.
     pub(super) fn allow_galvo_laser(&self) {
         if let Some(galvo) = self.galvo {
-            galvo.allow_laser(self.settings.laser_mode != LaserMode::Off);
+            let allowed = self.settings.laser_mode != LaserMode::Off;
+            galvo.allow_laser(allowed);
+            if !allowed {
+                self.gate.shut();
+            }
         }
     }
 
