@@ -82,3 +82,53 @@ fn laser_off_darkens_the_galvo_at_once_at_any_sample_period() {
         );
     }
 }
+
+#[test]
+fn laser_dwell_keeps_galvo_marking_dark_like_the_gimbal() {
+    // `laser dwell` = lit only while dwelling. The gimbal draws a circle
+    // dark in that mode; the galvo used to mark it lit (32 831 lit
+    // samples for `pattern circle 0 0 5 once`), also after `laser dwell`
+    // was typed mid-path.
+    let report = run_with(
+        "target galvo\nlaser dwell\npattern circle 0 0 5 once\nwait 1000\n",
+        SimOptions::default(),
+    );
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let lit = report.dac.iter().filter(|(_, s)| s.laser).count();
+    assert_eq!(lit, 0, "lit samples marking a circle in laser dwell mode");
+
+    for ts_us in [10, 1000] {
+        let report = run_with(
+            &format!(
+                "target galvo\nset galvo.ts_us {ts_us}\npattern circle 0 0 5\nwait 150\n\
+                 laser dwell\nwait 1000\nlaser auto\nwait 1000\nstop\n"
+            ),
+            SimOptions::default(),
+        );
+        assert!(report.succeeded(false), "{:?}", report.transcript);
+        let dwell_ns = system_tests::sent_at(&report, "laser dwell") * 1000;
+        let auto_ns = system_tests::sent_at(&report, "laser auto") * 1000;
+        let lit: Vec<u64> = report
+            .dac
+            .iter()
+            .filter(|(_, s)| s.laser)
+            .map(|(t, _)| t)
+            .collect();
+        assert!(lit.iter().any(|&t| t < dwell_ns), "ts {ts_us}: lit before");
+        let late = lit
+            .iter()
+            .filter(|&&t| t >= dwell_ns && t < auto_ns)
+            .count();
+        assert_eq!(late, 0, "ts {ts_us} µs: lit samples after `laser dwell`");
+        assert!(lit.iter().any(|&t| t > auto_ns), "ts {ts_us}: lit again");
+    }
+
+    // Grid points still light while dwelling.
+    let report = run_with(
+        "target galvo\nlaser dwell\nset dwell_ms 20\npattern corner once\nwait 200\n",
+        SimOptions::default(),
+    );
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let lit = report.dac.iter().filter(|(_, s)| s.laser).count();
+    assert_eq!(lit, 4 * 2000, "four 20 ms dwells lit");
+}
