@@ -133,6 +133,33 @@ impl LaserGate {
         }
     }
 
+    /// Closes the gate at once without ending the generation: the laser
+    /// goes dark now (samples already handed to the DAC included), but the
+    /// run goes on and may [`open`](Self::open) it again under the same
+    /// generation (`laser off` mid-run: the mirrors still draw, dark, and
+    /// `laser auto` lights them again). Returns the generation.
+    pub fn shut(&self) -> u32 {
+        let mut current = self.state.load(Ordering::Acquire);
+        loop {
+            let next = GateState {
+                generation: GateState::unpack(current).generation,
+                open: false,
+            };
+            match self.state.compare_exchange_weak(
+                current,
+                next.pack(),
+                Ordering::AcqRel,
+                Ordering::Acquire,
+            ) {
+                Ok(_) => {
+                    (self.on_change)(next);
+                    return next.generation;
+                }
+                Err(seen) => current = seen,
+            }
+        }
+    }
+
     /// Opens the gate for a run that started under `generation`; refused
     /// (`false`, gate unchanged) when it was closed since. `true` when
     /// the gate is open for `generation` afterwards.
@@ -218,6 +245,24 @@ mod tests {
         // A refused open changes nothing and reports nothing.
         assert!(!gate.open(a));
         assert_eq!(CHANGES.load(Ordering::Relaxed), 3);
+    }
+
+    #[test]
+    fn shutting_darkens_now_and_the_same_run_may_open_again() {
+        let gate = LaserGate::new();
+        let g = gate.close();
+        assert!(gate.open(g));
+        assert!(gate.passes(true, g));
+        assert_eq!(gate.shut(), g, "the generation goes on");
+        assert!(!gate.is_open());
+        assert!(!gate.passes(true, g), "samples already out are dark");
+        assert!(gate.open(g), "the same run lights again");
+        assert!(gate.passes(true, g));
+        // A close after the shut still ends the run for good.
+        gate.shut();
+        let g2 = gate.close();
+        assert!(!gate.open(g));
+        assert!(gate.open(g2));
     }
 
     #[test]

@@ -34,7 +34,10 @@ use crate::outbound::{LineKind, OutLine, Outbound};
 /// at most for earlier output to reach the host, so a host that reads
 /// (even slowly) gets every line; after it the host counts as not reading
 /// and the command runs anyway (lines that do not fit are dropped and
-/// counted). Commands without data lines (`stop`, `goto`, …) never wait.
+/// counted). Commands without data lines (`stop`, `goto`, …) never wait,
+/// and once the host counts as not reading no command waits again until
+/// the queue has drained: the wait is paid once per stall, so lines typed
+/// behind many data commands (a `stop`) are not held back by each.
 pub const HOST_STALL: Duration = Duration::from_millis(250);
 
 /// Longest line on the wire without its line end: `error: ` + text, bytes.
@@ -73,6 +76,9 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
     out.wait_until(|o| !o.awaiting_close()).await;
     let mut assembler = LineAssembler::new();
     let mut chunk = [0u8; 64];
+    // The host let a `HOST_STALL` pass without reading, and the queue has
+    // not drained since.
+    let mut host_not_reading = false;
     loop {
         let n = match rx.read(&mut chunk).await {
             Ok(0) => return ConsoleEnd::EndOfInput,
@@ -88,15 +94,15 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
             out.wait_until(Outbound::has_closer_room).await;
             match line {
                 Err(e) => link.error(e),
-                Ok(line) => dispatch(line.as_str(), link).await,
+                Ok(line) => dispatch(line.as_str(), link, &mut host_not_reading).await,
             }
         }
     }
 }
 
 /// Parses one line and runs it; returns once its reply is closed (queued,
-/// not necessarily written).
-async fn dispatch(line: &str, link: &CommandLink) {
+/// not necessarily written). `host_not_reading`: see [`HOST_STALL`].
+async fn dispatch(line: &str, link: &CommandLink, host_not_reading: &mut bool) {
     let out = &link.outbound;
     let command = match parse_line(line) {
         Ok(Some(command)) => command,
@@ -106,10 +112,14 @@ async fn dispatch(line: &str, link: &CommandLink) {
             return link.error(e);
         }
     };
-    if command.replies_with_data() && out.queued_bytes() > 0 {
+    if out.queued_bytes() == 0 {
+        *host_not_reading = false;
+    }
+    if command.replies_with_data() && out.queued_bytes() > 0 && !*host_not_reading {
         let drained = with_timeout(HOST_STALL, out.wait_until(|o| o.queued_bytes() == 0)).await;
         if drained.is_err() {
             log::warning!("usb: host is not reading; replies may be dropped");
+            *host_not_reading = true;
         }
     }
     // No await between marking and sending: a console cancelled by a

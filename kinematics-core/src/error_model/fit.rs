@@ -16,6 +16,14 @@ use crate::error::{Error, finite};
 /// determine the quadratic.
 const RANK_TOL: f64 = 1e-9;
 
+/// Smallest spread of the measured points (largest distance of a point
+/// from their centroid along x or y), mm, that can determine a quadratic.
+/// Closer together they are one spot for any real measurement (a board is
+/// measured to ~0.1 mm), and the fit's scale-free rank check would pass:
+/// its rounding noise, divided by the spread squared, came out as
+/// curvature that moved the spot by tens of mm at the grid corners.
+pub const MIN_SPREAD_MM: f64 = 1.0;
+
 /// One measurement: commanded position and the error observed there (mm).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MeasuredPoint {
@@ -188,7 +196,8 @@ pub fn sse_of(model: &Quadratic, points: &[MeasuredPoint], axis: usize) -> Resul
 /// Fits the error quadratics of both axes to `points` by least squares.
 ///
 /// Needs at least 6 points that determine a quadratic: not all on one line
-/// (or repeated), not all on one conic.
+/// (or repeated), not all on one conic, and spread over at least
+/// [`MIN_SPREAD_MM`] (not one spot measured many times).
 ///
 /// Every position and error must be within ±[`MAX_MEASURED_MM`] (10 m).
 /// The reported SSE, R² and RMSE are those of the returned raw
@@ -222,7 +231,7 @@ pub fn fit(points: &[MeasuredPoint]) -> Result<FitReport, Error> {
         .iter()
         .map(|p| (p.x_mm - cx).abs().max((p.y_mm - cy).abs()))
         .fold(0.0, f64::max);
-    if scale <= 0.0 || !scale.is_finite() {
+    if !scale.is_finite() || scale < MIN_SPREAD_MM {
         return Err(Error::DegeneratePoints);
     }
     let norm = Normalisation {
@@ -259,7 +268,15 @@ pub fn fit(points: &[MeasuredPoint]) -> Result<FitReport, Error> {
                 what: "fit residual",
             });
         }
-        let r2 = if sst > 0.0 {
+        // The mean's own rounding leaves an SST of about n·(n·ε·|d|)² when
+        // every error is the same: below that the data has no variance
+        // and 1 − SSE/SST would be a ratio of two rounding noises.
+        let largest = points
+            .iter()
+            .map(|p| if k == 0 { p.dx_mm } else { p.dy_mm }.abs())
+            .fold(0.0, f64::max);
+        let rounding = nf * f64::EPSILON * largest;
+        let r2 = if sst > nf * rounding * rounding {
             (1.0 - sse / sst).min(1.0)
         } else {
             1.0
@@ -407,6 +424,49 @@ mod tests {
         let mut bad = line.clone();
         bad[3].dy_mm = f64::NAN;
         assert_eq!(fit(&bad), Err(Error::NonFinite { what: "dy_mm" }));
+    }
+
+    #[test]
+    fn points_on_a_nanometre_patch_are_degenerate_not_a_board_wide_model() {
+        // The SPEC grid shrunk to a 0.2 µm patch, constant error: one spot
+        // measured 117 times. The normalised fit's rounding noise, divided
+        // by the patch size squared, used to come out as curvature that
+        // moved the spot by tens of mm at the grid corners.
+        let pts = grid(
+            (-6..=6).map(|i| f64::from(i) * 19.16e-9),
+            (-4..=4).map(|i| f64::from(i) * 19.16e-9),
+            |_, _| 0.1,
+            |_, _| -0.2,
+        );
+        assert_eq!(fit(&pts), Err(Error::DegeneratePoints));
+        // Spread over a millimetre it is a (well-determined) fit.
+        let q = Quadratic::new([0.1, 1e-3, -2e-3, 3e-4, 1e-4, -2e-4]);
+        let pts = grid(
+            (-6..=6).map(|i| 5.0 + f64::from(i) / 6.0),
+            (-4..=4).map(|i| 5.0 + f64::from(i) / 4.0),
+            |x, y| q.value(x, y),
+            |_, _| 0.0,
+        );
+        let fit = fit(&pts).unwrap();
+        for (a, b) in fit.dx.coef.iter().zip(q.coef.iter()) {
+            assert!((a - b).abs() < 1e-9, "{:?}", fit.dx.coef);
+        }
+    }
+
+    #[test]
+    fn a_constant_error_is_a_perfect_fit_whatever_the_rounding_of_its_mean() {
+        // dx = 0.1 mm everywhere: SST is rounding noise (~1e-30 mm²), and
+        // 1 − SSE/SST of two rounding noises used to report R² = 0.74.
+        let pts = grid(
+            (-6..=6).map(|i| f64::from(i) * 19.16 * 50.0),
+            (-4..=4).map(|i| f64::from(i) * 19.16 * 50.0),
+            |_, _| 0.1,
+            |x, _| 1e-3 * x,
+        );
+        let fit = fit(&pts).unwrap();
+        assert_eq!(fit.dx.r2, 1.0, "{:?}", fit.dx);
+        assert!(fit.dx.sse < 1e-20);
+        assert!((fit.dy.r2 - 1.0).abs() < 1e-12);
     }
 
     #[test]

@@ -57,6 +57,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     /// Sends the current grid or goto point to the galvo (board cm →
     /// galvo mm). Paths go whole, through [`Self::begin_galvo_path`].
     pub(super) fn begin_galvo_point(&mut self, target: Target) -> bool {
+        self.allow_galvo_laser();
         let Some(run) = self.run else { return false };
         let dwell_us = match run.pattern {
             None => HOLD_US,
@@ -81,6 +82,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
 
     /// Sends the running path pattern to the galvo as one job.
     pub(super) fn begin_galvo_path(&mut self) {
+        self.allow_galvo_laser();
         let path = self
             .run
             .and_then(|r| r.pattern)
@@ -142,10 +144,26 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     }
 
     /// Tells the galvo loop whether the laser mode lets it light (`laser
-    /// off`: it still moves, dark).
+    /// off`: it still moves, dark). `laser off` also shuts the gate, so
+    /// the halves the loop computed before it (up to three, 384 ms at
+    /// 1 ms per sample) go dark at once too; the run goes on and lights
+    /// again after `laser auto`.
+    /// `laser dwell` lights only dwells: a marked path (which has none)
+    /// stays dark, like the gimbal's.
     pub(super) fn allow_galvo_laser(&self) {
         if let Some(galvo) = self.galvo {
-            galvo.allow_laser(self.settings.laser_mode != LaserMode::Off);
+            let marking = self
+                .run
+                .is_some_and(|r| r.pattern.is_some_and(|p| p.is_path()));
+            let allowed = match self.settings.laser_mode {
+                LaserMode::Off => false,
+                LaserMode::Dwell => !marking,
+                LaserMode::Auto => true,
+            };
+            galvo.allow_laser(allowed);
+            if !allowed {
+                self.gate.shut();
+            }
         }
     }
 
