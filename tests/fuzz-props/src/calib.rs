@@ -1,0 +1,121 @@
+//! The calibration CSV reader of `cargo xtask calib fit`
+//! (`xtask::calib_csv::read_points`).
+//!
+//! Properties:
+//! * nothing panics, whatever the bytes;
+//! * every accepted row is finite and within ±[`VALUE_LIMIT_MM`] in every
+//!   column, and there are no more rows than lines;
+//! * accepted rows, written back as CSV, read back bit for bit;
+//! * a refused input gets an error that starts `line N: ` with N a line
+//!   of the input, and an error quoting a field names a line holding it.
+
+use kinematics_core::MeasuredPoint;
+use xtask::calib_csv::{VALUE_LIMIT_MM, read_points};
+
+/// What one input exercised.
+#[derive(Debug, Default)]
+pub struct Summary {
+    /// Rows accepted (0 when refused).
+    pub rows: usize,
+    /// The error, when refused.
+    pub error: Option<String>,
+}
+
+/// Runs the CSV reader properties on `data`; panics when one fails.
+pub fn check(data: &[u8]) -> Summary {
+    let lines = 1 + data.iter().filter(|&&b| b == b'\n').count();
+    match read_points(data) {
+        Ok(points) => {
+            assert!(
+                points.len() < lines,
+                "{} rows from {lines} lines",
+                points.len()
+            );
+            for p in &points {
+                for v in columns(p) {
+                    assert!(
+                        v.is_finite() && v.abs() <= VALUE_LIMIT_MM,
+                        "accepted value {v} in {p:?}"
+                    );
+                }
+            }
+            let mut text = String::from("x,y,dx,dy\n");
+            for p in &points {
+                let [x, y, dx, dy] = columns(p);
+                text.push_str(&format!("{x},{y},{dx},{dy}\n"));
+            }
+            let again = read_points(text.as_bytes())
+                .unwrap_or_else(|e| panic!("accepted rows written back are refused: {e}"));
+            let bits = |ps: &[MeasuredPoint]| -> Vec<[u64; 4]> {
+                ps.iter().map(|p| columns(p).map(f64::to_bits)).collect()
+            };
+            assert_eq!(bits(&again), bits(&points), "rows do not read back");
+            Summary {
+                rows: points.len(),
+                error: None,
+            }
+        }
+        Err(error) => {
+            let line = named_line(&error)
+                .unwrap_or_else(|| panic!("error {error:?} does not start `line N: `"));
+            assert!(
+                (1..=lines).contains(&line),
+                "error {error:?} names line {line} of {lines}"
+            );
+            if let Some(quoted) = quoted_field(&error) {
+                let text = String::from_utf8_lossy(data);
+                let held = text.split('\n').nth(line - 1).unwrap_or("");
+                assert!(
+                    held.contains(quoted),
+                    "error {error:?}: line {line} is {held:?}"
+                );
+            }
+            Summary {
+                rows: 0,
+                error: Some(error),
+            }
+        }
+    }
+}
+
+fn columns(p: &MeasuredPoint) -> [f64; 4] {
+    [p.x_mm, p.y_mm, p.dx_mm, p.dy_mm]
+}
+
+/// N of an error `line N: …`.
+fn named_line(error: &str) -> Option<usize> {
+    let rest = error.strip_prefix("line ")?;
+    let (number, _) = rest.split_once(": ")?;
+    number.parse().ok()
+}
+
+/// The field an error quotes as `` `text` ``, when it is one plain line of
+/// the input (no CSV quoting, which changes the text).
+fn quoted_field(error: &str) -> Option<&str> {
+    let (_, rest) = error.split_once("column ")?;
+    let (_, rest) = rest.split_once('`')?;
+    let (field, _) = rest.split_once('`')?;
+    (!field.contains(['"', '\n', '\r'])).then_some(field)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn accepted_and_refused_inputs_are_summarised() {
+        let ok = check(b"x,y,dx,dy\n0,0,0.5,-0.25\n10,-10,1e-3,0\n");
+        assert_eq!((ok.rows, ok.error), (2, None));
+        let bad = check(b"x,y,dx,dy\n0,0,0,0\n\n1,2,zz,4\n");
+        assert_eq!(
+            bad.error.as_deref(),
+            Some("line 4: column dx: `zz` is not a number")
+        );
+        assert_eq!(named_line("line 12: x"), Some(12));
+        assert_eq!(named_line("no line"), None);
+        assert_eq!(
+            quoted_field("line 2: column x: `1e400` is not"),
+            Some("1e400")
+        );
+    }
+}

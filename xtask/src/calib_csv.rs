@@ -1,0 +1,101 @@
+//! The calibration CSV reader of `cargo xtask calib fit` (SPEC §5): the
+//! measured points, header exactly `x,y,dx,dy`, all mm.
+
+use std::io::Read;
+
+use kinematics_core::MeasuredPoint;
+
+/// Column names, in order.
+pub const HEADER: [&str; 4] = ["x", "y", "dx", "dy"];
+/// Largest |value| accepted in any column, mm (10 m: far beyond any board
+/// or error the fit is for; larger values only lose the fit's precision).
+pub const VALUE_LIMIT_MM: f64 = 10_000.0;
+
+/// Parses the measured points. The header must be `x,y,dx,dy`; fields may
+/// be padded with spaces; blank lines and lines starting with `#` are
+/// skipped; every value must be finite and within ±[`VALUE_LIMIT_MM`].
+/// Errors name the 1-based line.
+pub fn read_points(mut input: impl Read) -> Result<Vec<MeasuredPoint>, String> {
+    let mut bytes = Vec::new();
+    input
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("cannot read: {e}"))?;
+    // 1-based line where the record at `pos` starts. csv positions a record
+    // at the blank or comment lines it skipped before it, so skip those too.
+    let line_of = |pos: &csv::Position| {
+        let mut at = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
+        loop {
+            match bytes.get(at) {
+                Some(b'\n' | b'\r') => at += 1,
+                Some(b'#') => {
+                    let rest = bytes.get(at..).unwrap_or_default();
+                    at += rest
+                        .iter()
+                        .position(|&b| b == b'\n')
+                        .map_or(rest.len(), |i| i + 1);
+                }
+                _ => break,
+            }
+        }
+        1 + bytes.iter().take(at).filter(|&&b| b == b'\n').count()
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .comment(Some(b'#'))
+        .from_reader(bytes.as_slice());
+    let mut points = Vec::new();
+    let mut header_seen = false;
+    for record in reader.records() {
+        let record = record.map_err(|e| match e.position() {
+            Some(pos) => format!("line {}: {e}", line_of(pos)),
+            None => e.to_string(),
+        })?;
+        let line = record.position().map_or(0, line_of);
+        if !header_seen {
+            if record.iter().ne(HEADER) {
+                let found: Vec<&str> = record.iter().collect();
+                return Err(format!(
+                    "line {line}: header must be exactly `x,y,dx,dy`, found `{}`",
+                    found.join(",")
+                ));
+            }
+            header_seen = true;
+            continue;
+        }
+        if record.len() != HEADER.len() {
+            return Err(format!(
+                "line {line}: expected 4 fields (x,y,dx,dy), found {}",
+                record.len()
+            ));
+        }
+        let mut v = [0.0; 4];
+        for ((slot, text), name) in v.iter_mut().zip(record.iter()).zip(HEADER) {
+            *slot = text
+                .parse::<f64>()
+                .map_err(|_| format!("line {line}: column {name}: `{text}` is not a number"))?;
+            if !slot.is_finite() {
+                return Err(format!(
+                    "line {line}: column {name}: `{text}` is not a finite number"
+                ));
+            }
+            if slot.abs() > VALUE_LIMIT_MM {
+                return Err(format!(
+                    "line {line}: column {name}: `{text}` mm is outside +-{VALUE_LIMIT_MM} mm"
+                ));
+            }
+        }
+        let [x_mm, y_mm, dx_mm, dy_mm] = v;
+        points.push(MeasuredPoint {
+            x_mm,
+            y_mm,
+            dx_mm,
+            dy_mm,
+        });
+    }
+    if !header_seen {
+        return Err("line 1: empty file, expected the header `x,y,dx,dy`".into());
+    }
+    Ok(points)
+}
