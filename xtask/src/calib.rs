@@ -17,7 +17,7 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use kinematics_core::{AxisFit, FitReport, MeasuredPoint, fit};
+use kinematics_core::{AxisFit, FitReport, fit};
 use serde::Serialize;
 
 use crate::kin::error_json;
@@ -187,6 +187,7 @@ fn axis_summary(axis: &str, f: &AxisFit) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use kinematics_core::MeasuredPoint;
 
     /// Known quadratic behind `kinematics-core/tests/data/quadratic_noise.csv`
     /// (11 × 11 grid over ±100 mm, Gaussian noise σ = 0.02 mm; see

@@ -99,3 +99,23 @@ pub fn read_points(mut input: impl Read) -> Result<Vec<MeasuredPoint>, String> {
     }
     Ok(points)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_beyond_ten_metres_are_refused_naming_the_line() {
+        let err = |csv: &str| read_points(csv.as_bytes()).unwrap_err();
+        assert_eq!(
+            err("x,y,dx,dy\n0,0,0,0\n1e308,0,0,0\n"),
+            "line 3: column x: `1e308` mm is outside +-10000 mm"
+        );
+        assert_eq!(
+            err("x,y,dx,dy\n0,-10000.001,0,0\n"),
+            "line 2: column y: `-10000.001` mm is outside +-10000 mm"
+        );
+        let edge = read_points("x,y,dx,dy\n10000,-10000,0.5,-0.5\n".as_bytes()).unwrap();
+        assert_eq!(edge[0].x_mm, VALUE_LIMIT_MM);
+    }
+}

@@ -2,6 +2,7 @@
 //! testing, flashing and simulating, plus the geometry and planning tools.
 
 mod calib;
+mod fuzz;
 mod kin;
 mod plan;
 mod sim;
@@ -36,6 +37,9 @@ enum Command {
     Calib(calib::CalibArgs),
     /// Galvo jump planning: `plan jump …`, `plan compare`.
     Plan(plan::PlanArgs),
+    /// Run the cargo-fuzz targets (nightly; installed when missing) and
+    /// merge new inputs into tests/fuzz/corpus.
+    Fuzz(fuzz::FuzzArgs),
 }
 
 fn main() -> ExitCode {
@@ -49,6 +53,7 @@ fn main() -> ExitCode {
         Command::Kin(args) => kin::run(args),
         Command::Calib(args) => calib::run(args),
         Command::Plan(args) => plan::run(args),
+        Command::Fuzz(args) => fuzz::fuzz(args).map(|()| ExitCode::SUCCESS),
     };
     match result {
         Ok(code) => code,
