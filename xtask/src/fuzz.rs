@@ -20,7 +20,7 @@ use crate::toolchain::{run, target_dir, workspace_root};
 const MAX_INPUT_LEN: usize = 4096;
 /// Corpus size above which `cargo xtask fuzz` asks for a minimisation
 /// (the corpus is committed: keep it small).
-const CORPUS_FILE_LIMIT: usize = 300;
+const CORPUS_FILE_LIMIT: usize = 400;
 /// Host triple the fuzz targets are built for (cargo-fuzz's default).
 const FUZZ_TRIPLE: &str = "x86_64-unknown-linux-gnu";
 
@@ -55,8 +55,8 @@ struct Outcome {
 pub struct RunStats {
     /// Inputs executed.
     pub executions: u64,
-    /// Seconds fuzzed (0 when the run ended early without saying).
-    pub seconds: u64,
+    /// Seconds fuzzed (`None` when the run ended early without saying).
+    pub seconds: Option<u64>,
 }
 
 fn fuzz_dir() -> PathBuf {
@@ -90,11 +90,18 @@ pub fn fuzz(args: FuzzArgs) -> Result<()> {
     );
     for o in &outcomes {
         let (execs, secs, rate) = match o.stats {
-            Some(s) => (
-                s.executions.to_string(),
-                s.seconds.to_string(),
-                (s.executions / s.seconds.max(1)).to_string(),
+            Some(RunStats {
+                executions,
+                seconds: Some(seconds),
+            }) => (
+                executions.to_string(),
+                seconds.to_string(),
+                (executions / seconds.max(1)).to_string(),
             ),
+            Some(RunStats {
+                executions,
+                seconds: None,
+            }) => (executions.to_string(), "?".into(), "?".into()),
             None => ("?".into(), "?".into(), "?".into()),
         };
         let corpus = format!("{}→{} (+{})", o.corpus_before, o.corpus_after, o.added);
@@ -259,7 +266,7 @@ fn fuzz_target(target: &str, seconds: u64) -> Result<Outcome> {
         Some(s) => println!(
             "   {target}: {} executions in {} s; corpus {} → {} files ({added} new)",
             s.executions,
-            s.seconds,
+            s.seconds.map_or("?".to_owned(), |s| s.to_string()),
             corpus_before.len(),
             corpus_after.len()
         ),
@@ -405,7 +412,7 @@ pub fn parse_run_stats(log: &str) -> Option<RunStats> {
         let (secs, _) = rest.split_once(' ')?;
         Some(RunStats {
             executions: runs.trim().parse().ok()?,
-            seconds: secs.trim().parse().ok()?,
+            seconds: Some(secs.trim().parse().ok()?),
         })
     });
     let executed = log.lines().rev().find_map(|line| {
@@ -415,7 +422,7 @@ pub fn parse_run_stats(log: &str) -> Option<RunStats> {
     // A run that crashed has no `Done` line: its time is not known.
     done.or(executed.map(|executions| RunStats {
         executions,
-        seconds: 0,
+        seconds: None,
     }))
 }
 
@@ -433,7 +440,7 @@ mod tests {
             parse_run_stats(log),
             Some(RunStats {
                 executions: 2_093_113,
-                seconds: 61
+                seconds: Some(61)
             })
         );
     }
@@ -447,7 +454,7 @@ mod tests {
             parse_run_stats(log),
             Some(RunStats {
                 executions: 4242,
-                seconds: 0
+                seconds: None
             })
         );
         assert_eq!(parse_run_stats("no statistics here"), None);
