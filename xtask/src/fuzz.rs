@@ -282,9 +282,9 @@ fn fuzz_target(target: &str, seconds: u64) -> Result<Outcome> {
     })
 }
 
-/// Replaces the committed corpus with its seeds (`seed-*`, kept always)
-/// plus the smallest set of the other corpus files and the new `found`
-/// inputs that reaches every code edge they reach (libFuzzer's merge,
+/// Replaces the committed corpus with its seeds (`seed-*`, kept always),
+/// the other corpus files that reach edges the seeds do not, and the new
+/// `found` inputs that reach edges none of those do (libFuzzer's merge,
 /// edges only: hit counts would keep hundreds of near-duplicates).
 /// Returns the new corpus's file names.
 fn minimise_corpus(target: &str, corpus: &Path, found: &Path, work: &Path) -> Result<Vec<String>> {
@@ -307,14 +307,19 @@ fn minimise_corpus(target: &str, corpus: &Path, found: &Path, work: &Path) -> Re
         "-use_counters=0".to_owned(),
         format!("-max_len={MAX_INPUT_LEN}"),
     ];
-    let log_path = work.join("merge.log");
-    let (ok, log) = run_fuzzer(target, &options, &[&merged, &old, found], &log_path)?;
-    if !ok {
-        bail!(
-            "merging the corpus of `{target}` failed (log {}):\n{}",
-            log_path.display(),
-            log.lines().rev().take(20).collect::<Vec<_>>().join("\n")
-        );
+    // The old corpus first, then the new inputs: a new input is kept only
+    // for edges the corpus does not reach yet, so unchanged coverage keeps
+    // the committed files as they are.
+    for (step, from) in [("old", old.as_path()), ("new", found)] {
+        let log_path = work.join(format!("merge-{step}.log"));
+        let (ok, log) = run_fuzzer(target, &options, &[&merged, from], &log_path)?;
+        if !ok {
+            bail!(
+                "merging the corpus of `{target}` failed (log {}):\n{}",
+                log_path.display(),
+                log.lines().rev().take(20).collect::<Vec<_>>().join("\n")
+            );
+        }
     }
     let keep = list_files(&merged);
     for name in list_files(corpus) {

@@ -32,10 +32,7 @@ fn inputs(kind: &str, target: &str) -> Vec<PathBuf> {
 /// Runs `check` on every corpus and regression input of `target`, naming
 /// the file when a property fails; returns the summaries.
 fn run_all<T>(target: &str, check: impl Fn(&[u8]) -> T) -> Vec<T> {
-    assert!(
-        TARGETS.iter().any(|t| t.name == target),
-        "{target} is not a fuzz target"
-    );
+    assert!(TARGETS.contains(&target), "{target} is not a fuzz target");
     let corpus = inputs("corpus", target);
     assert!(
         !corpus.is_empty(),
@@ -54,6 +51,29 @@ fn run_all<T>(target: &str, check: impl Fn(&[u8]) -> T) -> Vec<T> {
         }
     }
     summaries
+}
+
+#[test]
+fn every_fuzz_target_is_declared_and_replayed_here() {
+    // The `[[bin]]` names of the cargo-fuzz crate.
+    let manifest = std::fs::read_to_string(fuzz_dir().join("Cargo.toml")).expect("fuzz manifest");
+    let mut in_bin = false;
+    let mut declared = Vec::new();
+    for line in manifest.lines().map(str::trim) {
+        if line.starts_with('[') {
+            in_bin = line == "[[bin]]";
+        } else if let Some(name) = line.strip_prefix("name = ").filter(|_| in_bin) {
+            declared.push(name.trim_matches('"').to_owned());
+        }
+    }
+    let mut expected: Vec<String> = TARGETS.iter().map(|t| (*t).to_owned()).collect();
+    declared.sort();
+    expected.sort();
+    assert_eq!(declared, expected);
+    for target in TARGETS {
+        let source = fuzz_dir().join("fuzz_targets").join(format!("{target}.rs"));
+        assert!(source.is_file(), "{}", source.display());
+    }
 }
 
 #[test]
