@@ -12,14 +12,28 @@ pub const HEADER: [&str; 4] = ["x", "y", "dx", "dy"];
 pub const VALUE_LIMIT_MM: f64 = 10_000.0;
 
 /// Parses the measured points. The header must be `x,y,dx,dy`; fields may
-/// be padded with spaces; blank lines and lines starting with `#` are
-/// skipped; every value must be finite and within ±[`VALUE_LIMIT_MM`].
+/// be padded with spaces; lines end at LF, CRLF or CR; blank lines and
+/// lines starting with `#` are skipped; every value must be finite and within ±[`VALUE_LIMIT_MM`].
 /// Errors name the 1-based line.
 pub fn read_points(mut input: impl Read) -> Result<Vec<MeasuredPoint>, String> {
     let mut bytes = Vec::new();
     input
         .read_to_end(&mut bytes)
         .map_err(|e| format!("cannot read: {e}"))?;
+    // csv ends a comment at LF only, so with CR-only (old Mac) line ends a
+    // comment line would swallow the rows after it: make lone CRs LFs
+    // (same length, so positions stay) and lines read and count alike.
+    let lone_crs: Vec<usize> = bytes
+        .iter()
+        .enumerate()
+        .filter(|&(i, &b)| b == b'\r' && bytes.get(i + 1) != Some(&b'\n'))
+        .map(|(i, _)| i)
+        .collect();
+    for i in lone_crs {
+        if let Some(b) = bytes.get_mut(i) {
+            *b = b'\n';
+        }
+    }
     // 1-based line where the record at `pos` starts. csv positions a record
     // at the blank or comment lines it skipped before it, so skip those too.
     let line_of = |pos: &csv::Position| {
@@ -117,5 +131,26 @@ mod tests {
         );
         let edge = read_points("x,y,dx,dy\n10000,-10000,0.5,-0.5\n".as_bytes()).unwrap();
         assert_eq!(edge[0].x_mm, VALUE_LIMIT_MM);
+    }
+
+    #[test]
+    fn cr_only_line_ends_read_like_lf() {
+        // Found by the calib_csv fuzz target (tests/fuzz/artifacts/
+        // calib_csv/): with CR-only line ends every error named line 1,
+        // and a comment line swallowed the rows after it.
+        for csv in [
+            "x,y,dx,dy\r1,2,3,4\r# note\r\r5,6,abc,8\r",
+            "x,y,dx,dy\r\n1,2,3,4\n# note\r\r\n5,6,abc,8",
+            "x,y,dx,dy\n1,2,3,4\n# note\n\n5,6,abc,8\n",
+        ] {
+            assert_eq!(
+                read_points(csv.as_bytes()).unwrap_err(),
+                "line 5: column dx: `abc` is not a number",
+                "{csv:?}"
+            );
+        }
+        let rows = read_points("x,y,dx,dy\r# c\r1,2,3,4\r# c2\r5,6,7,8\r".as_bytes()).unwrap();
+        assert_eq!(rows.len(), 2);
+        assert_eq!(rows[1].dy_mm, 8.0);
     }
 }

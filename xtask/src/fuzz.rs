@@ -18,8 +18,8 @@ use crate::toolchain::{run, target_dir, workspace_root};
 /// Longest input generated, bytes: longer than a console line burst, a
 /// settings record or a measurement file needs.
 const MAX_INPUT_LEN: usize = 4096;
-/// Corpus size above which `cargo xtask fuzz` asks for a minimisation
-/// (the corpus is committed: keep it small).
+/// Corpus size above which `cargo xtask fuzz` warns (the corpus is
+/// committed: keep it to a few hundred small files).
 const CORPUS_FILE_LIMIT: usize = 400;
 /// Host triple the fuzz targets are built for (cargo-fuzz's default).
 const FUZZ_TRIPLE: &str = "x86_64-unknown-linux-gnu";
