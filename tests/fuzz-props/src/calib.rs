@@ -122,8 +122,9 @@ fn named_line(error: &str) -> Option<usize> {
 
 /// The field an error quotes as `` `text` `` (when it is on one line).
 fn quoted_field(error: &str) -> Option<&str> {
-    let (_, rest) = error.split_once("column ")?;
-    let (_, rest) = rest.split_once('`')?;
+    // `line N: column NAME: `text` …`
+    let (_, rest) = error.split_once(": ")?;
+    let (_, rest) = rest.strip_prefix("column ")?.split_once(": `")?;
     let (field, _) = rest.split_once('`')?;
     (!field.contains(['\n', '\r'])).then_some(field)
 }
@@ -147,6 +148,10 @@ mod tests {
         assert_eq!(
             quoted_field("line 2: column x: `1e400` is not"),
             Some("1e400")
+        );
+        assert_eq!(
+            quoted_field("line 1: header must be exactly `x,y,dx,dy`, found `column x: `1``"),
+            None
         );
     }
 }
