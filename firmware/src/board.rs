@@ -10,20 +10,24 @@
 //! | laser enable        | PB0 (active high) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
+//!
+//! Flash: the image in sectors 0–5 (≤ 256 KiB), the saved settings in
+//! sectors 10 and 11 (`settings_flash`, `memory.x`).
 
 use embassy_stm32::exti::ExtiInput;
-use embassy_stm32::flash::Flash;
+use embassy_stm32::flash::{self, Flash};
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::mode::Async;
 use embassy_stm32::peripherals::IWDG;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
-use embassy_stm32::{Peri, bind_interrupts, dma, exti, peripherals, usb};
+use embassy_stm32::{Peri, bind_interrupts, dma, exti, pac, peripherals, usb};
 use embassy_usb::UsbDevice;
 use embassy_usb::class::cdc_acm::{BufferedReceiver, CdcAcmClass, Sender, State};
+use laser_app::laser_gate::{GateState, LaserGate};
 use static_cell::StaticCell;
 
-use crate::settings_flash::FlashSettings;
+use crate::settings_flash::{FlashSettings, settings_store};
 use crate::tasks::{LaserPin, UsbDriver};
 
 bind_interrupts!(struct Irqs {
@@ -32,6 +36,7 @@ bind_interrupts!(struct Irqs {
     DMA1_STREAM5 => dma::InterruptHandler<peripherals::DMA1_CH5>;
     DMA1_STREAM6 => dma::InterruptHandler<peripherals::DMA1_CH6>;
     EXTI0 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI0>;
+    FLASH => flash::InterruptHandler;
 });
 
 /// USB full-speed bulk packet size, bytes.
@@ -67,6 +72,24 @@ pub fn clock_config() -> embassy_stm32::Config {
     config
 }
 
+/// Bit of the laser-enable pin in GPIOB (PB0).
+pub const LASER_PIN_BIT: usize = 0;
+
+/// The master laser gate (see `laser_app::laser_gate`): the sequencer
+/// closes it on every stop, fault and button press, the galvo loop on an
+/// underrun; closing pulls PB0 low at once.
+pub static LASER_GATE: LaserGate = LaserGate::with_hook(laser_gate_changed);
+
+/// The gate's hook: when it closes, PB0 goes low straight through the
+/// GPIO's set/reset register (one atomic store, safe from any task or
+/// interrupt), whoever holds the pin. (The galvo's laser stream is not
+/// wired on this board yet; when it is, closing also stops that stream.)
+pub fn laser_gate_changed(state: GateState) {
+    if !state.open {
+        pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
+    }
+}
+
 /// Everything the tasks need, configured.
 pub struct Board {
     /// Laser enable (PB0), low.
@@ -89,7 +112,7 @@ pub struct Board {
     pub fault_led: Output<'static>,
     /// User button (PA0).
     pub button: ExtiInput<'static, Async>,
-    /// Settings flash sector.
+    /// Settings store (flash sectors 10 and 11).
     pub settings: FlashSettings,
     /// Independent watchdog.
     pub iwdg: Peri<'static, IWDG>,
@@ -99,7 +122,10 @@ pub struct Board {
 pub fn init() -> Board {
     let p = embassy_stm32::init(clock_config());
     // Laser off before anything else can run.
-    let laser = LaserPin(Output::new(p.PB0, Level::Low, Speed::Low));
+    let laser = LaserPin {
+        pin: Output::new(p.PB0, Level::Low, Speed::Low),
+        gate: &LASER_GATE,
+    };
     defmt::info!(
         "{} {} (git {}) booting at {} MHz",
         laser_app::build_info::PRODUCT,
@@ -170,7 +196,7 @@ pub fn init() -> Board {
     let laser_led = Output::new(p.PD13, Level::Low, Speed::Low);
     let fault_led = Output::new(p.PD14, Level::Low, Speed::Low);
     let button = ExtiInput::new(p.PA0, p.EXTI0, Pull::Down, Irqs);
-    let settings = FlashSettings::new(Flash::new_blocking(p.FLASH));
+    let settings = settings_store(Flash::new(p.FLASH, Irqs));
 
     Board {
         laser,

@@ -1,17 +1,96 @@
-//! Panic handler: laser off first (straight through the GPIO registers, as
-//! nothing else can be trusted in a panic), then log and halt. The watchdog
-//! then resets the MCU; the laser stays off through reset.
+//! Panic and HardFault handlers: laser off first (straight through the GPIO
+//! registers, as nothing else can be trusted), then log and halt. The
+//! watchdog then resets the MCU; the laser stays off through reset.
+//!
+//! The image is linked with flip-link (`.cargo/config.toml`): the stack sits
+//! below `.data`/`.bss` at the bottom of RAM, so a stack overflow runs off
+//! the start of RAM and faults instead of overwriting statics. The HardFault
+//! handler therefore cannot use the stack it was entered with: it switches
+//! the laser off without touching the stack, restarts the stack at its top
+//! and only then logs.
 
-use core::panic::PanicInfo;
+use core::sync::atomic::{AtomicBool, Ordering};
 
 use embassy_stm32::pac;
 
-/// Bit of the laser-enable pin in GPIOB (PB0; see `board`).
-const LASER_PIN_BIT: usize = 0;
+/// Address of GPIOB's bit set/reset register (RM0090 §8.4.7), for the
+/// HardFault handler's assembly.
+const GPIOB_BSRR: u32 = 0x4002_0418;
+
+/// Set by the panic handler: its `udf` ends in the HardFault handler, which
+/// then has nothing new to report.
+static PANICKED: AtomicBool = AtomicBool::new(false);
+
+/// Laser off now: one store to GPIOB's bit set/reset register (atomic, no
+/// read-modify-write, no stack use once inlined), whatever state the
+/// program is in. Shared by the panic and HardFault handlers.
+#[inline(always)]
+fn laser_off_now() {
+    pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
+}
+use crate::board::LASER_PIN_BIT;
 
 #[panic_handler]
-fn panic(info: &PanicInfo<'_>) -> ! {
-    pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
-    defmt::error!("panic: {}", defmt::Display2Format(info));
+fn panic(info: &core::panic::PanicInfo<'_>) -> ! {
+    laser_off_now();
+    PANICKED.store(true, Ordering::Relaxed);
+    // The location only: formatting the message would keep every panic
+    // message of the image (and core's formatting machinery) in flash.
+    match info.location() {
+        Some(at) => defmt::error!("panic at {}:{}", at.file(), at.line()),
+        None => defmt::error!("panic"),
+    }
+    cortex_m::asm::udf()
+}
+
+// Top of the stack (cortex-m-rt's link.x; flip-link places it just below
+// `.data`).
+unsafe extern "C" {
+    static _stack_start: u32;
+}
+
+/// HardFault, also reached by a stack overflow. Naked: no prologue may push
+/// onto the stack before the laser is off (with an overflowed stack that
+/// push would fault again and lock the core up with the laser as it was).
+/// Then a fresh stack at its top for the log.
+///
+/// Defined as the `HardFault` vector symbol itself (cortex-m-rt's link
+/// script only provides a default when the image has none): the
+/// `#[exception]` macro requires a Rust-ABI function, which cannot be naked
+/// on stable Rust.
+#[unsafe(no_mangle)]
+#[unsafe(naked)]
+#[unsafe(link_section = ".HardFault.user")]
+unsafe extern "C" fn HardFault() -> ! {
+    core::arch::naked_asm!(
+        // GPIOB BSRR: reset bit of the laser pin (see `laser_off_now`).
+        "ldr r0, ={bsrr}",
+        "ldr r1, ={reset_laser}",
+        "str r1, [r0]",
+        "ldr r0, ={top}",
+        "msr MSP, r0",
+        "b {log}",
+        bsrr = const GPIOB_BSRR,
+        reset_laser = const 1u32 << (16 + LASER_PIN_BIT),
+        top = sym _stack_start,
+        log = sym hard_fault_log_and_halt,
+    )
+}
+
+/// Logs the fault (unless it is the end of a panic, already logged) and
+/// halts until the watchdog resets the MCU.
+extern "C" fn hard_fault_log_and_halt() -> ! {
+    if !PANICKED.load(Ordering::Relaxed) {
+        let cfsr = cortex_m::peripheral::SCB::PTR;
+        // SAFETY: read-only access to the fault status registers.
+        let (status, address) = unsafe { ((*cfsr).cfsr.read(), (*cfsr).bfar.read()) };
+        defmt::error!(
+            "hard fault (CFSR {=u32:#010x}, BFAR {=u32:#010x}); laser off",
+            status,
+            address
+        );
+    }
+    // A fault inside the HardFault handler locks the core up: halted, laser
+    // off, until the watchdog resets it.
     cortex_m::asm::udf()
 }

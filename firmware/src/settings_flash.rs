@@ -1,54 +1,66 @@
-//! Settings record in the last flash sector (sector 11, 128 KiB at
-//! 0x080E_0000 on the STM32F407VG), far from the firmware image.
+//! The settings flash: sectors 10 and 11 of the STM32F407VG (2 × 128 KiB at
+//! 0x080C_0000 and 0x080E_0000, outside the image: see `memory.x`). The
+//! store itself (power-fail safe, shared with the simulator) is
+//! `laser_app::settings::store`; this board only supplies the flash.
 //!
-//! `save` erases the sector and writes the record (versioned and CRC-checked
-//! by `laser_app::settings`); the CPU stalls for the erase (~1–2 s), which
-//! the watchdog timeout allows for.
+//! Erasing a sector (only when a sector fills up, about every 280 saves, or
+//! on the first save after an update from the earlier layout) stalls the
+//! CPU for ~1–2 s, which the watchdog timeout allows for; `save` is refused
+//! while a pattern runs.
 
-use embassy_stm32::flash::{Blocking, Flash};
-use laser_app::sequencer::SettingsStore;
+use embassy_stm32::flash::{Async, Error, Flash};
+use embedded_storage_async::nor_flash::{ErrorType, MultiwriteNorFlash, NorFlash, ReadNorFlash};
+use laser_app::settings::store::FlashSettingsStore;
+use sequential_storage::map::MapConfig;
 
-/// Offset of the settings sector from the start of flash, bytes.
-const SECTOR_OFFSET: u32 = 0x000E_0000;
-/// Size of the settings sector, bytes.
-const SECTOR_BYTES: u32 = 128 * 1024;
+/// Offset of sector 10 from the start of flash, bytes.
+const SETTINGS_START: u32 = 0x000C_0000;
+/// End of sector 11 (the end of the 1 MiB flash), bytes from its start.
+const SETTINGS_END: u32 = 0x0010_0000;
 
-/// The settings sector.
-pub struct FlashSettings {
-    flash: Flash<'static, Blocking>,
+/// The on-chip flash. Words of the STM32F4's flash can be programmed again
+/// (clearing more bits; it has no ECC), which the store uses once to retire
+/// a record of the earlier layout: hence [`MultiwriteNorFlash`].
+pub struct F4Flash(Flash<'static, Async>);
+
+impl ErrorType for F4Flash {
+    type Error = Error;
 }
 
-impl FlashSettings {
-    /// Wraps the flash peripheral.
-    pub fn new(flash: Flash<'static, Blocking>) -> Self {
-        Self { flash }
+impl ReadNorFlash for F4Flash {
+    const READ_SIZE: usize = <Flash<'static, Async> as ReadNorFlash>::READ_SIZE;
+
+    async fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Error> {
+        ReadNorFlash::read(&mut self.0, offset, bytes).await
+    }
+
+    fn capacity(&self) -> usize {
+        ReadNorFlash::capacity(&self.0)
     }
 }
 
-impl SettingsStore for FlashSettings {
-    async fn load(&mut self, buf: &mut [u8]) -> usize {
-        match self.flash.blocking_read(SECTOR_OFFSET, buf) {
-            Ok(()) => buf.len(),
-            Err(e) => {
-                defmt::warn!("settings: flash read failed: {}", defmt::Debug2Format(&e));
-                0
-            }
-        }
+impl NorFlash for F4Flash {
+    const WRITE_SIZE: usize = <Flash<'static, Async> as NorFlash>::WRITE_SIZE;
+    const ERASE_SIZE: usize = <Flash<'static, Async> as NorFlash>::ERASE_SIZE;
+
+    async fn erase(&mut self, from: u32, to: u32) -> Result<(), Error> {
+        NorFlash::erase(&mut self.0, from, to).await
     }
 
-    async fn save(&mut self, record: &[u8]) -> Result<(), &'static str> {
-        self.flash
-            .blocking_erase(SECTOR_OFFSET, SECTOR_OFFSET + SECTOR_BYTES)
-            .map_err(|_| "flash erase failed")?;
-        // Flash writes go in whole 32-bit words here: pad the record.
-        let mut padded = [0xFFu8; laser_app::settings::RECORD_LEN.next_multiple_of(4)];
-        if let Some(head) = padded.get_mut(..record.len()) {
-            head.copy_from_slice(record);
-        }
-        self.flash
-            .blocking_write(SECTOR_OFFSET, &padded)
-            .map_err(|_| "flash write failed")?;
-        defmt::info!("settings saved ({} bytes)", record.len());
-        Ok(())
+    async fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Error> {
+        NorFlash::write(&mut self.0, offset, bytes).await
     }
+}
+
+impl MultiwriteNorFlash for F4Flash {}
+
+/// The settings store the sequencer uses.
+pub type FlashSettings = FlashSettingsStore<F4Flash>;
+
+/// The settings store over sectors 10 and 11.
+pub fn settings_store(flash: Flash<'static, Async>) -> FlashSettings {
+    FlashSettingsStore::new(
+        F4Flash(flash),
+        const { MapConfig::new(SETTINGS_START..SETTINGS_END) },
+    )
 }

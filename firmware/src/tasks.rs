@@ -16,6 +16,7 @@ use embassy_time::Timer;
 use embassy_usb::UsbDevice;
 use embassy_usb::class::cdc_acm::{BufferedReceiver, Sender};
 use laser_app::command::CommandLink;
+use laser_app::laser_gate::LaserGate;
 use laser_app::sequencer::{LaserSwitch, Sequencer};
 use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
 use laser_app::status::StatusBoard;
@@ -58,15 +59,28 @@ pub async fn servo(
         .await
 }
 
-/// The laser-enable GPIO (active high).
-pub struct LaserPin(pub Output<'static>);
+/// The laser-enable GPIO (active high), ANDed with the master laser gate:
+/// it goes high only while the gate is open, and the gate's close hook
+/// ([`crate::board::laser_gate_changed`]) pulls it low at once from
+/// whatever context closed it.
+pub struct LaserPin {
+    /// PB0.
+    pub pin: Output<'static>,
+    /// The master gate.
+    pub gate: &'static LaserGate,
+}
 
 impl LaserSwitch for LaserPin {
     fn set(&mut self, on: bool) {
-        if on {
-            self.0.set_high();
+        if on && self.gate.is_open() {
+            self.pin.set_high();
+            // A close between the check and the write has already run
+            // its hook: look again so the pin cannot stay high.
+            if !self.gate.is_open() {
+                self.pin.set_low();
+            }
         } else {
-            self.0.set_low();
+            self.pin.set_low();
         }
     }
 }
@@ -80,8 +94,9 @@ pub async fn sequencer(
     laser: LaserPin,
     store: FlashSettings,
 ) -> ! {
+    let gate = laser.gate;
     // No galvo output in this build yet (see README, Status).
-    let mut sequencer = Sequencer::new(link, servo, None, status, laser, store).await;
+    let mut sequencer = Sequencer::new(link, servo, None, status, laser, gate, store).await;
     sequencer.run().await
 }
 

@@ -116,5 +116,5 @@ pub use error::Error;
 pub use jump::{JumpPlan, JumpSync, Method, MethodKind, PlanInfo, XyJump, plan_jump, plan_xy_jump};
 pub use min_energy::SeedConfig;
 pub use model::{Discrete, FlexParams, LinearModel, ModelKind, RigidParams};
-pub use path::{BlockEnd, MarkLimits, MarkSample, PathPlanner};
+pub use path::{ArcRotor, BlockEnd, MarkLimits, MarkSample, PathPlanner};
 pub use stepper::{Stepper, XyStepper};

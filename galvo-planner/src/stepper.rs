@@ -19,10 +19,11 @@
 //! `(Ad − I)·Z + Bd·U` and 4 add/subs for the compensated sum, i.e.
 //! **rigid (S = 3): 12 mul + 9 add + 12 add = 33 flops; flexible (S = 5):
 //! 30 + 25 + 20 = 75 flops**, plus a ring-buffer read and a counter
-//! compare. On the M4F (single-cycle `vmul`/`vadd`, plus loads and
-//! stores) that is roughly 50–100 cycles per axis for the rigid model,
-//! i.e. under 12 % of the ≈ 1680-cycle budget per sample for two axes at
-//! 100 kHz.
+//! compare. The rigid model runs as fixed multiply-adds (`advance3`:
+//! the loop builds this crate's generics for size, which keeps loops as
+//! loops). Measured on the M4F ISA (`cargo xtask bench-m4`): 204
+//! instructions per sample for both axes while moving (was 560 with the
+//! generic loops), ≈ 1.6 µs at 168 MHz and CPI 1.3.
 //!
 //! Accuracy (tests): over ±10° moves the `f32` angle stays within 2e-8 rad
 //! (about one `f32` ulp) of the `f64` ZOH simulation at Ts = 10 µs and 1 µs;
@@ -69,6 +70,79 @@ pub struct Stepper<const S: usize, const CAP: usize, const Q: usize = 4> {
 
 fn to_f32<const S: usize>(z: &Vector<S>) -> [f32; S] {
     core::array::from_fn(|i| at(z, i) as f32)
+}
+
+/// One sample of `Z += (Ad − I)·Z + Bd·u` with compensated (Kahan)
+/// summation of the increment into `z`.
+///
+/// The three-state rigid model (what the galvo loop runs) goes through
+/// `advance3`, written out as fixed multiply-adds: this function is
+/// instantiated in the caller's crate, which the firmware builds for size
+/// (its loops stay loops), while `advance3` is straight-line code.
+#[inline(always)]
+fn advance<const S: usize>(
+    a_minus_i: &[[f32; S]; S],
+    bd: &[f32; S],
+    z: &mut [f32; S],
+    comp: &mut [f32; S],
+    u: f32,
+) {
+    // S == 3 (resolved at compile time): the fixed three-state kernel.
+    if S == 3
+        && let (Some([r0, r1, r2]), Some(b3), Some(z3), Some(c3)) = (
+            a_minus_i.first_chunk::<3>(),
+            bd.first_chunk::<3>(),
+            z.first_chunk_mut::<3>(),
+            comp.first_chunk_mut::<3>(),
+        )
+        && let (Some(r0), Some(r1), Some(r2)) = (
+            r0.first_chunk::<3>(),
+            r1.first_chunk::<3>(),
+            r2.first_chunk::<3>(),
+        )
+    {
+        advance3([r0, r1, r2], b3, z3, c3, u);
+        return;
+    }
+    let z0 = *z;
+    for (((zi, ci), row), b) in z
+        .iter_mut()
+        .zip(comp.iter_mut())
+        .zip(a_minus_i.iter())
+        .zip(bd.iter())
+    {
+        let mut inc = b * u;
+        for (a, x) in row.iter().zip(z0.iter()) {
+            inc += a * x;
+        }
+        kahan_add(zi, ci, inc);
+    }
+}
+
+/// `x += inc` with the running compensation `c` (Kahan).
+#[inline(always)]
+fn kahan_add(x: &mut f32, c: &mut f32, inc: f32) {
+    let y = inc - *c;
+    let t = *x + y;
+    *c = (t - *x) - y;
+    *x = t;
+}
+
+/// [`advance`] for three states: 12 multiply-adds and 12 add/subs.
+#[inline]
+fn advance3(a: [&[f32; 3]; 3], b: &[f32; 3], z: &mut [f32; 3], c: &mut [f32; 3], u: f32) {
+    let [z0, z1, z2] = *z;
+    let [a0, a1, a2] = a;
+    let inc = [
+        b[0] * u + a0[0] * z0 + a0[1] * z1 + a0[2] * z2,
+        b[1] * u + a1[0] * z0 + a1[1] * z1 + a1[2] * z2,
+        b[2] * u + a2[0] * z0 + a2[1] * z1 + a2[2] * z2,
+    ];
+    let [x0, x1, x2] = z;
+    let [c0, c1, c2] = c;
+    kahan_add(x0, c0, inc[0]);
+    kahan_add(x1, c1, inc[1]);
+    kahan_add(x2, c2, inc[2]);
 }
 
 /// Relative tolerance for "the plan starts where the queue ends".
@@ -169,30 +243,14 @@ impl<const S: usize, const CAP: usize, const Q: usize> Stepper<S, CAP, Q> {
         self.read = (self.read + 1) % CAP;
         self.queued = self.queued.saturating_sub(1);
         // Z += (Ad − I)·Z + Bd·u, with compensated summation.
-        let z = self.z;
-        for (((zi, ci), row), b) in self
-            .z
-            .iter_mut()
-            .zip(self.comp.iter_mut())
-            .zip(self.a_minus_i.iter())
-            .zip(self.bd.iter())
-        {
-            let mut inc = b * u;
-            for (a, x) in row.iter().zip(z.iter()) {
-                inc += a * x;
-            }
-            let y = inc - *ci;
-            let t = *zi + y;
-            *ci = (t - *zi) - y;
-            *zi = t;
-        }
+        advance(&self.a_minus_i, &self.bd, &mut self.z, &mut self.comp, u);
         self.k_in_move += 1;
-        let current = self.moves.get(self.move_read).copied();
-        if let Some(m) = current
-            && self.k_in_move >= m.samples
-        {
-            // Land exactly on the planned target.
-            self.z = to_f32(&m.target);
+        let running = self.moves.get(self.move_read).map(|m| m.samples);
+        if running.is_some_and(|samples| self.k_in_move >= samples) {
+            // Land exactly on the planned target (once per move).
+            if let Some(m) = self.moves.get(self.move_read) {
+                self.z = to_f32(&m.target);
+            }
             self.comp = [0.0; S];
             self.k_in_move = 0;
             self.move_read = (self.move_read + 1) % Q;

@@ -85,6 +85,15 @@ pub enum Error {
     DegeneratePoints,
     /// Compensation (inverse of the error model) did not converge.
     NotConverged,
+    /// A measured point (0-based `index`) has a coordinate or error beyond
+    /// [`crate::error_model::MAX_MEASURED_MM`] (10 m): no board is that
+    /// large, and the quadratic of such values cannot be represented.
+    MeasurementOutOfRange {
+        /// 0-based index of the point.
+        index: usize,
+        /// Which value, e.g. `"x_mm"`.
+        what: &'static str,
+    },
 }
 
 impl fmt::Display for Error {
@@ -128,6 +137,11 @@ impl fmt::Display for Error {
                 f.write_str("measured points are degenerate (collinear, repeated or on one conic)")
             }
             Error::NotConverged => f.write_str("error-model compensation did not converge"),
+            Error::MeasurementOutOfRange { index, what } => write!(
+                f,
+                "measured point {} has {what} beyond +-10000 mm (10 m)",
+                index + 1
+            ),
         }
     }
 }

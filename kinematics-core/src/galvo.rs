@@ -159,33 +159,20 @@ impl<F: Real> DacAxis<F> {
     }
 
     /// DAC code for mechanical angle `theta_rad`, clamped to 0..=4095 (and
-    /// flagged) when outside the range.
+    /// flagged) when outside the range. Rounds half away from zero.
+    ///
+    /// The conversion stays in `F`: the code value is truncated to an
+    /// integer (one `VCVT` in `f32`) and the remainder, exact in `F`,
+    /// decides the rounding, so the `f32` path never widens to `f64`.
     ///
     /// Errors: [`Error::NonFinite`] (angle or mapping).
     #[inline]
     pub fn angle_to_code(&self, theta_rad: F) -> Result<DacCode, Error> {
-        let code = (self.offset_code + self.codes_per_rad * theta_rad).round();
-        if !code.is_finite() {
+        let value = self.offset_code + self.codes_per_rad * theta_rad;
+        if !value.is_finite() {
             return Err(Error::NonFinite { what: "DAC code" });
         }
-        let max = F::from_f64(f64::from(DAC_MAX_CODE));
-        Ok(if code < F::ZERO {
-            DacCode {
-                code: 0,
-                clamped: true,
-            }
-        } else if code > max {
-            DacCode {
-                code: DAC_MAX_CODE,
-                clamped: true,
-            }
-        } else {
-            DacCode {
-                // Whole and within 0..=4095: the cast is exact.
-                code: code.to_f64() as u16,
-                clamped: false,
-            }
-        })
+        Ok(round_to_code(value))
     }
 
     /// Mechanical angle (radians) of DAC code `code`.
@@ -206,6 +193,37 @@ impl<F: Real> DacAxis<F> {
             });
         }
         Ok((F::from_f64(f64::from(code)) - self.offset_code) / self.codes_per_rad)
+    }
+}
+
+/// A finite code value rounded half away from zero to a DAC code,
+/// clamped (and flagged) outside 0..=4095, without leaving `F`: the value
+/// is truncated to an integer (one `VCVT` in `f32`) and the remainder,
+/// exact in `F`, decides the rounding.
+#[inline]
+fn round_to_code<F: Real>(value: F) -> DacCode {
+    // round(value) < 0 ⇔ value ≤ −½; round(value) > 4095 ⇔ value ≥ 4095½.
+    let top = F::from_u16(DAC_MAX_CODE) + F::HALF;
+    if value <= -F::HALF {
+        DacCode {
+            code: 0,
+            clamped: true,
+        }
+    } else if value >= top {
+        DacCode {
+            code: DAC_MAX_CODE,
+            clamped: true,
+        }
+    } else {
+        // value ∈ (−½, 4095½): −½ < value < 0 truncates to 0 and rounds to
+        // 0; otherwise value − trunc(value) is exact.
+        // Below 4096: the narrowing cast is exact.
+        let whole = value.trunc_to_u32() as u16;
+        let up = value - F::from_u16(whole) >= F::HALF;
+        DacCode {
+            code: whole + u16::from(up),
+            clamped: false,
+        }
     }
 }
 
@@ -306,6 +324,78 @@ impl<F: Real> Galvo<F> {
                 offset_code: c(self.dac_y.offset_code),
             },
         }
+    }
+}
+
+/// The per-sample form of a [`Galvo<f32>`]: checked once when built, then
+/// board point or mirror angles → DAC codes with no per-call validation
+/// and no error plumbing, all in `f32` on the FPU (two `atanf`, one
+/// `VSQRT`, two divisions, two direct conversions). Its codes are those
+/// of [`Galvo::<f32>::board_to_codes`] / [`Galvo::angles_to_codes`], bit
+/// for bit (tests).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleMap {
+    d_mm: f32,
+    d2_mm2: f32,
+    e_mm: f32,
+    dac_x: DacAxis<f32>,
+    dac_y: DacAxis<f32>,
+}
+
+impl SampleMap {
+    /// The per-sample map of `galvo`.
+    ///
+    /// Errors: [`Error::InvalidConfig`] (geometry, or a zero / non-finite
+    /// DAC mapping).
+    pub fn new(galvo: &Galvo<f32>) -> Result<Self, Error> {
+        galvo.geometry.validate()?;
+        for dac in [galvo.dac_x, galvo.dac_y] {
+            if !dac.codes_per_rad.is_finite()
+                || dac.codes_per_rad == 0.0
+                || !dac.offset_code.is_finite()
+            {
+                return Err(Error::InvalidConfig {
+                    what: "DAC codes_per_rad must be finite and non-zero",
+                });
+            }
+        }
+        let d = galvo.geometry.d_mm;
+        Ok(Self {
+            d_mm: d,
+            d2_mm2: d * d,
+            e_mm: galvo.geometry.e_mm,
+            dac_x: galvo.dac_x,
+            dac_y: galvo.dac_y,
+        })
+    }
+
+    /// DAC codes for board point (`x_mm`, `y_mm`); `None` for a
+    /// non-finite coordinate.
+    #[inline]
+    pub fn board_to_codes(&self, x_mm: f32, y_mm: f32) -> Option<DacCodes> {
+        if !(x_mm.is_finite() && y_mm.is_finite()) {
+            return None;
+        }
+        // As GalvoGeometry::ik, operation for operation.
+        let y_rad = libm::atanf(y_mm / self.d_mm) * 0.5;
+        let path_mm = crate::real::sqrt_f32(self.d2_mm2 + y_mm * y_mm) + self.e_mm;
+        let x_rad = libm::atanf(x_mm / path_mm) * 0.5;
+        self.angles_to_codes(x_rad, y_rad)
+    }
+
+    /// DAC codes for mechanical mirror angles (rad); `None` for a
+    /// non-finite angle.
+    #[inline]
+    pub fn angles_to_codes(&self, x_rad: f32, y_rad: f32) -> Option<DacCodes> {
+        let x = self.dac_x.offset_code + self.dac_x.codes_per_rad * x_rad;
+        let y = self.dac_y.offset_code + self.dac_y.codes_per_rad * y_rad;
+        if !(x.is_finite() && y.is_finite()) {
+            return None;
+        }
+        Some(DacCodes {
+            x: round_to_code(x),
+            y: round_to_code(y),
+        })
     }
 }
 
@@ -475,6 +565,169 @@ mod tests {
             let c = g32.dac_y.angle_to_code(a).unwrap();
             assert_eq!((c.code, c.clamped), (code, false));
         }
+    }
+
+    /// Round half away from zero in f64, clamped to the DAC range.
+    fn reference_code(value: f64) -> (u16, bool) {
+        let r = libm::round(value);
+        if r < 0.0 {
+            (0, true)
+        } else if r > 4095.0 {
+            (4095, true)
+        } else {
+            (r as u16, false)
+        }
+    }
+
+    #[test]
+    fn direct_conversion_rounds_half_away_and_clamps() {
+        // Identity mapping: the code value is the angle itself, so every
+        // f32 near each half-integer tie and both range ends is exercised.
+        let dac = DacAxis::<f32> {
+            codes_per_rad: 1.0,
+            offset_code: 0.0,
+        };
+        let near = |k: i32| {
+            let tie = k as f32 + 0.5;
+            // Ties are exact in f32 here; their neighbours one ulp away.
+            let below = if tie > 0.0 {
+                tie.to_bits() - 1
+            } else {
+                tie.to_bits() + 1
+            };
+            let above = if tie > 0.0 {
+                tie.to_bits() + 1
+            } else {
+                tie.to_bits() - 1
+            };
+            [
+                tie,
+                f32::from_bits(below),
+                f32::from_bits(above),
+                k as f32,
+                k as f32 + 0.25,
+            ]
+        };
+        let extremes = [
+            [-0.0, 1e-30, -1e-30, -0.49999997, 0.49999997],
+            [-1e9, 1e9, -0.5, 4095.5, 4095.4998],
+        ];
+        for v in (-3..=4099)
+            .flat_map(near)
+            .chain(extremes.into_iter().flatten())
+        {
+            let got = dac.angle_to_code(v).unwrap();
+            let (code, clamped) = reference_code(f64::from(v));
+            assert_eq!((got.code, got.clamped), (code, clamped), "{v}");
+        }
+    }
+
+    /// The f32 per-sample path against the f64 reference over the whole
+    /// field: for every board point (as the f32 path receives it), the
+    /// f32 IK + DAC code is within half an LSB of the exact (f64) code
+    /// value, plus the f32 rounding of that value (< 1/256 LSB), i.e. it
+    /// differs from the f64 code only where the exact value is within
+    /// 1/256 LSB of a rounding tie.
+    #[test]
+    fn f32_codes_within_half_an_lsb_of_f64_over_the_field() {
+        const TOL: f64 = 1.0 / 256.0;
+        let g64 = Galvo::<f64>::default();
+        let g32 = Galvo::<f32>::default();
+        let map = SampleMap::new(&g32).unwrap();
+        let value = |dac: &DacAxis<f64>, theta: f64| dac.offset_code + dac.codes_per_rad * theta;
+        let (mut worst, mut differ, mut n) = (0.0f64, 0u32, 0u32);
+        // 801 × 801 mirror-angle grid over ±12.5°, mapped to board points.
+        for i in 0..=800 {
+            for j in 0..=800 {
+                let tx = FIELD_RAD * (f64::from(i) / 400.0 - 1.0) * 0.9999;
+                let ty = FIELD_RAD * (f64::from(j) / 400.0 - 1.0) * 0.9999;
+                let p = g64
+                    .geometry
+                    .fk(MirrorAngles {
+                        x_rad: tx,
+                        y_rad: ty,
+                    })
+                    .unwrap();
+                let p32 = PointMm::new(p.x_mm as f32, p.y_mm as f32);
+                let c32 = g32.board_to_codes(p32).unwrap();
+                assert_eq!(map.board_to_codes(p32.x_mm, p32.y_mm), Some(c32));
+                let a64 = g64
+                    .geometry
+                    .ik(PointMm::new(f64::from(p32.x_mm), f64::from(p32.y_mm)))
+                    .unwrap();
+                let c64 = g64.angles_to_codes(a64).unwrap();
+                for (code, dac, theta, reference) in [
+                    (c32.x, &g64.dac_x, a64.x_rad, c64.x),
+                    (c32.y, &g64.dac_y, a64.y_rad, c64.y),
+                ] {
+                    assert!(!code.clamped);
+                    let exact = value(dac, theta);
+                    let off = (f64::from(code.code) - exact).abs();
+                    assert!(off <= 0.5 + TOL, "({tx}, {ty}): {off} LSB");
+                    worst = worst.max(off - 0.5);
+                    differ += u32::from(code.code != reference.code);
+                    n += 1;
+                }
+            }
+        }
+        // Almost every code is identical; the rest sit on a tie.
+        assert!(differ * 1000 < n, "{differ} of {n} codes differ");
+        assert!(worst <= TOL, "{worst}");
+    }
+
+    #[test]
+    fn sample_map_equals_the_checked_path_and_refuses_bad_input() {
+        let g = Galvo::<f32> {
+            geometry: GalvoGeometry {
+                d_mm: 350.0,
+                e_mm: 12.0,
+            },
+            dac_x: DacAxis {
+                codes_per_rad: -9000.0,
+                offset_code: 2040.0,
+            },
+            dac_y: DacAxis {
+                codes_per_rad: 9500.0,
+                offset_code: 2050.5,
+            },
+        };
+        let map = SampleMap::new(&g).unwrap();
+        for i in -60..=60 {
+            for j in -60..=60 {
+                let (x, y) = (i as f32 * 3.7, j as f32 * 3.3);
+                assert_eq!(
+                    map.board_to_codes(x, y),
+                    g.board_to_codes(PointMm::new(x, y)).ok()
+                );
+                let (tx, ty) = (i as f32 * 0.004, j as f32 * -0.0041);
+                assert_eq!(
+                    map.angles_to_codes(tx, ty),
+                    g.angles_to_codes(MirrorAngles {
+                        x_rad: tx,
+                        y_rad: ty
+                    })
+                    .ok()
+                );
+            }
+        }
+        // Far outside: clamped and flagged, as the checked path.
+        let far = map.board_to_codes(1e6, -1e6).unwrap();
+        assert!(far.x.clamped && far.y.clamped);
+        assert_eq!(map.board_to_codes(f32::NAN, 0.0), None);
+        assert_eq!(map.board_to_codes(0.0, f32::INFINITY), None);
+        assert_eq!(map.angles_to_codes(f32::NAN, 0.0), None);
+        let mut bad = g;
+        bad.dac_y.codes_per_rad = 0.0;
+        assert!(matches!(
+            SampleMap::new(&bad),
+            Err(Error::InvalidConfig { .. })
+        ));
+        bad = g;
+        bad.geometry.d_mm = -1.0;
+        assert!(matches!(
+            SampleMap::new(&bad),
+            Err(Error::InvalidConfig { .. })
+        ));
     }
 
     #[test]

@@ -1,5 +1,6 @@
 #![no_std]
-#![forbid(unsafe_code)]
+// One `asm!` (the FPU square root, `real::sqrt_f32`) is allowed locally.
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 #![cfg_attr(
     not(test),
@@ -29,7 +30,7 @@
 //! | [`gimbal`] | exact (default) and seed gimbal FK/IK, the calibrated chain | [`Gimbal`] (`ik`, `fk`, `ik_wire`, `fk_wire`), [`GimbalModel`], [`JointAngles`], [`gimbal::exact`], [`gimbal::seed`] |
 //! | [`servo`] | joint ↔ servo angle ↔ FashionStar wire value (0.1°) | [`ServoAxis`], [`Direction`], [`WireAngles`] |
 //! | [`stepper`] | joint angle ↔ microsteps (0.05625°/step) | [`StepperAxis`] |
-//! | [`galvo`] | two-mirror FK/IK with pincushion, DAC mapping (`f32`/`f64`) | [`Galvo`], [`GalvoGeometry`], [`DacAxis`], [`MirrorAngles`], [`DacCodes`] |
+//! | [`galvo`] | two-mirror FK/IK with pincushion, DAC mapping (`f32`/`f64`), the per-sample `f32` map | [`Galvo`], [`GalvoGeometry`], [`DacAxis`], [`MirrorAngles`], [`DacCodes`], [`SampleMap`] |
 //! | [`grid`] | grid geometry, index ↔ board point | [`Grid`], [`GridIndex`] |
 //! | [`pattern`] | named test patterns as iterators | [`Pattern`] (`indices`, `points`) |
 //! | [`path`] | comparison-method line/arc/rectangle, uniform sampler | [`LineSteps`], [`ArcSteps`], [`RectSteps`], [`UniformSampler`], [`Segment`] |
@@ -67,11 +68,11 @@ pub mod stepper;
 pub use error::{Error, Joint};
 pub use error_model::{AxisFit, ErrorModel, FitReport, MeasuredPoint, Quadratic, fit};
 pub use frames::{BoardFrame, BoardPoint, BoardPose, GlobalPoint, PointMm};
-pub use galvo::{DacAxis, DacCode, DacCodes, Galvo, GalvoGeometry, MirrorAngles};
+pub use galvo::{DacAxis, DacCode, DacCodes, Galvo, GalvoGeometry, MirrorAngles, SampleMap};
 pub use gimbal::{Gimbal, GimbalGeometry, GimbalModel, JointAngles};
 pub use grid::{Grid, GridIndex};
 pub use path::{ArcSteps, Criterion, LineSteps, RectSteps, Rotation, Segment, UniformSampler};
 pub use pattern::Pattern;
-pub use real::Real;
+pub use real::{Real, sqrt_f32};
 pub use servo::{Direction, ServoAxis, WireAngles};
 pub use stepper::StepperAxis;

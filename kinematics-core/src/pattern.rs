@@ -185,6 +185,18 @@ impl Iterator for PatternIndices {
         let n = usize::from(self.back.saturating_sub(self.front));
         (n, Some(n))
     }
+
+    /// The `n`-th next index in O(1) (indices are computed, not walked).
+    fn nth(&mut self, n: usize) -> Option<GridIndex> {
+        let left = usize::from(self.back.saturating_sub(self.front));
+        if n >= left {
+            self.front = self.back;
+            return None;
+        }
+        // n < left ≤ u16::MAX.
+        self.front += n as u16;
+        self.next()
+    }
 }
 
 impl DoubleEndedIterator for PatternIndices {
@@ -340,6 +352,29 @@ mod tests {
                 let mut rev: Vec<_> = p.indices(&g).rev().collect();
                 rev.reverse();
                 assert_eq!(rev, v, "{p:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn nth_jumps_to_the_same_index_as_walking() {
+        for (cols, rows) in [(12, 8), (2, 2), (254, 254), (0, 0)] {
+            let g = Grid {
+                cols,
+                rows,
+                ..Grid::default()
+            };
+            for p in Pattern::ALL {
+                let all: Vec<_> = p.indices(&g).collect();
+                for k in [0, 1, all.len() / 2, all.len().saturating_sub(1), all.len()] {
+                    let mut it = p.indices(&g);
+                    assert_eq!(it.nth(k), all.get(k).copied(), "{p:?} {k}");
+                    // The iterator goes on after the index it jumped to.
+                    assert_eq!(it.next(), all.get(k + 1).copied(), "{p:?} {k}");
+                }
+                let mut it = p.indices(&g);
+                assert_eq!(it.nth(usize::MAX), None);
+                assert_eq!(it.next(), None);
             }
         }
     }

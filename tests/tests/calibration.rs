@@ -7,7 +7,7 @@
 use kinematics_core::{MeasuredPoint, fit};
 use laser_sim::physics::PhysicalGimbal;
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::run_with;
+use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with};
 
 fn imperfect_build() -> PhysicalGimbal {
     let mut physical = PhysicalGimbal::default();
@@ -24,6 +24,7 @@ fn run_grid(setup: &str) -> SimReport {
             ..SimOptions::default()
         },
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);
     assert_eq!(report.recording.dwells.len(), 13 * 9);
     report

@@ -33,6 +33,7 @@ fn run(compute_ns_per_sample: u64) -> Run {
     let recording = Rc::new(RefCell::new(DacRecording::default()));
     let events: Rc<RefCell<Vec<GalvoEvent>>> = Rc::default();
     let finished = Rc::new(RefCell::new(false));
+    let gate = laser_sim::laser::recorded_gate(&recording);
     let (rec, ev, fin) = (recording.clone(), events.clone(), finished.clone());
     let end = executor::run(
         false,
@@ -41,7 +42,7 @@ fn run(compute_ns_per_sample: u64) -> Run {
             executor::spawn(&spawner, async move {
                 let mut dac = SimDac::new(128, 10_000, compute_ns_per_sample, rec);
                 let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
-                galvo.run(&mut dac, link).await;
+                galvo.run(&mut dac, link, gate).await;
             });
             executor::spawn(&spawner, async move {
                 for (i, &(x_mm, y_mm)) in POINTS.iter().enumerate() {
@@ -145,5 +146,155 @@ fn a_loop_slower_than_the_sample_rate_underruns_and_turns_the_laser_off() {
             .skip(after_report)
             .all(|(_, s)| !s.laser),
         "laser off after the underrun"
+    );
+}
+
+#[test]
+fn an_underrun_mid_dwell_replays_dark_and_the_laser_is_dark_at_once() {
+    // The loop keeps up until it is lit at a point, then becomes slower
+    // than the sample rate (15 µs per 10 µs sample) and stays so.
+    let link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
+    let recording = Rc::new(RefCell::new(DacRecording::default()));
+    let gate = laser_sim::laser::recorded_gate(&recording);
+    let dac = SimDac::new(128, 10_000, 0, recording.clone());
+    let cost = dac.compute_cost();
+    let slowed_at = Rc::new(RefCell::new(None));
+    let finished = Rc::new(RefCell::new(false));
+    let (fin, slowed) = (finished.clone(), slowed_at.clone());
+    let end = executor::run(
+        false,
+        2_000_000,
+        move |spawner| {
+            executor::spawn(&spawner, async move {
+                let mut dac = dac;
+                let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
+                galvo.run(&mut dac, link, gate).await;
+            });
+            executor::spawn(&spawner, async move {
+                link.requests
+                    .send(GalvoRequest::Point {
+                        seq: 1,
+                        x_mm: 20.0,
+                        y_mm: 10.0,
+                        dwell_us: 30_000,
+                    })
+                    .await;
+                embassy_time::Timer::after_millis(10).await;
+                cost.set(15_000);
+                *slowed.borrow_mut() = Some(embassy_time::Instant::now().as_micros() * 1000);
+                loop {
+                    if let GalvoEvent::Underrun(_) = link.events.receive().await {
+                        break;
+                    }
+                }
+                // Still too slow, but idle: it must hold quietly.
+                embassy_time::Timer::after_millis(200).await;
+                *fin.borrow_mut() = true;
+            });
+        },
+        move || *finished.borrow(),
+    );
+    assert_eq!(end, RunEnd::Stopped);
+    let recording = recording.borrow().clone();
+    let slowed_ns = slowed_at.borrow().expect("slowed down");
+    let samples: Vec<(u64, DacSample)> = recording.iter().collect();
+    assert!(
+        samples.iter().any(|(t, s)| *t < slowed_ns && s.laser),
+        "lit at the point before the loop fell behind"
+    );
+    let &(at, halves) = recording.underruns.first().expect("an underrun");
+    let replayed = at..at + halves as usize * 128;
+    let t_underrun = samples[at].0;
+    // What the stale halves held was lit (the dwell): the replay is what
+    // makes it dark.
+    assert!(
+        recording
+            .stream_runs()
+            .any(|(_, _, _, s, generation)| generation.is_none() && s.laser),
+        "the replayed content was lit"
+    );
+    assert!(
+        samples[replayed].iter().all(|(_, s)| !s.laser),
+        "replay dark"
+    );
+    // Dark from the moment the DAC reached the unwritten half.
+    let lit_after: Vec<_> = samples
+        .iter()
+        .filter(|(t, s)| *t >= t_underrun && s.laser)
+        .collect();
+    assert!(
+        lit_after.is_empty(),
+        "lit after the underrun: {:?}",
+        lit_after.first()
+    );
+    // The loop is still too slow, but holding costs nothing: no underrun
+    // once it holds (a jump in flight lands first).
+    let quiet_from = t_underrun + 20_000_000;
+    let late: Vec<_> = recording
+        .underruns
+        .iter()
+        .filter(|(at, _)| samples[*at].0 > quiet_from)
+        .collect();
+    assert!(late.is_empty(), "idle underruns: {late:?}");
+    assert!(samples.last().expect("samples").0 > quiet_from + 100_000_000);
+}
+
+#[test]
+fn closing_the_gate_stops_the_loop_even_when_no_stop_request_gets_through() {
+    // A full job queue of long dwells; then only the gate closes (no
+    // `Stop` request): the loop drops everything, and nothing it had
+    // handed to the DAC lights after the close.
+    let link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
+    let recording = Rc::new(RefCell::new(DacRecording::default()));
+    let gate = laser_sim::laser::recorded_gate(&recording);
+    let closed_at = Rc::new(RefCell::new(None));
+    let finished = Rc::new(RefCell::new(false));
+    let (fin, closed) = (finished.clone(), closed_at.clone());
+    let rec = recording.clone();
+    let end = executor::run(
+        false,
+        5_000_000,
+        move |spawner| {
+            executor::spawn(&spawner, async move {
+                let mut dac = SimDac::new(128, 10_000, 0, rec);
+                let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
+                galvo.run(&mut dac, link, gate).await;
+            });
+            executor::spawn(&spawner, async move {
+                for seq in 0..5 {
+                    link.requests
+                        .send(GalvoRequest::Point {
+                            seq,
+                            x_mm: 8.0 * seq as f32,
+                            y_mm: -5.0,
+                            dwell_us: 500_000,
+                        })
+                        .await;
+                }
+                while link.state().1 < 4 {
+                    embassy_time::Timer::after_millis(1).await;
+                }
+                embassy_time::Timer::after_millis(20).await;
+                *closed.borrow_mut() = Some(embassy_time::Instant::now().as_micros() * 1000);
+                gate.close();
+                embassy_time::Timer::after_millis(2000).await;
+                *fin.borrow_mut() = true;
+            });
+        },
+        move || *finished.borrow(),
+    );
+    assert_eq!(end, RunEnd::Stopped);
+    assert_eq!(link.state(), (laser_app::galvo::Phase::Idle, 0));
+    let closed_ns = closed_at.borrow().expect("closed");
+    let recording = recording.borrow().clone();
+    let samples: Vec<(u64, DacSample)> = recording.iter().collect();
+    assert!(samples.iter().any(|(t, s)| *t < closed_ns && s.laser));
+    assert!(samples.iter().all(|(t, s)| *t < closed_ns || !s.laser));
+    // The loop itself stopped (not only the gate): its stream is dark
+    // from the next half it computed.
+    assert!(
+        recording
+            .stream_runs()
+            .all(|(t, _, _, s, _)| t < closed_ns + 3 * 1_280_000 || !s.laser)
     );
 }

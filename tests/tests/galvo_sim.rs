@@ -6,7 +6,10 @@ use galvo_planner::{JumpSync, Method, RigidParams, XyStepper, plan_xy_jump};
 use kinematics_core::{Galvo, PointMm};
 use laser_app::galvo::DacSample;
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::{run_to_idle, run_with, spec_patterns, terminal_lines};
+use system_tests::{
+    UNTIL_STEP_FIXES, assert_safe_allowing, run_to_idle, run_with, sent_at, spec_patterns,
+    terminal_lines,
+};
 
 /// SPEC grid pitch, mm.
 const PITCH_MM: f64 = 19.16;
@@ -47,6 +50,7 @@ fn check_galvo_pattern(name: &str, expected: Vec<(i8, i8)>) {
     let report = run_to_idle(&format!(
         "target galvo\nset dwell_ms 20\npattern {name} once\nwait {wait_ms}\n"
     ));
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{name}: {:?}", report.transcript);
     assert_eq!(report.galvo_underruns, 0);
     let samples = samples(&report);
@@ -175,6 +179,7 @@ fn jumps_take_the_planned_time_with_either_planner() {
         let report = run_to_idle(&format!(
             "target galvo\nplanner {planner}\nset dwell_ms 5\npattern home once\nwait 20\npattern corner once\nwait 40\n"
         ));
+        assert_safe_allowing(&report, UNTIL_STEP_FIXES);
         assert!(report.succeeded(false));
         let samples = samples(&report);
         let runs = lit_runs(&samples);
@@ -210,6 +215,7 @@ fn jumps_take_the_planned_time_with_either_planner() {
 #[test]
 fn both_actuators_visit_the_same_points_together() {
     let report = run_to_idle("target both\nset dwell_ms 50\npattern corner once\nwait 1500\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);
     let gimbal: Vec<(i8, i8)> = report
         .recording
@@ -233,6 +239,7 @@ fn both_actuators_visit_the_same_points_together() {
 fn switching_pattern_mid_dwell_stops_the_galvo_cleanly() {
     let report =
         run_to_idle("target galvo\npattern visit-all\nwait 2500\npattern home once\nwait 1010\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false));
     let samples = samples(&report);
     assert_no_step_beyond_a_planned_jump(&samples);
@@ -250,6 +257,7 @@ fn galvo_commands_refuse_what_it_cannot_do() {
         "pattern tuning once\ntarget both\npattern line 0 0 5 5 once\ntarget galvo\ngoto 30 0\ngalvo status\nstatus\n",
         SimOptions::default(),
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     let errors: Vec<&str> = terminal_lines(&report)
         .into_iter()
         .filter(|l| l.starts_with("error:"))
@@ -283,6 +291,7 @@ fn the_galvo_marks_paths_from_the_command_line() {
     let report = run_to_idle(
         "target galvo\npattern circle 1 -1 3 ccw once\nwait 300\npattern tuning 0 0 5 once\nwait 500\n",
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);
     let samples = samples(&report);
     let runs = lit_runs(&samples);
@@ -318,6 +327,7 @@ fn switching_pattern_mid_path_brakes_dark_and_moves_on() {
     let report = run_to_idle(
         "target galvo\npattern rect -4 3 4 -3\nwait 20\npattern home once\nwait 1100\n",
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false));
     let samples = samples(&report);
     let runs = lit_runs(&samples);
@@ -336,6 +346,7 @@ fn a_galvo_loop_too_slow_for_the_sample_rate_is_reported_and_stopped() {
             ..SimOptions::default()
         },
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.galvo_underruns > 0);
     assert!(
         report
@@ -352,6 +363,7 @@ fn a_galvo_loop_too_slow_for_the_sample_rate_is_reported_and_stopped() {
 #[test]
 fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
     let report = run_to_idle("target galvo\ngoto 2 1\nwait 50\nstatus\nstop\nwait 10\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);
     let lines = terminal_lines(&report);
     assert!(
@@ -373,43 +385,9 @@ fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
 
 #[test]
 fn random_command_sequences_keep_every_safety_invariant() {
-    // Meaningful commands in random order and timing: actuators, planners,
-    // patterns (grid and paths), gotos, stops, parameter changes.
-    let templates: &[&dyn Fn(u64) -> String] = &[
-        &|_| "target galvo".into(),
-        &|_| "target gimbal".into(),
-        &|_| "target both".into(),
-        &|r| format!("planner {}", if r % 2 == 0 { "optimal" } else { "seed" }),
-        &|r| {
-            format!(
-                "pattern {} once",
-                ["corner", "home", "horizontal", "vertical"][(r % 4) as usize]
-            )
-        },
-        &|_| "pattern tuning 1 -1 5".into(),
-        &|_| "pattern circle -3 2 2.5 ccw".into(),
-        &|_| "pattern rect -4 3 4 -3 once".into(),
-        &|r| format!("goto {} {}", (r % 17) as f64 - 8.0, (r % 11) as f64 - 5.0),
-        &|_| "stop".into(),
-        &|r| format!("set dwell_ms {}", r % 120),
-        &|r| format!("set galvo.mark_speed_mm_s {}", 200 + r % 3000),
-        &|r| format!("set galvo.laser_on_delay_us {}", r % 400),
-        &|r| format!("wait {}", r % 80),
-    ];
-    let mut x: u64 = 0x2545_f491_4f6c_dd1d;
-    let mut next = || {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        x
-    };
-    let mut script = String::new();
-    for _ in 0..1000 {
-        let pick = (next() % templates.len() as u64) as usize;
-        script.push_str(&templates[pick](next()));
-        script.push('\n');
-    }
-    script.push_str("stop\nwait 20\nstatus\ngalvo status\n");
+    // Meaningful commands in random order and timing (the same script runs
+    // under the safety checker in `safety_campaign.rs`).
+    let script = system_tests::random_meaningful_commands();
     let report = run_with(&script, SimOptions::default());
     assert!(report.transcript.script_done, "every line got its reply");
     assert_ne!(report.end, laser_sim::executor::RunEnd::Livelock);
@@ -451,5 +429,317 @@ fn random_command_sequences_keep_every_safety_invariant() {
         lines.contains(&"state: idle"),
         "{:?}",
         &lines[lines.len().saturating_sub(20)..]
+    );
+}
+
+/// Lines the terminal sent, with their times (µs).
+fn sent_lines(report: &SimReport) -> Vec<(u64, &str)> {
+    report
+        .transcript
+        .lines
+        .iter()
+        .filter_map(|(t, l)| l.strip_prefix("> ").map(|c| (*t, c)))
+        .collect()
+}
+
+/// After every `stop`, the galvo's effective laser is dark in every sample
+/// output from 1 ms after the line was processed (the simulated USB has no
+/// latency: when it was sent) until the next line. Returns the longest
+/// stop → lit sample time seen, ns (`None`: none lit at or after a stop),
+/// and the lit samples output shortly before the stops (the check is not
+/// vacuous when they are many).
+fn assert_dark_after_stops(report: &SimReport, label: &str) -> (Option<u64>, usize) {
+    let lines = sent_lines(report);
+    let samples: Vec<(u64, DacSample)> = report.dac.iter().collect();
+    let mut worst_ns = None;
+    let mut lit_before = 0;
+    for (i, (t_us, line)) in lines.iter().enumerate() {
+        if *line != "stop" {
+            continue;
+        }
+        let from_ns = t_us * 1000;
+        let until_ns = lines.get(i + 1).map_or(u64::MAX, |(t, _)| t * 1000);
+        let start = samples.partition_point(|(t, _)| *t < from_ns);
+        lit_before += samples[..start]
+            .iter()
+            .rev()
+            .take(10_000)
+            .filter(|(_, s)| s.laser)
+            .count();
+        for (t, s) in samples[start..].iter().take_while(|(t, _)| *t < until_ns) {
+            if s.laser {
+                worst_ns = worst_ns.max(Some(t - from_ns));
+                assert!(
+                    t - from_ns < 1_000_000,
+                    "{label}: galvo lit {} µs after `stop` (sent at {t_us} µs)",
+                    (t - from_ns) / 1000
+                );
+            }
+        }
+    }
+    (worst_ns, lit_before)
+}
+
+fn galvo_status_line(report: &SimReport) -> String {
+    terminal_lines(report)
+        .into_iter()
+        .rfind(|l| l.starts_with("galvo: "))
+        .expect("galvo status answered")
+        .to_owned()
+}
+
+#[test]
+fn stop_reaches_the_galvo_loop_whatever_the_sequencer_thinks() {
+    // Issue 9 defect 1: re-aiming a long dwell over and over used to queue
+    // a job behind the running one each time, fill the galvo queue, drop
+    // the sequencer's run without stopping the loop — and `stop` then sent
+    // nothing while the DAC stayed lit for seconds.
+    for reaims in [1, 3, 5, 8] {
+        let mut script = String::from("target galvo\nset dwell_ms 1000\npattern corner\nwait 5\n");
+        for i in 0..reaims {
+            script.push_str(if i % 2 == 0 {
+                "model seed\n"
+            } else {
+                "model exact\n"
+            });
+        }
+        script.push_str("stop\nwait 20\ngalvo status\nstatus\nwait 3000\n");
+        let report = run_with(&script, SimOptions::default());
+        assert!(report.succeeded(false), "{:?}", report.transcript);
+        assert!(
+            report.transcript.notices.is_empty(),
+            "{reaims} re-aims: {:?}",
+            report.transcript.notices
+        );
+        let (worst_ns, lit_before) = assert_dark_after_stops(&report, "re-aimed corner");
+        assert!(lit_before > 0, "the galvo was drawing when stopped");
+        eprintln!("{reaims} re-aims: last lit sample {worst_ns:?} ns after stop");
+        assert_eq!(galvo_status_line(&report), "galvo: Idle, 0 points queued");
+        // Re-aiming replaces the job: the point is drawn again, lit, at the
+        // same grid corner.
+        let runs = lit_runs(&samples(&report));
+        let first = runs.first().expect("lit").2;
+        assert!(
+            runs.iter()
+                .all(|r| (r.2.0 - first.0).abs() < 0.1 && (r.2.1 - first.1).abs() < 0.1),
+            "{runs:?}"
+        );
+    }
+}
+
+#[test]
+fn stop_darkens_the_galvo_within_a_millisecond_at_any_sample_period() {
+    // Issue 9 defect 2: halves already handed to the DAC kept drawing
+    // after `stop` (up to 313 ms at 1 ms per sample).
+    let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x
+    };
+    let mut lit_total = 0;
+    for ts_us in [10, 20, 100, 1000] {
+        for pattern in ["corner", "circle -3 2 2.5 ccw", "tuning 1 -1 5"] {
+            let stop_ms = 1 + next() % 700;
+            let script = format!(
+                "target galvo\nset galvo.ts_us {ts_us}\nset dwell_ms 300\npattern {pattern}\nwait {stop_ms}\nstop\nwait 600\n"
+            );
+            let report = run_with(&script, SimOptions::default());
+            assert!(report.succeeded(false), "{script}: {:?}", report.transcript);
+            let label = format!("ts {ts_us} µs, {pattern}, stop at {stop_ms} ms");
+            let (worst_ns, lit_before) = assert_dark_after_stops(&report, &label);
+            lit_total += lit_before;
+            eprintln!("{label}: last lit sample {worst_ns:?} ns after stop");
+        }
+    }
+    assert!(lit_total > 0, "some stops interrupted a lit drawing");
+}
+
+#[test]
+fn random_galvo_campaigns_are_dark_within_a_millisecond_of_every_stop() {
+    let templates: &[&dyn Fn(u64) -> String] = &[
+        &|r| {
+            format!(
+                "pattern {}{}",
+                ["corner", "home", "horizontal", "vertical"][(r % 4) as usize],
+                if r % 3 == 0 { " once" } else { "" }
+            )
+        },
+        &|r| {
+            format!(
+                "pattern {}",
+                ["circle -3 2 2.5 ccw", "rect -4 3 4 -3", "tuning 1 -1 5"][(r % 3) as usize]
+            )
+        },
+        &|r| format!("goto {} {}", (r % 17) as f64 - 8.0, (r % 11) as f64 - 5.0),
+        &|r| format!("model {}", if r % 2 == 0 { "seed" } else { "exact" }),
+        &|r| format!("planner {}", if r % 2 == 0 { "optimal" } else { "seed" }),
+        &|r| format!("set dwell_ms {}", r % 800),
+        &|r| format!("set galvo.ts_us {}", [10, 20, 50, 1000][(r % 4) as usize]),
+        &|r| format!("set galvo.mark_speed_mm_s {}", 200 + r % 3000),
+        &|_| "stop".into(),
+        &|_| "stop".into(),
+        &|r| format!("wait {}", r % 400),
+        &|r| format!("wait {}", r % 40),
+    ];
+    let mut stops = 0;
+    for seed in [1u64, 2, 3, 4, 5, 6] {
+        let mut x = seed.wrapping_mul(0x2545_f491_4f6c_dd1d) | 1;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut script = format!(
+            "target galvo\nset galvo.ts_us {}\n",
+            [10, 1000, 20][(seed % 3) as usize]
+        );
+        for _ in 0..80 {
+            let pick = (next() % templates.len() as u64) as usize;
+            script.push_str(&templates[pick](next()));
+            script.push('\n');
+        }
+        script.push_str("stop\nwait 300\ngalvo status\n");
+        let report = run_with(&script, SimOptions::default());
+        assert!(
+            report.transcript.script_done,
+            "seed {seed}: every line answered"
+        );
+        let (worst_ns, _) = assert_dark_after_stops(&report, &format!("seed {seed}"));
+        stops += sent_lines(&report)
+            .iter()
+            .filter(|(_, l)| *l == "stop")
+            .count();
+        eprintln!("seed {seed}: last lit sample {worst_ns:?} ns after a stop");
+        assert_eq!(galvo_status_line(&report), "galvo: Idle, 0 points queued");
+        assert!(
+            !report
+                .transcript
+                .notices
+                .iter()
+                .any(|(_, n)| n.contains("not responding")),
+            "seed {seed}: {:?}",
+            report.transcript.notices
+        );
+    }
+    assert!(stops > 50);
+}
+
+#[test]
+fn an_idle_galvo_loop_slower_than_the_sample_rate_never_underruns() {
+    // Issue 9 defect 3: at 20 µs of loop time per 10 µs sample the idle
+    // loop underran hundreds of times a second. Holding, it has nothing
+    // to compute.
+    for cost_ns in [10_001, 20_000, 200_000] {
+        let report = run_with(
+            "wait 3000\ngalvo status\n",
+            SimOptions {
+                galvo_cost_ns_per_sample: cost_ns,
+                ..SimOptions::default()
+            },
+        );
+        assert_eq!(report.galvo_underruns, 0, "{cost_ns} ns per sample");
+        assert!(report.dac.len() >= 290_000, "the DAC kept outputting");
+        // After a job the loop is too slow for, it comes back to a quiet
+        // hold too.
+        let report = run_with(
+            "target galvo\ngoto 2 1\nwait 50\nstop\nwait 3000\n",
+            SimOptions {
+                galvo_cost_ns_per_sample: cost_ns,
+                ..SimOptions::default()
+            },
+        );
+        let stop_ns = sent_lines(&report)
+            .iter()
+            .find(|(_, l)| *l == "stop")
+            .map(|(t, _)| t * 1000)
+            .expect("stop sent");
+        let samples: Vec<(u64, DacSample)> = report.dac.iter().collect();
+        let late: Vec<_> = report
+            .dac
+            .underruns
+            .iter()
+            .filter(|(at, _)| {
+                samples
+                    .get(*at)
+                    .is_some_and(|(t, _)| *t > stop_ns + 100_000_000)
+            })
+            .collect();
+        assert!(late.is_empty(), "{cost_ns} ns: idle underruns {late:?}");
+    }
+}
+
+#[test]
+fn a_galvo_underrun_replays_dark_and_the_laser_is_dark_at_once() {
+    let report = run_with(
+        "target galvo\nset dwell_ms 50\npattern corner\nwait 300\n",
+        SimOptions {
+            galvo_cost_ns_per_sample: 12_000,
+            ..SimOptions::default()
+        },
+    );
+    assert!(report.galvo_underruns > 0);
+    let samples: Vec<(u64, DacSample)> = report.dac.iter().collect();
+    let &(first, _) = report.dac.underruns.first().expect("an underrun");
+    for &(at, halves) in &report.dac.underruns {
+        let replayed = &samples[at..(at + halves as usize * 128).min(samples.len())];
+        assert!(
+            replayed.iter().all(|(_, s)| !s.laser),
+            "replay at {at} dark"
+        );
+    }
+    let t0 = samples[first].0;
+    assert!(
+        samples.iter().all(|(t, s)| *t < t0 + 1_000_000 || !s.laser),
+        "dark from 1 ms after the underrun on"
+    );
+}
+
+#[test]
+fn laser_off_keeps_the_galvo_dark_while_it_still_draws() {
+    // From the start: the galvo visits every corner, never lit.
+    let report =
+        run_to_idle("target galvo\nlaser off\nset dwell_ms 20\npattern corner once\nwait 150\n");
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let samples = samples(&report);
+    assert!(samples.iter().all(|s| !s.laser), "lit with laser off");
+    let corner = (-6.0 * PITCH_MM, 4.0 * PITCH_MM);
+    assert!(
+        samples.iter().any(|s| {
+            let p = spot_mm(s);
+            (p.0 - corner.0).abs() <= 0.1 && (p.1 - corner.1).abs() <= 0.1
+        }),
+        "the mirrors still went to the first corner"
+    );
+
+    // Mid-run: dark from three half buffers (the two already handed to
+    // the DAC and the one computed and waiting for its slot: 3.84 ms at
+    // 100 kHz) after the line is processed; lit again after `laser auto`.
+    let report = run_to_idle(
+        "target galvo\nset dwell_ms 200\npattern corner once\nwait 100\nlaser off\nwait 400\nlaser auto\nwait 400\n",
+    );
+    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let off_ns = sent_at(&report, "laser off") * 1000;
+    let auto_ns = sent_at(&report, "laser auto") * 1000;
+    let lit: Vec<u64> = report
+        .dac
+        .iter()
+        .filter(|(_, s)| s.laser)
+        .map(|(t, _)| t)
+        .collect();
+    assert!(lit.iter().any(|&t| t < off_ns), "lit before laser off");
+    assert!(
+        lit.iter().all(|&t| t < off_ns + 3_850_000 || t > auto_ns),
+        "lit between laser off ({off_ns} ns) and laser auto: {:?}",
+        lit.iter()
+            .filter(|&&t| t >= off_ns + 3_850_000 && t <= auto_ns)
+            .take(3)
+            .collect::<Vec<_>>()
+    );
+    assert!(
+        lit.iter().any(|&t| t > auto_ns),
+        "lit again after laser auto"
     );
 }

@@ -4,7 +4,10 @@
 use laser_sim::recorder::Direction;
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::SimOptions;
-use system_tests::{run_to_idle, run_with, sent_at, spec_patterns, terminal_lines};
+use system_tests::{
+    UNTIL_STEP_FIXES, assert_safe_allowing, run_to_idle, run_with, sent_at, spec_patterns,
+    terminal_lines,
+};
 
 /// Pointing tolerance of the exact model, cm (0.5 mm).
 const TOLERANCE_CM: f64 = 0.05;
@@ -13,6 +16,7 @@ const PITCH_CM: f64 = 1.916;
 
 fn check_pattern(name: &str, expected: Vec<(i8, i8)>) {
     let report = run_to_idle(&format!("set dwell_ms 50\npattern {name} once\n"));
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{name}: {:?}", report.transcript);
     let visited: Vec<(i8, i8)> = report
         .recording
@@ -67,6 +71,7 @@ fn full_grid_raster_and_serpentine() {
 fn full_grid_with_one_second_dwells_runs_fast_in_virtual_time() {
     let wall = std::time::Instant::now();
     let report = run_to_idle("pattern grid-full once\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false));
     assert_eq!(report.recording.dwells.len(), 13 * 9);
     assert!(report.end_time_us > 117_000_000, "117 dwells of 1 s each");
@@ -78,6 +83,7 @@ fn full_grid_with_one_second_dwells_runs_fast_in_virtual_time() {
 fn switching_pattern_mid_dwell_takes_effect_within_one_servo_frame() {
     // The first corner is reached after ~0.3 s; at 1.0 s the gimbal dwells.
     let report = run_to_idle("pattern corner\nwait 1000\npattern home once\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false));
     let switched_at = sent_at(&report, "pattern home once");
     let first_frame_after = report
@@ -104,6 +110,7 @@ fn switching_pattern_mid_dwell_takes_effect_within_one_servo_frame() {
 #[test]
 fn stop_turns_the_laser_off_at_once() {
     let report = run_to_idle("pattern visit-all\nwait 2500\nstop\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false));
     let stop_at = sent_at(&report, "stop");
     let (t_off, on) = *report
@@ -137,6 +144,7 @@ fn a_silent_servo_is_a_fault_with_the_laser_off_within_the_timeout() {
         ..SimOptions::default()
     };
     let report = run_with("pattern visit-all\nwait 3000\nstatus\n", options);
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     let (t_notice, notice) = report
         .transcript
         .notices
@@ -178,6 +186,7 @@ fn garbage_on_the_servo_bus_is_survived() {
         ..SimOptions::default()
     };
     let report = run_with("set dwell_ms 50\npattern corner once\n", options);
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript.notices);
     assert_eq!(report.recording.dwells.len(), 4);
 }
@@ -236,6 +245,7 @@ fn a_thousand_random_command_lines_never_wedge_the_command_line() {
     }
     script.push_str("stop\nstatus\n");
     let report = run_with(&script, SimOptions::default());
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.transcript.script_done, "every line got its reply");
     let sent = report
         .transcript
@@ -261,6 +271,7 @@ fn a_thousand_random_command_lines_never_wedge_the_command_line() {
 fn a_circle_is_drawn_on_its_path_and_closes() {
     // Radius 4 cm about (2, 1) cm, 0.2 cm steps, no dwell between steps.
     let report = run_to_idle("pattern circle 2 1 4 ccw once\nwait 2500\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);
     let drawn: Vec<_> = report.recording.spot.iter().filter(|s| s.laser).collect();
     let first_on_circle = drawn
@@ -302,6 +313,7 @@ fn saved_settings_survive_a_reboot_and_a_corrupt_record_falls_back_to_defaults()
         "pattern corner\nsave\nstop\nset dwell_ms 123\nset oq_cm 30\nsave\n",
         SimOptions::default(),
     );
+    assert_safe_allowing(&first, UNTIL_STEP_FIXES);
     assert_eq!(
         first.transcript.error_replies, 1,
         "save is refused while a pattern runs: {:?}",
@@ -315,6 +327,7 @@ fn saved_settings_survive_a_reboot_and_a_corrupt_record_falls_back_to_defaults()
             ..SimOptions::default()
         },
     );
+    assert_safe_allowing(&rebooted, UNTIL_STEP_FIXES);
     let lines = terminal_lines(&rebooted);
     assert!(
         lines.iter().any(|l| l.starts_with("dwell_ms = 123")),
@@ -333,6 +346,7 @@ fn saved_settings_survive_a_reboot_and_a_corrupt_record_falls_back_to_defaults()
             ..SimOptions::default()
         },
     );
+    assert_safe_allowing(&fallback, UNTIL_STEP_FIXES);
     assert!(fallback.succeeded(false));
     assert!(
         fallback
@@ -350,6 +364,7 @@ fn servo_ids_from_the_settings_are_used_on_the_bus() {
         "set yaw.id 7\ngoto 3 2\nwait 500\nstatus\n",
         SimOptions::default(),
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(
         report
             .transcript
@@ -370,9 +385,12 @@ fn servo_ids_from_the_settings_are_used_on_the_bus() {
         tx_ids.contains(&7),
         "angle queries went to servo 7: {tx_ids:?}"
     );
-    assert_eq!(
+    // Dark at the end (travel to a goto is dark, so it may never have lit).
+    assert_ne!(
         report.recording.laser_events.last().map(|e| e.1),
-        Some(false)
+        Some(true),
+        "{:?}",
+        report.recording.laser_events
     );
 }
 
@@ -380,7 +398,9 @@ fn servo_ids_from_the_settings_are_used_on_the_bus() {
 fn goto_holds_the_point_with_the_seed_model_off_by_its_known_error() {
     // Bottom-right corner: the seed model errs by ~13.9 mm here (kin grid-error).
     let exact = run_to_idle("goto 11.496 -7.664\nwait 500\n");
+    assert_safe_allowing(&exact, UNTIL_STEP_FIXES);
     let seed = run_to_idle("model seed\ngoto 11.496 -7.664\nwait 500\n");
+    assert_safe_allowing(&seed, UNTIL_STEP_FIXES);
     let end = |r: &laser_sim::world::SimReport| {
         let s = r.recording.spot.last().expect("spot sampled");
         ((s.x_cm - 11.496).powi(2) + (s.y_cm + 7.664).powi(2)).sqrt() * 10.0
@@ -414,6 +434,7 @@ fn a_servo_that_answers_again_is_reported_recovered_and_patterns_run_again() {
         "pattern corner\nwait 3500\nset dwell_ms 50\npattern corner once\n",
         options,
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     let notice_at = |prefix: &str| {
         report
             .transcript
@@ -446,6 +467,7 @@ fn a_servo_that_answers_again_is_reported_recovered_and_patterns_run_again() {
 fn laser_stays_off_while_idle_and_in_dwell_mode_lights_only_the_points() {
     let report =
         run_to_idle("laser on\nwait 300\nlaser dwell\nset dwell_ms 100\npattern corner once\n");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false));
     let started = sent_at(&report, "pattern corner once");
     assert!(
@@ -474,5 +496,55 @@ fn laser_stays_off_while_idle_and_in_dwell_mode_lights_only_the_points() {
             "lit {:.2} cm from the nearest corner",
             nearest
         );
+    }
+}
+
+#[test]
+fn the_trace_has_a_row_at_every_laser_change_and_ends_in_the_final_state() {
+    for script in [
+        "pattern corner once\n",
+        "laser dwell\npattern home once\n",
+        "goto 3 2\nwait 300\nstop\nwait 7\n",
+    ] {
+        let report = run_to_idle(script);
+        let csv = report.recording.trace_csv();
+        let rows: Vec<(u64, bool)> = csv
+            .lines()
+            .skip(1)
+            .map(|line| {
+                let f: Vec<&str> = line.split(',').collect();
+                let t_ms: f64 = f[0].parse().expect("t_ms");
+                ((t_ms * 1000.0).round() as u64, f[3] == "1")
+            })
+            .collect();
+        let events = &report.recording.laser_events;
+        assert!(events.iter().any(|e| e.1), "{script}: the laser was used");
+        for &(t_us, on) in events {
+            assert!(
+                rows.contains(&(t_us, on)),
+                "{script}: no trace row for the laser turning {} at {t_us} µs",
+                if on { "on" } else { "off" }
+            );
+        }
+        // Rows in time order; the last row of each instant has the state
+        // the laser was left in at that instant.
+        assert!(rows.windows(2).all(|w| w[0].0 <= w[1].0));
+        for (i, &(t_us, laser)) in rows.iter().enumerate() {
+            if rows.get(i + 1).is_some_and(|next| next.0 == t_us) {
+                continue;
+            }
+            assert_eq!(
+                laser,
+                report.recording.laser_at(t_us),
+                "{script}: row at {t_us} µs"
+            );
+        }
+        let &(last_t, last_laser) = rows.last().expect("rows");
+        assert_eq!(
+            last_t, report.end_time_us,
+            "{script}: the trace reaches the end"
+        );
+        assert!(!last_laser, "{script}: ends dark");
+        assert_eq!(Some(last_laser), events.last().map(|e| e.1));
     }
 }

@@ -5,7 +5,9 @@
 //! spot − commanded), fits the quadratic of each axis and prints one JSON
 //! object `{"dx":{"coef":[c0..c5],"sse":…,"r2":…,"rmse":…,"n":…},"dy":{…}}`
 //! (coefficients for 1, x, y, x², xy, y²; `rmse` is null for exactly 6
-//! points). Errors print `{"error":"…"}` (naming the CSV line) and exit 1.
+//! points). `sse`, `r2` and `rmse` are those of the printed coefficients
+//! evaluated as the firmware evaluates them. Every value must be finite
+//! and within ±10 m (10000 mm). Errors print `{"error":"…"}` (naming the CSV line) and exit 1.
 //!
 //! `--output FILE` writes the model as firmware command lines: `#` comment
 //! lines, then `set err.dx.c0 <mm>` … `set err.dy.c5 <mm>` at full
@@ -17,14 +19,13 @@ use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use kinematics_core::error_model::COEF_LIMITS;
 use kinematics_core::{AxisFit, FitReport, fit};
 use serde::Serialize;
 
 use crate::kin::error_json;
 use xtask::calib_csv::read_points;
 
-/// Largest |coefficient| the firmware's `set err.*` accepts (its range).
-const FIRMWARE_COEF_LIMIT: f64 = 1e3;
 /// Longest line the firmware's command line accepts, bytes.
 const FIRMWARE_MAX_LINE: usize = 128;
 
@@ -161,10 +162,10 @@ fn firmware_commands(report: &FitReport, source: &Path) -> Result<String, String
         let _ = writeln!(out, "{}", comment_line(&c));
     }
     for (axis, f) in [("dx", &report.dx), ("dy", &report.dy)] {
-        for (i, c) in f.coef.iter().enumerate() {
-            if c.abs() > FIRMWARE_COEF_LIMIT {
+        for ((i, c), limit) in f.coef.iter().enumerate().zip(COEF_LIMITS) {
+            if c.abs() > limit {
                 return Err(format!(
-                    "err.{axis}.c{i} = {c} mm is outside the firmware's range +-{FIRMWARE_COEF_LIMIT}; \
+                    "err.{axis}.c{i} = {c} is outside the firmware's range +-{limit}; \
                      check the units (mm) of the CSV"
                 ));
             }
@@ -265,6 +266,71 @@ mod tests {
             let axis = if k < 6 { "dx" } else { "dy" };
             assert_eq!(*v, json[axis]["coef"][k % 6].as_f64().unwrap());
         }
+    }
+
+    #[test]
+    fn reported_sse_is_that_of_the_written_model() {
+        let out = tmp("model-sse.txt");
+        let args = FitArgs {
+            input: data_file(),
+            output: Some(out.clone()),
+        };
+        let json: serde_json::Value = serde_json::from_str(&fit_command(&args).unwrap()).unwrap();
+        let text = std::fs::read_to_string(&out).unwrap();
+        std::fs::remove_file(&out).ok();
+        // The coefficients as the firmware will hold them: parsed back from
+        // the `set` lines.
+        let values: Vec<f64> = text
+            .lines()
+            .filter_map(|l| l.strip_prefix("set "))
+            .map(|rest| rest.split_once(' ').unwrap().1.parse().unwrap())
+            .collect();
+        let points = read_points(File::open(data_file()).unwrap()).unwrap();
+        for (axis, name) in [(0, "dx"), (1, "dy")] {
+            let coef: [f64; 6] = values[axis * 6..axis * 6 + 6].try_into().unwrap();
+            let q = kinematics_core::Quadratic::new(coef);
+            let sse: f64 = points
+                .iter()
+                .map(|p| {
+                    let d = if axis == 0 { p.dx_mm } else { p.dy_mm };
+                    let r = d - q.eval(p.x_mm, p.y_mm).unwrap();
+                    r * r
+                })
+                .sum();
+            assert_eq!(json[name]["sse"].as_f64(), Some(sse), "{name}");
+        }
+    }
+
+    #[test]
+    fn huge_or_non_finite_measurements_are_refused_naming_the_line() {
+        let rows: String = (0..8).map(|i| format!("{i},{},0.1,0\n", i * i)).collect();
+        for (bad, col) in [
+            ("1e308,5,0.1,0", "x"),
+            ("-1e308,5,0.1,0", "x"),
+            ("5,10000.5,0.1,0", "y"),
+            ("5,5,-20000,0", "dx"),
+            ("5,5,0.1,1e300", "dy"),
+            ("5,5,NaN,0", "dx"),
+        ] {
+            let csv = format!("x,y,dx,dy\n{rows}{bad}\n");
+            let e = read_points(csv.as_bytes()).unwrap_err();
+            assert!(e.starts_with(&format!("line 10: column {col}:")), "{e}");
+        }
+        // The reproducer: points at ±1e308 mm no longer fit to R² = 1.
+        let path = tmp("huge.csv");
+        let mut csv = String::from("x,y,dx,dy\n");
+        for (x, y) in [(1e308, 0.0), (-1e308, 0.0), (0.0, 1e308), (0.0, -1e308)] {
+            csv.push_str(&format!("{x:e},{y:e},1,1\n"));
+        }
+        csv.push_str(&rows);
+        std::fs::write(&path, csv).unwrap();
+        let e = fit_command(&FitArgs {
+            input: path.clone(),
+            output: None,
+        })
+        .unwrap_err();
+        std::fs::remove_file(path).ok();
+        assert!(e.contains("line 2: column x:"), "{e}");
     }
 
     #[test]

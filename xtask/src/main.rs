@@ -1,6 +1,7 @@
 //! `cargo xtask <command>`: the project's one entry point for building,
 //! testing, flashing and simulating, plus the geometry and planning tools.
 
+mod bench_m4;
 mod calib;
 mod fuzz;
 mod kin;
@@ -25,6 +26,8 @@ enum Command {
     Test,
     /// Build the release firmware for thumbv7em-none-eabihf.
     Build,
+    /// The hot paths on the Cortex-M4F ISA (QEMU mps2-an386, -icount): instruction counts, µs, budgets.
+    BenchM4,
     /// Build the release firmware and flash it with `probe-rs run` (streams defmt logs).
     Flash,
     /// Print the release firmware's size (text/data/bss) against the budget.
@@ -47,6 +50,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Test => toolchain::test().map(|()| ExitCode::SUCCESS),
         Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
+        Command::BenchM4 => bench_m4::bench_m4().map(|()| ExitCode::SUCCESS),
         Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => sim::run_sim(args),

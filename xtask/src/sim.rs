@@ -14,7 +14,10 @@ use laser_sim::world::{SimOptions, run};
 /// Options of `cargo xtask sim`.
 #[derive(clap::Args, Debug)]
 pub struct SimArgs {
-    /// Script of command lines (`wait <ms>` pauses; `#` comments); `-`
+    /// Script of command lines (`wait <ms>` pauses; `#` comments;
+    /// `@stall-read <ms>` stops the host reading replies for a while,
+    /// `@type-ahead <line>` types without waiting for the reply, `@button`
+    /// presses the stop button); `-`
     /// reads it from stdin. Without it, piped stdin is the script, and a
     /// terminal or empty stdin runs the demo (writing sim.svg).
     #[arg(long)]
@@ -35,8 +38,9 @@ pub struct SimArgs {
     /// above the 10 µs sample period the loop underruns).
     #[arg(long, default_value_t = 0)]
     galvo_cost_ns: u64,
-    /// Inject a fault: `servo-silent:<id>@<t_ms>[-<end_ms>]`, `servo-corrupt:<probability>`,
-    /// `servo-slow:<factor>` (repeatable).
+    /// Inject a fault: `servo-silent:<id>@<t_ms>[-<end_ms>]`, `servo-corrupt:<probability>`
+    /// (per response byte), `servo-forge:<probability>` (per angle response: a wrong angle
+    /// with a valid checksum), `servo-slow:<factor>` (repeatable).
     #[arg(long = "fault")]
     faults: Vec<String>,
     /// Run until the script has ended and the sequencer is idle; exit 1 if
@@ -57,6 +61,12 @@ pub struct SimArgs {
     /// --interactive).
     #[arg(long)]
     max_time_s: Option<f64>,
+    /// Check the safety invariants after the run (laser dark within 1 ms
+    /// of stop/fault/button/underrun, never lit while moving, one reply
+    /// per line, no task step over 1 ms of CPU time); print every
+    /// violation and exit 1 on any.
+    #[arg(long)]
+    check_safety: bool,
     /// Log level of the firmware logs on stderr (error, warn, info, debug, trace, off).
     #[arg(long, default_value = "info")]
     log: String,
@@ -98,14 +108,18 @@ pub fn parse_faults(specs: &[String]) -> Result<(BusFaults, f64)> {
                     until_ms,
                 });
             }
-            "servo-corrupt" => {
+            "servo-corrupt" | "servo-forge" => {
                 let p: f64 = value
                     .parse()
                     .with_context(|| format!("fault {spec:?}: bad probability"))?;
                 if !(0.0..=1.0).contains(&p) {
                     bail!("fault {spec:?}: probability must be in [0, 1]");
                 }
-                faults.corrupt_probability = p;
+                if kind == "servo-forge" {
+                    faults.forge_probability = p;
+                } else {
+                    faults.corrupt_probability = p;
+                }
             }
             "servo-slow" => {
                 let f: f64 = value
@@ -117,7 +131,9 @@ pub fn parse_faults(specs: &[String]) -> Result<(BusFaults, f64)> {
                 slow = f;
             }
             other => {
-                bail!("unknown fault kind {other:?} (servo-silent, servo-corrupt, servo-slow)")
+                bail!(
+                    "unknown fault kind {other:?} (servo-silent, servo-corrupt, servo-forge, servo-slow)"
+                )
             }
         }
     }
@@ -216,6 +232,21 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         report.galvo_underruns,
         report.transcript.error_replies
     );
+    let mut unsafe_run = false;
+    if args.check_safety {
+        let violations = laser_sim::safety::check(&report);
+        eprint!("xtask sim: {}", laser_sim::safety::report_text(&violations));
+        for task in &report.task_steps {
+            eprintln!(
+                "xtask sim:   {:<18} {:>9} steps, longest {:.3} ms CPU at {:.3} ms",
+                task.name,
+                task.polls,
+                task.max_cpu_ns as f64 / 1e6,
+                task.max_at_us as f64 / 1000.0
+            );
+        }
+        unsafe_run = !violations.is_empty();
+    }
     if report.end == RunEnd::Livelock {
         eprintln!(
             "xtask sim: a task kept running without letting time pass (busy loop); run stopped"
@@ -226,6 +257,9 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         if !report.idle_at_end {
             eprintln!("xtask sim: the sequencer was still busy when the run ended");
         }
+        return Ok(ExitCode::FAILURE);
+    }
+    if unsafe_run {
         return Ok(ExitCode::FAILURE);
     }
     Ok(ExitCode::SUCCESS)
@@ -241,6 +275,7 @@ mod tests {
             "servo-silent:1@2500".to_owned(),
             "servo-silent:0@100-400".to_owned(),
             "servo-corrupt:0.05".to_owned(),
+            "servo-forge:0.2".to_owned(),
             "servo-slow:3".to_owned(),
         ];
         let (faults, slow) = parse_faults(&specs).unwrap();
@@ -260,12 +295,14 @@ mod tests {
             ]
         );
         assert_eq!(faults.corrupt_probability, 0.05);
+        assert_eq!(faults.forge_probability, 0.2);
         assert_eq!(slow, 3.0);
         for bad in [
             "servo-silent:1",
             "servo-silent:1@500-400",
             "servo-silent:1@5-x",
             "servo-corrupt:2",
+            "servo-forge:-1",
             "servo-slow:0.5",
             "gremlins:1",
             "x",

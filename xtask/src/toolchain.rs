@@ -85,7 +85,8 @@ fn package_args<'a>(packages: &[&'a str]) -> Vec<&'a str> {
     packages.iter().flat_map(|p| ["-p", *p]).collect()
 }
 
-/// `cargo xtask test`: the whole gate, in the order a reviewer would run it.
+/// `cargo xtask test`: the whole gate, in the order a reviewer would run it
+/// (ends with `bench-m4`, the M4 budgets on QEMU).
 pub fn test() -> Result<()> {
     ensure_toolchain()?;
     run("cargo", &["fmt", "--all", "--check"])?;
@@ -95,7 +96,16 @@ pub fn test() -> Result<()> {
     clippy_host.extend(["--", "-D", "warnings"]);
     run("cargo", &clippy_host)?;
 
-    let mut clippy_target = vec!["clippy", "--target", TARGET, "--release", "-p", "firmware"];
+    let mut clippy_target = vec![
+        "clippy",
+        "--target",
+        TARGET,
+        "--release",
+        "-p",
+        "firmware",
+        "-p",
+        "bench-m4",
+    ];
     clippy_target.extend(package_args(&TARGET_LIBRARIES));
     clippy_target.extend(["--", "-D", "warnings"]);
     run("cargo", &clippy_target)?;
@@ -113,12 +123,34 @@ pub fn test() -> Result<()> {
     run("cargo", &tests)?;
 
     build_firmware()?;
-    size()
+    size()?;
+
+    // The per-sample and refill budgets on the target's instruction set.
+    crate::bench_m4::bench_m4()
+}
+
+/// Installs flip-link, the firmware's linker wrapper (`.cargo/config.toml`:
+/// stack below `.data`/`.bss`, so an overflow faults instead of corrupting
+/// them), with `cargo install flip-link --locked` when it is not on `PATH`.
+pub fn ensure_flip_link() -> Result<()> {
+    // flip-link has no `--version`; whether it starts at all is the test.
+    match Command::new("flip-link").output() {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            println!(
+                "flip-link (the firmware's stack-overflow-protecting linker) is not installed: \
+                 installing it with `cargo install flip-link --locked`"
+            );
+            run("cargo", &["install", "flip-link", "--locked"])
+        }
+        Err(e) => Err(e).context("could not start `flip-link`"),
+        Ok(_) => Ok(()),
+    }
 }
 
 /// Builds the release firmware and returns the path of the ELF image.
 pub fn build_firmware() -> Result<PathBuf> {
     ensure_toolchain()?;
+    ensure_flip_link()?;
     run(
         "cargo",
         &["build", "--release", "--target", TARGET, "-p", "firmware"],

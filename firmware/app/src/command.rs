@@ -2,10 +2,11 @@
 //! the firmware, and the reply path back.
 //!
 //! The console task parses a line into a [`Command`], sends it on
-//! [`CommandLink::commands`] and then forwards [`Reply`] items from
-//! [`CommandLink::replies`] until the closing `ok` / `error:`; the sequencer
-//! task receives commands (also while a pattern runs, so a new command
-//! preempts it) and answers each with exactly one closing reply.
+//! [`CommandLink::commands`] and waits until its reply is closed; the
+//! sequencer task receives commands (also while a pattern runs, so a new
+//! command preempts it) and answers each with zero or more data lines and
+//! exactly one closing `ok` / `error:`, queued on [`CommandLink::outbound`]
+//! without ever waiting for the host (the console's writer sends them).
 
 use core::fmt::{self, Write as _};
 
@@ -14,6 +15,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
 use crate::cli::format::Shortest;
+use crate::outbound::{LineKind, Outbound};
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
 
 /// Longest reply line, bytes (longer lines are cut).
@@ -215,6 +217,20 @@ impl Command {
             Command::GalvoStatus => "galvo status",
         }
     }
+
+    /// Whether the reply has data lines before its closer (the console
+    /// gives earlier output time to reach the host before it sends these).
+    pub fn replies_with_data(&self) -> bool {
+        matches!(
+            self,
+            Command::Help
+                | Command::Version
+                | Command::Status
+                | Command::Get(_)
+                | Command::Params
+                | Command::GalvoStatus
+        )
+    }
 }
 
 /// The pattern in command-line syntax (`circle 2 1 4 ccw`).
@@ -311,25 +327,6 @@ impl defmt::Format for Command {
     }
 }
 
-/// One item of a reply. Every command gets zero or more `Data` lines and
-/// then exactly one `Ok` or `Error`.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Reply {
-    /// An informational line (printed as is).
-    Data(ReplyText),
-    /// The command succeeded (printed as `ok`).
-    Ok,
-    /// The command failed (printed as `error: <reason>`).
-    Error(ReplyText),
-}
-
-impl Reply {
-    /// Whether this item closes the reply.
-    pub fn is_final(&self) -> bool {
-        !matches!(self, Reply::Data(_))
-    }
-}
-
 /// Formats into a reply line, cutting it at [`REPLY_LINE_LEN`] bytes.
 pub fn reply_text(args: fmt::Arguments<'_>) -> ReplyText {
     let mut out = Truncating(ReplyText::new());
@@ -351,22 +348,17 @@ impl fmt::Write for Truncating {
 }
 
 /// Depth of the command queue. One command is in flight at a time (the
-/// console waits for its reply), so a small queue suffices.
+/// console waits for its closing reply to be queued), so a small queue
+/// suffices.
 pub const COMMAND_QUEUE_DEPTH: usize = 2;
-/// Depth of the reply queue.
-pub const REPLY_QUEUE_DEPTH: usize = 4;
-/// Depth of the notice queue.
-pub const EVENT_QUEUE_DEPTH: usize = 4;
 
 /// Channels between the console task and the sequencer task.
 pub struct CommandLink {
     /// Console → sequencer.
     pub commands: Channel<CriticalSectionRawMutex, Command, COMMAND_QUEUE_DEPTH>,
-    /// Sequencer → console.
-    pub replies: Channel<CriticalSectionRawMutex, Reply, REPLY_QUEUE_DEPTH>,
-    /// Unsolicited notices (faults, recoveries) → console, printed between
-    /// replies. Sent with `try_send`: dropped when the console is behind.
-    pub events: Channel<CriticalSectionRawMutex, ReplyText, EVENT_QUEUE_DEPTH>,
+    /// Replies and notices → console: whole lines, queued without waiting
+    /// (see [`Outbound`]).
+    pub outbound: Outbound,
     /// Stop request from the board's button: stop and laser off, no reply.
     pub stop_request: Signal<CriticalSectionRawMutex, ()>,
 }
@@ -376,38 +368,41 @@ impl CommandLink {
     pub const fn new() -> Self {
         Self {
             commands: Channel::new(),
-            replies: Channel::new(),
-            events: Channel::new(),
+            outbound: Outbound::new(),
             stop_request: Signal::new(),
         }
     }
 
-    /// Queues an unsolicited notice line for the console (dropped if the
-    /// queue is full: notices must never block the sequencer).
+    /// Queues an unsolicited notice line, printed in brackets. Never
+    /// waits: when the host is not reading and the queue is full it is
+    /// dropped and counted, and the count is reported later.
     pub fn notify(&self, args: fmt::Arguments<'_>) {
-        let _ = self.events.try_send(reply_text(args));
+        self.outbound.push_fmt(LineKind::Notice, args);
     }
 
-    /// Sends one data line of the current reply.
-    pub async fn data(&self, args: fmt::Arguments<'_>) {
-        self.replies.send(Reply::Data(reply_text(args))).await;
+    /// Queues one data line of the current reply (never waits; dropped and
+    /// counted when the host is not reading and the queue is full).
+    pub fn data(&self, args: fmt::Arguments<'_>) {
+        self.outbound.push_fmt(LineKind::Data, args);
     }
 
-    /// Sends one data line already formatted.
-    pub async fn data_line(&self, line: ReplyText) {
-        self.replies.send(Reply::Data(line)).await;
+    /// Queues one data line already formatted (never waits, like
+    /// [`CommandLink::data`]).
+    pub fn data_line(&self, line: ReplyText) {
+        self.outbound.push(LineKind::Data, &line);
     }
 
-    /// Closes the current reply with `ok`.
-    pub async fn ok(&self) {
-        self.replies.send(Reply::Ok).await;
+    /// Closes the current reply with `ok` (never waits; a closer always
+    /// has room).
+    pub fn ok(&self) {
+        self.outbound.push(LineKind::Ok, "");
     }
 
-    /// Closes the current reply with `error: <reason>`.
-    pub async fn error(&self, reason: impl fmt::Display) {
-        self.replies
-            .send(Reply::Error(reply_text(format_args!("{reason}"))))
-            .await;
+    /// Closes the current reply with `error: <reason>` (never waits; a
+    /// closer always has room).
+    pub fn error(&self, reason: impl fmt::Display) {
+        self.outbound
+            .push_fmt(LineKind::Error, format_args!("{reason}"));
     }
 }
 
@@ -431,12 +426,5 @@ mod tests {
             reply_text(format_args!("a={} b={}", 1, 2.5)).as_str(),
             "a=1 b=2.5"
         );
-    }
-
-    #[test]
-    fn only_ok_and_error_close_a_reply() {
-        assert!(Reply::Ok.is_final());
-        assert!(Reply::Error(ReplyText::new()).is_final());
-        assert!(!Reply::Data(ReplyText::new()).is_final());
     }
 }

@@ -8,13 +8,16 @@
 //! [`servo`] (servo task body and FashionStar codec) and [`galvo`] (the
 //! galvo loop body feeding the DAC).
 //! Text handling lives in [`cli`], parameters in [`settings`], shared
-//! state for LEDs/watchdog/simulator in [`status`].
+//! state for LEDs/watchdog/simulator in [`status`], the master laser gate
+//! that no laser command or sample stream can override in [`laser_gate`].
 
 pub mod build_info;
 pub mod cli;
 pub mod command;
 pub mod galvo;
+pub mod laser_gate;
 mod log;
+pub mod outbound;
 pub mod sequencer;
 pub mod servo;
 pub mod settings;

@@ -24,12 +24,23 @@ pub enum Activity {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Phase {
-    /// The servos are travelling to the point.
+    /// The servos are travelling to the first point of a pass of a
+    /// pattern, or to a goto target: off the figure, laser dark in every
+    /// mode.
+    Approaching,
+    /// The servos are travelling from one point of the figure to the next.
     Moving,
     /// Arrived; dwelling on the point.
     Dwelling,
     /// Arrived at a goto target; holding until the next command.
     Holding,
+}
+
+impl Phase {
+    /// Whether the servos are travelling (no arrival confirmed yet).
+    pub fn is_travel(self) -> bool {
+        matches!(self, Phase::Approaching | Phase::Moving)
+    }
 }
 
 /// A copy of the firmware state.

@@ -52,6 +52,70 @@ pub struct FrameRecord {
     pub bytes: Vec<u8>,
 }
 
+/// A sequencer event that decides when a laser may be lit, as processed by
+/// the firmware (see `laser_app::sequencer::LaserEvent`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SequencerEvent {
+    /// The sequencer stopped; `why` as logged (`"stop command"`,
+    /// `"stop button"`, `"servo fault"`, `"galvo underrun"`, …).
+    Stopped {
+        /// Reason.
+        why: String,
+    },
+    /// A pattern or goto started.
+    RunStarted,
+    /// A servo move was sent.
+    GimbalMoveSent,
+    /// The servo task's arrival confirmation was accepted.
+    GimbalArrived,
+}
+
+/// A [`SequencerEvent`] with the simulated time it was processed.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct EventRecord {
+    /// Simulated time, µs.
+    pub t_us: u64,
+    /// What happened.
+    pub event: SequencerEvent,
+    /// Laser switches (`Recording::laser_events`) recorded before it: the
+    /// order of events and switches within one instant.
+    pub laser_switches_before: usize,
+}
+
+/// One gimbal servo's true state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ServoState {
+    /// True angle, degrees (unquantised).
+    pub angle_deg: f64,
+    /// Target of its current (or last) move, degrees (0.1° resolution).
+    pub target_deg: f64,
+}
+
+/// The gimbal servos' true angles and targets at one time, with the
+/// gimbal laser's state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ServoSample {
+    /// Simulated time, µs.
+    pub t_us: u64,
+    /// Yaw servo (`None`: no such servo on the bus).
+    pub yaw: Option<ServoState>,
+    /// Pitch servo.
+    pub pitch: Option<ServoState>,
+    /// Gimbal laser output at that time (after any switch at `t_us`).
+    pub laser: bool,
+}
+
+/// A response frame the fault injection corrupted on the wire.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CorruptedFrame {
+    /// When its first byte went on the wire, µs (as in [`FrameRecord`]).
+    pub t_us: u64,
+    /// The bytes as the servo sent them.
+    pub sent: Vec<u8>,
+    /// The bytes as the firmware received them.
+    pub received: Vec<u8>,
+}
+
 /// Everything recorded during a run.
 #[derive(Debug, Default, Clone)]
 pub struct Recording {
@@ -63,6 +127,14 @@ pub struct Recording {
     pub laser_events: Vec<(u64, bool)>,
     /// Servo-bus frames.
     pub frames: Vec<FrameRecord>,
+    /// Sequencer events that decide when a laser may be lit, in order.
+    pub events: Vec<EventRecord>,
+    /// Servo angles and targets: every spot sample period and at every
+    /// gimbal laser switch and sequencer event.
+    pub servos: Vec<ServoSample>,
+    /// Response frames corrupted by the fault injection (their clean
+    /// bytes), in order.
+    pub clean_rx: Vec<CorruptedFrame>,
 }
 
 impl Recording {

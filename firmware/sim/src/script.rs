@@ -1,5 +1,10 @@
 //! Simulator scripts: one command line per line, `wait <ms>` pauses in
-//! simulated time, blank lines and `#` comments are skipped.
+//! simulated time, blank lines and `#` comments are skipped. Lines starting
+//! with `@` direct the simulated host instead of being typed:
+//! `@stall-read <ms>` makes it stop reading the device's output for that
+//! long (the script goes on, so lines can be typed during the stall),
+//! `@type-ahead <line>` types a line without waiting for its reply, and
+//! `@button` presses the board's stop button.
 
 use anyhow::{Context, Result, bail};
 
@@ -10,6 +15,32 @@ pub enum Step {
     Send(String),
     /// Let simulated time pass, ms.
     WaitMs(u64),
+    /// The host stops reading the device's output for this long, ms, from
+    /// now; the script goes on meanwhile.
+    StallReadMs(u64),
+    /// Send this line without waiting for its reply (the next `Send`, and
+    /// the end of the script, wait for every reply outstanding).
+    SendAhead(String),
+    /// Press the board's stop button (stop, laser off, no reply).
+    StopButton,
+}
+
+/// A whole number of milliseconds: the only argument of `word`.
+fn ms_argument<'a>(
+    word: &str,
+    mut args: impl Iterator<Item = &'a str>,
+    number: usize,
+) -> Result<u64> {
+    let ms = args
+        .next()
+        .with_context(|| format!("script line {number}: `{word}` needs a time in ms"))?;
+    let ms: u64 = ms
+        .parse()
+        .with_context(|| format!("script line {number}: bad {word} time {ms:?}"))?;
+    if args.next().is_some() {
+        bail!("script line {number}: `{word} <ms>` takes one argument");
+    }
+    Ok(ms)
 }
 
 /// Parses a script; `wait` needs a whole number of milliseconds.
@@ -20,20 +51,32 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
         if line.is_empty() || line.starts_with('#') {
             continue;
         }
+        let number = number + 1;
         let mut words = line.split_ascii_whitespace();
-        if words.next() == Some("wait") {
-            let ms = words.next().with_context(|| {
-                format!("script line {}: `wait` needs a time in ms", number + 1)
-            })?;
-            let ms: u64 = ms
-                .parse()
-                .with_context(|| format!("script line {}: bad wait time {ms:?}", number + 1))?;
-            if words.next().is_some() {
-                bail!("script line {}: `wait <ms>` takes one argument", number + 1);
+        match words.next() {
+            Some("wait") => steps.push(Step::WaitMs(ms_argument("wait", words, number)?)),
+            Some("@stall-read") => {
+                steps.push(Step::StallReadMs(ms_argument(
+                    "@stall-read",
+                    words,
+                    number,
+                )?));
             }
-            steps.push(Step::WaitMs(ms));
-        } else {
-            steps.push(Step::Send(line.to_owned()));
+            Some("@type-ahead") => {
+                let typed = line.trim_start_matches("@type-ahead").trim();
+                if typed.is_empty() {
+                    bail!("script line {number}: `@type-ahead` needs a line to type");
+                }
+                steps.push(Step::SendAhead(typed.to_owned()));
+            }
+            Some("@button") if line == "@button" => steps.push(Step::StopButton),
+            Some(directive) if directive.starts_with('@') => {
+                bail!(
+                    "script line {number}: unknown directive {directive:?} \
+                     (@stall-read <ms>, @type-ahead <line>, @button)"
+                );
+            }
+            _ => steps.push(Step::Send(line.to_owned())),
         }
     }
     Ok(steps)
@@ -59,13 +102,14 @@ mod tests {
 
     #[test]
     fn parses_commands_waits_and_skips_comments() {
-        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\n").unwrap();
+        let steps = parse_script("# hi\n\npattern corner\n  wait 250 \nstop\n@button\n").unwrap();
         assert_eq!(
             steps,
             vec![
                 Step::Send("pattern corner".into()),
                 Step::WaitMs(250),
-                Step::Send("stop".into())
+                Step::Send("stop".into()),
+                Step::StopButton,
             ]
         );
     }
@@ -76,6 +120,31 @@ mod tests {
         assert!(err.contains("line 2"), "{err}");
         assert!(parse_script("wait").is_err());
         assert!(parse_script("wait 1 2").is_err());
+    }
+
+    #[test]
+    fn host_directives_parse_and_bad_ones_name_the_line() {
+        let steps = parse_script("@stall-read 3000\n@type-ahead  get dwell_ms \nparams\n").unwrap();
+        assert_eq!(
+            steps,
+            vec![
+                Step::StallReadMs(3000),
+                Step::SendAhead("get dwell_ms".into()),
+                Step::Send("params".into())
+            ]
+        );
+        for bad in [
+            "@stall-read",
+            "@stall-read 1 2",
+            "@stall-read -5",
+            "@type-ahead",
+            "@stall 5",
+        ] {
+            let err = parse_script(&format!("stop\n{bad}\n"))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("line 2"), "{bad}: {err}");
+        }
     }
 
     #[test]

@@ -13,7 +13,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 use embassy_time::{Instant, Timer};
 
-use crate::recorder::{Direction, FrameRecord, Recording};
+use crate::recorder::{CorruptedFrame, Direction, FrameRecord, Recording};
 use crate::servo_model::SimServoBus;
 
 /// Time one byte takes on the wire at 115200 baud 8N1 (10 bits), µs.
@@ -26,6 +26,13 @@ pub struct BusFaults {
     pub silent: Vec<SilentWindow>,
     /// Probability that a response byte is corrupted (one bit flipped).
     pub corrupt_probability: f64,
+    /// Probability that an angle response is corrupted so that its 8-bit
+    /// checksum still holds (two bit flips that cancel in the sum, as
+    /// random corruption produces now and then): a wrong angle the
+    /// checksum cannot catch.
+    pub forge_probability: f64,
+    /// Seed of the corruption's random numbers (0: the default seed).
+    pub seed: u64,
 }
 
 /// Servo `id` does not answer from `from_ms` until `until_ms` (for good
@@ -66,13 +73,14 @@ impl SimServoPort {
         faults: BusFaults,
         seed: u64,
     ) -> Self {
+        let rng_seed = if faults.seed != 0 { faults.seed } else { seed };
         Self {
             bus,
             recording,
             faults,
             incoming: RefCell::default(),
             arrived: Signal::new(),
-            rng: RefCell::new(seed | 1),
+            rng: RefCell::new(rng_seed | 1),
         }
     }
 
@@ -96,11 +104,9 @@ impl SimServoPort {
         }
     }
 
-    async fn write_bytes(&self, bytes: &[u8]) {
-        let start = Instant::now().as_micros();
-        // The bytes are on the wire for their transmission time.
-        Timer::after_micros(BYTE_TIME_US * bytes.len() as u64).await;
-        let done = Instant::now().as_micros();
+    /// Records a frame sent from `start` to `done` (µs), lets the servos
+    /// act on it and queues their responses.
+    fn deliver(&self, start: u64, done: u64, bytes: &[u8]) {
         self.recording.borrow_mut().frames.push(FrameRecord {
             t_us: start,
             direction: Direction::Tx,
@@ -109,6 +115,12 @@ impl SimServoPort {
         self.apply_silence(done);
         let responses = self.bus.borrow_mut().receive(done, bytes);
         for (ready_at_us, mut response) in responses {
+            let sent = response.clone();
+            if self.faults.forge_probability > 0.0
+                && self.random_unit() < self.faults.forge_probability
+            {
+                self.forge_angle(&mut response);
+            }
             for byte in response.iter_mut() {
                 if self.faults.corrupt_probability > 0.0
                     && self.random_unit() < self.faults.corrupt_probability
@@ -116,17 +128,65 @@ impl SimServoPort {
                     *byte ^= 1 << (self.random_unit() * 8.0) as u32;
                 }
             }
-            self.recording.borrow_mut().frames.push(FrameRecord {
+            let mut recording = self.recording.borrow_mut();
+            if response != sent {
+                recording.clean_rx.push(CorruptedFrame {
+                    t_us: ready_at_us,
+                    sent,
+                    received: response.clone(),
+                });
+            }
+            recording.frames.push(FrameRecord {
                 t_us: ready_at_us,
                 direction: Direction::Rx,
                 bytes: response.clone(),
             });
+            drop(recording);
             let mut incoming = self.incoming.borrow_mut();
             for (i, byte) in response.into_iter().enumerate() {
                 incoming.push_back((ready_at_us + BYTE_TIME_US * (i as u64 + 1), byte));
             }
         }
+    }
+
+    async fn write_bytes(&self, bytes: &[u8]) {
+        let start = Instant::now().as_micros();
+        // The bytes are on the wire for their transmission time.
+        Timer::after_micros(BYTE_TIME_US * bytes.len() as u64).await;
+        let done = Instant::now().as_micros();
+        // The simulated bus and servos: not firmware work.
+        crate::executor::simulator_work(|| self.deliver(start, done, bytes));
         self.arrived.signal(());
+    }
+
+    /// Flips two bits of an angle response (code 10, 8 bytes) so that the
+    /// checksum still holds: the same bit set in one angle byte and cleared
+    /// in the other, or set in an angle byte and in the checksum.
+    fn forge_angle(&self, frame: &mut [u8]) {
+        const ANGLE_CODE: u8 = 10;
+        if frame.len() != 8 || frame.get(2) != Some(&ANGLE_CODE) {
+            return;
+        }
+        let (lo, hi, cs) = (5, 6, 7);
+        for _ in 0..32 {
+            let mask = 1u8 << (self.random_unit() * 8.0) as u32;
+            let (a, b) = if self.random_unit() < 0.5 {
+                (lo, hi)
+            } else {
+                (hi, lo)
+            };
+            if self.random_unit() < 0.5 {
+                if frame[a] & mask == 0 && frame[b] & mask != 0 {
+                    frame[a] |= mask;
+                    frame[b] &= !mask;
+                    return;
+                }
+            } else if frame[a] & mask == 0 && frame[cs] & mask == 0 {
+                frame[a] |= mask;
+                frame[cs] |= mask;
+                return;
+            }
+        }
     }
 
     async fn read_bytes(&self, buf: &mut [u8]) -> usize {

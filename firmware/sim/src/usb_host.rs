@@ -1,16 +1,23 @@
 //! The simulated USB host: a terminal that types the script into the
 //! firmware's command line (over byte pipes standing in for CDC-ACM) and
 //! reads back every reply, one command at a time like a G-code sender.
+//!
+//! The device → host pipe is bounded ([`FromDevice`]), like the CDC-ACM
+//! endpoint and the host driver's buffer: when the terminal stops reading
+//! (`@stall-read <ms>` in a script) the device's writes block once it is
+//! full, so back-pressure reaches the firmware as it does on a real port.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
+use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
-use embassy_sync::channel::Channel;
 use embassy_sync::pipe::Pipe;
+use embassy_sync::signal::Signal;
 use embassy_time::Timer;
 
 use crate::script::Step;
+use laser_app::command::CommandLink;
 
 /// Host → firmware bytes.
 pub type ToDevice = Pipe<CriticalSectionRawMutex, 256>;
@@ -30,6 +37,9 @@ pub struct Transcript {
     pub notices: Vec<(u64, String)>,
     /// The script has been sent completely and every reply received.
     pub script_done: bool,
+    /// Bytes received after the last line end (a line cut short shows
+    /// here).
+    pub unterminated: String,
 }
 
 /// Shared between the script and terminal tasks.
@@ -38,8 +48,14 @@ pub struct UsbHost {
     pub to_device: ToDevice,
     /// Device → host pipe.
     pub from_device: FromDevice,
-    /// Closing replies (true = `ok`), terminal → script task.
-    finals: Channel<CriticalSectionRawMutex, bool, 4>,
+    /// Lines typed whose closing reply has not been read yet.
+    outstanding: Cell<usize>,
+    /// A closing reply was read (wakes the script task).
+    closed: Signal<CriticalSectionRawMutex, ()>,
+    /// The terminal does not read before this time, µs.
+    stall_until_us: Cell<u64>,
+    /// A stall began (wakes the terminal out of its read).
+    stalled: Signal<CriticalSectionRawMutex, ()>,
     /// What happened.
     pub transcript: RefCell<Transcript>,
     /// Echo the transcript on stdout as it happens.
@@ -52,7 +68,10 @@ impl UsbHost {
         Self {
             to_device: Pipe::new(),
             from_device: Pipe::new(),
-            finals: Channel::new(),
+            outstanding: Cell::new(0),
+            closed: Signal::new(),
+            stall_until_us: Cell::new(0),
+            stalled: Signal::new(),
             transcript: RefCell::default(),
             echo,
         }
@@ -65,16 +84,49 @@ impl UsbHost {
         let t = crate::clock::now_us();
         self.transcript.borrow_mut().lines.push((t, line));
     }
-}
 
-/// Types the script: each command line, then waits for its closing reply.
-pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>) {
-    for step in steps {
-        match step {
-            Step::WaitMs(ms) => Timer::after_millis(ms).await,
-            Step::Send(line) => send_line(&host, &line).await,
+    /// Stops reading the device's output for `ms` from now.
+    pub fn stall_read(&self, ms: u64) {
+        let until = crate::clock::now_us() + ms * 1000;
+        self.stall_until_us
+            .set(self.stall_until_us.get().max(until));
+        self.stalled.signal(());
+    }
+
+    /// Waits until every line typed so far has its closing reply.
+    async fn replies_read(&self) {
+        while self.outstanding.get() > 0 {
+            self.closed.wait().await;
         }
     }
+}
+
+/// Runs one script step; `@button` presses `button`'s stop request (the
+/// interactive terminal has no button).
+async fn run_step(host: &UsbHost, step: Step, button: Option<&CommandLink>) {
+    match step {
+        Step::StopButton => {
+            if let Some(link) = button {
+                link.stop_request.signal(());
+            }
+        }
+        Step::WaitMs(ms) => Timer::after_millis(ms).await,
+        Step::Send(line) => {
+            type_line(host, &line).await;
+            host.replies_read().await;
+        }
+        Step::SendAhead(line) => type_line(host, &line).await,
+        Step::StallReadMs(ms) => host.stall_read(ms),
+    }
+}
+
+/// Types the script: each command line, then waits for its closing reply;
+/// `@button` steps press the board's stop button (`link`'s stop request).
+pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, link: &CommandLink) {
+    for step in steps {
+        run_step(&host, step, Some(link)).await;
+    }
+    host.replies_read().await;
     host.transcript.borrow_mut().script_done = true;
 }
 
@@ -86,10 +138,7 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
         match lines.try_recv() {
             Ok(line) => {
                 for step in crate::script::parse_script(&line).unwrap_or_default() {
-                    match step {
-                        Step::WaitMs(ms) => Timer::after_millis(ms).await,
-                        Step::Send(line) => send_line(&host, &line).await,
-                    }
+                    run_step(&host, step, None).await;
                 }
             }
             Err(std::sync::mpsc::TryRecvError::Empty) => Timer::after_millis(20).await,
@@ -99,20 +148,30 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
     host.transcript.borrow_mut().script_done = true;
 }
 
-/// Types one command line and waits for its closing reply.
-async fn send_line(host: &UsbHost, line: &str) {
+/// Types one command line (its reply is then outstanding).
+async fn type_line(host: &UsbHost, line: &str) {
     host.record(format!("> {line}"));
+    host.outstanding.set(host.outstanding.get() + 1);
     host.to_device.write_all(line.as_bytes()).await;
     host.to_device.write_all(b"\r\n").await;
-    host.finals.receive().await;
 }
 
-/// Reads the device's output line by line.
+/// Reads the device's output line by line (not while stalled).
 pub async fn terminal_task(host: Rc<UsbHost>) {
     let mut pending = Vec::new();
     let mut chunk = [0u8; 128];
     loop {
-        let n = host.from_device.read(&mut chunk).await;
+        let now = crate::clock::now_us();
+        let until = host.stall_until_us.get();
+        if now < until {
+            Timer::after_micros(until - now).await;
+            continue;
+        }
+        // A stall that begins while waiting wins over bytes ready.
+        let n = match select(host.stalled.wait(), host.from_device.read(&mut chunk)).await {
+            Either::First(()) => continue,
+            Either::Second(n) => n,
+        };
         pending.extend_from_slice(chunk.get(..n).unwrap_or(&[]));
         while let Some(end) = pending.iter().position(|&b| b == b'\n') {
             let raw: Vec<u8> = pending.drain(..=end).collect();
@@ -128,9 +187,12 @@ pub async fn terminal_task(host: Rc<UsbHost>) {
                 if is_error {
                     host.transcript.borrow_mut().error_replies += 1;
                 }
-                host.finals.send(is_ok).await;
+                host.outstanding
+                    .set(host.outstanding.get().saturating_sub(1));
+                host.closed.signal(());
             }
         }
+        host.transcript.borrow_mut().unterminated = String::from_utf8_lossy(&pending).into_owned();
     }
 }
 
@@ -175,5 +237,35 @@ mod tests {
         assert_eq!(lines, ["> status", "ok", "> goto 1 2", "ok"]);
         let goto_at = transcript.lines[2].0;
         assert!(goto_at >= 100_000, "the wait line waited: {goto_at} µs");
+    }
+
+    #[test]
+    fn a_stalled_terminal_reads_nothing_until_the_stall_ends() {
+        let host = Rc::new(UsbHost::new(false));
+        let steps =
+            crate::script::parse_script("@stall-read 500\n@type-ahead a\nb\nwait 10\nc\n").unwrap();
+        let (h1, h2, h3, stop) = (host.clone(), host.clone(), host.clone(), host.clone());
+        let end = executor::run(
+            false,
+            10_000_000,
+            move |spawner| {
+                let link: &'static CommandLink = Box::leak(Box::new(CommandLink::new()));
+                executor::spawn(&spawner, script_task(steps, h1, link));
+                executor::spawn(&spawner, terminal_task(h2));
+                executor::spawn(&spawner, echo_ok_device(h3));
+            },
+            move || stop.transcript.borrow().script_done,
+        );
+        assert_eq!(end, executor::RunEnd::Stopped);
+        let transcript = host.transcript.borrow();
+        let lines: Vec<&str> = transcript.lines.iter().map(|(_, l)| l.as_str()).collect();
+        assert_eq!(lines, ["> a", "> b", "ok", "ok", "> c", "ok"]);
+        let first_ok = transcript.lines[2].0;
+        assert!(
+            first_ok >= 500_000,
+            "read during the stall at {first_ok} µs"
+        );
+        assert!(transcript.lines[1].0 < 1_000, "typed during the stall");
+        assert!(transcript.unterminated.is_empty());
     }
 }

@@ -11,14 +11,21 @@ use std::sync::atomic::Ordering;
 
 use laser_app::command::CommandLink;
 use laser_app::galvo::{GalvoConfig, GalvoLink, GalvoLoop};
-use laser_app::sequencer::{LaserSwitch, Sequencer, SettingsStore};
+use laser_app::sequencer::{LaserEvent, LaserSwitch, Sequencer, SettingsStore};
 use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
+use laser_app::settings::store::FlashSettingsStore;
 use laser_app::status::{Activity, Phase, StatusBoard};
+use sequential_storage::map::MapConfig;
 
 use crate::dac::{DacRecording, SimDac};
+use crate::executor::TaskKind;
 use crate::executor::{self, RunEnd};
+use crate::flash::{FlashStats, FlashTiming, PowerCut, SimFlash};
+use crate::laser::{GatedLaserPin, recorded_gate};
 use crate::physics::PhysicalGimbal;
-use crate::recorder::{DwellRecord, Recording, SpotSample};
+use crate::recorder::{
+    DwellRecord, EventRecord, Recording, SequencerEvent, ServoSample, ServoState, SpotSample,
+};
 use crate::script::Step;
 use crate::servo_model::SimServoBus;
 use crate::servo_port::{BusFaults, PortHandle, SimServoPort};
@@ -26,6 +33,38 @@ use crate::usb_host::{Transcript, UsbHost, interactive_task, script_task, termin
 
 /// Samples per galvo DAC half buffer (1.28 ms at 100 kHz).
 pub const GALVO_HALF_LEN: usize = 128;
+
+/// Bytes per sector of the settings flash (the STM32F407's sectors 10 and
+/// 11 are 128 KiB each).
+pub const SETTINGS_SECTOR_BYTES: usize = 128 * 1024;
+/// The settings flash as the target has it: sectors 10 and 11.
+pub type SettingsFlash = SimFlash<SETTINGS_SECTOR_BYTES>;
+/// Offset of the settings sectors from the start of flash (0x080C_0000).
+pub const SETTINGS_FLASH_OFFSET: u32 = 0x000C_0000;
+/// Sectors the settings use.
+pub const SETTINGS_SECTORS: usize = 2;
+
+/// The settings store over `flash`, laid out as on the target.
+pub fn settings_store(flash: SettingsFlash) -> FlashSettingsStore<SettingsFlash> {
+    FlashSettingsStore::new(
+        flash,
+        const {
+            MapConfig::new(
+                SETTINGS_FLASH_OFFSET
+                    ..SETTINGS_FLASH_OFFSET + (SETTINGS_SECTORS * SETTINGS_SECTOR_BYTES) as u32,
+            )
+        },
+    )
+}
+
+/// The record a boot from `image` (the settings sectors) loads, if any.
+pub fn load_settings_record(image: Vec<u8>) -> Option<Vec<u8>> {
+    let mut store = settings_store(SettingsFlash::from_image(SETTINGS_FLASH_OFFSET, image));
+    let mut record = vec![0u8; laser_app::settings::RECORD_LEN];
+    let n = embassy_futures::block_on(store.load(&mut record));
+    record.truncate(n);
+    (n > 0).then_some(record)
+}
 
 /// How to run a simulation.
 #[derive(Debug, Clone)]
@@ -49,8 +88,15 @@ pub struct SimOptions {
     pub echo: bool,
     /// Period of the spot sampler, µs.
     pub sample_period_us: u64,
-    /// Saved settings record to boot with (as if read from flash).
+    /// Saved settings record to boot with (saved through the store into
+    /// erased flash before the boot).
     pub saved_settings: Option<Vec<u8>>,
+    /// The settings sectors to boot from, as an earlier run left them
+    /// ([`SimReport::settings_flash`]); overrides `saved_settings`.
+    pub settings_flash: Option<Vec<u8>>,
+    /// Cut the power of the settings flash at this program/erase step
+    /// (counted from boot); the flash then refuses every access.
+    pub settings_flash_cut: Option<PowerCut>,
     /// The true gimbal: bus ids, geometry, servo mounting and board pose
     /// (set a pose or zero error to model a real, imperfect build).
     pub physical: PhysicalGimbal,
@@ -72,6 +118,8 @@ impl Default for SimOptions {
             echo: false,
             sample_period_us: 2_000,
             saved_settings: None,
+            settings_flash: None,
+            settings_flash_cut: None,
             physical: PhysicalGimbal::default(),
             galvo_cost_ns_per_sample: 0,
         }
@@ -91,12 +139,19 @@ pub struct SimReport {
     pub end_time_us: u64,
     /// The sequencer was idle (or holding a goto) at the end.
     pub idle_at_end: bool,
-    /// Settings record saved with `save` during the run, if any.
+    /// The settings record a reboot would load from the flash as the run
+    /// left it, if any.
     pub saved_settings: Option<Vec<u8>>,
+    /// The settings sectors at the end (boot the next run from them).
+    pub settings_flash: Vec<u8>,
+    /// What the settings flash did during the run.
+    pub settings_flash_stats: FlashStats,
     /// Every galvo DAC sample.
     pub dac: DacRecording,
     /// Galvo underruns.
     pub galvo_underruns: u32,
+    /// CPU-time accounting of every task's steps (polls).
+    pub task_steps: Vec<executor::TaskSteps>,
 }
 
 impl SimReport {
@@ -110,34 +165,75 @@ impl SimReport {
     }
 }
 
-/// The laser output: records every switch with its time.
-struct RecordingLaser(Rc<RefCell<Recording>>);
+/// The gimbal laser output: the gated pin (which records the effective
+/// laser), plus every sequencer event with its time and the servos' true
+/// state at each switch and event (for the safety checker).
+struct RecordingLaser {
+    /// The gated pin that records the effective gimbal laser.
+    pin: GatedLaserPin,
+    recording: Rc<RefCell<Recording>>,
+    bus: Rc<RefCell<SimServoBus>>,
+    gimbal: PhysicalGimbal,
+}
 
-impl LaserSwitch for RecordingLaser {
-    fn set(&mut self, on: bool) {
-        let t = crate::clock::now_us();
-        self.0.borrow_mut().laser_events.push((t, on));
+impl RecordingLaser {
+    fn record_servos(&self, rec: &mut Recording, t_us: u64) {
+        let laser = rec.laser_at(t_us);
+        rec.servos
+            .push(servo_sample(&self.bus.borrow(), self.gimbal, t_us, laser));
     }
 }
 
-/// Settings "flash" in memory.
-struct MemoryStore(Rc<RefCell<Option<Vec<u8>>>>);
-
-impl SettingsStore for MemoryStore {
-    async fn load(&mut self, buf: &mut [u8]) -> usize {
-        match &*self.0.borrow() {
-            Some(record) => {
-                let n = record.len().min(buf.len());
-                buf[..n].copy_from_slice(&record[..n]);
-                n
-            }
-            None => 0,
-        }
+impl LaserSwitch for RecordingLaser {
+    fn set(&mut self, on: bool) {
+        self.pin.set(on);
+        crate::executor::simulator_work(|| {
+            let t = crate::clock::now_us();
+            let mut rec = self.recording.borrow_mut();
+            self.record_servos(&mut rec, t);
+        });
     }
 
-    async fn save(&mut self, record: &[u8]) -> Result<(), &'static str> {
-        *self.0.borrow_mut() = Some(record.to_vec());
-        Ok(())
+    fn note(&mut self, event: LaserEvent<'_>) {
+        crate::executor::simulator_work(|| self.record_event(event));
+    }
+}
+
+impl RecordingLaser {
+    fn record_event(&self, event: LaserEvent<'_>) {
+        let t_us = crate::clock::now_us();
+        let event = match event {
+            LaserEvent::Stopped { why } => SequencerEvent::Stopped {
+                why: why.to_owned(),
+            },
+            LaserEvent::RunStarted => SequencerEvent::RunStarted,
+            LaserEvent::GimbalMoveSent => SequencerEvent::GimbalMoveSent,
+            LaserEvent::GimbalArrived => SequencerEvent::GimbalArrived,
+        };
+        let mut rec = self.recording.borrow_mut();
+        let laser_switches_before = rec.laser_events.len();
+        rec.events.push(EventRecord {
+            t_us,
+            event,
+            laser_switches_before,
+        });
+        self.record_servos(&mut rec, t_us);
+    }
+}
+
+/// The gimbal servos' true angles and targets at `t_us`.
+fn servo_sample(bus: &SimServoBus, gimbal: PhysicalGimbal, t_us: u64, laser: bool) -> ServoSample {
+    let state = |id| {
+        bus.servo(id).map(|s| ServoState {
+            angle_deg: s.angle_deg(t_us),
+            target_deg: f64::from(s.target_tenths()) / 10.0,
+        })
+    };
+    ServoSample {
+        t_us,
+        yaw: state(gimbal.yaw_id),
+        pitch: state(gimbal.pitch_id),
+        laser,
     }
 }
 
@@ -157,10 +253,11 @@ pub fn run(options: SimOptions) -> SimReport {
     let servo_link: &'static ServoLink = Box::leak(Box::new(ServoLink::new()));
     let galvo_link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
     let dac_recording = Rc::new(RefCell::new(DacRecording::default()));
+    let gate = recorded_gate(&dac_recording);
     let status: &'static StatusBoard = Box::leak(Box::new(StatusBoard::new()));
     let host = Rc::new(UsbHost::new(options.echo));
     let recording = Rc::new(RefCell::new(Recording::default()));
-    let flash = Rc::new(RefCell::new(options.saved_settings.clone()));
+    let flash = boot_settings_flash(&options);
     let gimbal = options.physical;
     let bus = Rc::new(RefCell::new(SimServoBus::new(
         &[gimbal.yaw_id, gimbal.pitch_id],
@@ -190,7 +287,7 @@ pub fn run(options: SimOptions) -> SimReport {
             options.max_time_ms * 1000,
             move |spawner| {
                 let console_host = host.clone();
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "console", TaskKind::Firmware, async move {
                     let mut rx = &console_host.to_device;
                     let mut tx = &console_host.from_device;
                     laser_app::usb::run_console(&mut rx, &mut tx, link).await;
@@ -204,13 +301,28 @@ pub fn run(options: SimOptions) -> SimReport {
                             }
                         }
                     });
-                    executor::spawn(&spawner, interactive_task(lines, host.clone()));
+                    executor::spawn_task(
+                        &spawner,
+                        "host (interactive)",
+                        TaskKind::Simulator,
+                        interactive_task(lines, host.clone()),
+                    );
                 } else {
-                    executor::spawn(&spawner, script_task(script, host.clone()));
+                    executor::spawn_task(
+                        &spawner,
+                        "host (script)",
+                        TaskKind::Simulator,
+                        script_task(script, host.clone(), link),
+                    );
                 }
-                executor::spawn(&spawner, terminal_task(host.clone()));
+                executor::spawn_task(
+                    &spawner,
+                    "host (terminal)",
+                    TaskKind::Simulator,
+                    terminal_task(host.clone()),
+                );
                 let servo_port = port.clone();
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "servo", TaskKind::Firmware, async move {
                     ServoBus::new(
                         PortHandle(servo_port.clone()),
                         PortHandle(servo_port),
@@ -219,16 +331,32 @@ pub fn run(options: SimOptions) -> SimReport {
                     .run(servo_link)
                     .await;
                 });
-                let laser = RecordingLaser(recording.clone());
-                let store = MemoryStore(flash.clone());
-                executor::spawn(&spawner, async move {
-                    let mut sequencer =
-                        Sequencer::new(link, servo_link, Some(galvo_link), status, laser, store)
-                            .await;
+                let spot_bus = bus.clone();
+                let laser = RecordingLaser {
+                    pin: GatedLaserPin::new(
+                        recording.clone(),
+                        Box::new(move |t_us| gimbal_spot_cm(&spot_bus, gimbal, t_us)),
+                    ),
+                    recording: recording.clone(),
+                    bus: bus.clone(),
+                    gimbal,
+                };
+                let store = settings_store(flash.clone());
+                executor::spawn_task(&spawner, "sequencer", TaskKind::Firmware, async move {
+                    let mut sequencer = Sequencer::new(
+                        link,
+                        servo_link,
+                        Some(galvo_link),
+                        status,
+                        laser,
+                        gate,
+                        store,
+                    )
+                    .await;
                     sequencer.run().await;
                 });
                 let (dac_recording, cost) = (galvo_dac, options.galvo_cost_ns_per_sample);
-                executor::spawn(&spawner, async move {
+                executor::spawn_task(&spawner, "galvo", TaskKind::Firmware, async move {
                     let config = GalvoConfig::default();
                     let mut dac = SimDac::new(
                         GALVO_HALF_LEN,
@@ -237,12 +365,14 @@ pub fn run(options: SimOptions) -> SimReport {
                         dac_recording,
                     );
                     match GalvoLoop::new(config) {
-                        Ok(mut galvo) => galvo.run(&mut dac, galvo_link).await,
+                        Ok(mut galvo) => galvo.run(&mut dac, galvo_link, gate).await,
                         Err(e) => log::error!("galvo loop not started: {e}"),
                     }
                 });
-                executor::spawn(
+                executor::spawn_task(
                     &spawner,
+                    "spot sampler",
+                    TaskKind::Simulator,
                     spot_sampler(
                         bus.clone(),
                         recording.clone(),
@@ -259,19 +389,75 @@ pub fn run(options: SimOptions) -> SimReport {
         )
     };
     let transcript = host.transcript.borrow().clone();
+    let end_time_us = crate::clock::now_us();
+    {
+        // The trace ends with the laser's final state at the end time.
+        let mut rec = recording.borrow_mut();
+        if rec.spot.last().is_none_or(|s| s.t_us < end_time_us)
+            && let Some((x_cm, y_cm)) = gimbal_spot_cm(&bus, gimbal, end_time_us)
+        {
+            let laser = crate::laser::gimbal_lit();
+            rec.spot.push(SpotSample {
+                t_us: end_time_us,
+                x_cm,
+                y_cm,
+                laser,
+            });
+        }
+    }
     let recording = recording.borrow().clone();
-    let saved_settings = flash.borrow().clone();
+    let settings_flash = flash.image();
+    let settings_flash_stats = flash.stats();
+    let saved_settings = load_settings_record(settings_flash.clone());
     let dac = dac_recording.borrow().clone();
     SimReport {
         transcript,
         recording,
         end,
-        end_time_us: crate::clock::now_us(),
+        end_time_us,
         idle_at_end: is_idle(status),
         saved_settings,
+        settings_flash,
+        settings_flash_stats,
         dac,
         galvo_underruns: galvo_link.underruns.load(Ordering::Relaxed),
+        task_steps: executor::task_steps(),
     }
+}
+
+/// The settings flash a run boots with (see [`SimOptions::settings_flash`]).
+fn boot_settings_flash(options: &SimOptions) -> SettingsFlash {
+    let flash = match (&options.settings_flash, &options.saved_settings) {
+        (Some(image), _) => SettingsFlash::from_image(SETTINGS_FLASH_OFFSET, image.clone()),
+        (None, Some(record)) => {
+            let mut store = settings_store(SettingsFlash::erased(
+                SETTINGS_FLASH_OFFSET,
+                SETTINGS_SECTORS,
+            ));
+            if let Err(e) = embassy_futures::block_on(store.save(record)) {
+                log::error!("could not seed the settings flash: {e}");
+            }
+            // A fresh handle: operation counts start at the boot.
+            SettingsFlash::from_image(SETTINGS_FLASH_OFFSET, store.into_flash().image())
+        }
+        (None, None) => SettingsFlash::erased(SETTINGS_FLASH_OFFSET, SETTINGS_SECTORS),
+    };
+    flash
+        .with_power_cut(options.settings_flash_cut)
+        .with_timing(FlashTiming::Virtual)
+}
+
+/// Where the gimbal spot is at `t_us` (from the simulated servos' true
+/// angles through the exact forward kinematics), board cm.
+fn gimbal_spot_cm(
+    bus: &Rc<RefCell<SimServoBus>>,
+    gimbal: PhysicalGimbal,
+    t_us: u64,
+) -> Option<(f64, f64)> {
+    let bus = bus.borrow();
+    let yaw_deg = bus.angle_deg(gimbal.yaw_id, t_us).unwrap_or(0.0);
+    let pitch_deg = bus.angle_deg(gimbal.pitch_id, t_us).unwrap_or(0.0);
+    gimbal.spot_cm(yaw_deg, pitch_deg)
 }
 
 /// Samples the spot from the simulated servos' true angles, and records
@@ -286,17 +472,12 @@ async fn spot_sampler(
     let mut open_dwell: Option<(DwellKey, usize)> = None;
     loop {
         let t_us = crate::clock::now_us();
-        let (yaw_deg, pitch_deg) = {
-            let bus = bus.borrow();
-            (
-                bus.angle_deg(gimbal.yaw_id, t_us).unwrap_or(0.0),
-                bus.angle_deg(gimbal.pitch_id, t_us).unwrap_or(0.0),
-            )
-        };
+        let spot = gimbal_spot_cm(&bus, gimbal, t_us);
         {
             let mut rec = recording.borrow_mut();
             let laser = rec.laser_at(t_us);
-            let spot = gimbal.spot_cm(yaw_deg, pitch_deg);
+            rec.servos
+                .push(servo_sample(&bus.borrow(), gimbal, t_us, laser));
             if let Some((x_cm, y_cm)) = spot {
                 rec.spot.push(SpotSample {
                     t_us,

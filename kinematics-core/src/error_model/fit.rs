@@ -9,7 +9,7 @@
 //! gives the coefficients in the normalised basis, which are then expanded
 //! exactly into the raw basis `1, x, y, x², xy, y²`.
 
-use super::{ErrorModel, N_COEF, Quadratic};
+use super::{ErrorModel, MAX_MEASURED_MM, N_COEF, Quadratic};
 use crate::error::{Error, finite};
 
 /// Relative size below which a diagonal entry of R means the points do not
@@ -34,10 +34,12 @@ pub struct MeasuredPoint {
 pub struct AxisFit {
     /// Coefficients for 1, x, y, x², xy, y² (x, y in mm; Δ in mm).
     pub coef: [f64; N_COEF],
-    /// Sum of squared residuals, mm².
+    /// Sum of squared residuals of the model as it is used: `coef`
+    /// evaluated by [`Quadratic::eval`] (the firmware's evaluation) at each
+    /// point, mm².
     pub sse: f64,
-    /// Coefficient of determination `1 − SSE/SST` (1 when the errors are
-    /// all equal, SST = 0).
+    /// Coefficient of determination `1 − SSE/SST` with the SSE above (1
+    /// when the errors are all equal, SST = 0).
     pub r2: f64,
     /// `√(SSE / (n − 6))`, mm; `None` for n = 6 (no residual degrees of
     /// freedom).
@@ -168,13 +170,33 @@ impl Qr {
     }
 }
 
+/// Sum of squared residuals of `model` for axis `axis` (0: dx, 1: dy) over
+/// `points`, mm², with the model evaluated by [`Quadratic::eval`] exactly
+/// as the firmware evaluates it.
+///
+/// Errors: [`Error::NonFinite`] (an input, or an overflowing residual).
+pub fn sse_of(model: &Quadratic, points: &[MeasuredPoint], axis: usize) -> Result<f64, Error> {
+    let mut sse = 0.0;
+    for p in points {
+        let d = if axis == 0 { p.dx_mm } else { p.dy_mm };
+        let r = finite(d, "measured error")? - model.eval(p.x_mm, p.y_mm)?;
+        sse += r * r;
+    }
+    finite(sse, "fit residual")
+}
+
 /// Fits the error quadratics of both axes to `points` by least squares.
 ///
 /// Needs at least 6 points that determine a quadratic: not all on one line
 /// (or repeated), not all on one conic.
 ///
+/// Every position and error must be within ±[`MAX_MEASURED_MM`] (10 m).
+/// The reported SSE, R² and RMSE are those of the returned raw
+/// coefficients (see [`sse_of`]), not of the internal normalised fit.
+///
 /// Errors: [`Error::TooFewPoints`], [`Error::NonFinite`] (a non-finite
-/// input, or a fit that overflows), [`Error::DegeneratePoints`].
+/// input, or a fit that overflows), [`Error::MeasurementOutOfRange`],
+/// [`Error::DegeneratePoints`].
 pub fn fit(points: &[MeasuredPoint]) -> Result<FitReport, Error> {
     let n = points.len();
     if n < N_COEF {
@@ -182,11 +204,18 @@ pub fn fit(points: &[MeasuredPoint]) -> Result<FitReport, Error> {
     }
     let nf = n as f64;
     let (mut sx, mut sy, mut sdx, mut sdy) = (0.0, 0.0, 0.0, 0.0);
-    for p in points {
-        sx += finite(p.x_mm, "x_mm")?;
-        sy += finite(p.y_mm, "y_mm")?;
-        sdx += finite(p.dx_mm, "dx_mm")?;
-        sdy += finite(p.dy_mm, "dy_mm")?;
+    for (index, p) in points.iter().enumerate() {
+        let check = |v: f64, what: &'static str| {
+            let v = finite(v, what)?;
+            if v.abs() > MAX_MEASURED_MM {
+                return Err(Error::MeasurementOutOfRange { index, what });
+            }
+            Ok(v)
+        };
+        sx += check(p.x_mm, "x_mm")?;
+        sy += check(p.y_mm, "y_mm")?;
+        sdx += check(p.dx_mm, "dx_mm")?;
+        sdy += check(p.dy_mm, "dy_mm")?;
     }
     let (cx, cy) = (sx / nf, sy / nf);
     let scale = points
@@ -208,24 +237,26 @@ pub fn fit(points: &[MeasuredPoint]) -> Result<FitReport, Error> {
     qr.check_rank(n)?;
     let means = [sdx / nf, sdy / nf];
     let axis = |k: usize| -> Result<AxisFit, Error> {
-        let g = qr.solve(k);
-        let mean = means.get(k).copied().unwrap_or(0.0);
-        let (mut sse, mut sst) = (0.0, 0.0);
-        for p in points {
-            let d = if k == 0 { p.dx_mm } else { p.dy_mm };
-            let fitted: f64 = norm
-                .basis(p.x_mm, p.y_mm)
-                .iter()
-                .zip(g.iter())
-                .map(|(b, c)| b * c)
-                .sum();
-            sse += (d - fitted) * (d - fitted);
-            sst += (d - mean) * (d - mean);
-        }
-        let coef = norm.expand_to_raw(g);
-        if !coef.iter().all(|c| c.is_finite()) || !sse.is_finite() || !sst.is_finite() {
+        let coef = norm.expand_to_raw(qr.solve(k));
+        if !coef.iter().all(|c| c.is_finite()) {
             return Err(Error::NonFinite {
                 what: "fitted coefficient",
+            });
+        }
+        let mean = means.get(k).copied().unwrap_or(0.0);
+        let sst: f64 = points
+            .iter()
+            .map(|p| {
+                let d = if k == 0 { p.dx_mm } else { p.dy_mm };
+                (d - mean) * (d - mean)
+            })
+            .sum();
+        // The residuals of the raw coefficients, evaluated as the firmware
+        // evaluates them: what the fit reports is what the model does.
+        let sse = sse_of(&Quadratic::new(coef), points, k)?;
+        if !sst.is_finite() {
+            return Err(Error::NonFinite {
+                what: "fit residual",
             });
         }
         let r2 = if sst > 0.0 {

@@ -8,13 +8,22 @@
 
 mod fit;
 
-pub use fit::{AxisFit, FitReport, MeasuredPoint, fit};
+pub use fit::{AxisFit, FitReport, MeasuredPoint, fit, sse_of};
 
 use crate::error::{Error, finite};
 use crate::frames::{BoardPoint, PointMm};
 
 /// Number of coefficients per axis.
 pub const N_COEF: usize = 6;
+/// Largest |value| of a measured position or error accepted by [`fit`],
+/// mm (10 m: far beyond any board, far below where `x²` loses the
+/// precision of a millimetre-scale fit).
+pub const MAX_MEASURED_MM: f64 = 10_000.0;
+/// Largest |coefficient| the firmware accepts per coefficient (its `set
+/// err.*` ranges): c0 ±100 mm (a 10 cm offset is a mis-mounted board),
+/// c1/c2 ±1 mm/mm (100 % scale error), c3..c5 ±0.01 1/mm (100 mm of error
+/// 100 mm from the centre).
+pub const COEF_LIMITS: [f64; N_COEF] = [100.0, 1.0, 1.0, 0.01, 0.01, 0.01];
 /// Most fixed-point iterations [`ErrorModel::compensate`] takes.
 pub const MAX_ITERATIONS: u32 = 100;
 /// Relative residual at which compensation stops: `|c + Δ(c) − target|`

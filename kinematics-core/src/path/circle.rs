@@ -20,7 +20,8 @@ use crate::frames::BoardPoint;
 /// stops on the lattice point nearest the end point once it has swept the
 /// arc (or, should it pass that point by, as soon as it passes the end's
 /// angle), then adds the end point itself if it is not on the lattice.
-#[derive(Debug, Clone)]
+/// No allocation; `Copy` (each next point is O(1)).
+#[derive(Debug, Clone, Copy)]
 pub struct ArcSteps {
     origin: BoardPoint,
     end: BoardPoint,

@@ -13,8 +13,10 @@ use crate::frames::BoardPoint;
 /// Each axis takes `⌈|Δ| / step⌉` moves of equal length (≤ `step_cm`), so
 /// the staircase ends exactly on `end` with integer arithmetic for the
 /// deviation function `F = j·nx − i·ny` (moves `i` of `nx` along x, `j` of
-/// `ny` along y, in the line's quadrant). Exact size; no allocation.
-#[derive(Debug, Clone)]
+/// `ny` along y, in the line's quadrant). Exact size; no allocation;
+/// `Copy`, so a caller can keep the interpolation state in plain data
+/// (each next point is O(1)).
+#[derive(Debug, Clone, Copy)]
 pub struct LineSteps {
     start: BoardPoint,
     end: BoardPoint,

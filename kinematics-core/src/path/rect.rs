@@ -9,8 +9,9 @@ use crate::frames::BoardPoint;
 /// The border of the axis-aligned rectangle with opposite corners `a` and
 /// `b` (board, cm): `a → (b.x, a.y) → b → (a.x, b.y) → a`, each edge
 /// interpolated by [`LineSteps`]; every corner appears once, and the path
-/// closes on `a`. Exact size; no allocation.
-#[derive(Debug, Clone)]
+/// closes on `a`. Exact size; no allocation; `Copy` (each next point is
+/// O(1)).
+#[derive(Debug, Clone, Copy)]
 pub struct RectSteps {
     edges: [LineSteps; 4],
     edge: usize,

@@ -3,7 +3,7 @@
 //!
 //! Properties:
 //! * nothing panics, whatever the bytes;
-//! * every accepted row is finite and within ±[`VALUE_LIMIT_MM`] in every
+//! * every accepted row is finite and within ±[`MAX_MEASURED_MM`] in every
 //!   column; there are fewer rows than lines (CR, LF or CRLF), and without
 //!   CSV quoting exactly one per line that is not the header, blank or a
 //!   `#` comment;
@@ -12,7 +12,8 @@
 //!   of the input, and an error quoting a field names a line holding it.
 
 use kinematics_core::MeasuredPoint;
-use xtask::calib_csv::{VALUE_LIMIT_MM, read_points};
+use kinematics_core::error_model::MAX_MEASURED_MM;
+use xtask::calib_csv::read_points;
 
 /// What one input exercised.
 #[derive(Debug, Default)]
@@ -47,7 +48,7 @@ pub fn check(data: &[u8]) -> Summary {
             for p in &points {
                 for v in columns(p) {
                     assert!(
-                        v.is_finite() && v.abs() <= VALUE_LIMIT_MM,
+                        v.is_finite() && v.abs() <= MAX_MEASURED_MM,
                         "accepted value {v} in {p:?}"
                     );
                 }

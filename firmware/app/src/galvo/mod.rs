@@ -9,7 +9,11 @@
 //! Each requested point is a jump (laser off, planned by `galvo-planner`,
 //! time-optimal or the patent's bisection method), a settling delay, a
 //! dwell with the laser on, and a laser-off delay. A half the DAC had
-//! already begun to replay is an underrun: counted, reported, laser off.
+//! already begun to replay is an underrun: counted, reported, laser off
+//! (the master [`LaserGate`](crate::laser_gate::LaserGate) closes).
+//! While nothing runs the loop holds: it lets the DAC replay the dark
+//! hold both halves already hold instead of recomputing it, so an idle
+//! loop cannot underrun.
 //!
 //! The sequencer drives it through [`GalvoLink`] (`target galvo|both`);
 //! the simulator feeds a simulated DAC. Not wired yet: the target's
@@ -27,7 +31,7 @@ pub const GALVO_OUTPUT: bool = cfg!(feature = "galvo");
 pub use path::GalvoPath;
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, Phase};
 
-use core::sync::atomic::{AtomicU8, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 
 use galvo_planner::{Method, RigidParams};
 use kinematics_core::{DacAxis, Galvo, GalvoGeometry};
@@ -93,8 +97,26 @@ pub struct Underrun {
     pub halves: u32,
 }
 
+/// One half buffer handed to the DAC.
+#[derive(Debug, Clone, Copy)]
+pub struct Half<'a> {
+    /// The samples (`half_len` of them).
+    pub samples: &'a [DacSample],
+    /// [`LaserGate`](crate::laser_gate::LaserGate) generation the samples
+    /// were computed under: their laser bits shine only while the gate is
+    /// open at this generation (a half computed before a stop stays dark).
+    pub generation: u32,
+    /// Samples the loop actually computed; the rest repeat a hold sample
+    /// (the simulated DAC charges loop time per computed sample).
+    pub computed: usize,
+}
+
 /// A hardware-timed DAC fed from a double buffer: a timer-triggered DMA
 /// on the target, a simulated DAC with the same deadlines on the host.
+///
+/// The DAC's laser output is the samples' laser bit AND the master
+/// [`LaserGate`](crate::laser_gate::LaserGate) at the half's generation;
+/// a half the DAC replays because the loop was late is output dark.
 #[allow(async_fn_in_trait)]
 pub trait DacStream {
     /// Samples per half buffer.
@@ -103,11 +125,21 @@ pub trait DacStream {
     /// Sets the sample period (s) for the halves written from now on.
     fn set_sample_period(&mut self, period_s: f64);
 
+    /// Whether both halves already hold nothing but `sample` (then
+    /// [`Self::repeat_half`] outputs the same as writing it again).
+    fn holds(&self, sample: DacSample) -> bool;
+
     /// Waits until the half the DAC is not reading is free, then stores
-    /// `samples` (`half_len` of them) in it. `Err` when the DAC had
-    /// already started on that half (the loop was late): the samples are
-    /// then output one half late.
-    async fn write_half(&mut self, samples: &[DacSample]) -> Result<(), Underrun>;
+    /// `half` in it. `Err` when the DAC had already started on that half
+    /// (the loop was late): it replayed that half dark and outputs these
+    /// samples one half late.
+    async fn write_half(&mut self, half: Half<'_>) -> Result<(), Underrun>;
+
+    /// Waits like [`Self::write_half`] but leaves the next half as the
+    /// DAC holds it. Only when [`Self::holds`] the same sample: replaying
+    /// an identical hold is the intended output, so this is never an
+    /// underrun, however late.
+    async fn repeat_half(&mut self);
 }
 
 /// What the sequencer asks of the galvo loop.
@@ -135,7 +167,9 @@ pub enum GalvoRequest {
     },
     /// Drop queued jobs, laser off at once; the mirrors finish the jump in
     /// flight (a jump is rest to rest) or brake along the stroke being
-    /// marked, and hold.
+    /// marked, and hold. Also clears an underrun latch. (Closing the
+    /// [`LaserGate`](crate::laser_gate::LaserGate) stops the loop the same
+    /// way, without the latch, and cannot get lost in a full channel.)
     Stop,
 }
 
@@ -143,7 +177,8 @@ pub enum GalvoRequest {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum GalvoEvent {
-    /// Point `seq` is done (jump, settle, dwell, laser-off delay).
+    /// Point `seq` is done (jump, settle, dwell, laser-off delay) and the
+    /// DAC has output its last sample.
     Done {
         /// Request number.
         seq: u32,
@@ -175,6 +210,9 @@ pub struct GalvoLink {
     pub underruns: AtomicU32,
     /// Half buffers written since boot (liveness for the watchdog).
     pub halves: AtomicU32,
+    /// Whether the laser mode lets the galvo light at all (`laser off`
+    /// clears it); applied to every half buffer computed from then on.
+    laser_allowed: AtomicBool,
     /// [`Phase`] after the last half buffer.
     phase: AtomicU8,
     /// Points queued in the loop after the last half buffer.
@@ -192,6 +230,19 @@ const PHASES: [Phase; 7] = [
 ];
 
 impl GalvoLink {
+    /// Lets the galvo light its dwells and strokes (`true`, laser modes
+    /// `auto` and `dwell`) or keeps every sample it computes from now on
+    /// dark (`false`, `laser off`). The master gate still decides whether
+    /// an allowed sample shines.
+    pub fn allow_laser(&self, allowed: bool) {
+        self.laser_allowed.store(allowed, Ordering::Relaxed);
+    }
+
+    /// Whether the laser mode lets the galvo light (see [`Self::allow_laser`]).
+    pub fn laser_allowed(&self) -> bool {
+        self.laser_allowed.load(Ordering::Relaxed)
+    }
+
     /// The loop's phase and queued points after its last half buffer.
     pub fn state(&self) -> (Phase, usize) {
         let phase = PHASES
@@ -217,6 +268,7 @@ impl GalvoLink {
             events: Channel::new(),
             underruns: AtomicU32::new(0),
             halves: AtomicU32::new(0),
+            laser_allowed: AtomicBool::new(true),
             phase: AtomicU8::new(0),
             queued: AtomicU8::new(0),
         }

@@ -7,11 +7,12 @@ use core::sync::atomic::Ordering;
 use galvo_planner::{
     Discrete, JumpSync, Method, PathPlanner, RigidParams, XyStepper, plan_xy_jump,
 };
-use kinematics_core::{Galvo, MirrorAngles, PointMm};
+use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
 use super::path::GalvoPath;
-use super::{DacSample, DacStream, GalvoEvent, GalvoLink, GalvoRequest};
+use super::{DacSample, DacStream, GalvoEvent, GalvoLink, GalvoRequest, Half};
+use crate::laser_gate::LaserGate;
 use crate::log;
 use crate::settings::GalvoSettings;
 
@@ -134,6 +135,8 @@ struct Active {
 /// [`GalvoLoop::fill`] directly).
 pub struct GalvoLoop {
     config: GalvoConfig,
+    /// `config.galvo` checked once for the per-sample f32 path.
+    sample_map: SampleMap,
     planning: Galvo<f64>,
     disc: Discrete<3>,
     mirrors: XyStepper<3, STEPPER_CAPACITY>,
@@ -173,15 +176,13 @@ impl GalvoLoop {
             .map_err(|_| GalvoError::Planner)?;
         let mirrors = XyStepper::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
         let [x_rad, y_rad] = angles_rad;
-        let codes = config
-            .galvo
-            .angles_to_codes(MirrorAngles {
-                x_rad: x_rad as f32,
-                y_rad: y_rad as f32,
-            })
-            .map_err(|_| GalvoError::Kinematics)?;
+        let sample_map = SampleMap::new(&config.galvo).map_err(|_| GalvoError::Kinematics)?;
+        let codes = sample_map
+            .angles_to_codes(x_rad as f32, y_rad as f32)
+            .ok_or(GalvoError::Kinematics)?;
         let ts = config.sample_period_s;
         Ok(Self {
+            sample_map,
             planning: config.galvo.cast(),
             disc,
             mirrors,
@@ -343,9 +344,41 @@ impl GalvoLoop {
         self.faulted = true;
     }
 
+    /// The sample every fill produces while nothing runs (no job, none
+    /// queued, mirrors at rest, no parameters waiting): the mirrors where
+    /// they rest, laser off. `None` otherwise.
+    pub fn hold_sample(&mut self) -> Option<DacSample> {
+        if self.active.is_some()
+            || !self.queue.is_empty()
+            || !self.mirrors.is_idle()
+            || self.pending_config.is_some()
+        {
+            return None;
+        }
+        // An idle stepper returns its rest position and does not change.
+        let [x_rad, y_rad] = self.mirrors.step();
+        let (x_code, y_code) = self
+            .sample_map
+            .angles_to_codes(x_rad, y_rad)
+            .map_or((self.last.x_code, self.last.y_code), |c| {
+                (c.x.code, c.y.code)
+            });
+        Some(DacSample {
+            x_code,
+            y_code,
+            laser: false,
+        })
+    }
+
     /// Fills `out` with the next samples; `on_event` gets each job's
-    /// `Done` (or `Refused`, when it cannot be planned).
-    pub fn fill(&mut self, out: &mut [DacSample], mut on_event: impl FnMut(GalvoEvent)) {
+    /// `Done` (or `Refused`, when it cannot be planned). Returns how many
+    /// samples it computed: while holding, one, copied into the rest.
+    pub fn fill(&mut self, out: &mut [DacSample], mut on_event: impl FnMut(GalvoEvent)) -> usize {
+        if let Some(hold) = self.hold_sample() {
+            out.fill(hold);
+            self.last = hold;
+            return out.len().min(1);
+        }
         for slot in out.iter_mut() {
             self.advance(&mut on_event);
             let codes = match self.phase() {
@@ -353,10 +386,8 @@ impl GalvoLoop {
                 Phase::Braking => self.brake_sample(),
                 _ => {
                     let [x_rad, y_rad] = self.mirrors.step();
-                    self.config
-                        .galvo
-                        .angles_to_codes(MirrorAngles { x_rad, y_rad })
-                        .ok()
+                    self.sample_map
+                        .angles_to_codes(x_rad, y_rad)
                         .map(|c| (c.x.code, c.y.code))
                 }
             };
@@ -373,6 +404,7 @@ impl GalvoLoop {
                 a.samples_left = a.samples_left.saturating_sub(1);
             }
         }
+        out.len()
     }
 
     /// Moves the state machine on until the current phase has samples to
@@ -493,15 +525,44 @@ impl GalvoLoop {
     }
 
     /// Runs the loop forever: requests between half buffers, one half per
-    /// wake-up. An underrun turns the laser off, drops the queued jobs
-    /// (also those still in the request channel) and is reported; jobs
-    /// are refused until the next `Stop`.
-    pub async fn run<D: DacStream>(&mut self, dac: &mut D, link: &GalvoLink) -> ! {
+    /// wake-up, laser through the master `gate`.
+    ///
+    /// * A close of the gate (by anyone: `stop`, a fault, a new run) is a
+    ///   stop that cannot get lost in a full queue: queued jobs are
+    ///   dropped and the laser stays off; halves computed before it stay
+    ///   dark. The loop opens the gate only for lit samples of jobs taken
+    ///   after the last close.
+    /// * An underrun closes the gate at once, drops the queued jobs (also
+    ///   those still in the request channel) and is reported; jobs are
+    ///   refused until the next `Stop`.
+    /// * Holding still, the loop lets the DAC replay the hold both halves
+    ///   already hold: no work, so an idle loop cannot underrun.
+    /// * A job's `Done` is reported once the DAC has output its last
+    ///   sample (the loop computes up to two halves ahead), so the
+    ///   sequencer can close the gate when a pattern ends without cutting
+    ///   its last dwell short.
+    pub async fn run<D: DacStream>(
+        &mut self,
+        dac: &mut D,
+        link: &GalvoLink,
+        gate: &LaserGate,
+    ) -> ! {
         let n = dac.half_len().clamp(1, MAX_HALF_LEN);
         let mut half = [DacSample::default(); MAX_HALF_LEN];
         let mut period_s = self.config.sample_period_s;
+        let mut generation = gate.generation();
+        // `Done` events waiting for their samples to be output, with the
+        // half-buffer hand-overs still to come.
+        let mut drawing: heapless::Deque<(GalvoEvent, u8), DONE_QUEUE> = heapless::Deque::new();
         dac.set_sample_period(period_s);
         loop {
+            let now = gate.generation();
+            if now != generation {
+                self.stop();
+                // The stopped run's points were cut short.
+                drawing.clear();
+                generation = now;
+            }
             while let Ok(request) = link.requests.try_receive() {
                 if let Some(event) = self.request(request) {
                     let _ = link.events.try_send(event);
@@ -517,13 +578,47 @@ impl GalvoLoop {
                 period_s = self.config.sample_period_s;
                 dac.set_sample_period(period_s);
             }
-            let out = &mut half[..n];
-            self.fill(out, |event| {
-                let _ = link.events.try_send(event);
-            });
             link.halves.fetch_add(1, Ordering::Relaxed);
+            if let Some(hold) = self.hold_sample()
+                && dac.holds(hold)
+            {
+                link.publish(self.phase(), self.queue.len());
+                dac.repeat_half().await;
+                release_drawn(&mut drawing, link);
+                continue;
+            }
+            let out = &mut half[..n];
+            let computed = self.fill(out, |event| match event {
+                // Output when the half after this one starts.
+                GalvoEvent::Done { .. } => {
+                    if let Err((event, _)) = drawing.push_back((event, 3)) {
+                        let _ = link.events.try_send(event);
+                    }
+                }
+                _ => {
+                    let _ = link.events.try_send(event);
+                }
+            });
             link.publish(self.phase(), self.queue.len());
-            if let Err(underrun) = dac.write_half(out).await {
+            if !link.laser_allowed() {
+                // `laser off`: the mirrors still move, dark.
+                out.iter_mut().for_each(|s| s.laser = false);
+            }
+            if out.iter().any(|s| s.laser) {
+                // Refused (the half stays dark) when the gate closed since.
+                gate.open(generation);
+            }
+            let written = dac
+                .write_half(Half {
+                    samples: out,
+                    generation,
+                    computed,
+                })
+                .await;
+            release_drawn(&mut drawing, link);
+            if let Err(underrun) = written {
+                generation = gate.close();
+                drawing.clear();
                 link.underruns.fetch_add(underrun.halves, Ordering::Relaxed);
                 log::warning!(
                     "galvo: underrun ({} halves late), laser off",
@@ -538,6 +633,21 @@ impl GalvoLoop {
                 let _ = link.events.try_send(GalvoEvent::Underrun(underrun));
             }
         }
+    }
+}
+
+/// `Done` events held until their samples are out.
+const DONE_QUEUE: usize = 8;
+
+/// Counts one half-buffer hand-over down for the held `Done` events and
+/// reports those whose samples the DAC has now output.
+fn release_drawn(drawing: &mut heapless::Deque<(GalvoEvent, u8), DONE_QUEUE>, link: &GalvoLink) {
+    for (_, halves) in drawing.iter_mut() {
+        *halves = halves.saturating_sub(1);
+    }
+    while let Some((event, 0)) = drawing.front().copied() {
+        drawing.pop_front();
+        let _ = link.events.try_send(event);
     }
 }
 

@@ -6,31 +6,37 @@ use core::sync::atomic::Ordering;
 use super::targets::{self, Target};
 use super::{LaserSwitch, Phase, Sequencer, SettingsStore};
 use crate::cli::format::Shortest;
-use crate::galvo::{GalvoEvent, GalvoRequest, config_from};
+use crate::galvo::{GALVO_OUTPUT, GalvoEvent, GalvoRequest, config_from};
 use crate::log;
+use crate::settings::LaserMode;
 
 /// Dwell of a goto on the galvo: held until the next command, µs.
 const HOLD_US: u32 = u32::MAX;
 
 impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
-    /// Queues a request for the galvo loop; `false` (with an error
-    /// notice) when the loop does not keep up.
-    pub(super) fn send_galvo(&mut self, request: GalvoRequest) -> bool {
+    /// Tells the galvo loop to stop (drop its jobs, laser off, clear an
+    /// underrun latch). Never lost: requests it has not taken yet are
+    /// dropped first, so there is room.
+    pub(super) fn stop_galvo(&mut self) {
+        if let Some(galvo) = self.galvo.filter(|_| GALVO_OUTPUT) {
+            while galvo.requests.try_receive().is_ok() {}
+            let _ = galvo.requests.try_send(GalvoRequest::Stop);
+        }
+    }
+
+    /// Queues a job for the galvo loop; `false` (with an error notice,
+    /// everything stopped) when the loop does not keep up.
+    fn send_galvo(&mut self, request: GalvoRequest) -> bool {
         let Some(galvo) = self.galvo else {
             return false;
         };
-        if request == GalvoRequest::Stop {
-            // Stop cancels whatever the loop has not taken yet anyway.
-            while galvo.requests.try_receive().is_ok() {}
-        }
         if galvo.requests.try_send(request).is_ok() {
             return true;
         }
         log::warning!("galvo: request queue full");
         self.link
             .notify(format_args!("error: galvo not responding; stopped"));
-        self.run = None;
-        self.publish();
+        self.stop("galvo not responding");
         false
     }
 
@@ -132,30 +138,36 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
         if let Some(galvo) = self.galvo {
             galvo.config.signal(config_from(&self.settings.galvo));
         }
+        self.allow_galvo_laser();
+    }
+
+    /// Tells the galvo loop whether the laser mode lets it light (`laser
+    /// off`: it still moves, dark).
+    pub(super) fn allow_galvo_laser(&self) {
+        if let Some(galvo) = self.galvo {
+            galvo.allow_laser(self.settings.laser_mode != LaserMode::Off);
+        }
     }
 
     /// `galvo status` lines.
-    pub(super) async fn report_galvo_status(&self) {
+    pub(super) fn report_galvo_status(&self) {
         let link = self.link;
         let Some(galvo) = self.galvo else {
-            link.data(format_args!("galvo: not in this build")).await;
+            link.data(format_args!("galvo: not in this build"));
             return;
         };
         let (phase, queued) = galvo.state();
         let g = &self.settings.galvo;
-        link.data(format_args!("galvo: {phase:?}, {queued} points queued"))
-            .await;
+        link.data(format_args!("galvo: {phase:?}, {queued} points queued"));
         link.data(format_args!(
             "planner: {}, sample period {} us",
             g.planner.name(),
             Shortest(g.sample_period_us)
-        ))
-        .await;
+        ));
         link.data(format_args!(
             "underruns: {}, half buffers: {}",
             galvo.underruns.load(Ordering::Relaxed),
             galvo.halves.load(Ordering::Relaxed)
-        ))
-        .await;
+        ));
     }
 }

@@ -8,6 +8,7 @@
 //! running pattern immediately, in any phase.
 
 mod commands;
+mod faults;
 mod galvo;
 mod laser;
 pub mod targets;
@@ -15,18 +16,20 @@ pub mod targets;
 use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
-pub use self::laser::{LaserSwitch, laser_wanted};
-use self::targets::{Aim, Target};
+pub use self::laser::{LaserEvent, LaserSwitch, laser_wanted};
+use self::targets::{Aim, PathCursor, Target};
 use crate::cli::format::Fixed;
 use crate::command::{Actuator, AimModel, CommandLink, Pattern};
 use crate::galvo::GalvoLink;
+use crate::laser_gate::LaserGate;
 use crate::log;
 use crate::servo::task::{ServoLink, ServoOutcome, ServoRequest};
 use crate::settings::{RecordError, Settings};
 use crate::status::{Activity, Phase, StatusBoard};
 
-/// Where settings are saved (a flash sector on the target, memory or a file
-/// in the simulator).
+/// Where settings are saved: [`crate::settings::store::FlashSettingsStore`]
+/// over the target's flash sectors 10 and 11, or over the simulator's model
+/// of them.
 #[allow(async_fn_in_trait)]
 pub trait SettingsStore {
     /// Reads the saved record into `buf`; returns the bytes read (0 when
@@ -48,6 +51,12 @@ pub struct Sequencer<'a, L: LaserSwitch, S: SettingsStore> {
     galvo: Option<&'a GalvoLink>,
     status: &'a StatusBoard,
     laser: L,
+    /// The master laser gate: closed at once by every stop, opened only
+    /// for a run that draws.
+    gate: &'a LaserGate,
+    /// Gate generation of the current run (since the last close): the
+    /// gimbal laser opens the gate only for it.
+    gate_generation: u32,
     store: S,
     settings: Settings,
     model: AimModel,
@@ -58,8 +67,9 @@ pub struct Sequencer<'a, L: LaserSwitch, S: SettingsStore> {
     run: Option<Run>,
     /// Request number of the servo move in flight.
     next_seq: u32,
-    /// Servo ids currently faulty.
-    faulty_servo: Option<u8>,
+    /// Servos known dead (faulted, not yet answering again), and whether
+    /// the gimbal laser waits for a confirmed arrival after a fault.
+    faults: faults::ServoFaults,
     /// Last aim sent to the servos.
     last_aim: Option<(Target, Aim)>,
     /// Last measured servo angles, 0.1°.
@@ -77,6 +87,10 @@ struct Run {
     once: bool,
     /// Index of the current point within the pass.
     index: usize,
+    /// A path's interpolation state in the current pass (next point in
+    /// O(1)); `None` for grid patterns (looked up by index in O(1)), a
+    /// goto, and paths the galvo marks itself.
+    path: Option<PathCursor>,
     /// Completed passes.
     pass: u32,
     phase: Phase,
@@ -94,16 +108,19 @@ struct Run {
 
 impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     /// A sequencer with settings loaded from `store` (defaults, with a
-    /// warning, when the record is missing, old or corrupt).
+    /// warning, when the record is missing, old or corrupt). `gate` is the
+    /// master laser gate shared with the galvo loop and the laser pin.
     pub async fn new(
         link: &'a CommandLink,
         servo: &'a ServoLink,
         galvo: Option<&'a GalvoLink>,
         status: &'a StatusBoard,
         mut laser: L,
+        gate: &'a LaserGate,
         mut store: S,
     ) -> Self {
         laser.set(false);
+        let gate_generation = gate.close();
         let mut record = [0u8; crate::settings::RECORD_LEN];
         let n = store.load(&mut record).await;
         let settings = match Settings::from_record(record.get(..n).unwrap_or(&[])) {
@@ -125,6 +142,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             galvo
                 .config
                 .signal(crate::galvo::config_from(&settings.galvo));
+            galvo.allow_laser(settings.laser_mode != crate::settings::LaserMode::Off);
         }
         Self {
             link,
@@ -132,6 +150,8 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             galvo,
             status,
             laser,
+            gate,
+            gate_generation,
             store,
             settings,
             model: AimModel::Exact,
@@ -139,7 +159,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             booted_at: Instant::now(),
             run: None,
             next_seq: 0,
-            faulty_servo: None,
+            faults: faults::ServoFaults::default(),
             last_aim: None,
             measured: None,
             laser_on: false,
@@ -206,37 +226,57 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     }
 
     /// Starts `run` at its first point.
-    fn start(&mut self, run: Run) {
+    fn start(&mut self, mut run: Run) {
         let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
         log::info!("start {} (once={})", name, run.once);
+        self.laser.note(laser::LaserEvent::RunStarted);
+        run.path = self.path_cursor(run.pattern);
+        // Nothing of an earlier run may shine: a new gate generation, and
+        // the galvo drops its points and an underrun latch.
+        self.close_gate();
         self.run = Some(run);
-        self.faulty_servo = None;
-        if self.actuator.uses_galvo() {
-            // Clears points of an earlier run and an underrun latch.
-            self.send_galvo(crate::galvo::GalvoRequest::Stop);
-        }
         self.begin_point();
     }
 
-    /// Stops whatever runs.
+    /// Stops whatever runs — and, whatever the sequencer thinks runs, the
+    /// laser and the galvo loop: the gate closes at once and the loop gets
+    /// `Stop`.
     fn stop(&mut self, why: &str) {
+        self.laser.note(laser::LaserEvent::Stopped { why });
+        self.close_gate();
         if let Some(run) = self.run.take() {
             let name = run.pattern.map(|p| p.name()).unwrap_or("goto");
             log::info!("stop {} ({})", name, why);
-            if self.actuator.uses_galvo() {
-                self.send_galvo(crate::galvo::GalvoRequest::Stop);
-            }
         }
         self.publish();
+    }
+
+    /// Closes the master laser gate (laser dark from now on, also samples
+    /// the galvo DAC already holds) and stops the galvo loop.
+    fn close_gate(&mut self) {
+        self.gate_generation = self.gate.close();
+        self.stop_galvo();
     }
 
     /// The target of the current point of the run.
     fn current_target(&self) -> Option<Target> {
         let run = self.run?;
-        match run.pattern {
-            Some(pattern) => targets::pattern_target(&pattern, run.index, &self.settings),
-            None => run.single,
+        match (run.pattern, run.path) {
+            (Some(_), Some(path)) => Some(path.target()),
+            (Some(pattern), None) => targets::grid_target(&pattern, run.index, &self.settings),
+            (None, _) => run.single,
         }
+    }
+
+    /// The cursor at the first point of a pass of `pattern` when the
+    /// gimbal draws it point by point (`None` otherwise, or when the path
+    /// cannot be interpolated: the run then has no points and stops).
+    fn path_cursor(&self, pattern: Option<Pattern>) -> Option<PathCursor> {
+        let pattern = pattern?;
+        if self.actuator.uses_galvo() {
+            return None;
+        }
+        PathCursor::start(&pattern, &self.settings)?.ok()
     }
 
     /// Whether the run is a path marked by the galvo alone (one job per
@@ -259,6 +299,13 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             self.stop("pattern has no points");
             return;
         };
+        // Travel to the first point of a pass (or to a goto target) is off
+        // the figure: dark in every laser mode. A later pass of a closed
+        // figure starts where the last one ended (arrived there): no travel.
+        let approach = self.run.is_some_and(|r| {
+            let closed = r.pass > 0 && self.last_aim.is_some_and(|(t, _)| t.point == target.point);
+            r.pattern.is_none() || (r.index == 0 && !closed)
+        });
         let gimbal_started = !self.actuator.uses_gimbal() || self.begin_gimbal_move(target);
         let galvo_started =
             gimbal_started && (!self.actuator.uses_galvo() || self.begin_galvo_point(target));
@@ -267,7 +314,11 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         }
         let holds = self.run.is_some_and(|r| r.pattern.is_none());
         if let Some(run) = self.run.as_mut() {
-            run.phase = Phase::Moving;
+            run.phase = if approach {
+                Phase::Approaching
+            } else {
+                Phase::Moving
+            };
             run.dwell_until = None;
             run.gimbal_busy = self.actuator.uses_gimbal();
             // A goto's galvo holds the point, laser on, until the next
@@ -286,8 +337,14 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             Err(e) => {
                 let why = crate::command::reply_text(format_args!("{e}"));
                 log::warning!("target unreachable: {}", why.as_str());
+                // What happened first: the reason may be cut at the
+                // reply line length.
+                let name = self
+                    .run
+                    .and_then(|r| r.pattern)
+                    .map_or("goto", |p| p.name());
                 self.link.notify(format_args!(
-                    "error: target ({}, {}) cm unreachable: {}; stopped, laser off",
+                    "error: {name} stopped, laser off: point ({}, {}) cm unreachable: {}",
                     Fixed::<2>(target.point.x_cm),
                     Fixed::<2>(target.point.y_cm),
                     why
@@ -306,10 +363,12 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             interval_ms,
             ids: (self.settings.yaw.id, self.settings.pitch.id),
             deadband_tenths: (self.settings.deadband_deg * 10.0) as u16,
+            ranges_tenths: faults::servo_ranges_tenths(&self.settings),
         };
         // Newest request wins: drop one the servo task has not taken yet.
         let _ = self.servo.requests.try_receive();
         let _ = self.servo.requests.try_send(request);
+        self.laser.note(laser::LaserEvent::GimbalMoveSent);
         log::info!(
             "target ({}, {}) cm -> servo {} {} (0.1 deg) over {} ms",
             target.point.x_cm,
@@ -342,24 +401,21 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
 
     fn handle_outcome(&mut self, outcome: ServoOutcome) {
         match outcome {
-            ServoOutcome::Recovered { id } => {
-                if self.faulty_servo == Some(id) {
-                    self.faulty_servo = None;
-                }
-                self.link
-                    .notify(format_args!("info: servo {id} answering again"));
-                self.publish();
-            }
+            ServoOutcome::Recovered { id } => self.servo_recovered(id),
             ServoOutcome::Arrived {
                 seq,
                 yaw_tenths,
                 pitch_tenths,
             } => {
                 self.measured = Some((yaw_tenths, pitch_tenths));
+                // Both servos answered and arrived: they are alive.
+                self.faults
+                    .arrived(self.settings.yaw.id, self.settings.pitch.id);
                 let Some(run) = self.run.as_mut().filter(|r| r.seq == seq) else {
                     return;
                 };
                 run.phase = Phase::Dwelling;
+                self.laser.note(laser::LaserEvent::GimbalArrived);
                 let dwell = if run.pattern.is_some_and(|p| p.is_path()) {
                     0.0
                 } else {
@@ -370,22 +426,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 log::info!("arrived (servo {} {})", yaw_tenths, pitch_tenths);
                 self.publish();
             }
-            ServoOutcome::Fault { seq, id, fault } => {
-                // A fault of an older, superseded move is stale; any other
-                // fault (of the current move, or found by the servo task's
-                // health check while dwelling or idle) stops everything.
-                if self
-                    .run
-                    .is_some_and(|r| r.seq != seq && r.phase == Phase::Moving)
-                {
-                    return;
-                }
-                self.faulty_servo = Some(id);
-                self.link.notify(format_args!(
-                    "error: servo {id} fault ({fault:?}); pattern stopped, laser off"
-                ));
-                self.stop("servo fault");
-            }
+            ServoOutcome::Fault { seq, id, fault } => self.servo_fault(seq, id, fault),
             ServoOutcome::Superseded { .. } => {}
         }
     }
@@ -414,9 +455,14 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             return;
         };
         run.index += 1;
-        if self.is_galvo_path_run()
-            || targets::pattern_target(&pattern, run.index, &self.settings).is_none()
-        {
+        let more = match run.path.as_mut() {
+            Some(path) => path.advance(),
+            None => {
+                !self.is_galvo_path_run()
+                    && targets::grid_target(&pattern, run.index, &self.settings).is_some()
+            }
+        };
+        if !more {
             run.pass += 1;
             run.index = 0;
             if run.once {
@@ -424,6 +470,8 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 self.stop("pattern complete");
                 return;
             }
+            // A new pass takes the path parameters as they are now.
+            run.path = self.path_cursor(Some(pattern));
         }
         self.run = Some(run);
         self.begin_point();
@@ -435,7 +483,18 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         // The galvo's laser is switched per sample by the galvo loop; this
         // is the gimbal's.
         let wanted = self.actuator.uses_gimbal()
-            && laser_wanted(self.settings.laser_mode, phase, self.faulty_servo.is_some());
+            && laser_wanted(
+                self.settings.laser_mode,
+                phase,
+                self.faults.gimbal_laser_blocked(
+                    self.settings.yaw.id,
+                    self.settings.pitch.id,
+                    phase,
+                ),
+            )
+            // Refused when the gate was closed since the run began (a
+            // galvo underrun): dark until the run is stopped or restarted.
+            && self.gate.open(self.gate_generation);
         if wanted != self.laser_on {
             self.laser.set(wanted);
             self.laser_on = wanted;
@@ -449,7 +508,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         let run = self.run;
         let aim = self.last_aim;
         let laser = self.laser_on;
-        let fault = self.faulty_servo;
+        let fault = self.faults.first_dead();
         self.status.update(|s| {
             s.activity = match run {
                 None => Activity::Idle,

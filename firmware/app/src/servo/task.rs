@@ -3,6 +3,14 @@
 //! retries, detects arrival by polling the angles, and reports a
 //! [`ServoOutcome`] for every request. A servo that stops answering is a
 //! fault; it is pinged while idle and reported again when it recovers.
+//!
+//! Every angle reading passes the plausibility filter of
+//! [`super::plausibility`] before it can drive arrival or fault logic: a
+//! reading outside the servo's range, or a jump no servo can make, is
+//! rejected and counted ([`ServoLink::implausible_readings`]), and a run of
+//! them is a fault ([`ServoFault::ImplausibleReading`]). Arrival is
+//! declared only when two readings in a row (the second taken at once to
+//! confirm the first) are inside the deadband.
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
@@ -11,6 +19,7 @@ use embassy_sync::channel::Channel;
 use embassy_time::{Duration, Instant, Timer, with_deadline, with_timeout};
 use embedded_io_async::{Read, Write};
 
+use super::plausibility::{IMPLAUSIBLE_RUN, ReadingFilter, Verdict, WIRE_LIMIT_TENTHS};
 use super::protocol::{MAX_FRAME_LEN, Request, Response, ResponseDecoder, SetAngle};
 use crate::log;
 
@@ -38,6 +47,9 @@ pub struct ServoBusConfig {
     /// queried, so a servo that stops answering during a dwell or a held
     /// goto is a fault within this period plus the retries), ms.
     pub health_check_ms: u16,
+    /// Configured angle range of the yaw and the pitch servo, 0.1°
+    /// (`(min, max)`; readings outside are implausible).
+    pub ranges_tenths: [(i16, i16); 2],
 }
 
 impl Default for ServoBusConfig {
@@ -51,6 +63,7 @@ impl Default for ServoBusConfig {
             poll_period_ms: 10,
             arrival_margin_ms: 300,
             health_check_ms: 100,
+            ranges_tenths: [(-WIRE, WIRE); 2],
         }
     }
 }
@@ -75,6 +88,9 @@ pub enum ServoRequest {
         ids: (u8, u8),
         /// Arrival deadband, 0.1° (used from now on).
         deadband_tenths: u16,
+        /// Configured range `(min, max)` of the yaw and the pitch servo,
+        /// 0.1° (used from now on by the plausibility filter).
+        ranges_tenths: [(i16, i16); 2],
     },
 }
 
@@ -103,6 +119,13 @@ pub enum ServoFault {
     },
     /// Writing to the UART failed.
     BusError,
+    /// [`IMPLAUSIBLE_RUN`] angle readings in a row were physically
+    /// impossible (outside the range, or a jump no servo can make): the
+    /// bus delivers corrupted frames that pass the checksum.
+    ImplausibleReading {
+        /// The last rejected reading, 0.1°.
+        at_tenths: i16,
+    },
 }
 
 /// What the servo task reports.
@@ -148,6 +171,8 @@ pub struct ServoLink {
     /// Incremented by the servo task at least every [`IDLE_TICK`]
     /// (liveness for the watchdog).
     pub alive: AtomicU32,
+    /// Angle readings rejected as physically impossible since boot.
+    pub implausible_readings: AtomicU32,
 }
 
 impl ServoLink {
@@ -157,6 +182,7 @@ impl ServoLink {
             requests: Channel::new(),
             outcomes: Channel::new(),
             alive: AtomicU32::new(0),
+            implausible_readings: AtomicU32::new(0),
         }
     }
 }
@@ -164,6 +190,61 @@ impl ServoLink {
 impl Default for ServoLink {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+/// Largest single-turn angle, 0.1° (default range before the first move).
+const WIRE: i16 = WIRE_LIMIT_TENTHS as i16;
+
+/// A set of servo bus ids (0..=255), e.g. the servos known faulty.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ServoIdSet([u32; 8]);
+
+impl ServoIdSet {
+    /// The empty set.
+    pub const fn new() -> Self {
+        Self([0; 8])
+    }
+
+    fn word_bit(id: u8) -> (usize, u32) {
+        (usize::from(id / 32), 1u32 << (id % 32))
+    }
+
+    /// Adds `id`.
+    pub fn insert(&mut self, id: u8) {
+        let (w, bit) = Self::word_bit(id);
+        if let Some(word) = self.0.get_mut(w) {
+            *word |= bit;
+        }
+    }
+
+    /// Removes `id`.
+    pub fn remove(&mut self, id: u8) {
+        let (w, bit) = Self::word_bit(id);
+        if let Some(word) = self.0.get_mut(w) {
+            *word &= !bit;
+        }
+    }
+
+    /// Whether `id` is in the set.
+    pub fn contains(&self, id: u8) -> bool {
+        let (w, bit) = Self::word_bit(id);
+        self.0.get(w).is_some_and(|word| word & bit != 0)
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(&self) -> bool {
+        self.0.iter().all(|w| *w == 0)
+    }
+
+    /// The smallest id in the set.
+    pub fn first(&self) -> Option<u8> {
+        self.iter().next()
+    }
+
+    /// The ids in the set, ascending.
+    pub fn iter(&self) -> impl Iterator<Item = u8> + '_ {
+        (0..=u8::MAX).filter(|id| self.contains(*id))
     }
 }
 
@@ -180,8 +261,11 @@ pub struct ServoBus<R, W> {
     tx: W,
     decoder: ResponseDecoder,
     config: ServoBusConfig,
-    /// Faulty flags for yaw and pitch.
-    faulty: [bool; 2],
+    /// Servos known faulty (pinged until they answer again).
+    faulty: ServoIdSet,
+    /// Plausibility filter of the yaw and the pitch servo's readings, with
+    /// the id each belongs to.
+    filters: [(u8, ReadingFilter); 2],
 }
 
 enum Poll {
@@ -198,7 +282,11 @@ impl<R: Read, W: Write> ServoBus<R, W> {
             tx,
             decoder: ResponseDecoder::new(),
             config,
-            faulty: [false; 2],
+            faulty: ServoIdSet::new(),
+            filters: [
+                (config.yaw_id, ReadingFilter::new(config.ranges_tenths[0])),
+                (config.pitch_id, ReadingFilter::new(config.ranges_tenths[1])),
+            ],
         }
     }
 
@@ -227,7 +315,7 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                             self.health_check(link, seq).await;
                         }
                     }
-                    if self.faulty.iter().any(|f| *f) && now >= next_recovery_ping {
+                    if !self.faulty.is_empty() && now >= next_recovery_ping {
                         next_recovery_ping = now + RECOVERY_PING_PERIOD;
                         self.ping_faulty(link).await;
                     }
@@ -240,10 +328,11 @@ impl<R: Read, W: Write> ServoBus<R, W> {
             match outcome {
                 ServoOutcome::Fault { id, fault, .. } => {
                     log::warning!("servo {}: fault {:?}", id, fault);
-                    self.set_faulty(id, true);
+                    self.faulty.insert(id);
                 }
                 ServoOutcome::Arrived { .. } => {
-                    self.faulty = [false; 2];
+                    self.faulty.remove(self.config.yaw_id);
+                    self.faulty.remove(self.config.pitch_id);
                 }
                 _ => {}
             }
@@ -251,25 +340,17 @@ impl<R: Read, W: Write> ServoBus<R, W> {
         }
     }
 
-    fn set_faulty(&mut self, id: u8, faulty: bool) {
-        if id == self.config.yaw_id {
-            self.faulty[0] = faulty;
-        }
-        if id == self.config.pitch_id {
-            self.faulty[1] = faulty;
-        }
-    }
-
     /// Queries the angle of every servo not yet known faulty; one that does
     /// not answer is reported as a fault of move `seq`.
     async fn health_check(&mut self, link: &ServoLink, seq: u32) {
         for (slot, id) in [(0, self.config.yaw_id), (1, self.config.pitch_id)] {
-            if self.faulty.get(slot).copied().unwrap_or(true) {
+            if self.faulty.contains(id) {
                 continue;
             }
-            if let Err(fault) = self.query_angle(id).await {
+            // A rejected reading (`Ok(None)`) is no news; a run of them is.
+            if let Err(fault) = self.read_angle(slot, id, link).await {
                 log::warning!("servo {}: fault {:?} while holding", id, fault);
-                self.set_faulty(id, true);
+                self.faulty.insert(id);
                 link.outcomes
                     .send(ServoOutcome::Fault { seq, id, fault })
                     .await;
@@ -277,16 +358,17 @@ impl<R: Read, W: Write> ServoBus<R, W> {
         }
     }
 
+    /// Pings every servo known faulty (also one no longer configured, so
+    /// whoever marked it learns when it answers again).
     async fn ping_faulty(&mut self, link: &ServoLink) {
-        for (slot, id) in [(0, self.config.yaw_id), (1, self.config.pitch_id)] {
-            if self.faulty.get(slot).copied().unwrap_or(false)
-                && matches!(
-                    self.transact(Request::Ping { id }, id).await,
-                    Ok(Response::Ping { .. })
-                )
-            {
+        let faulty = self.faulty;
+        for id in faulty.iter() {
+            if matches!(
+                self.transact(Request::Ping { id }, id).await,
+                Ok(Response::Ping { .. })
+            ) {
                 log::info!("servo {}: answering again", id);
-                self.set_faulty(id, false);
+                self.faulty.remove(id);
                 link.outcomes.send(ServoOutcome::Recovered { id }).await;
             }
         }
@@ -301,13 +383,24 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                 interval_ms,
                 ids: (yaw_id, pitch_id),
                 deadband_tenths,
+                ranges_tenths,
             } => {
-                if (yaw_id, pitch_id) != (self.config.yaw_id, self.config.pitch_id) {
-                    self.faulty = [false; 2];
-                }
                 self.config.yaw_id = yaw_id;
                 self.config.pitch_id = pitch_id;
                 self.config.deadband_tenths = deadband_tenths;
+                self.config.ranges_tenths = ranges_tenths;
+                for ((filter_id, filter), (id, range)) in self
+                    .filters
+                    .iter_mut()
+                    .zip([yaw_id, pitch_id].into_iter().zip(ranges_tenths))
+                {
+                    if *filter_id != id {
+                        // Another servo: its history says nothing.
+                        *filter_id = id;
+                        filter.reset();
+                    }
+                    filter.set_range(range);
+                }
                 let entry = |id, angle_tenths_deg| SetAngle {
                     id,
                     angle_tenths_deg,
@@ -341,8 +434,9 @@ impl<R: Read, W: Write> ServoBus<R, W> {
         }
     }
 
-    /// Polls both angles until both are within the deadband, the deadline
-    /// passes, or a newer request is waiting.
+    /// Polls both angles until both are within the deadband (confirmed by
+    /// a second reading at once), the deadline passes, or a newer request
+    /// is waiting. Implausible readings never count as arrived.
     async fn wait_arrival(
         &mut self,
         yaw_target: i16,
@@ -356,22 +450,34 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                 interval + interval / 2 + u64::from(self.config.arrival_margin_ms),
             );
         let deadband = i32::from(self.config.deadband_tenths);
+        let off = |angle: i16, target: i16| (i32::from(angle) - i32::from(target)).abs();
         loop {
-            let yaw = match self.query_angle(self.config.yaw_id).await {
-                Ok(a) => a,
-                Err(fault) => return Poll::Fault(self.config.yaw_id, fault),
+            let (yaw, pitch) = match self.read_both(link).await {
+                Ok(readings) => readings,
+                Err(fault) => return fault,
             };
-            let pitch = match self.query_angle(self.config.pitch_id).await {
-                Ok(a) => a,
-                Err(fault) => return Poll::Fault(self.config.pitch_id, fault),
+            let inside = |yaw: Option<i16>, pitch: Option<i16>| {
+                yaw.is_some_and(|a| off(a, yaw_target) <= deadband)
+                    && pitch.is_some_and(|a| off(a, pitch_target) <= deadband)
             };
-            let yaw_off = (i32::from(yaw) - i32::from(yaw_target)).abs();
-            let pitch_off = (i32::from(pitch) - i32::from(pitch_target)).abs();
-            if yaw_off <= deadband && pitch_off <= deadband {
-                return Poll::Arrived(yaw, pitch);
+            if inside(yaw, pitch) {
+                // Confirm with a second reading of both before declaring.
+                match self.read_both(link).await {
+                    Ok((Some(yaw), Some(pitch))) if inside(Some(yaw), Some(pitch)) => {
+                        return Poll::Arrived(yaw, pitch);
+                    }
+                    Ok(_) => {}
+                    Err(fault) => return fault,
+                }
             }
             if Instant::now() >= deadline {
-                let (id, at, target) = if yaw_off > deadband {
+                // The last believed angles (a rejected reading is no
+                // evidence either way).
+                let believed = |slot: usize| self.filters.get(slot).and_then(|f| f.1.last_good());
+                let yaw = yaw.or(believed(0));
+                let pitch = pitch.or(believed(1));
+                let yaw_away = yaw.is_none_or(|a| off(a, yaw_target) > deadband);
+                let (id, at, target) = if yaw_away {
                     (self.config.yaw_id, yaw, yaw_target)
                 } else {
                     (self.config.pitch_id, pitch, pitch_target)
@@ -379,7 +485,7 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                 return Poll::Fault(
                     id,
                     ServoFault::NotArrived {
-                        at_tenths: at,
+                        at_tenths: at.unwrap_or(i16::MIN),
                         target_tenths: target,
                     },
                 );
@@ -391,6 +497,56 @@ impl<R: Read, W: Write> ServoBus<R, W> {
             Timer::after_millis(u64::from(self.config.poll_period_ms)).await;
             if !link.requests.is_empty() {
                 return Poll::Superseded;
+            }
+        }
+    }
+
+    /// Reads yaw then pitch; `None` for a reading the filter rejected.
+    async fn read_both(&mut self, link: &ServoLink) -> Result<(Option<i16>, Option<i16>), Poll> {
+        let (yaw_id, pitch_id) = (self.config.yaw_id, self.config.pitch_id);
+        let yaw = self
+            .read_angle(0, yaw_id, link)
+            .await
+            .map_err(|fault| Poll::Fault(yaw_id, fault))?;
+        let pitch = self
+            .read_angle(1, pitch_id, link)
+            .await
+            .map_err(|fault| Poll::Fault(pitch_id, fault))?;
+        Ok((yaw, pitch))
+    }
+
+    /// Queries the angle of servo `id` (filter `slot`: 0 yaw, 1 pitch) and
+    /// judges it: `Ok(Some(angle))` when plausible, `Ok(None)` when
+    /// rejected (counted), `Err` when the servo does not answer or
+    /// [`IMPLAUSIBLE_RUN`] readings in a row were implausible.
+    async fn read_angle(
+        &mut self,
+        slot: usize,
+        id: u8,
+        link: &ServoLink,
+    ) -> Result<Option<i16>, ServoFault> {
+        let reading = self.query_angle(id).await?;
+        let now = Instant::now();
+        let Some((_, filter)) = self.filters.get_mut(slot) else {
+            return Ok(Some(reading));
+        };
+        match filter.judge(reading, now) {
+            Verdict::Accepted(angle) => Ok(Some(angle)),
+            Verdict::Unconfirmed => Ok(None),
+            Verdict::Implausible { run } => {
+                link.implausible_readings.fetch_add(1, Ordering::Relaxed);
+                log::warning!(
+                    "servo {}: implausible reading {} (0.1 deg), {} in a row",
+                    id,
+                    reading,
+                    run
+                );
+                if run >= IMPLAUSIBLE_RUN {
+                    filter.reset();
+                    Err(ServoFault::ImplausibleReading { at_tenths: reading })
+                } else {
+                    Ok(None)
+                }
             }
         }
     }

@@ -5,6 +5,7 @@ use core::fmt;
 use super::{LaserMode, Settings};
 use crate::cli::error::CommandError;
 use crate::cli::format::Shortest;
+use kinematics_core::error_model::COEF_LIMITS;
 
 /// How a parameter's value is stored.
 #[derive(Clone, Copy)]
@@ -18,15 +19,36 @@ pub(super) enum Slot {
     Planner,
 }
 
-/// Description of one parameter.
+/// The precision a parameter's value is used in by the code that reads
+/// it (the value is stored as f64 either way).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Precision {
+    /// Used as f64 (or as a whole number).
+    F64,
+    /// Converted to f32 where it is used (galvo geometry and DAC mapping,
+    /// marking): it must stay finite and, when non-zero, non-zero in f32.
+    F32,
+}
+
+/// Description of one parameter. Every value is checked against
+/// `min..=max` (and `min_magnitude`) before it is stored; the ranges are
+/// the physically meaningful ones for the hardware of SPEC §2, so a value
+/// that passes cannot degenerate (divide by ~0, overflow or vanish) in the
+/// precision it is used in.
 #[derive(Clone, Copy)]
 pub struct ParamSpec {
     /// Name used by `set` / `get`.
     pub name: &'static str,
-    /// Lowest accepted value.
+    /// Lowest accepted value (in the parameter's unit).
     pub min: f64,
-    /// Highest accepted value.
+    /// Highest accepted value (in the parameter's unit).
     pub max: f64,
+    /// Smallest accepted magnitude `|value|` (0: none). For parameters
+    /// whose sign is a direction (DAC scales), so neither sign can come
+    /// close to 0.
+    pub min_magnitude: f64,
+    /// Precision the value is used in.
+    pub precision: Precision,
     /// What it is, with unit.
     pub help: &'static str,
     pub(super) slot: Slot,
@@ -34,22 +56,66 @@ pub struct ParamSpec {
 
 macro_rules! real {
     ($name:literal, $min:expr, $max:expr, $help:literal, |$s:ident| $place:expr) => {
+        real!($name, $min, $max, Precision::F64, $help, |$s| $place)
+    };
+    ($name:literal, $min:expr, $max:expr, $precision:expr, $help:literal, |$s:ident| $place:expr) => {
         ParamSpec {
             name: $name,
             min: $min,
             max: $max,
+            min_magnitude: 0.0,
+            precision: $precision,
             help: $help,
             slot: Slot::Real(|$s| &mut $place),
         }
     };
 }
 
+/// A whole-number parameter (ids, counts).
+macro_rules! count {
+    ($name:literal, $min:expr, $max:expr, $help:literal, |$s:ident| $place:expr) => {
+        ParamSpec {
+            name: $name,
+            min: $min,
+            max: $max,
+            min_magnitude: 0.0,
+            precision: Precision::F64,
+            help: $help,
+            slot: Slot::Count(|$s| &mut $place),
+        }
+    };
+}
+
+/// A parameter that is one of a few codes (`slot` decides which).
+macro_rules! choice {
+    ($name:literal, $min:expr, $max:expr, $help:literal, $slot:expr) => {
+        ParamSpec {
+            name: $name,
+            min: $min,
+            max: $max,
+            min_magnitude: 0.0,
+            precision: Precision::F64,
+            help: $help,
+            slot: $slot,
+        }
+    };
+}
+
+/// Error-model coefficients (SPEC §5): `Δ = c0 + c1·x + c2·y + c3·x² +
+/// c4·x·y + c5·y²` with x, y, Δ in mm. Ranges from
+/// [`kinematics_core::error_model::COEF_LIMITS`] (shared with `cargo xtask
+/// calib fit`): c0 ±100 mm, c1/c2 ±1 mm/mm, c3..c5 ±0.01 1/mm.
 macro_rules! err_coef {
-    ($name:literal, $axis:ident, $i:literal) => {
-        real!($name, -1e3, 1e3, "error-model coefficient, mm", |s| s.$axis
+    ($name:literal, $axis:ident, $i:literal, $help:literal) => {
+        real!($name, -COEF_LIMITS[$i], COEF_LIMITS[$i], $help, |s| s.$axis
             [$i])
     };
 }
+
+/// Smallest |galvo DAC scale|, codes/rad: 4096 codes over ±45° of mirror.
+pub const MIN_CODES_PER_RAD: f64 = 1_000.0;
+/// Largest |galvo DAC scale|, codes/rad: 4096 codes over ±1° of mirror.
+pub const MAX_CODES_PER_RAD: f64 = 120_000.0;
 
 /// The parameter table (also the order of `params` and of the saved record).
 pub const PARAMS: &[ParamSpec] = &[
@@ -63,20 +129,10 @@ pub const PARAMS: &[ParamSpec] = &[
     real!("ol_cm", 0.0, 20.0, "laser axis offset OL, cm", |s| s.ol_cm),
     real!("grid.pitch_cm", 0.1, 20.0, "grid pitch, cm", |s| s
         .grid_pitch_cm),
-    ParamSpec {
-        name: "grid.cols",
-        min: 2.0,
-        max: 40.0,
-        help: "grid columns (even), cells",
-        slot: Slot::Count(|s| &mut s.grid_cols),
-    },
-    ParamSpec {
-        name: "grid.rows",
-        min: 2.0,
-        max: 40.0,
-        help: "grid rows (even), cells",
-        slot: Slot::Count(|s| &mut s.grid_rows),
-    },
+    count!("grid.cols", 2.0, 40.0, "grid columns (even), cells", |s| s
+        .grid_cols),
+    count!("grid.rows", 2.0, 40.0, "grid rows (even), cells", |s| s
+        .grid_rows),
     real!(
         "grid.x_offset_cm",
         -100.0,
@@ -126,20 +182,14 @@ pub const PARAMS: &[ParamSpec] = &[
         "line/circle/rect interpolation step, cm",
         |s| s.path_step_cm
     ),
-    ParamSpec {
-        name: "yaw.id",
-        min: 0.0,
-        max: 253.0,
-        help: "yaw servo bus id",
-        slot: Slot::Count(|s| &mut s.yaw.id),
-    },
-    ParamSpec {
-        name: "yaw.dir",
-        min: -1.0,
-        max: 1.0,
-        help: "yaw direction, +1 or -1",
-        slot: Slot::Sign(|s| &mut s.yaw.direction),
-    },
+    count!("yaw.id", 0.0, 253.0, "yaw servo bus id", |s| s.yaw.id),
+    choice!(
+        "yaw.dir",
+        -1.0,
+        1.0,
+        "yaw direction, +1 or -1",
+        Slot::Sign(|s| &mut s.yaw.direction)
+    ),
     real!("yaw.scale", 0.5, 2.0, "yaw servo deg per joint deg", |s| s
         .yaw
         .scale),
@@ -164,20 +214,14 @@ pub const PARAMS: &[ParamSpec] = &[
         "yaw servo upper limit, deg",
         |s| s.yaw.max_deg
     ),
-    ParamSpec {
-        name: "pitch.id",
-        min: 0.0,
-        max: 253.0,
-        help: "pitch servo bus id",
-        slot: Slot::Count(|s| &mut s.pitch.id),
-    },
-    ParamSpec {
-        name: "pitch.dir",
-        min: -1.0,
-        max: 1.0,
-        help: "pitch direction, +1 or -1",
-        slot: Slot::Sign(|s| &mut s.pitch.direction),
-    },
+    count!("pitch.id", 0.0, 253.0, "pitch servo bus id", |s| s.pitch.id),
+    choice!(
+        "pitch.dir",
+        -1.0,
+        1.0,
+        "pitch direction, +1 or -1",
+        Slot::Sign(|s| &mut s.pitch.direction)
+    ),
     real!(
         "pitch.scale",
         0.5,
@@ -206,30 +250,81 @@ pub const PARAMS: &[ParamSpec] = &[
         "pitch servo upper limit, deg",
         |s| s.pitch.max_deg
     ),
-    ParamSpec {
-        name: "laser.mode",
-        min: 0.0,
-        max: 2.0,
-        help: "0 auto, 1 dwell, 2 off",
-        slot: Slot::Laser,
-    },
-    err_coef!("err.dx.c0", err_dx, 0),
-    err_coef!("err.dx.c1", err_dx, 1),
-    err_coef!("err.dx.c2", err_dx, 2),
-    err_coef!("err.dx.c3", err_dx, 3),
-    err_coef!("err.dx.c4", err_dx, 4),
-    err_coef!("err.dx.c5", err_dx, 5),
-    err_coef!("err.dy.c0", err_dy, 0),
-    err_coef!("err.dy.c1", err_dy, 1),
-    err_coef!("err.dy.c2", err_dy, 2),
-    err_coef!("err.dy.c3", err_dy, 3),
-    err_coef!("err.dy.c4", err_dy, 4),
-    err_coef!("err.dy.c5", err_dy, 5),
+    choice!(
+        "laser.mode",
+        0.0,
+        2.0,
+        "0 auto, 1 dwell, 2 off",
+        Slot::Laser
+    ),
+    err_coef!("err.dx.c0", err_dx, 0, "error-model constant c0, mm"),
+    err_coef!(
+        "err.dx.c1",
+        err_dx,
+        1,
+        "error-model coefficient c1 of x, mm/mm"
+    ),
+    err_coef!(
+        "err.dx.c2",
+        err_dx,
+        2,
+        "error-model coefficient c2 of y, mm/mm"
+    ),
+    err_coef!(
+        "err.dx.c3",
+        err_dx,
+        3,
+        "error-model coefficient c3 of x^2, 1/mm"
+    ),
+    err_coef!(
+        "err.dx.c4",
+        err_dx,
+        4,
+        "error-model coefficient c4 of x*y, 1/mm"
+    ),
+    err_coef!(
+        "err.dx.c5",
+        err_dx,
+        5,
+        "error-model coefficient c5 of y^2, 1/mm"
+    ),
+    err_coef!("err.dy.c0", err_dy, 0, "error-model constant c0, mm"),
+    err_coef!(
+        "err.dy.c1",
+        err_dy,
+        1,
+        "error-model coefficient c1 of x, mm/mm"
+    ),
+    err_coef!(
+        "err.dy.c2",
+        err_dy,
+        2,
+        "error-model coefficient c2 of y, mm/mm"
+    ),
+    err_coef!(
+        "err.dy.c3",
+        err_dy,
+        3,
+        "error-model coefficient c3 of x^2, 1/mm"
+    ),
+    err_coef!(
+        "err.dy.c4",
+        err_dy,
+        4,
+        "error-model coefficient c4 of x*y, 1/mm"
+    ),
+    err_coef!(
+        "err.dy.c5",
+        err_dy,
+        5,
+        "error-model coefficient c5 of y^2, 1/mm"
+    ),
     #[cfg(feature = "galvo")]
     real!(
         "galvo.d_mm",
         50.0,
         5000.0,
+        Precision::F32,
         "galvo Y mirror to board distance d, mm",
         |s| s.galvo.d_mm
     ),
@@ -238,38 +333,45 @@ pub const PARAMS: &[ParamSpec] = &[
         "galvo.e_mm",
         0.0,
         100.0,
+        Precision::F32,
         "galvo mirror separation e, mm",
         |s| s.galvo.e_mm
     ),
     #[cfg(feature = "galvo")]
-    real!(
-        "galvo.x_codes_per_rad",
-        -1e6,
-        1e6,
-        "galvo X DAC codes per rad (sign = direction)",
-        |s| s.galvo.x_codes_per_rad
-    ),
+    ParamSpec {
+        name: "galvo.x_codes_per_rad",
+        min: -MAX_CODES_PER_RAD,
+        max: MAX_CODES_PER_RAD,
+        min_magnitude: MIN_CODES_PER_RAD,
+        precision: Precision::F32,
+        help: "galvo X DAC codes/rad, |v| >= 1000, sign = direction",
+        slot: Slot::Real(|s| &mut s.galvo.x_codes_per_rad),
+    },
     #[cfg(feature = "galvo")]
     real!(
         "galvo.x_offset_code",
         0.0,
         4095.0,
+        Precision::F32,
         "galvo X DAC code at angle 0",
         |s| s.galvo.x_offset_code
     ),
     #[cfg(feature = "galvo")]
-    real!(
-        "galvo.y_codes_per_rad",
-        -1e6,
-        1e6,
-        "galvo Y DAC codes per rad (sign = direction)",
-        |s| s.galvo.y_codes_per_rad
-    ),
+    ParamSpec {
+        name: "galvo.y_codes_per_rad",
+        min: -MAX_CODES_PER_RAD,
+        max: MAX_CODES_PER_RAD,
+        min_magnitude: MIN_CODES_PER_RAD,
+        precision: Precision::F32,
+        help: "galvo Y DAC codes/rad, |v| >= 1000, sign = direction",
+        slot: Slot::Real(|s| &mut s.galvo.y_codes_per_rad),
+    },
     #[cfg(feature = "galvo")]
     real!(
         "galvo.y_offset_code",
         0.0,
         4095.0,
+        Precision::F32,
         "galvo Y DAC code at angle 0",
         |s| s.galvo.y_offset_code
     ),
@@ -318,13 +420,13 @@ pub const PARAMS: &[ParamSpec] = &[
         |s| s.galvo.sample_period_us
     ),
     #[cfg(feature = "galvo")]
-    ParamSpec {
-        name: "galvo.planner",
-        min: 0.0,
-        max: 1.0,
-        help: "galvo jump planner: 0 optimal, 1 seed",
-        slot: Slot::Planner,
-    },
+    choice!(
+        "galvo.planner",
+        0.0,
+        1.0,
+        "galvo jump planner: 0 optimal, 1 seed",
+        Slot::Planner
+    ),
     #[cfg(feature = "galvo")]
     real!(
         "galvo.laser_on_delay_us",
@@ -354,6 +456,7 @@ pub const PARAMS: &[ParamSpec] = &[
         "galvo.mark_accel_mm_s2",
         100.0,
         1.0e8,
+        Precision::F32,
         "galvo marking acceleration, mm/s^2",
         |s| s.galvo.mark_accel_mm_s2
     ),
@@ -373,6 +476,14 @@ pub(super) fn check_value(param: &ParamSpec, value: f64) -> Result<(), CommandEr
             max: param.max,
         });
     }
+    if value.abs() < param.min_magnitude {
+        return Err(CommandError::Rejected(
+            "value too close to 0 (see `params` for the smallest magnitude)",
+        ));
+    }
+    if param.precision == Precision::F32 && !survives_f32(value) {
+        return Err(CommandError::Rejected("value not representable in f32"));
+    }
     // In range, so the cast is exact for every whole value.
     let whole = (value as i64) as f64 == value;
     match param.slot {
@@ -391,17 +502,27 @@ pub(super) fn check_value(param: &ParamSpec, value: f64) -> Result<(), CommandEr
     }
 }
 
-/// Format of `get`/`params` lines: `name = value  # help`.
+/// Whether `value` keeps its meaning as f32: finite, and non-zero unless
+/// it is 0 (the ranges keep every accepted value far from both limits;
+/// this is the check that they do).
+pub(super) fn survives_f32(value: f64) -> bool {
+    let narrow = value as f32;
+    narrow.is_finite() && (narrow != 0.0 || value == 0.0)
+}
+
+/// Format of `get`/`params` lines: `name = value  # help [min, max]`.
 pub struct ParamLine<'a>(pub &'a ParamSpec, pub f64);
 
 impl fmt::Display for ParamLine<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} = {}  # {}",
+            "{} = {}  # {} [{}, {}]",
             self.0.name,
             Shortest(self.1),
-            self.0.help
+            self.0.help,
+            Shortest(self.0.min),
+            Shortest(self.0.max)
         )
     }
 }

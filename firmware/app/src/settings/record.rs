@@ -87,6 +87,20 @@ impl Settings {
     }
 }
 
+/// Length of the record at the start of `bytes` when it is complete and its
+/// checksum matches, whatever its version (the length comes from its own
+/// parameter count); `None` for anything else. Tells a record written by an
+/// older firmware straight into flash from erased or partly written flash.
+pub fn intact_record_len(bytes: &[u8]) -> Option<usize> {
+    if bytes.get(..4)? != RECORD_MAGIC {
+        return None;
+    }
+    let count = u16::from_le_bytes([*bytes.get(6)?, *bytes.get(7)?]);
+    let len = 4 + 2 + 2 + 8 * usize::from(count) + 4;
+    let (body, crc) = bytes.get(..len)?.split_at(len - 4);
+    (crc32(body).to_le_bytes() == crc).then_some(len)
+}
+
 struct Cursor<'a> {
     buf: &'a mut [u8],
     at: usize,
@@ -142,6 +156,27 @@ mod tests {
         };
         let record = s.to_record();
         assert_eq!(Settings::from_record(&record), Ok(s));
+    }
+
+    #[test]
+    fn intact_record_len_accepts_only_whole_checksummed_records() {
+        let record = Settings::default().to_record();
+        let mut flash = [0xFFu8; RECORD_LEN + 64];
+        flash[..RECORD_LEN].copy_from_slice(&record);
+        assert_eq!(intact_record_len(&flash), Some(RECORD_LEN));
+        // Cut short (a write interrupted at any byte) or truncated input.
+        for cut in 0..RECORD_LEN {
+            let mut partial = [0xFFu8; RECORD_LEN + 64];
+            partial[..cut].copy_from_slice(&record[..cut]);
+            assert_eq!(intact_record_len(&partial), None, "cut at {cut}");
+            assert_eq!(intact_record_len(&record[..cut]), None);
+        }
+        // Any single flipped bit.
+        for bit in 0..RECORD_LEN * 8 {
+            let mut flipped = record;
+            flipped[bit / 8] ^= 1 << (bit % 8);
+            assert_eq!(intact_record_len(&flipped), None, "bit {bit}");
+        }
     }
 
     #[test]

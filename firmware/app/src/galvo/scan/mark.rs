@@ -15,16 +15,16 @@ use crate::galvo::path::{GalvoPath, Segment};
 pub(super) struct Motion {
     pub(super) position_mm: [f32; 2],
     pub(super) step_mm: [f32; 2],
+    /// Speed lost per braking sample, mm per sample (accel · Ts²).
+    pub(super) brake_mm: f32,
 }
 
 impl GalvoLoop {
     /// DAC codes of a board position (mm).
     fn codes_at(&self, position_mm: [f32; 2]) -> Option<(u16, u16)> {
         let [x_mm, y_mm] = position_mm;
-        self.config
-            .galvo
-            .board_to_codes(PointMm { x_mm, y_mm })
-            .ok()
+        self.sample_map
+            .board_to_codes(x_mm, y_mm)
             .map(|c| (c.x.code, c.y.code))
     }
 
@@ -40,6 +40,7 @@ impl GalvoLoop {
             self.motion = Motion {
                 position_mm: [x_mm, y_mm],
                 step_mm: [x_mm - px, y_mm - py],
+                ..self.motion
             };
             return self.codes_at([x_mm, y_mm]);
         }
@@ -56,9 +57,9 @@ impl GalvoLoop {
     /// marking acceleration; at rest the mirrors hold and the job ends.
     pub(super) fn brake_sample(&mut self) -> Option<(u16, u16)> {
         let [sx, sy] = self.motion.step_mm;
-        let speed = libm::hypotf(sx, sy);
-        let ts = self.config.sample_period_s as f32;
-        let slow_by = self.config.mark_accel_mm_s2 as f32 * ts * ts;
+        // libm's hypotf computes in f64: √ on the FPU instead.
+        let speed = kinematics_core::sqrt_f32(sx * sx + sy * sy);
+        let slow_by = self.motion.brake_mm;
         let scale = if speed > slow_by {
             (speed - slow_by) / speed
         } else {
@@ -72,6 +73,7 @@ impl GalvoLoop {
                 self.motion = Motion {
                     position_mm: next,
                     step_mm: step,
+                    ..self.motion
                 };
                 Some(codes)
             }
@@ -133,9 +135,11 @@ impl GalvoLoop {
         match loaded {
             Ok(planner) => {
                 self.marker = Some(planner);
+                let ts = self.config.sample_period_s;
                 self.motion = Motion {
                     position_mm: [start[0] as f32, start[1] as f32],
                     step_mm: [0.0, 0.0],
+                    brake_mm: (self.config.mark_accel_mm_s2 * ts * ts) as f32,
                 };
                 if let Some(a) = self.active.as_mut() {
                     a.enter(Phase::Marking, 0);

@@ -223,6 +223,45 @@ fn stop_during_a_jump_lands_and_holds_dark() {
 }
 
 #[test]
+fn holding_computes_one_sample_and_outputs_what_a_full_fill_would() {
+    let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
+    let centre = galvo.hold_sample().expect("idle at boot");
+    assert!(!centre.laser);
+    let mut half = [DacSample::default(); 128];
+    assert_eq!(galvo.fill(&mut half, |_| {}), 1, "one computed sample");
+    assert!(half.iter().all(|s| *s == centre));
+    // Busy: no hold, every sample computed.
+    galvo.request(point(1, 30.0, -20.0, 300));
+    assert_eq!(galvo.hold_sample(), None);
+    assert_eq!(galvo.fill(&mut half, |_| {}), 128);
+    let (samples, _) = run(&mut galvo, done(1));
+    // The last samples of the job (laser-off delay) are the hold that
+    // follows, at the point: the fast path changes nothing in the output.
+    let last = *samples.last().unwrap();
+    let hold = galvo.hold_sample().expect("idle after the point");
+    assert_eq!(
+        hold,
+        DacSample {
+            laser: false,
+            ..last
+        }
+    );
+    let p = spot_mm(&hold);
+    assert!(
+        (p.x_mm - 30.0).abs() < 0.1 && (p.y_mm + 20.0).abs() < 0.1,
+        "{p:?}"
+    );
+    // New parameters waiting: not a plain hold until they are applied.
+    galvo.configure(GalvoConfig {
+        laser_on_delay_us: 300,
+        ..GalvoConfig::default()
+    });
+    assert_eq!(galvo.hold_sample(), None);
+    galvo.fill(&mut half, |_| {});
+    assert_eq!(galvo.hold_sample(), Some(hold));
+}
+
+#[test]
 fn delays_round_up_to_whole_samples() {
     assert_eq!(samples_for(100, 10e-6), 10);
     assert_eq!(samples_for(101, 10e-6), 11);

@@ -1,0 +1,500 @@
+//! The one outbound path to the host: a bounded queue of whole text lines
+//! (replies and notices) between the tasks that produce them and the
+//! console's writer.
+//!
+//! Producers (the sequencer, the console's own line checks) push complete
+//! lines with try semantics: a push never waits, so a host that stops
+//! reading can never delay the sequencer, servo or galvo tasks. The
+//! console's writer takes one line at a time and writes it whole to the
+//! host, so a line is never cut: a line either reaches the host complete or
+//! is dropped before its first byte is written.
+//!
+//! Room is shared by priority: data lines may use the queue up to
+//! [`DATA_LIMIT`] bytes, notices up to [`NOTICE_LIMIT`], and the closing
+//! `ok` / `error:` all of it. The console dispatches a command only while
+//! [`CLOSER_ROOM`] bytes are free ([`Outbound::has_closer_room`]), and only
+//! one command is in flight, so every closer fits: the protocol "zero or
+//! more data lines, then exactly one `ok` or `error:` per input line, in
+//! order" holds whatever the host does. Dropped data lines and notices are
+//! counted; the writer reports them, where they were dropped, with a
+//! bracketed notice once the host reads again.
+
+use core::cell::RefCell;
+use core::fmt;
+
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::signal::Signal;
+use heapless::Deque;
+
+use crate::command::{REPLY_LINE_LEN, ReplyText, reply_text};
+
+/// Size of the outbound queue, bytes (lines are stored with a 2-byte
+/// header). Holds the longest reply (`params`, about 3.2 KiB stored) with
+/// room to spare, so a host that reads gets every line.
+pub const OUTBOUND_BYTES: usize = 6 * 1024;
+
+/// Stored size of the longest line (header + text), bytes.
+const LINE_ENTRY_MAX: usize = HEADER + REPLY_LINE_LEN;
+/// Header of a stored entry: kind, text length.
+const HEADER: usize = 2;
+/// Stored size of a drop marker (header + two u32 counters), bytes.
+const MARKER_ENTRY: usize = HEADER + 8;
+
+/// Bytes that only a closing `ok` / `error:` (with a drop marker before
+/// it) may use.
+pub const CLOSER_ROOM: usize = LINE_ENTRY_MAX + MARKER_ENTRY;
+/// Notices may fill the queue up to this many bytes.
+pub const NOTICE_LIMIT: usize = OUTBOUND_BYTES - CLOSER_ROOM;
+/// Data lines may fill the queue up to this many bytes (the rest is kept
+/// for four notices and the closer).
+pub const DATA_LIMIT: usize = NOTICE_LIMIT - 4 * (LINE_ENTRY_MAX + MARKER_ENTRY);
+
+/// What a queued line is; decides how it is printed and its priority.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum LineKind {
+    /// A data line of the current reply (printed as is).
+    Data,
+    /// The reply's closing `ok`.
+    Ok,
+    /// The reply's closing `error: <text>`.
+    Error,
+    /// An unsolicited notice, printed in brackets: `[<text>]`.
+    Notice,
+}
+
+impl LineKind {
+    /// Whether this line closes a reply.
+    pub fn is_closer(self) -> bool {
+        matches!(self, LineKind::Ok | LineKind::Error)
+    }
+
+    fn code(self) -> u8 {
+        match self {
+            LineKind::Data => 0,
+            LineKind::Ok => 1,
+            LineKind::Error => 2,
+            LineKind::Notice => 3,
+        }
+    }
+
+    fn from_code(code: u8) -> Option<Self> {
+        match code {
+            0 => Some(LineKind::Data),
+            1 => Some(LineKind::Ok),
+            2 => Some(LineKind::Error),
+            3 => Some(LineKind::Notice),
+            _ => None,
+        }
+    }
+
+    /// Bytes of the queue this kind may fill.
+    fn limit(self) -> usize {
+        match self {
+            LineKind::Data => DATA_LIMIT,
+            LineKind::Notice => NOTICE_LIMIT,
+            LineKind::Ok | LineKind::Error => OUTBOUND_BYTES,
+        }
+    }
+}
+
+/// Entry code of a drop marker.
+const MARKER_CODE: u8 = 0xff;
+
+/// Lines dropped because the queue was full.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Dropped {
+    /// Data lines of replies.
+    pub data_lines: u32,
+    /// Notices (faults, recoveries).
+    pub notices: u32,
+}
+
+impl Dropped {
+    /// Whether nothing was dropped.
+    pub fn is_empty(&self) -> bool {
+        self.data_lines == 0 && self.notices == 0
+    }
+
+    fn count(&mut self, kind: LineKind) {
+        match kind {
+            LineKind::Data => self.data_lines = self.data_lines.saturating_add(1),
+            LineKind::Notice => self.notices = self.notices.saturating_add(1),
+            // Closers always have room (see the module doc); should one
+            // ever be refused it is counted with the data lines.
+            LineKind::Ok | LineKind::Error => self.data_lines = self.data_lines.saturating_add(1),
+        }
+    }
+}
+
+/// The notice reporting dropped lines (`info:` for reply lines only,
+/// `error:` when notices, which may report faults, were lost too).
+impl fmt::Display for Dropped {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let plural = |n: u32| if n == 1 { "" } else { "s" };
+        let (lines, notices) = (self.data_lines, self.notices);
+        if notices == 0 {
+            write!(f, "info: {lines} reply line{}", plural(lines))?;
+        } else {
+            write!(f, "error: {notices} notice{}", plural(notices))?;
+            if lines > 0 {
+                write!(f, " and {lines} reply line{}", plural(lines))?;
+            }
+        }
+        f.write_str(" dropped while the host was not reading")?;
+        if notices > 0 {
+            f.write_str("; `status` shows faults")?;
+        }
+        Ok(())
+    }
+}
+
+/// One line taken from the queue for writing.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct OutLine {
+    /// What it is.
+    pub kind: LineKind,
+    /// Its text (without `error: `, brackets or line end).
+    pub text: ReplyText,
+}
+
+struct Queue {
+    bytes: Deque<u8, OUTBOUND_BYTES>,
+    /// Dropped since the last line that was queued (reported by a marker
+    /// before the next queued line, or by the writer once the queue is
+    /// empty).
+    dropped: Dropped,
+    /// A command was dispatched and has not been closed yet.
+    awaiting_close: bool,
+}
+
+impl Queue {
+    const fn new() -> Self {
+        Self {
+            bytes: Deque::new(),
+            dropped: Dropped {
+                data_lines: 0,
+                notices: 0,
+            },
+            awaiting_close: false,
+        }
+    }
+
+    fn push_bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            // Room was checked by the caller.
+            let _ = self.bytes.push_back(b);
+        }
+    }
+
+    /// Queues `text` as a `kind` line, after a drop marker if lines were
+    /// dropped before it; counts it as dropped when its share is full.
+    fn push(&mut self, kind: LineKind, text: &str) -> bool {
+        // At most REPLY_LINE_LEN bytes, cut on a character boundary.
+        let mut end = text.len().min(REPLY_LINE_LEN);
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        let text = text.as_bytes().get(..end).unwrap_or(&[]);
+        let marker = if self.dropped.is_empty() {
+            0
+        } else {
+            MARKER_ENTRY
+        };
+        let needed = marker + HEADER + text.len();
+        if self.bytes.len() + needed > kind.limit() {
+            self.dropped.count(kind);
+            return false;
+        }
+        if marker > 0 {
+            let d = core::mem::take(&mut self.dropped);
+            self.push_bytes(&[MARKER_CODE, 8]);
+            self.push_bytes(&d.data_lines.to_le_bytes());
+            self.push_bytes(&d.notices.to_le_bytes());
+        }
+        // `text` is at most REPLY_LINE_LEN (< 256) bytes.
+        self.push_bytes(&[kind.code(), text.len() as u8]);
+        self.push_bytes(text);
+        true
+    }
+
+    fn pop_bytes<const N: usize>(&mut self) -> [u8; N] {
+        let mut out = [0u8; N];
+        for b in out.iter_mut() {
+            *b = self.bytes.pop_front().unwrap_or(0);
+        }
+        out
+    }
+
+    /// Takes the oldest entry: a line, or a drop marker turned into its
+    /// notice. With an empty queue, reports drops not yet reported.
+    fn pop(&mut self) -> Option<OutLine> {
+        let Some([code, len]) = (self.bytes.len() >= HEADER).then(|| self.pop_bytes::<2>()) else {
+            if self.dropped.is_empty() {
+                return None;
+            }
+            let d = core::mem::take(&mut self.dropped);
+            return Some(dropped_notice(d));
+        };
+        if code == MARKER_CODE {
+            let lines = u32::from_le_bytes(self.pop_bytes::<4>());
+            let notices = u32::from_le_bytes(self.pop_bytes::<4>());
+            return Some(dropped_notice(Dropped {
+                data_lines: lines,
+                notices,
+            }));
+        }
+        let mut text = ReplyText::new();
+        let mut utf8 = heapless::Vec::<u8, REPLY_LINE_LEN>::new();
+        for _ in 0..len {
+            let _ = utf8.push(self.bytes.pop_front().unwrap_or(b'?'));
+        }
+        // Lines were queued from `&str`s, whole: always valid UTF-8.
+        let _ = text.push_str(core::str::from_utf8(&utf8).unwrap_or("?"));
+        Some(OutLine {
+            kind: LineKind::from_code(code).unwrap_or(LineKind::Data),
+            text,
+        })
+    }
+}
+
+fn dropped_notice(dropped: Dropped) -> OutLine {
+    OutLine {
+        kind: LineKind::Notice,
+        text: reply_text(format_args!("{dropped}")),
+    }
+}
+
+/// The outbound line queue (usable in a `static`).
+pub struct Outbound {
+    queue: Mutex<CriticalSectionRawMutex, RefCell<Queue>>,
+    /// A line was queued (wakes the writer).
+    queued: Signal<CriticalSectionRawMutex, ()>,
+    /// Room was freed or a reply closed (wakes the console's reader).
+    freed: Signal<CriticalSectionRawMutex, ()>,
+}
+
+impl Outbound {
+    /// An empty queue.
+    pub const fn new() -> Self {
+        Self {
+            queue: Mutex::new(RefCell::new(Queue::new())),
+            queued: Signal::new(),
+            freed: Signal::new(),
+        }
+    }
+
+    fn with<T>(&self, f: impl FnOnce(&mut Queue) -> T) -> T {
+        self.queue.lock(|q| f(&mut q.borrow_mut()))
+    }
+
+    /// Queues one line without waiting; `false` when it was dropped (and
+    /// counted) because its share of the queue is full. A closer also ends
+    /// the command in flight.
+    pub fn push(&self, kind: LineKind, text: &str) -> bool {
+        let queued = self.with(|q| {
+            if kind.is_closer() {
+                q.awaiting_close = false;
+            }
+            q.push(kind, text)
+        });
+        if queued {
+            self.queued.signal(());
+        } else {
+            crate::log::debug!("outbound: host not reading, {:?} line dropped", kind);
+        }
+        if kind.is_closer() {
+            self.freed.signal(());
+        }
+        queued
+    }
+
+    /// Queues a line formatted from `args` (cut at [`REPLY_LINE_LEN`]).
+    pub fn push_fmt(&self, kind: LineKind, args: fmt::Arguments<'_>) -> bool {
+        self.push(kind, &reply_text(args))
+    }
+
+    /// Takes the next line to write (drop reports included), if any.
+    pub fn take(&self) -> Option<OutLine> {
+        let line = self.with(Queue::pop);
+        if line.is_some() {
+            self.freed.signal(());
+        }
+        line
+    }
+
+    /// Waits until a line (or a drop report) can be taken.
+    pub async fn next_line(&self) -> OutLine {
+        loop {
+            if let Some(line) = self.take() {
+                return line;
+            }
+            self.queued.wait().await;
+        }
+    }
+
+    /// Bytes queued and not yet taken by the writer.
+    pub fn queued_bytes(&self) -> usize {
+        self.with(|q| q.bytes.len())
+    }
+
+    /// Whether a closer (and a drop marker before it) still fits beyond
+    /// what notices may fill: the console dispatches a line only then.
+    pub fn has_closer_room(&self) -> bool {
+        self.queued_bytes() <= OUTBOUND_BYTES - CLOSER_ROOM
+    }
+
+    /// Lines dropped and not yet reported.
+    pub fn unreported_drops(&self) -> Dropped {
+        self.with(|q| q.dropped)
+    }
+
+    /// Marks a command as dispatched: its closer is awaited.
+    pub fn begin_command(&self) {
+        self.with(|q| q.awaiting_close = true);
+    }
+
+    /// Whether a dispatched command has not been closed yet.
+    pub fn awaiting_close(&self) -> bool {
+        self.with(|q| q.awaiting_close)
+    }
+
+    /// Waits until `ready` holds, re-checking whenever room is freed or a
+    /// reply closes.
+    pub async fn wait_until(&self, mut ready: impl FnMut(&Self) -> bool) {
+        while !ready(self) {
+            self.freed.wait().await;
+        }
+    }
+}
+
+impl Default for Outbound {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use std::format;
+    use std::string::String;
+
+    use super::*;
+
+    fn drain(out: &Outbound) -> heapless::Vec<OutLine, 256> {
+        let mut lines = heapless::Vec::new();
+        while let Some(line) = out.take() {
+            let _ = lines.push(line);
+        }
+        lines
+    }
+
+    #[test]
+    fn lines_come_out_whole_and_in_order() {
+        let out = Outbound::new();
+        assert!(out.push(LineKind::Notice, "info: servo 1 answering again"));
+        assert!(out.push(LineKind::Data, "dwell_ms = 1000 ms"));
+        assert!(out.push(LineKind::Ok, ""));
+        let lines = drain(&out);
+        let kinds: heapless::Vec<LineKind, 8> = lines.iter().map(|l| l.kind).collect();
+        assert_eq!(
+            kinds.as_slice(),
+            [LineKind::Notice, LineKind::Data, LineKind::Ok]
+        );
+        assert_eq!(lines[1].text.as_str(), "dwell_ms = 1000 ms");
+        assert_eq!(out.queued_bytes(), 0);
+    }
+
+    #[test]
+    fn a_full_queue_drops_whole_data_lines_keeps_notices_and_the_closer_and_says_where() {
+        let out = Outbound::new();
+        out.begin_command();
+        let line = String::from("x").repeat(100);
+        let mut queued = 0;
+        for _ in 0..200 {
+            if out.push(LineKind::Data, &line) {
+                queued += 1;
+            }
+        }
+        assert!(queued > 0 && queued < 200);
+        assert!(out.queued_bytes() <= DATA_LIMIT);
+        assert!(out.push(LineKind::Notice, "error: servo 1 fault (Timeout)"));
+        assert!(out.push(LineKind::Ok, ""));
+        assert!(!out.awaiting_close());
+        let lines = drain(&out);
+        assert_eq!(lines.len(), queued + 3);
+        assert!(lines[..queued].iter().all(|l| l.text.as_str() == line));
+        let report = &lines[queued];
+        assert_eq!(report.kind, LineKind::Notice);
+        assert_eq!(
+            report.text.as_str(),
+            format!(
+                "info: {} reply lines dropped while the host was not reading",
+                200 - queued
+            )
+        );
+        assert_eq!(lines[queued + 1].kind, LineKind::Notice);
+        assert_eq!(lines[queued + 2].kind, LineKind::Ok);
+        assert!(out.unreported_drops().is_empty());
+    }
+
+    #[test]
+    fn notices_fill_only_their_share_and_drops_at_the_end_are_reported_when_empty() {
+        let out = Outbound::new();
+        let notice = String::from("e").repeat(REPLY_LINE_LEN);
+        let mut dropped = 0;
+        for _ in 0..100 {
+            if !out.push(LineKind::Notice, &notice) {
+                dropped += 1;
+            }
+        }
+        assert!(dropped > 0);
+        assert!(out.has_closer_room(), "a closer always fits");
+        assert!(out.push(LineKind::Error, "unknown command"));
+        let lines = drain(&out);
+        let report = &lines[lines.len() - 2];
+        assert!(
+            report
+                .text
+                .starts_with(&format!("error: {dropped} notices dropped")),
+            "{report:?}"
+        );
+        assert_eq!(lines[lines.len() - 1].kind, LineKind::Error);
+        // Drops after the last queued line are reported once it is empty.
+        for _ in 0..100 {
+            out.push(LineKind::Notice, &notice);
+        }
+        out.push(LineKind::Data, "lost");
+        let lines = drain(&out);
+        let last = lines.last().map(|l| l.text.as_str()).unwrap_or("");
+        assert!(last.contains("and 1 reply line dropped"), "{last}");
+        assert!(out.take().is_none());
+    }
+
+    #[test]
+    fn long_text_is_cut_on_a_character_boundary() {
+        let out = Outbound::new();
+        let text = String::from("é").repeat(REPLY_LINE_LEN);
+        assert!(out.push(LineKind::Data, &text));
+        let line = out.take().expect("queued");
+        assert_eq!(line.text.len(), REPLY_LINE_LEN);
+        assert!(line.text.chars().all(|c| c == 'é'));
+    }
+
+    #[test]
+    fn the_longest_reply_fits_a_reading_host() {
+        use crate::settings::{PARAMS, ParamLine, Settings};
+        let out = Outbound::new();
+        let settings = Settings::default();
+        for param in PARAMS {
+            assert!(out.push_fmt(
+                LineKind::Data,
+                format_args!("{}", ParamLine(param, settings.get(param)))
+            ));
+        }
+        assert!(out.queued_bytes() * 3 / 2 < DATA_LIMIT, "room to spare");
+    }
+}
