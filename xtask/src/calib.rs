@@ -16,20 +16,18 @@
 
 use std::fmt::Write as _;
 use std::fs::File;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use kinematics_core::error_model::{COEF_LIMITS, MAX_MEASURED_MM};
-use kinematics_core::{AxisFit, FitReport, MeasuredPoint, fit};
+use kinematics_core::error_model::COEF_LIMITS;
+use kinematics_core::{AxisFit, FitReport, fit};
 use serde::Serialize;
 
 use crate::kin::error_json;
+use xtask::calib_csv::read_points;
 
 /// Longest line the firmware's command line accepts, bytes.
 const FIRMWARE_MAX_LINE: usize = 128;
-/// Column names, in order.
-const HEADER: [&str; 4] = ["x", "y", "dx", "dy"];
 
 /// `cargo xtask calib …`
 #[derive(clap::Args, Debug)]
@@ -116,95 +114,6 @@ fn fit_json(report: &FitReport) -> Result<String, String> {
     .map_err(|e| e.to_string())
 }
 
-/// Parses the measured points. The header must be `x,y,dx,dy`; fields may
-/// be padded with spaces; blank lines and lines starting with `#` are
-/// skipped. Errors name the 1-based line.
-fn read_points(mut input: impl Read) -> Result<Vec<MeasuredPoint>, String> {
-    let mut bytes = Vec::new();
-    input
-        .read_to_end(&mut bytes)
-        .map_err(|e| format!("cannot read: {e}"))?;
-    // 1-based line where the record at `pos` starts. csv positions a record
-    // at the blank or comment lines it skipped before it, so skip those too.
-    let line_of = |pos: &csv::Position| {
-        let mut at = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
-        loop {
-            match bytes.get(at) {
-                Some(b'\n' | b'\r') => at += 1,
-                Some(b'#') => {
-                    let rest = bytes.get(at..).unwrap_or_default();
-                    at += rest
-                        .iter()
-                        .position(|&b| b == b'\n')
-                        .map_or(rest.len(), |i| i + 1);
-                }
-                _ => break,
-            }
-        }
-        1 + bytes.iter().take(at).filter(|&&b| b == b'\n').count()
-    };
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(false)
-        .flexible(true)
-        .trim(csv::Trim::All)
-        .comment(Some(b'#'))
-        .from_reader(bytes.as_slice());
-    let mut points = Vec::new();
-    let mut header_seen = false;
-    for record in reader.records() {
-        let record = record.map_err(|e| match e.position() {
-            Some(pos) => format!("line {}: {e}", line_of(pos)),
-            None => e.to_string(),
-        })?;
-        let line = record.position().map_or(0, line_of);
-        if !header_seen {
-            if record.iter().ne(HEADER) {
-                let found: Vec<&str> = record.iter().collect();
-                return Err(format!(
-                    "line {line}: header must be exactly `x,y,dx,dy`, found `{}`",
-                    found.join(",")
-                ));
-            }
-            header_seen = true;
-            continue;
-        }
-        if record.len() != HEADER.len() {
-            return Err(format!(
-                "line {line}: expected 4 fields (x,y,dx,dy), found {}",
-                record.len()
-            ));
-        }
-        let mut v = [0.0; 4];
-        for ((slot, text), name) in v.iter_mut().zip(record.iter()).zip(HEADER) {
-            *slot = text
-                .parse::<f64>()
-                .map_err(|_| format!("line {line}: column {name}: `{text}` is not a number"))?;
-            if !slot.is_finite() {
-                return Err(format!(
-                    "line {line}: column {name}: `{text}` is not a finite number"
-                ));
-            }
-            if slot.abs() > MAX_MEASURED_MM {
-                return Err(format!(
-                    "line {line}: column {name}: {text} mm is beyond +-{MAX_MEASURED_MM} mm (10 m); \
-                     check the units (mm) of the CSV"
-                ));
-            }
-        }
-        let [x_mm, y_mm, dx_mm, dy_mm] = v;
-        points.push(MeasuredPoint {
-            x_mm,
-            y_mm,
-            dx_mm,
-            dy_mm,
-        });
-    }
-    if !header_seen {
-        return Err("line 1: empty file, expected the header `x,y,dx,dy`".into());
-    }
-    Ok(points)
-}
-
 /// A value in the shortest form that parses back to exactly `v`, short
 /// enough for a firmware command line.
 fn exact_number(v: f64) -> String {
@@ -279,6 +188,7 @@ fn axis_summary(axis: &str, f: &AxisFit) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use kinematics_core::MeasuredPoint;
 
     /// Known quadratic behind `kinematics-core/tests/data/quadratic_noise.csv`
     /// (11 × 11 grid over ±100 mm, Gaussian noise σ = 0.02 mm; see

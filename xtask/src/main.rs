@@ -3,6 +3,7 @@
 
 mod bench_m4;
 mod calib;
+mod fuzz;
 mod kin;
 mod plan;
 mod sim;
@@ -39,6 +40,9 @@ enum Command {
     Calib(calib::CalibArgs),
     /// Galvo jump planning: `plan jump …`, `plan compare`.
     Plan(plan::PlanArgs),
+    /// Run the cargo-fuzz targets (nightly; installed when missing) and
+    /// merge new inputs into tests/fuzz/corpus.
+    Fuzz(fuzz::FuzzArgs),
 }
 
 fn main() -> ExitCode {
@@ -53,6 +57,7 @@ fn main() -> ExitCode {
         Command::Kin(args) => kin::run(args),
         Command::Calib(args) => calib::run(args),
         Command::Plan(args) => plan::run(args),
+        Command::Fuzz(args) => fuzz::fuzz(args).map(|()| ExitCode::SUCCESS),
     };
     match result {
         Ok(code) => code,

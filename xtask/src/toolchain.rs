@@ -17,13 +17,14 @@ pub const RAM_BUDGET_BYTES: u64 = 96 * 1024;
 /// rustup components the project uses (llvm-tools provides `llvm-size`).
 const COMPONENTS: [&str; 3] = ["rustfmt", "clippy", "llvm-tools"];
 /// Crates that build for the host (everything but the firmware binary).
-const HOST_PACKAGES: [&str; 6] = [
+const HOST_PACKAGES: [&str; 7] = [
     "kinematics-core",
     "galvo-planner",
     "laser-app",
     "laser-sim",
     "xtask",
     "system-tests",
+    "fuzz-props",
 ];
 /// `no_std` crates that must also build for the target.
 const TARGET_LIBRARIES: [&str; 3] = ["kinematics-core", "galvo-planner", "laser-app"];

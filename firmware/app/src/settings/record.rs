@@ -75,6 +75,11 @@ impl Settings {
             let value = f64::from_le_bytes(le);
             check_value(p, value).map_err(|_| RecordError::Invalid)?;
             settings.apply(p, value);
+            // Only the encoding `to_record` writes loads (e.g. not −0 for
+            // an id), so a loaded record re-saves byte for byte.
+            if settings.get(p).to_bits() != value.to_bits() {
+                return Err(RecordError::Invalid);
+            }
         }
         // Cross-parameter rules apply to the loaded set as a whole.
         settings.validate().map_err(|_| RecordError::Invalid)?;
@@ -200,5 +205,36 @@ mod tests {
             Settings::from_record(&bad.to_record()),
             Err(RecordError::Invalid)
         );
+    }
+
+    #[test]
+    fn only_the_written_encoding_loads() {
+        // −0 where an id, a mode or the planner is stored: check_value
+        // takes it (−0 == 0), but it would load as +0 and re-save
+        // differently. Found by the settings_record fuzz target's property
+        // (tests/fuzz/artifacts/settings_record/).
+        for name in ["yaw.id", "laser.mode", "galvo.planner"] {
+            let Some(at) = PARAMS.iter().position(|p| p.name == name) else {
+                continue;
+            };
+            let mut record = Settings::default().to_record();
+            let field = 8 + 8 * at;
+            record[field..field + 8].copy_from_slice(&(-0.0f64).to_le_bytes());
+            let body = RECORD_LEN - 4;
+            let crc = crc32(&record[..body]);
+            record[body..].copy_from_slice(&crc.to_le_bytes());
+            assert_eq!(
+                Settings::from_record(&record),
+                Err(RecordError::Invalid),
+                "{name} = -0"
+            );
+        }
+        // −0 in a real-valued parameter is stored as is and loads.
+        let s = Settings {
+            x_offset_cm: -0.0,
+            ..Settings::default()
+        };
+        let loaded = Settings::from_record(&s.to_record()).unwrap();
+        assert_eq!(loaded.x_offset_cm.to_bits(), (-0.0f64).to_bits());
     }
 }
