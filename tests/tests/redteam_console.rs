@@ -5,9 +5,12 @@ use laser_sim::world::{SimOptions, SimReport};
 use system_tests::{run_with, sent_at};
 
 /// Time from `t_us` to the gimbal laser's next switch-off, µs (the laser
-/// was on at `t_us`).
+/// was on just before `t_us`).
 fn gimbal_dark_after(report: &SimReport, t_us: u64) -> u64 {
-    assert!(report.recording.laser_at(t_us), "lit when stop was typed");
+    assert!(
+        report.recording.laser_at(t_us.saturating_sub(1)),
+        "lit when stop was typed"
+    );
     let (off, _) = report
         .recording
         .laser_events
@@ -63,7 +66,6 @@ fn stop_typed_right_after_data_commands_of_a_stalled_host_is_not_held_back() {
 }
 
 #[test]
-#[ignore = "redteam: a stalled host that types ahead more closers than the 6 KiB outbound queue holds (300 refused lines) blocks the console's input, so its `stop` runs only when the host reads again: lit 5 s after stop"]
 fn stop_typed_behind_a_flood_of_refused_lines_by_a_stalled_host_is_not_held_back() {
     for flood in [300, 1500] {
         let mut script =
@@ -77,6 +79,17 @@ fn stop_typed_behind_a_flood_of_refused_lines_by_a_stalled_host_is_not_held_back
         let stop_us = sent_at(&report, "stop");
         let dark_us = gimbal_dark_after(&report, stop_us);
         eprintln!("{flood} refused lines typed ahead: dark {dark_us} µs after stop");
+        // Every line still gets exactly one closer, in order: the lines
+        // that found the output queue full are refused, their `stop` says ok.
+        let lines = &report.transcript.lines;
+        let sent = lines.iter().filter(|(_, l)| l.starts_with("> ")).count();
+        let closers: Vec<&str> = lines
+            .iter()
+            .map(|(_, l)| l.as_str())
+            .filter(|l| *l == "ok" || l.starts_with("error:"))
+            .collect();
+        assert_eq!(closers.len(), sent, "one closer per line");
+        assert_eq!(closers.last(), Some(&"ok"), "the stop's closer comes last");
         assert!(
             dark_us <= 255_000,
             "{flood} refused lines typed ahead of `stop` by a host not reading: \

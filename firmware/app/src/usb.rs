@@ -79,22 +79,113 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
     // The host let a `HOST_STALL` pass without reading, and the queue has
     // not drained since.
     let mut host_not_reading = false;
+    let mut owed = OwedClosers::default();
     loop {
-        let n = match rx.read(&mut chunk).await {
-            Ok(0) => return ConsoleEnd::EndOfInput,
-            Ok(n) => n,
-            Err(_) => return ConsoleEnd::ReadFailed,
+        let read = async {
+            if owed.is_empty() {
+                Either::First(rx.read(&mut chunk).await)
+            } else {
+                // Pay the owed closers as soon as the host reads again,
+                // even if it types nothing more.
+                select(
+                    rx.read(&mut chunk),
+                    out.wait_until(Outbound::has_closer_room),
+                )
+                .await
+            }
+        };
+        let n = match read.await {
+            Either::First(Ok(0)) => return ConsoleEnd::EndOfInput,
+            Either::First(Ok(n)) => n,
+            Either::First(Err(_)) => return ConsoleEnd::ReadFailed,
+            Either::Second(()) => {
+                owed.pay(link);
+                continue;
+            }
         };
         for &byte in chunk.iter().take(n) {
             let Some(line) = assembler.push(byte) else {
                 continue;
             };
-            // The closer of this line must fit: until it does, the host's
-            // input waits (it is not reading its replies either).
-            out.wait_until(Outbound::has_closer_room).await;
+            owed.pay(link);
+            if !owed.is_empty() || !out.has_closer_room() {
+                // The host types ahead but reads nothing, and its replies
+                // fill the queue: this line cannot be answered in order
+                // now. A `stop` still stops at once (as the button does);
+                // every line is owed its closer, paid in order once the
+                // host reads.
+                let is_stop = matches!(
+                    line.as_ref().map(|l| parse_line(l.as_str())),
+                    Ok(Ok(Some(crate::command::Command::Stop)))
+                );
+                if is_stop {
+                    log::warning!("usb: stop typed while the host is not reading: stopping now");
+                    link.stop_request.signal(());
+                }
+                if owed.owe(is_stop) {
+                    continue;
+                }
+                // More alternations than it remembers: the host's input
+                // waits until its replies fit.
+                while !owed.is_empty() || !out.has_closer_room() {
+                    out.wait_until(Outbound::has_closer_room).await;
+                    owed.pay(link);
+                }
+            }
             match line {
                 Err(e) => link.error(e),
                 Ok(line) => dispatch(line.as_str(), link, &mut host_not_reading).await,
+            }
+        }
+    }
+}
+
+/// Closers owed to lines that arrived while the outbound queue had no room
+/// for their replies (a host typing ahead but not reading), in order, as
+/// runs: `ok` for a `stop` (carried out at once), `error:` for any other
+/// line (not run).
+#[derive(Default)]
+struct OwedClosers {
+    /// `(ok, count)` runs, oldest first.
+    runs: heapless::Deque<(bool, u32), 8>,
+}
+
+/// Reply of a line that was not run because its reply could not be queued.
+const NOT_RUN: &str =
+    "not run: the host was not reading replies (output queue full); send it again";
+
+impl OwedClosers {
+    fn is_empty(&self) -> bool {
+        self.runs.is_empty()
+    }
+
+    /// Owes one closer (`ok` when `ok`); `false` when there is no room
+    /// left to remember it (nothing recorded).
+    fn owe(&mut self, ok: bool) -> bool {
+        if let Some((last_ok, count)) = self.runs.back_mut()
+            && *last_ok == ok
+        {
+            *count = count.saturating_add(1);
+            return true;
+        }
+        self.runs.push_back((ok, 1)).is_ok()
+    }
+
+    /// Queues as many owed closers, oldest first, as the outbound queue has
+    /// room for.
+    fn pay(&mut self, link: &CommandLink) {
+        while link.outbound.has_closer_room() {
+            let Some((ok, count)) = self.runs.front_mut() else {
+                return;
+            };
+            if *ok {
+                link.ok();
+            } else {
+                link.error(NOT_RUN);
+            }
+            *count -= 1;
+            if *count == 0 {
+                self.runs.pop_front();
             }
         }
     }
