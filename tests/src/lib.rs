@@ -21,6 +21,19 @@ pub fn run_with(script: &str, options: SimOptions) -> SimReport {
     })
 }
 
+/// Runs `script` to idle with default options but a galvo loop charged
+/// `cost_ns_per_sample` of compute time per DAC sample, ns (above the
+/// sample period it underruns).
+pub fn run_with_galvo_cost(script: &str, cost_ns_per_sample: u64) -> SimReport {
+    run_with(
+        script,
+        SimOptions {
+            galvo_cost_ns_per_sample: cost_ns_per_sample,
+            ..SimOptions::default()
+        },
+    )
+}
+
 /// Runs `script` to idle with `options` under the safety checker
 /// (`laser_sim::safety`): panics listing every violated invariant.
 pub fn run_checked(script: &str, options: SimOptions) -> SimReport {
@@ -86,6 +99,16 @@ pub fn sent_at(report: &SimReport, line: &str) -> u64 {
         .find(|(_, l)| l.strip_prefix("> ") == Some(line))
         .map(|(t, _)| *t)
         .unwrap_or_else(|| panic!("{line:?} was not sent"))
+}
+
+/// Times of the DAC samples output with the galvo laser lit, ns.
+pub fn lit_sample_times_ns(report: &SimReport) -> Vec<u64> {
+    report
+        .dac
+        .iter()
+        .filter(|(_, s)| s.laser)
+        .map(|(t, _)| t)
+        .collect()
 }
 
 /// Grid indices of SPEC §4.6's patterns, written out from the spec (not
