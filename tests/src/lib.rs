@@ -111,6 +111,18 @@ pub fn lit_sample_times_ns(report: &SimReport) -> Vec<u64> {
         .collect()
 }
 
+/// Time from `t_us` to the gimbal laser's next switch-off at or after it,
+/// µs.
+pub fn gimbal_dark_after(report: &SimReport, t_us: u64) -> u64 {
+    let (off, _) = report
+        .recording
+        .laser_events
+        .iter()
+        .find(|&&(t, on)| t >= t_us && !on)
+        .expect("the laser went off");
+    off - t_us
+}
+
 /// Grid indices of SPEC §4.6's patterns, written out from the spec (not
 /// from the firmware's pattern code).
 pub mod spec_patterns {
