@@ -111,6 +111,17 @@ pub fn lit_sample_times_ns(report: &SimReport) -> Vec<u64> {
         .collect()
 }
 
+/// Time of the first notice (`[error: …]`, `[info: …]`) starting with
+/// `prefix`, µs (`None`: no such notice).
+pub fn notice_at(report: &SimReport, prefix: &str) -> Option<u64> {
+    report
+        .transcript
+        .notices
+        .iter()
+        .find(|(_, n)| n.starts_with(prefix))
+        .map(|(t, _)| *t)
+}
+
 /// Time from `t_us` to the gimbal laser's next switch-off at or after it,
 /// µs.
 pub fn gimbal_dark_after(report: &SimReport, t_us: u64) -> u64 {

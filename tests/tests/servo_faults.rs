@@ -7,7 +7,7 @@ use laser_app::servo::protocol::{Request, RequestDecoder, Response, ResponseDeco
 use laser_sim::recorder::Direction;
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::run_with;
+use system_tests::{notice_at, run_with};
 
 /// Deterministic xorshift for reproducible random scripts.
 struct Rng(u64);
@@ -86,15 +86,6 @@ fn replies(report: &SimReport) -> Vec<(u64, String, String)> {
         out.push((*t, cmd.to_owned(), reply));
     }
     out
-}
-
-fn notice_at(report: &SimReport, prefix: &str) -> Option<u64> {
-    report
-        .transcript
-        .notices
-        .iter()
-        .find(|(_, n)| n.starts_with(prefix))
-        .map(|(t, _)| *t)
 }
 
 /// Time the gimbal laser was on within `[from, to)`, µs.
