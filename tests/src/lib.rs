@@ -200,6 +200,11 @@ impl XorShift {
     pub fn below(&mut self, n: u64) -> u64 {
         self.next_u64() % n.max(1)
     }
+
+    /// One of `items` (not empty), chosen with [`below`](Self::below).
+    pub fn pick<'a>(&mut self, items: &[&'a str]) -> &'a str {
+        items[self.below(items.len() as u64) as usize]
+    }
 }
 
 /// The 1000 meaningful commands in random order and timing of
