@@ -5,23 +5,8 @@
 use kinematics_core::error_model::MAX_MEASURED_MM;
 use kinematics_core::{Error, MeasuredPoint, Quadratic, fit};
 
-/// The 11 × 11 noisy grid of `tests/data/quadratic_noise.csv` (mm).
-fn noisy_grid() -> Vec<MeasuredPoint> {
-    let text = include_str!("data/quadratic_noise.csv");
-    text.lines()
-        .skip(1)
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|f| f.trim().parse().unwrap()).collect();
-            MeasuredPoint {
-                x_mm: v[0],
-                y_mm: v[1],
-                dx_mm: v[2],
-                dy_mm: v[3],
-            }
-        })
-        .collect()
-}
+mod support;
+use support::noisy_grid;
 
 fn field(p: &mut MeasuredPoint, k: usize) -> &mut f64 {
     match k {

@@ -21,6 +21,19 @@ pub fn run_with(script: &str, options: SimOptions) -> SimReport {
     })
 }
 
+/// Runs `script` to idle with default options but a galvo loop charged
+/// `cost_ns_per_sample` of compute time per DAC sample, ns (above the
+/// sample period it underruns).
+pub fn run_with_galvo_cost(script: &str, cost_ns_per_sample: u64) -> SimReport {
+    run_with(
+        script,
+        SimOptions {
+            galvo_cost_ns_per_sample: cost_ns_per_sample,
+            ..SimOptions::default()
+        },
+    )
+}
+
 /// Runs `script` to idle with `options` under the safety checker
 /// (`laser_sim::safety`): panics listing every violated invariant.
 pub fn run_checked(script: &str, options: SimOptions) -> SimReport {
@@ -88,6 +101,39 @@ pub fn sent_at(report: &SimReport, line: &str) -> u64 {
         .unwrap_or_else(|| panic!("{line:?} was not sent"))
 }
 
+/// Times of the DAC samples output with the galvo laser lit, ns.
+pub fn lit_sample_times_ns(report: &SimReport) -> Vec<u64> {
+    report
+        .dac
+        .iter()
+        .filter(|(_, s)| s.laser)
+        .map(|(t, _)| t)
+        .collect()
+}
+
+/// Time of the first notice (`[error: …]`, `[info: …]`) starting with
+/// `prefix`, µs (`None`: no such notice).
+pub fn notice_at(report: &SimReport, prefix: &str) -> Option<u64> {
+    report
+        .transcript
+        .notices
+        .iter()
+        .find(|(_, n)| n.starts_with(prefix))
+        .map(|(t, _)| *t)
+}
+
+/// Time from `t_us` to the gimbal laser's next switch-off at or after it,
+/// µs.
+pub fn gimbal_dark_after(report: &SimReport, t_us: u64) -> u64 {
+    let (off, _) = report
+        .recording
+        .laser_events
+        .iter()
+        .find(|&&(t, on)| t >= t_us && !on)
+        .expect("the laser went off");
+    off - t_us
+}
+
 /// Grid indices of SPEC §4.6's patterns, written out from the spec (not
 /// from the firmware's pattern code).
 pub mod spec_patterns {
@@ -153,6 +199,11 @@ impl XorShift {
     /// A number in `0..n` (`n` > 0).
     pub fn below(&mut self, n: u64) -> u64 {
         self.next_u64() % n.max(1)
+    }
+
+    /// One of `items` (not empty), chosen with [`below`](Self::below).
+    pub fn pick<'a>(&mut self, items: &[&'a str]) -> &'a str {
+        items[self.below(items.len() as u64) as usize]
     }
 }
 

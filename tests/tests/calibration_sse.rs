@@ -3,28 +3,15 @@
 //! form, parsed by the firmware's command line, stored by `set err.*`, and
 //! evaluated by the firmware's error model.
 
-use kinematics_core::{MeasuredPoint, PointMm, fit};
+use kinematics_core::{PointMm, fit};
 use laser_app::cli::parse::parse_line;
 use laser_app::command::Command;
 use laser_app::sequencer::targets::error_model;
 use laser_app::settings::Settings;
 
-fn noisy_grid() -> Vec<MeasuredPoint> {
-    include_str!("../../kinematics-core/tests/data/quadratic_noise.csv")
-        .lines()
-        .skip(1)
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|f| f.trim().parse().unwrap()).collect();
-            MeasuredPoint {
-                x_mm: v[0],
-                y_mm: v[1],
-                dx_mm: v[2],
-                dy_mm: v[3],
-            }
-        })
-        .collect()
-}
+#[path = "../../kinematics-core/tests/support/mod.rs"]
+mod support;
+use support::noisy_grid;
 
 #[test]
 fn reported_sse_is_that_of_the_model_the_firmware_holds() {

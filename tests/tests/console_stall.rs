@@ -10,7 +10,7 @@ use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, SimReport};
 use proptest::prelude::*;
 use system_tests::console::{ExpectedReply, ReplyAudit, audit_replies, replies_of};
-use system_tests::{run_with, sent_at};
+use system_tests::{gimbal_dark_after, run_with, sent_at};
 
 /// Commands whose reply depends neither on time nor on what ran before,
 /// and that change nothing the sequencer does (no parameter, no motion).
@@ -70,13 +70,7 @@ fn dark_after(report: &SimReport, t_us: u64) -> u64 {
         report.recording.laser_at(t_us - 1),
         "the laser was on at {t_us} µs"
     );
-    let (off, _) = report
-        .recording
-        .laser_events
-        .iter()
-        .find(|&&(t, on)| t >= t_us && !on)
-        .expect("the laser went off");
-    off - t_us
+    gimbal_dark_after(report, t_us)
 }
 
 fn audit(report: &SimReport) -> ReplyAudit {

@@ -7,8 +7,8 @@ use kinematics_core::{Galvo, PointMm};
 use laser_app::galvo::DacSample;
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::{
-    UNTIL_STEP_FIXES, assert_safe_allowing, run_to_idle, run_with, sent_at, spec_patterns,
-    terminal_lines,
+    UNTIL_STEP_FIXES, assert_safe_allowing, lit_sample_times_ns, run_to_idle, run_with,
+    run_with_galvo_cost, sent_at, spec_patterns, terminal_lines,
 };
 
 /// SPEC grid pitch, mm.
@@ -339,13 +339,7 @@ fn switching_pattern_mid_path_brakes_dark_and_moves_on() {
 
 #[test]
 fn a_galvo_loop_too_slow_for_the_sample_rate_is_reported_and_stopped() {
-    let report = run_with(
-        "target galvo\npattern corner\nwait 200\n",
-        SimOptions {
-            galvo_cost_ns_per_sample: 12_000,
-            ..SimOptions::default()
-        },
-    );
+    let report = run_with_galvo_cost("target galvo\npattern corner\nwait 200\n", 12_000);
     assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.galvo_underruns > 0);
     assert!(
@@ -633,23 +627,14 @@ fn an_idle_galvo_loop_slower_than_the_sample_rate_never_underruns() {
     // loop underran hundreds of times a second. Holding, it has nothing
     // to compute.
     for cost_ns in [10_001, 20_000, 200_000] {
-        let report = run_with(
-            "wait 3000\ngalvo status\n",
-            SimOptions {
-                galvo_cost_ns_per_sample: cost_ns,
-                ..SimOptions::default()
-            },
-        );
+        let report = run_with_galvo_cost("wait 3000\ngalvo status\n", cost_ns);
         assert_eq!(report.galvo_underruns, 0, "{cost_ns} ns per sample");
         assert!(report.dac.len() >= 290_000, "the DAC kept outputting");
         // After a job the loop is too slow for, it comes back to a quiet
         // hold too.
-        let report = run_with(
+        let report = run_with_galvo_cost(
             "target galvo\ngoto 2 1\nwait 50\nstop\nwait 3000\n",
-            SimOptions {
-                galvo_cost_ns_per_sample: cost_ns,
-                ..SimOptions::default()
-            },
+            cost_ns,
         );
         let stop_ns = sent_lines(&report)
             .iter()
@@ -673,12 +658,9 @@ fn an_idle_galvo_loop_slower_than_the_sample_rate_never_underruns() {
 
 #[test]
 fn a_galvo_underrun_replays_dark_and_the_laser_is_dark_at_once() {
-    let report = run_with(
+    let report = run_with_galvo_cost(
         "target galvo\nset dwell_ms 50\npattern corner\nwait 300\n",
-        SimOptions {
-            galvo_cost_ns_per_sample: 12_000,
-            ..SimOptions::default()
-        },
+        12_000,
     );
     assert!(report.galvo_underruns > 0);
     let samples: Vec<(u64, DacSample)> = report.dac.iter().collect();
@@ -723,12 +705,7 @@ fn laser_off_keeps_the_galvo_dark_while_it_still_draws() {
     assert!(report.succeeded(false), "{:?}", report.transcript);
     let off_ns = sent_at(&report, "laser off") * 1000;
     let auto_ns = sent_at(&report, "laser auto") * 1000;
-    let lit: Vec<u64> = report
-        .dac
-        .iter()
-        .filter(|(_, s)| s.laser)
-        .map(|(t, _)| t)
-        .collect();
+    let lit = lit_sample_times_ns(&report);
     assert!(lit.iter().any(|&t| t < off_ns), "lit before laser off");
     assert!(
         lit.iter().all(|&t| t < off_ns + 3_850_000 || t > auto_ns),

@@ -436,12 +436,7 @@ fn a_servo_that_answers_again_is_reported_recovered_and_patterns_run_again() {
     );
     assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     let notice_at = |prefix: &str| {
-        report
-            .transcript
-            .notices
-            .iter()
-            .find(|(_, n)| n.starts_with(prefix))
-            .map(|(t, _)| *t)
+        system_tests::notice_at(&report, prefix)
             .unwrap_or_else(|| panic!("no {prefix} notice in {:?}", report.transcript.notices))
     };
     let fault = notice_at("[error: servo 0");

@@ -5,19 +5,13 @@ use laser_sim::world::{SimOptions, SimReport};
 use system_tests::{run_with, sent_at};
 
 /// Time from `t_us` to the gimbal laser's next switch-off, µs (the laser
-/// was on just before `t_us`).
-fn gimbal_dark_after(report: &SimReport, t_us: u64) -> u64 {
+/// was on just before `t_us`: a stop typed may darken it at that instant).
+fn lit_gimbal_dark_after(report: &SimReport, t_us: u64) -> u64 {
     assert!(
         report.recording.laser_at(t_us.saturating_sub(1)),
         "lit when stop was typed"
     );
-    let (off, _) = report
-        .recording
-        .laser_events
-        .iter()
-        .find(|&&(t, on)| t >= t_us && !on)
-        .expect("the laser went off");
-    off - t_us
+    system_tests::gimbal_dark_after(report, t_us)
 }
 
 /// Last lit galvo sample at or after `t_us`, µs after it (0: none).
@@ -51,7 +45,7 @@ fn stop_typed_right_after_data_commands_of_a_stalled_host_is_not_held_back() {
             assert!(report.transcript.script_done, "{script}");
             let stop_us = sent_at(&report, "stop");
             let late_us = if target == "gimbal" {
-                gimbal_dark_after(&report, stop_us)
+                lit_gimbal_dark_after(&report, stop_us)
             } else {
                 galvo_lit_after(&report, stop_us)
             };
@@ -77,7 +71,7 @@ fn stop_typed_behind_a_flood_of_refused_lines_by_a_stalled_host_is_not_held_back
         let report = run_with(&script, SimOptions::default());
         assert!(report.transcript.script_done);
         let stop_us = sent_at(&report, "stop");
-        let dark_us = gimbal_dark_after(&report, stop_us);
+        let dark_us = lit_gimbal_dark_after(&report, stop_us);
         eprintln!("{flood} refused lines typed ahead: dark {dark_us} µs after stop");
         // Every line still gets exactly one closer, in order: the lines
         // that found the output queue full are refused, their `stop` says ok.

@@ -2,7 +2,7 @@
 //! step-time rule) that the fixes' own tests did not try.
 
 use laser_sim::world::SimOptions;
-use system_tests::run_with;
+use system_tests::{lit_sample_times_ns, run_with, run_with_galvo_cost};
 
 /// Longest executor poll (host CPU) of a run with two 160 mm galvo jumps at
 /// sample period `ts_us` with `planner`, µs.
@@ -58,12 +58,7 @@ fn laser_off_darkens_the_galvo_at_once_at_any_sample_period() {
         assert!(report.succeeded(false), "{:?}", report.transcript);
         let off_ns = system_tests::sent_at(&report, "laser off") * 1000;
         let auto_ns = system_tests::sent_at(&report, "laser auto") * 1000;
-        let lit: Vec<u64> = report
-            .dac
-            .iter()
-            .filter(|(_, s)| s.laser)
-            .map(|(t, _)| t)
-            .collect();
+        let lit = lit_sample_times_ns(&report);
         assert!(lit.iter().any(|&t| t < off_ns), "ts {ts_us}: lit before");
         let late: Vec<u64> = lit
             .iter()
@@ -108,12 +103,7 @@ fn laser_dwell_keeps_galvo_marking_dark_like_the_gimbal() {
         assert!(report.succeeded(false), "{:?}", report.transcript);
         let dwell_ns = system_tests::sent_at(&report, "laser dwell") * 1000;
         let auto_ns = system_tests::sent_at(&report, "laser auto") * 1000;
-        let lit: Vec<u64> = report
-            .dac
-            .iter()
-            .filter(|(_, s)| s.laser)
-            .map(|(t, _)| t)
-            .collect();
+        let lit = lit_sample_times_ns(&report);
         assert!(lit.iter().any(|&t| t < dwell_ns), "ts {ts_us}: lit before");
         let late = lit
             .iter()
@@ -137,12 +127,9 @@ fn laser_dwell_keeps_galvo_marking_dark_like_the_gimbal() {
 #[ignore = "redteam: at 5 ms of loop time per sample (a sample costs more than a whole 1.28 ms half) a goto stopped at 100 ms gives 11 underrun notices, 10 of them while the loop is idle again after the stop"]
 fn an_idle_galvo_loop_never_underruns_after_a_job_however_slow() {
     for cost_ns in [1_300_000, 2_000_000, 5_000_000] {
-        let report = run_with(
+        let report = run_with_galvo_cost(
             "target galvo\ngoto 1 1\nwait 100\nstop\nwait 5000\n",
-            SimOptions {
-                galvo_cost_ns_per_sample: cost_ns,
-                ..SimOptions::default()
-            },
+            cost_ns,
         );
         let notices: Vec<&String> = report
             .transcript

@@ -15,7 +15,9 @@
 
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::{UNTIL_STEP_FIXES, assert_safe, assert_safe_allowing, run_with};
+use system_tests::{
+    UNTIL_STEP_FIXES, assert_safe, assert_safe_allowing, run_with, run_with_galvo_cost,
+};
 
 // Item 1: a sequencer that gave up on the galvo ("galvo not responding;
 // stopped") never told the loop, and `stop` then sends nothing: the
@@ -91,12 +93,9 @@ fn holds_after_the_master_laser_gate_on_a_servo_fault() {
 // ~2.5 ms after the loop learned of it.
 
 fn slow_galvo_loop(cost_ns_per_sample: u64) -> SimReport {
-    run_with(
+    run_with_galvo_cost(
         "target galvo\nset dwell_ms 5\npattern corner\nwait 300\n",
-        SimOptions {
-            galvo_cost_ns_per_sample: cost_ns_per_sample,
-            ..SimOptions::default()
-        },
+        cost_ns_per_sample,
     )
 }
 

@@ -7,25 +7,7 @@ use laser_app::servo::protocol::{Request, RequestDecoder, Response, ResponseDeco
 use laser_sim::recorder::Direction;
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::run_with;
-
-/// Deterministic xorshift for reproducible random scripts.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-    fn pick<'a>(&mut self, items: &[&'a str]) -> &'a str {
-        items[self.below(items.len() as u64) as usize]
-    }
-}
+use system_tests::{XorShift, notice_at, run_with};
 
 /// Commands that move the gimbal when it is the target.
 fn needs_gimbal(line: &str) -> bool {
@@ -35,7 +17,7 @@ fn needs_gimbal(line: &str) -> bool {
 }
 
 /// A random command line (gimbal moves, laser modes, targets, stops).
-fn random_command(rng: &mut Rng) -> String {
+fn random_command(rng: &mut XorShift) -> String {
     match rng.below(12) {
         0..=2 => format!(
             "goto {} {}",
@@ -88,15 +70,6 @@ fn replies(report: &SimReport) -> Vec<(u64, String, String)> {
     out
 }
 
-fn notice_at(report: &SimReport, prefix: &str) -> Option<u64> {
-    report
-        .transcript
-        .notices
-        .iter()
-        .find(|(_, n)| n.starts_with(prefix))
-        .map(|(t, _)| *t)
-}
-
 /// Time the gimbal laser was on within `[from, to)`, µs.
 fn lit_us(report: &SimReport, from: u64, to: u64) -> u64 {
     let mut on_since: Option<u64> = None;
@@ -121,7 +94,7 @@ fn lit_us(report: &SimReport, from: u64, to: u64) -> u64 {
 /// Runs a random campaign with servo `id` silent from 1.5 s until
 /// `silent_until_ms`; returns the report and the script.
 fn campaign(id: u8, seed: u64, silent_until_ms: u64) -> (SimReport, String) {
-    let mut rng = Rng(seed);
+    let mut rng = XorShift(seed);
     let mut script = String::from("set dwell_ms 100\npattern corner\nwait 2000\n");
     for _ in 0..30 {
         script.push_str(&random_command(&mut rng));
@@ -311,7 +284,7 @@ fn arrivals_on_real_readings_only(faults: impl Fn(u64) -> BusFaults) -> (usize, 
         // At 10 % of bytes corrupted many queries fail three times (a
         // NoResponse fault, refused commands until the servo answers a
         // ping again): many short gotos give many arrivals anyway.
-        let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let mut rng = XorShift(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15));
         let mut script = String::from("set dwell_ms 20\n");
         for _ in 0..100 {
             script.push_str(&format!(

@@ -112,25 +112,7 @@ impl LaserGate {
     /// returns: everything requested under earlier generations stays dark
     /// for good.
     pub fn close(&self) -> u32 {
-        let mut current = self.state.load(Ordering::Acquire);
-        loop {
-            let next = GateState {
-                generation: (GateState::unpack(current).generation + 1) & (u32::MAX >> 1),
-                open: false,
-            };
-            match self.state.compare_exchange_weak(
-                current,
-                next.pack(),
-                Ordering::AcqRel,
-                Ordering::Acquire,
-            ) {
-                Ok(_) => {
-                    (self.on_change)(next);
-                    return next.generation;
-                }
-                Err(seen) => current = seen,
-            }
-        }
+        self.close_into(|generation| (generation + 1) & (u32::MAX >> 1))
     }
 
     /// Closes the gate at once without ending the generation: the laser
@@ -139,10 +121,17 @@ impl LaserGate {
     /// generation (`laser off` mid-run: the mirrors still draw, dark, and
     /// `laser auto` lights them again). Returns the generation.
     pub fn shut(&self) -> u32 {
+        self.close_into(|generation| generation)
+    }
+
+    /// Closes the gate atomically, its generation becoming
+    /// `next_generation` of the current one; reports the change and
+    /// returns the new generation.
+    fn close_into(&self, next_generation: impl Fn(u32) -> u32) -> u32 {
         let mut current = self.state.load(Ordering::Acquire);
         loop {
             let next = GateState {
-                generation: GateState::unpack(current).generation,
+                generation: next_generation(GateState::unpack(current).generation),
                 open: false,
             };
             match self.state.compare_exchange_weak(

@@ -25,8 +25,10 @@ use core::fmt::Write;
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
+use galvo_planner::model::RIGID_STATES;
 use galvo_planner::{
-    JumpSync, MarkLimits, Method, PathPlanner, RigidParams, XyStepper, plan_jump, plan_xy_jump,
+    Discrete, JumpSync, MarkLimits, Method, PathPlanner, RigidParams, XyStepper, plan_jump,
+    plan_xy_jump,
 };
 use kinematics_core::{BoardPoint, DacAxis, ErrorModel, Galvo, Gimbal, MirrorAngles, PointMm};
 use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoPath, GalvoRequest, Phase};
@@ -280,13 +282,18 @@ fn kinematics(b: &mut Bench) {
     });
 }
 
+/// The reference rigid galvo model discretized at the 10 µs sample
+/// period.
+fn reference_plant_at_10us() -> Result<Discrete<RIGID_STATES>, galvo_planner::Error> {
+    RigidParams::REFERENCE
+        .model()
+        .and_then(|m| m.discretize(10e-6))
+}
+
 /// The per-sample stepper during a jump, the path sampler on lines and
 /// arcs, and adding a segment to the look-ahead planner.
 fn stepper_and_path(b: &mut Bench) {
-    let disc = match RigidParams::REFERENCE
-        .model()
-        .and_then(|m| m.discretize(10e-6))
-    {
+    let disc = match reference_plant_at_10us() {
         Ok(d) => d,
         Err(e) => return b.fail("stepper.setup", e),
     };
@@ -597,10 +604,7 @@ fn loop_halves(b: &mut Bench) {
 /// Jump planning per method over 0.1°–20° (one axis, mechanical), and
 /// two-axis jumps as the loop plans them.
 fn planning(b: &mut Bench) {
-    let disc = match RigidParams::REFERENCE
-        .model()
-        .and_then(|m| m.discretize(10e-6))
-    {
+    let disc = match reference_plant_at_10us() {
         Ok(d) => d,
         Err(e) => return b.fail("plan.setup", e),
     };

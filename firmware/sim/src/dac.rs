@@ -590,20 +590,16 @@ mod tests {
         let rec = with_dac(1_000_000, move |mut dac, _| async move {
             let h = [hold; HALF];
             assert!(!dac.holds(hold), "not before it is primed");
-            dac.write_half(Half {
-                samples: &h,
-                generation: 0,
-                computed: 0,
-            })
-            .await
-            .unwrap();
-            dac.write_half(Half {
-                samples: &h,
-                generation: 0,
-                computed: 0,
-            })
-            .await
-            .unwrap();
+            // Both halves of the double buffer.
+            for _ in 0..2 {
+                dac.write_half(Half {
+                    samples: &h,
+                    generation: 0,
+                    computed: 0,
+                })
+                .await
+                .unwrap();
+            }
             assert!(dac.holds(hold));
             assert!(!dac.holds(DacSample { x_code: 0, ..hold }));
             for i in 0..200 {

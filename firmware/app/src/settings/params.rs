@@ -74,15 +74,7 @@ macro_rules! real {
 /// A whole-number parameter (ids, counts).
 macro_rules! count {
     ($name:literal, $min:expr, $max:expr, $help:literal, |$s:ident| $place:expr) => {
-        ParamSpec {
-            name: $name,
-            min: $min,
-            max: $max,
-            min_magnitude: 0.0,
-            precision: Precision::F64,
-            help: $help,
-            slot: Slot::Count(|$s| &mut $place),
-        }
+        choice!($name, $min, $max, $help, Slot::Count(|$s| &mut $place))
     };
 }
 
