@@ -317,8 +317,13 @@ mod tests {
             let joint = lo + t * (hi - lo);
             let wire = s.joint_to_wire(Joint::Yaw, joint).unwrap();
             let back = s.wire_to_joint(wire).unwrap();
-            // Half a 0.1° step in servo degrees, divided by the scale.
-            prop_assert!((back - joint).abs() <= 0.05 / s.scale + 1e-9);
+            // Half a 0.1° step in servo degrees, divided by the scale; a
+            // whole step at a limit off the 0.1° grid (the nearest wire
+            // value would lie beyond it, so the last one inside is used).
+            let (lo_wire, hi_wire) = s.wire_limits();
+            let at_limit = f64::from(wire) == lo_wire || f64::from(wire) == hi_wire;
+            let step = if at_limit { 0.1 } else { 0.05 };
+            prop_assert!((back - joint).abs() <= step / s.scale + 1e-9);
         }
 
         #[test]
