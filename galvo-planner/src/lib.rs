@@ -101,6 +101,7 @@
 //! ```
 
 pub mod error;
+pub mod fast_optimal;
 pub mod jump;
 pub mod linalg;
 pub mod min_energy;

@@ -1,0 +1,50 @@
+extern crate std;
+
+use super::*;
+use crate::jump::{Method, plan_jump};
+use crate::test_support::{DEG, assert_lands, rigid};
+use std::println;
+
+#[test]
+fn expm1_matches_f64() {
+    let mut worst = 0.0f64;
+    let mut z = -30.0f64;
+    while z < 0.5 {
+        let exact = libm::expm1(f64::from(z as f32));
+        let got = f64::from(expm1_f32(z as f32));
+        let rel = ((got - exact) / exact).abs();
+        if exact != 0.0 {
+            worst = worst.max(rel);
+        }
+        z += 0.0137;
+    }
+    assert!(worst < 5e-7, "worst relative error {worst}");
+}
+
+#[test]
+fn cbrt_matches() {
+    for x in [1e-6f32, 0.3, 1.0, 8.0, 1234.5, 3e7] {
+        let y = cbrt_f32(x);
+        assert!((y * y * y - x).abs() <= 1e-5 * x, "{x}: {y}");
+    }
+}
+
+#[test]
+fn compare_with_reference_planner() {
+    let d = rigid(10e-6);
+    let mut k = 1e-4;
+    while k < 26.0 {
+        let fast = plan_jump(&d, 0.0, k * DEG, Method::TimeOptimal, 100_000).expect("fast");
+        let slow = crate::optimal::plan_time_optimal(&d, 0.0, k * DEG, 100_000).expect("slow");
+        let err = assert_lands(&fast, true, "fast");
+        println!(
+            "{k:9.4}° fast {} slow {} err {:?} {:?}",
+            fast.samples(),
+            slow.samples(),
+            err,
+            fast.info()
+        );
+        assert!(fast.samples() <= slow.samples());
+        k *= 1.5;
+    }
+}
