@@ -132,6 +132,10 @@ struct Switches {
     sigma2: f32,
 }
 
+/// How far (samples) a converged switch may sit outside the sample it was
+/// solved in: rounding only.
+const CELL_TOL: f32 = 1e-3;
+
 /// Newton iterations per solve (piecewise linear: exact after the switch
 /// samples settle; 2–5 in practice).
 const MAX_NEWTON: u32 = 24;
@@ -157,8 +161,13 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
         // Residual of mode i with v eliminated by the integrator equation:
         // fixed N: (M − N + 2σ1 − 2σ2) + Gi(N) − 2Gi(σ1) + 2Gi(σ2);
         // free N (v = Umax): Gi(N) − 2Gi(σ1) + 2Gi(σ2).
+        // Split into integer and fractional parts so that long moves keep
+        // the precision of M (the integers are exact in f32).
         let base = match fixed_n {
-            Some(n) => m - n + 2.0 * s.sigma1 - 2.0 * s.sigma2,
+            Some(n) => {
+                let (n1, n2) = ((s.sigma1 as i32) as f32, (s.sigma2 as i32) as f32);
+                (m - (n - 2.0 * n1 + 2.0 * n2)) + 2.0 * ((s.sigma1 - n1) - (s.sigma2 - n2))
+            }
             None => 0.0,
         };
         let dbase = if fixed_n.is_some() { 2.0 } else { 0.0 };
@@ -182,21 +191,24 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
         let [r0, r1] = r;
         let d1 = -(d * r0 - b * r1) / det;
         let d2 = -(a * r1 - c * r0) / det;
-        if cells == last_cells
-            && d1.abs() <= 1e-5 * (1.0 + s.sigma1)
-            && d2.abs() <= 1e-5 * (1.0 + s.sigma1)
-        {
-            // Same switch samples as the previous step: the linear solve
-            // was exact; apply the last (tiny) correction and stop.
+        if cells == last_cells {
+            // Same switch samples as the previous step: within them the
+            // equations are linear, so this step is the exact solution if
+            // it stays in those samples (a rounding-size overshoot of a
+            // cell edge is allowed).
             let out = Switches {
                 sigma1: s.sigma1 + d1,
                 sigma2: s.sigma2 + d2,
             };
-            return valid(
-                out,
-                fixed_n.unwrap_or(m + 2.0 * out.sigma1 - 2.0 * out.sigma2),
-                s2_min,
-            );
+            let n_out = fixed_n.unwrap_or(m + 2.0 * out.sigma1 - 2.0 * out.sigma2);
+            let inside = |x: f32, c: i32| {
+                let lo = c as f32;
+                x >= lo - CELL_TOL && x <= lo + 1.0 + CELL_TOL
+            };
+            if inside(out.sigma1, cells.1) && inside(out.sigma2, cells.2) && inside(n_out, cells.0)
+            {
+                return valid(out, n_out, s2_min);
+            }
         }
         last_cells = cells;
         // Damped: at most a quarter of the move per step.
@@ -309,7 +321,7 @@ fn fast_plan(
     };
     let cont = newton(modes, m, None, guess);
     let n_star = cont.map_or(n_tri, |s| m + 2.0 * s.sigma1 - 2.0 * s.sigma2);
-    let first = libm::ceilf(n_star - 1e-4);
+    let first = libm::ceilf(n_star - 5e-3);
     let first = if first.is_finite() && first >= 1.0 {
         first as usize
     } else {
@@ -350,7 +362,8 @@ fn fast_plan(
         let Some(s) = newton(modes, m, Some(nf), guess) else {
             continue;
         };
-        let w = m - (nf - 2.0 * s.sigma1 + 2.0 * s.sigma2 - 1.0);
+        let (n1, n2) = ((s.sigma1 as i32) as f32, (s.sigma2 as i32) as f32);
+        let w = (m - (nf - 2.0 * n1 + 2.0 * n2 - 1.0)) + 2.0 * ((s.sigma1 - n1) - (s.sigma2 - n2));
         if w.abs() <= 1.0 {
             return Ok(Some(FastSolution {
                 n,

@@ -31,20 +31,22 @@ fn cbrt_matches() {
 
 #[test]
 fn compare_with_reference_planner() {
-    let d = rigid(10e-6);
-    let mut k = 1e-4;
-    while k < 26.0 {
-        let fast = plan_jump(&d, 0.0, k * DEG, Method::TimeOptimal, 100_000).expect("fast");
-        let slow = crate::optimal::plan_time_optimal(&d, 0.0, k * DEG, 100_000).expect("slow");
-        let err = assert_lands(&fast, true, "fast");
-        println!(
-            "{k:9.4}° fast {} slow {} err {:?} {:?}",
-            fast.samples(),
-            slow.samples(),
-            err,
-            fast.info()
-        );
-        assert!(fast.samples() <= slow.samples());
-        k *= 1.5;
+    for ts in [10e-6, 1e-6, 3.3e-6, 25e-6, 0.2e-6, 100e-6] {
+        let d = rigid(ts);
+        let mut k = 1e-4;
+        while k < 26.0 {
+            let fast = plan_jump(&d, 0.0, k * DEG, Method::TimeOptimal, 100_000).expect("fast");
+            let slow = crate::optimal::plan_time_optimal(&d, 0.0, k * DEG, 100_000).expect("slow");
+            let err = assert_lands(&fast, true, "fast");
+            println!(
+                "{k:9.4}° fast {} slow {} err {:?} {:?}",
+                fast.samples(),
+                slow.samples(),
+                err,
+                fast.info()
+            );
+            assert!(fast.samples() <= slow.samples());
+            k *= 1.5;
+        }
     }
 }
