@@ -249,6 +249,19 @@ fn valid(s: Switches, n: f32, s2_min: f32) -> Option<Switches> {
     }
 }
 
+/// Smallest `|p·Ts|` of a mode the `f32` form handles: a mode that decays
+/// over more than ~1000 samples is nearly a second integrator, and the
+/// landing equations become too ill-conditioned for single precision.
+const MIN_ABS_ELL: f32 = 1.0e-3;
+
+/// Largest estimated relative landing error (θ, of the move) accepted
+/// from the `f32` solution (see [`fast_plan`]); the reference galvo at
+/// Ts = 10 µs stays below 2.5e-4 down to one-sample moves.
+const MAX_REL_LANDING_ERROR: f32 = 1e-3;
+
+/// Longest move (samples) planned in `f32`; longer ones use `f64`.
+const MAX_F32_SAMPLES: f32 = 4096.0;
+
 /// The modal data of a rigid model, or `None` when its electrical poles are
 /// complex or too close for the modal form in `f32`.
 fn modes<const S: usize>(disc: &Discrete<S>) -> Option<[Mode; 2]> {
@@ -274,7 +287,7 @@ fn modes<const S: usize>(disc: &Discrete<S>) -> Option<[Mode; 2]> {
     let out = [mode(p2), mode(p1)];
     if out
         .iter()
-        .all(|m| m.ell < 0.0 && m.ell > -80.0 && m.mu < 0.0)
+        .all(|m| m.ell < -MIN_ABS_ELL && m.ell > -80.0 && m.mu < 0.0)
     {
         Some(out)
     } else {
@@ -321,6 +334,16 @@ fn fast_plan(
     };
     let cont = newton(modes, m, None, guess);
     let n_star = cont.map_or(n_tri, |s| m + 2.0 * s.sigma1 - 2.0 * s.sigma2);
+    // Precision of f32: the mode equations are sums of ±Umax over N
+    // samples whose net is M, so their rounding, mapped back to θ through
+    // the modal coupling (≈ (|ℓ1|+|ℓ2|)/|ℓ1−ℓ2|), is ≈ 2·ε·(N/M)·coupling
+    // of the move. Long moves, moves short against the electrical modes and
+    // nearly coincident modes that would land worse go to the f64 planner.
+    let coupling = (m1.ell.abs() + m2.ell.abs()) / (m1.ell - m2.ell).abs();
+    let rel_err = 2.0 * f32::EPSILON * (n_star / m) * coupling;
+    if !(n_star <= MAX_F32_SAMPLES) || (n_star > 3.5 && !(rel_err <= MAX_REL_LANDING_ERROR)) {
+        return Ok(None);
+    }
     let first = libm::ceilf(n_star - 5e-3);
     let first = if first.is_finite() && first >= 1.0 {
         first as usize
