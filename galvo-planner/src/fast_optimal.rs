@@ -183,8 +183,22 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
             }
         }
         let cells = (n as i32, s.sigma1 as i32, s.sigma2 as i32);
-        let [[a, b], [c, d]] = jac;
-        let det = a * d - b * c;
+        let [[mut a, mut b], [mut c, mut d]] = jac;
+        let mut det = a * d - b * c;
+        if det == 0.0 {
+            // Two of N, σ1, σ2 share a sample (the piecewise-linear
+            // Jacobian is singular there): step with the slopes of the
+            // continuous-time weights e^{ℓx} instead, which differ.
+            let slope = |mode: &Mode, x: f32| 1.0 + expm1_f32(x * mode.ell);
+            let [ma, mb] = modes;
+            let row = |mode: &Mode| {
+                let (ln, l1, l2) = (slope(mode, n), slope(mode, s.sigma1), slope(mode, s.sigma2));
+                [dbase + ln * dn - 2.0 * l1, -dbase - ln * dn + 2.0 * l2]
+            };
+            [a, b] = row(ma);
+            [c, d] = row(mb);
+            det = a * d - b * c;
+        }
         if det == 0.0 || !det.is_finite() {
             return None;
         }
@@ -461,6 +475,7 @@ pub fn plan_time_optimal_fast<const S: usize>(
         samples_lower_bound,
         switch_samples: (0.0, 0.0),
         last_sample_v: 0.0,
+        single_precision: true,
     };
     let n = sol.n;
     match sol.kind {

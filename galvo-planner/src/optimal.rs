@@ -77,6 +77,10 @@ pub struct OptimalInfo {
     pub switch_samples: (f64, f64),
     /// Voltage of the free last sample, V, signed (bang-bang only).
     pub last_sample_v: f64,
+    /// Solved in single precision by
+    /// [`plan_time_optimal_fast`](crate::fast_optimal::plan_time_optimal_fast)
+    /// (microseconds on the M4F) rather than by this module's `f64` solver.
+    pub single_precision: bool,
 }
 
 /// Halvings of the minimum-energy fallback.
@@ -648,6 +652,7 @@ pub fn plan_time_optimal<const S: usize>(
         samples_lower_bound: if cont.is_some() { n_lo } else { 0 },
         switch_samples: (0.0, 0.0),
         last_sample_v: 0.0,
+        single_precision: false,
     };
     if n_lo <= S {
         if S > capacity {

@@ -50,26 +50,3 @@ fn compare_with_reference_planner() {
         }
     }
 }
-
-#[test]
-fn debug_case() {
-    let p = crate::model::RigidParams {
-        kt_nm_per_a: 0.00070320413733823,
-        j_kg_m2: 1.440322421198139e-10,
-        l_h: 0.010000000000000004,
-        r_ohm: 16.79024312286719,
-        u_max_v: 44.75156011850579,
-    };
-    let d = p
-        .model()
-        .and_then(|m| m.discretize(8.807959483329216e-6))
-        .unwrap();
-    let plan = plan_jump(&d, 0.0, 0.0603139292241701, Method::TimeOptimal, 20_000).unwrap();
-    println!(
-        "{} {:?} {:?}",
-        plan.samples(),
-        plan.info(),
-        plan.landing_error()
-    );
-    println!("{:?}", modes(&d));
-}
