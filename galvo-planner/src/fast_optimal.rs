@@ -136,6 +136,14 @@ struct Switches {
 /// solved in: rounding only.
 const CELL_TOL: f32 = 1e-3;
 
+#[cfg(test)]
+extern crate std;
+#[cfg(test)]
+std::thread_local! {
+    /// Newton iterations (tests count them).
+    pub(crate) static ITERATIONS: core::cell::Cell<u32> = const { core::cell::Cell::new(0) };
+}
+
 /// Newton iterations per solve (piecewise linear: exact after the switch
 /// samples settle; 2–5 in practice).
 const MAX_NEWTON: u32 = 24;
@@ -148,8 +156,13 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
     // With v = Umax the last sample is part of the third arc (σ2 ≥ 0);
     // with a free last sample the third arc starts before it (σ2 ≥ 1).
     let s2_min = if fixed_n.is_some() { 1.0 } else { 0.0 };
+    // G(N) once when N is fixed.
+    let [ma, mb] = modes;
+    let g_fixed = fixed_n.map_or([(0.0, 0.0); 2], |n| [ma.g(n), mb.g(n)]);
     let mut last_cells = (-1i32, -1i32, -1i32);
-    for _ in 0..MAX_NEWTON {
+    for _it in 0..MAX_NEWTON {
+        #[cfg(test)]
+        ITERATIONS.with(|c| c.set(c.get() + 1));
         // N and its derivative wrt σ1 (−that wrt σ2).
         let (n, dn) = match fixed_n {
             Some(n) => (n, 0.0),
@@ -174,7 +187,10 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
         let mut r = [0.0f32; 2];
         let mut jac = [[0.0f32; 2]; 2];
         for (i, mode) in modes.iter().enumerate() {
-            let (gn, ln) = mode.g(n);
+            let (gn, ln) = match (fixed_n, g_fixed.get(i)) {
+                (Some(_), Some(g)) => *g,
+                _ => mode.g(n),
+            };
             let (g1, l1) = mode.g(s.sigma1);
             let (g2, l2) = mode.g(s.sigma2);
             if let (Some(ri), Some(row)) = (r.get_mut(i), jac.get_mut(i)) {
@@ -190,7 +206,6 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
             // Jacobian is singular there): step with the slopes of the
             // continuous-time weights e^{ℓx} instead, which differ.
             let slope = |mode: &Mode, x: f32| 1.0 + expm1_f32(x * mode.ell);
-            let [ma, mb] = modes;
             let row = |mode: &Mode| {
                 let (ln, l1, l2) = (slope(mode, n), slope(mode, s.sigma1), slope(mode, s.sigma2));
                 [dbase + ln * dn - 2.0 * l1, -dbase - ln * dn + 2.0 * l2]
@@ -331,21 +346,35 @@ fn fast_plan(
     u_max: f32,
     capacity: usize,
 ) -> Result<Option<FastSolution>, Error> {
-    // 1. Real-valued N* with v = Umax, from the jerk-limited shape. The
-    // jerk-limited move of S0: N³/32·(jerk) … in modal terms the third
-    // moment; start from N = cbrt(M·k)… a robust start is the
-    // triple-integrator estimate below.
     let [m1, m2] = modes;
-    // Triple integrator: D = jerk·T³/32 with jerk·Ts³ = (ℓ1·ℓ2)·S0·Ts/(Kt)…
-    // In sample units: M = N·(1 − …); the third-order term gives
-    // N ≈ cbrt(32·M/(ℓ1·ℓ2))^(1/…). Use N0 = cbrt(32·M/|ℓ1·ℓ2|) capped
-    // below by 4, and the large-move estimate M + 2/|ℓ1|.
-    let prod = m1.ell * m2.ell;
-    let n_tri = cbrt_f32(32.0 * m / prod);
+    // Start: the triple integrator (jerk-limited) move, `D = jerk·T³/32`,
+    // switches at T/4 and 3T/4; in modal sample units `N³ = 32·M/(ℓ1·ℓ2)`.
+    let n_tri = cbrt_f32(32.0 * m / (m1.ell * m2.ell));
     let guess = Switches {
         sigma1: 0.75 * n_tri,
         sigma2: 0.25 * n_tri,
     };
+    // Tiny moves: the unique 3-sample (dead-beat) input, optimal whenever
+    // it is within Umax (fewer than 3 samples cannot land 3 states).
+    if n_tri < 4.0 {
+        if 3 > capacity {
+            return Err(Error::CapacityExceeded {
+                needed: 3,
+                capacity,
+            });
+        }
+        let (l1, l2) = (1.0 + m1.mu, 1.0 + m2.mu);
+        let k = m * u_max / (m1.mu * m2.mu);
+        let u = [k * l1 * l2, -k * (l1 + l2), k];
+        if u.iter().all(|x| x.abs() <= u_max) {
+            return Ok(Some(FastSolution {
+                n: 3,
+                kind: FastKind::DeadBeat(u),
+                n_star: n_tri,
+                cont: None,
+            }));
+        }
+    }
     let cont = newton(modes, m, None, guess);
     let n_star = cont.map_or(n_tri, |s| m + 2.0 * s.sigma1 - 2.0 * s.sigma2);
     // Precision of f32: the mode equations are sums of ±Umax over N
@@ -364,30 +393,11 @@ fn fast_plan(
     } else {
         1
     };
-    // Tiny moves: the unique 3-sample input.
-    if first <= 3 {
-        if 3 > capacity {
-            return Err(Error::CapacityExceeded {
-                needed: 3,
-                capacity,
-            });
-        }
-        let (l1, l2) = (1.0 + m1.mu, 1.0 + m2.mu);
-        let k = m * u_max / (m1.mu * m2.mu);
-        let u = [k * l1 * l2, -k * (l1 + l2), k];
-        if u.iter().all(|x| x.abs() <= u_max) {
-            return Ok(Some(FastSolution {
-                n: 3,
-                kind: FastKind::DeadBeat(u),
-                n_star,
-                cont,
-            }));
-        }
-    }
     let mut guess = cont.unwrap_or(guess);
     guess.sigma2 = guess.sigma2.max(1.0);
     guess.sigma1 = guess.sigma1.max(guess.sigma2);
-    for n in first.max(4)..first.max(4) + 4 {
+    let first = first.max(4);
+    for n in first..first + 4 {
         if n > capacity {
             return Err(Error::CapacityExceeded {
                 needed: n,

@@ -158,6 +158,11 @@ impl BangBang {
     /// saturated (no pass over the samples).
     pub(crate) fn peak_abs_u_v(&self) -> f64 {
         let last = self.n.saturating_sub(1);
+        if last >= 3 && libm::fabs(self.v_last) <= self.u_max_v {
+            // At most two of the first n−1 ≥ 3 samples hold a switch: one
+            // is saturated, and nothing exceeds Umax.
+            return self.u_max_v;
+        }
         let saturated = (0..last).len()
             > usize::from(self.k1 < last) + usize::from(self.k2 < last && self.k2 != self.k1);
         let mut peak = if saturated { self.u_max_v } else { 0.0 };

@@ -50,3 +50,17 @@ fn compare_with_reference_planner() {
         }
     }
 }
+
+#[test]
+fn iteration_counts() {
+    let d = rigid(10e-6);
+    for k in [0.0061, 0.02, 0.1, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 25.0] {
+        ITERATIONS.with(|c| c.set(0));
+        let p = plan_jump(&d, 0.0, k * DEG, Method::TimeOptimal, 100_000).expect("plan");
+        println!(
+            "{k}° n {} iterations {}",
+            p.samples(),
+            ITERATIONS.with(|c| c.get())
+        );
+    }
+}
