@@ -399,6 +399,7 @@ fn fast_plan(
     guess.sigma2 = guess.sigma2.max(1.0);
     guess.sigma1 = guess.sigma1.max(guess.sigma2);
     let first = first.max(4);
+    let mut prev_n = n_star.max(1.0);
     for n in first..first + 4 {
         if n > capacity {
             return Err(Error::CapacityExceeded {
@@ -407,7 +408,11 @@ fn fast_plan(
             });
         }
         let nf = n as f32;
-        guess.sigma1 = guess.sigma1.min(nf);
+        // Stretch the previous switches to the new length.
+        let stretch = nf / prev_n;
+        guess.sigma1 = (guess.sigma1 * stretch).min(nf);
+        guess.sigma2 = (guess.sigma2 * stretch).max(1.0).min(guess.sigma1);
+        prev_n = nf;
         let Some(s) = newton(modes, m, Some(nf), guess) else {
             continue;
         };
