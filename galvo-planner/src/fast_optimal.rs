@@ -106,6 +106,11 @@ fn cbrt_f32(x: f32) -> f32 {
     y
 }
 
+/// `√x` in `f32` for `x ≥ 0` (initial guesses only): libm's `sqrtf`.
+fn sqrt_f32(x: f32) -> f32 {
+    libm::sqrtf(x.max(0.0))
+}
+
 /// One decaying mode of the sampled model: `λ = e^ℓ`, `ℓ = p·Ts < 0`.
 #[derive(Debug, Clone, Copy)]
 struct Mode {
@@ -352,9 +357,18 @@ fn fast_plan(
     // Start: the triple integrator (jerk-limited) move, `D = jerk·T³/32`,
     // switches at T/4 and 3T/4; in modal sample units `N³ = 32·M/(ℓ1·ℓ2)`.
     let n_tri = cbrt_f32(32.0 * m / (m1.ell * m2.ell));
+    // Longer moves are current-limited: a double integrator with the
+    // acceleration Kt·Umax/(R·J), `N = 2·√(M·τm/Ts)` (τm/Ts = |ℓ1+ℓ2|/(ℓ1·ℓ2)),
+    // plus the electrical lag ≈ 0.4·L/(R·Ts) = 0.4/|ℓ1+ℓ2|. The third arc
+    // tends to T/4 (jerk-limited) or ≈ L/(R·Ts) (current-limited), and
+    // `N = M + 2·(σ1 − σ2)` fixes σ1. Only the start of Newton's method.
+    let sum = (m1.ell + m2.ell).abs();
+    let n_cur = 2.0 * sqrt_f32(m * sum / (m1.ell * m2.ell)) + 0.4 / sum;
+    let n0 = n_tri.max(n_cur);
+    let sigma2 = 1.0 / (4.0 / n0 + sum);
     let guess = Switches {
-        sigma1: 0.75 * n_tri,
-        sigma2: 0.25 * n_tri,
+        sigma1: sigma2 + 0.5 * (n0 - m).max(0.0),
+        sigma2,
     };
     // Tiny moves: the unique 3-sample (dead-beat) input, optimal whenever
     // it is within Umax (fewer than 3 samples cannot land 3 states).

@@ -57,10 +57,25 @@ fn iteration_counts() {
     for k in [0.0061, 0.02, 0.1, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 25.0] {
         ITERATIONS.with(|c| c.set(0));
         let p = plan_jump(&d, 0.0, k * DEG, Method::TimeOptimal, 100_000).expect("plan");
+        let crate::jump::PlanInfo::Optimal(i) = p.info() else {
+            panic!()
+        };
+        let md = modes(&d).unwrap();
+        let m = (k * DEG * 0.0115 / (10e-6 * 24.0)) as f32;
+        let sum = (md[0].ell + md[1].ell).abs();
+        let prod = md[0].ell * md[1].ell;
+        let n_di = 2.0 * (m * sum / prod).sqrt() + 1.0 / sum;
+        let n_tri = cbrt_f32(32.0 * m / prod);
         println!(
-            "{k}° n {} iterations {}",
+            "{k}° n {} it {} cont {:?} n_di {n_di} n_tri {n_tri} 1/sum {}",
             p.samples(),
-            ITERATIONS.with(|c| c.get())
+            ITERATIONS.with(|c| c.get()),
+            i.continuous.map(|c| (
+                c.time_s / 1e-5,
+                (c.time_s - c.switches_s.0) / 1e-5,
+                (c.time_s - c.switches_s.1) / 1e-5
+            )),
+            1.0 / sum
         );
     }
 }
