@@ -106,9 +106,22 @@ fn cbrt_f32(x: f32) -> f32 {
     y
 }
 
+/// The larger of `a` and `b` (plain compare: `f32::max` is a library call
+/// on the M4F); `b` when `a` is NaN.
+#[inline(always)]
+fn hi(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+/// The smaller of `a` and `b`; `b` when `a` is NaN.
+#[inline(always)]
+fn lo(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
 /// `√x` in `f32` for `x ≥ 0` (initial guesses only): libm's `sqrtf`.
 fn sqrt_f32(x: f32) -> f32 {
-    libm::sqrtf(x.max(0.0))
+    libm::sqrtf(hi(x, 0.0))
 }
 
 /// One decaying mode of the sampled model: `λ = e^ℓ`, `ℓ = p·Ts < 0`.
@@ -248,16 +261,16 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
         }
         last_cells = cells;
         // Damped: at most a quarter of the move per step.
-        let cap = 0.25 * n.max(4.0);
-        let lim = |x: f32| x.max(-cap).min(cap);
+        let cap = 0.25 * hi(n, 4.0);
+        let lim = |x: f32| lo(hi(x, -cap), cap);
         let mut s1 = s.sigma1 + lim(d1);
         let mut s2 = s.sigma2 + lim(d2);
         // Project onto 1 ≤ σ2 ≤ σ1 (≤ N when N is fixed).
         if let Some(n) = fixed_n {
-            s1 = s1.min(n);
+            s1 = lo(s1, n);
         }
-        s2 = s2.max(s2_min);
-        s1 = s1.max(s2);
+        s2 = hi(s2, s2_min);
+        s1 = hi(s1, s2);
         if !(s1.is_finite() && s2.is_finite()) {
             return None;
         }
@@ -277,8 +290,8 @@ fn valid(s: Switches, n: f32, s2_min: f32) -> Option<Switches> {
         && s.sigma1 >= s.sigma2 - tol
         && s.sigma1 <= n + tol
     {
-        let sigma2 = s.sigma2.max(s2_min);
-        let sigma1 = s.sigma1.max(sigma2).min(n);
+        let sigma2 = hi(s.sigma2, s2_min);
+        let sigma1 = lo(hi(s.sigma1, sigma2), n);
         Some(Switches { sigma1, sigma2 })
     } else {
         None
@@ -364,10 +377,10 @@ fn fast_plan(
     // `N = M + 2·(σ1 − σ2)` fixes σ1. Only the start of Newton's method.
     let sum = (m1.ell + m2.ell).abs();
     let n_cur = 2.0 * sqrt_f32(m * sum / (m1.ell * m2.ell)) + 0.4 / sum;
-    let n0 = n_tri.max(n_cur);
+    let n0 = hi(n_tri, n_cur);
     let sigma2 = 1.0 / (4.0 / n0 + sum);
     let guess = Switches {
-        sigma1: sigma2 + 0.5 * (n0 - m).max(0.0),
+        sigma1: sigma2 + 0.5 * hi(n0 - m, 0.0),
         sigma2,
     };
     // Tiny moves: the unique 3-sample (dead-beat) input, optimal whenever
@@ -410,10 +423,10 @@ fn fast_plan(
         1
     };
     let mut guess = cont.unwrap_or(guess);
-    guess.sigma2 = guess.sigma2.max(1.0);
-    guess.sigma1 = guess.sigma1.max(guess.sigma2);
+    guess.sigma2 = hi(guess.sigma2, 1.0);
+    guess.sigma1 = hi(guess.sigma1, guess.sigma2);
     let first = first.max(4);
-    let mut prev_n = n_star.max(1.0);
+    let mut prev_n = hi(n_star, 1.0);
     for n in first..first + 4 {
         if n > capacity {
             return Err(Error::CapacityExceeded {
@@ -424,8 +437,8 @@ fn fast_plan(
         let nf = n as f32;
         // Stretch the previous switches to the new length.
         let stretch = nf / prev_n;
-        guess.sigma1 = (guess.sigma1 * stretch).min(nf);
-        guess.sigma2 = (guess.sigma2 * stretch).max(1.0).min(guess.sigma1);
+        guess.sigma1 = lo(guess.sigma1 * stretch, nf);
+        guess.sigma2 = lo(hi(guess.sigma2 * stretch, 1.0), guess.sigma1);
         prev_n = nf;
         let Some(s) = newton(modes, m, Some(nf), guess) else {
             continue;
@@ -514,7 +527,7 @@ pub fn plan_time_optimal_fast<const S: usize>(
             info.structure = OptimalStructure::DeadBeat;
             let u64: [f64; 3] =
                 core::array::from_fn(|j| sign * f64::from(*u.get(2 - j).unwrap_or(&0.0)));
-            let peak = u.iter().fold(0.0f32, |p, x| p.max(x.abs()));
+            let peak = u.iter().fold(0.0f32, |p, x| hi(p, x.abs()));
             Ok(JumpPlan::with_peak(
                 disc,
                 z0,
