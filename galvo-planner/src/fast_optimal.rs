@@ -136,11 +136,36 @@ impl Mode {
     /// `(G(x), λ^⌊x⌋)` for `x ≥ 0`.
     #[inline]
     fn g(&self, x: f32) -> (f32, f32) {
-        let n = (x as i32) as f32; // x ≥ 0: truncation is floor
+        self.g_cached(x, &mut PowerCache::EMPTY)
+    }
+
+    /// [`g`](Self::g) reusing `λ^n − 1` when `x` is still in sample `n`
+    /// (Newton's last steps stay in the same samples).
+    #[inline]
+    fn g_cached(&self, x: f32, cache: &mut PowerCache) -> (f32, f32) {
+        let cell = x as i32; // x ≥ 0: truncation is floor
+        let n = cell as f32;
         let f = x - n;
-        let m = expm1_f32(n * self.ell);
+        let m = if cache.cell == cell {
+            cache.pm1
+        } else {
+            let m = expm1_f32(n * self.ell);
+            *cache = PowerCache { cell, pm1: m };
+            m
+        };
         (m / self.mu + f * (1.0 + m), 1.0 + m)
     }
+}
+
+/// `λ^n − 1` of the last sample `n` a point was in.
+#[derive(Debug, Clone, Copy)]
+struct PowerCache {
+    cell: i32,
+    pm1: f32,
+}
+
+impl PowerCache {
+    const EMPTY: Self = Self { cell: -1, pm1: 0.0 };
 }
 
 /// The sampled bang-bang in reversed switch points, units of `Umax`.
@@ -178,6 +203,7 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
     let [ma, mb] = modes;
     let g_fixed = fixed_n.map_or([(0.0, 0.0); 2], |n| [ma.g(n), mb.g(n)]);
     let mut last_cells = (-1i32, -1i32, -1i32);
+    let mut caches = [[PowerCache::EMPTY; 3]; 2];
     for _it in 0..MAX_NEWTON {
         #[cfg(test)]
         ITERATIONS.with(|c| c.set(c.get() + if fixed_n.is_some() { 100 } else { 1 }));
@@ -204,13 +230,14 @@ fn newton(modes: &[Mode; 2], m: f32, fixed_n: Option<f32>, mut s: Switches) -> O
         let dbase = if fixed_n.is_some() { 2.0 } else { 0.0 };
         let mut r = [0.0f32; 2];
         let mut jac = [[0.0f32; 2]; 2];
-        for (i, mode) in modes.iter().enumerate() {
+        for ((i, mode), cache) in modes.iter().enumerate().zip(caches.iter_mut()) {
+            let [c_n, c_1, c_2] = cache;
             let (gn, ln) = match (fixed_n, g_fixed.get(i)) {
                 (Some(_), Some(g)) => *g,
-                _ => mode.g(n),
+                _ => mode.g_cached(n, c_n),
             };
-            let (g1, l1) = mode.g(s.sigma1);
-            let (g2, l2) = mode.g(s.sigma2);
+            let (g1, l1) = mode.g_cached(s.sigma1, c_1);
+            let (g2, l2) = mode.g_cached(s.sigma2, c_2);
             if let (Some(ri), Some(row)) = (r.get_mut(i), jac.get_mut(i)) {
                 *ri = base + gn - 2.0 * g1 + 2.0 * g2;
                 *row = [dbase + ln * dn - 2.0 * l1, -dbase - ln * dn + 2.0 * l2];

@@ -79,3 +79,15 @@ fn iteration_counts() {
         );
     }
 }
+
+#[test]
+fn sizes() {
+    println!(
+        "JumpPlan {} Discrete {} InputLaw {} PlanInfo {} XyJump {}",
+        core::mem::size_of::<JumpPlan<3>>(),
+        core::mem::size_of::<Discrete<3>>(),
+        core::mem::size_of::<InputLaw<3>>(),
+        core::mem::size_of::<PlanInfo>(),
+        core::mem::size_of::<crate::jump::XyJump<3>>()
+    );
+}
