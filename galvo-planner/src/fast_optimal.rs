@@ -42,7 +42,7 @@
 use crate::error::{Error, finite};
 use crate::jump::{InputLaw, JumpPlan, MethodKind, PlanInfo, effective_capacity};
 use crate::linalg::at;
-use crate::model::{Discrete, ModelKind};
+use crate::model::{Discrete, LinearModel, ModelKind};
 use crate::optimal::{
     BangBang, ContinuousOptimum, OptimalInfo, OptimalStructure, plan_time_optimal,
 };
@@ -119,13 +119,22 @@ fn lo(a: f32, b: f32) -> f32 {
     if a < b { a } else { b }
 }
 
-/// `√x` in `f32` for `x ≥ 0` (initial guesses only): libm's `sqrtf`.
+/// `√x` for `x ≥ 0` to ~1e-5 (initial guesses only; libm's `sqrtf` is a
+/// software routine on the M4F): exponent halved by bit manipulation, then
+/// three Newton steps.
 fn sqrt_f32(x: f32) -> f32 {
-    libm::sqrtf(hi(x, 0.0))
+    if !(x > 0.0 && x.is_finite()) {
+        return 0.0;
+    }
+    let mut y = f32::from_bits((x.to_bits() >> 1) + 0x1fbd_1df5);
+    for _ in 0..3 {
+        y = 0.5 * (y + x / y);
+    }
+    y
 }
 
 /// One decaying mode of the sampled model: `λ = e^ℓ`, `ℓ = p·Ts < 0`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 struct Mode {
     ell: f32,
     /// `λ − 1`.
@@ -136,7 +145,8 @@ impl Mode {
     /// `(G(x), λ^⌊x⌋)` for `x ≥ 0`.
     #[inline]
     fn g(&self, x: f32) -> (f32, f32) {
-        self.g_cached(x, &mut PowerCache::EMPTY)
+        let mut cache = PowerCache::EMPTY;
+        self.g_cached(x, &mut cache)
     }
 
     /// [`g`](Self::g) reusing `λ^n − 1` when `x` is still in sample `n`
@@ -338,36 +348,57 @@ const MAX_REL_LANDING_ERROR: f32 = 1e-3;
 /// Longest move (samples) planned in `f32`; longer ones use `f64`.
 const MAX_F32_SAMPLES: f32 = 4096.0;
 
-/// The modal data of a rigid model, or `None` when its electrical poles are
-/// complex or too close for the modal form in `f32`.
-fn modes<const S: usize>(disc: &Discrete<S>) -> Option<[Mode; 2]> {
-    let a = disc.model().a();
-    let get = |i: usize, j: usize| a.get(i).map_or(0.0, |row| at(row, j));
-    // ω' = (Kt/J)·I, I' = −(Kt/L)·ω − (R/L)·I.
-    let alpha = -(get(2, 2) as f32);
-    let beta = -(get(1, 2) as f32) * (get(2, 1) as f32);
-    let ts = disc.ts_s() as f32;
-    let disc2 = alpha * alpha - 4.0 * beta;
-    if !(alpha > 0.0 && beta > 0.0 && disc2 > 1e-2 * alpha * alpha) {
-        return None;
-    }
-    let q = -0.5 * (alpha + libm::sqrtf(disc2));
-    let (p1, p2) = (q, beta / q);
-    let mode = |p: f32| {
-        let ell = p * ts;
-        Mode {
-            ell,
-            mu: expm1_f32(ell),
+/// What the `f32` planner needs of a sampled rigid model, computed once
+/// when the model is discretised (part of [`Discrete`]): the two decaying
+/// modes and the integrator gain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RigidModes {
+    modes: [Mode; 2],
+    /// `Kt/(Ts·Umax)`: `M = D·m_per_rad` in samples of `Umax`.
+    m_per_rad: f32,
+    u_max_v: f32,
+    ts_s: f32,
+}
+
+impl RigidModes {
+    /// `None` when the model is not rigid, its electrical poles are complex
+    /// or too close for the modal form in `f32`, or a mode is too slow.
+    pub(crate) fn new<const S: usize>(model: &LinearModel<S>, ts_s: f64) -> Option<Self> {
+        if S != 3 || model.kind() != ModelKind::Rigid {
+            return None;
         }
-    };
-    let out = [mode(p2), mode(p1)];
-    if out
-        .iter()
-        .all(|m| m.ell < -MIN_ABS_ELL && m.ell > -80.0 && m.mu < 0.0)
-    {
-        Some(out)
-    } else {
-        None
+        let a = model.a();
+        let get = |i: usize, j: usize| a.get(i).map_or(0.0, |row| at(row, j));
+        // ω' = (Kt/J)·I, I' = −(Kt/L)·ω − (R/L)·I.
+        let alpha = -(get(2, 2) as f32);
+        let beta = -(get(1, 2) as f32) * (get(2, 1) as f32);
+        let ts = ts_s as f32;
+        let disc2 = alpha * alpha - 4.0 * beta;
+        if !(alpha > 0.0 && beta > 0.0 && disc2 > 1e-2 * alpha * alpha) {
+            return None;
+        }
+        let q = -0.5 * (alpha + libm::sqrtf(disc2));
+        let (p1, p2) = (q, beta / q);
+        let mode = |p: f32| {
+            let ell = p * ts;
+            Mode {
+                ell,
+                mu: expm1_f32(ell),
+            }
+        };
+        let modes = [mode(p2), mode(p1)];
+        let m_per_rad = (model.drive().kt_nm_per_a / (ts_s * model.u_max_v())) as f32;
+        let ok = modes
+            .iter()
+            .all(|m| m.ell < -MIN_ABS_ELL && m.ell > -80.0 && m.mu < 0.0)
+            && m_per_rad.is_finite()
+            && m_per_rad > 0.0;
+        ok.then_some(Self {
+            modes,
+            m_per_rad,
+            u_max_v: model.u_max_v() as f32,
+            ts_s: ts,
+        })
     }
 }
 
@@ -512,21 +543,21 @@ pub fn plan_time_optimal_fast<const S: usize>(
     } else {
         (delta, 1.0)
     };
-    let Some(modes) = modes(disc) else {
+    let Some(fast) = disc.rigid_modes() else {
         return plan_time_optimal(disc, from_rad, to_rad, capacity);
     };
+    let modes = fast.modes;
     let u_max = disc.u_max_v();
-    let u_max32 = u_max as f32;
+    let u_max32 = fast.u_max_v;
     // M = S0/Umax = D·Kt/(Ts·Umax), samples.
-    let kt = model.drive().kt_nm_per_a as f32;
-    let m = (d as f32) * kt / ((disc.ts_s() as f32) * u_max32);
+    let m = (d as f32) * fast.m_per_rad;
     if !(m.is_finite() && m > 0.0) || m > 1.0e6 {
         return plan_time_optimal(disc, from_rad, to_rad, capacity);
     }
     let Some(sol) = fast_plan(&modes, m, u_max32, capacity)? else {
         return plan_time_optimal(disc, from_rad, to_rad, capacity);
     };
-    let ts = disc.ts_s() as f32;
+    let ts = fast.ts_s;
     let continuous = sol.cont.map(|s| ContinuousOptimum {
         time_s: f64::from(sol.n_star * ts),
         switches_s: (
