@@ -25,7 +25,8 @@
 //! 1. The shortest real-valued `N*` with `v = Umax` (the continuous-time
 //!    optimum in samples is its lower bound) by Newton on two unknowns
 //!    (the integrator equation gives `N` in closed form), started from the
-//!    jerk-limited shape `σ2 = N/4, σ1 = 3N/4`.
+//!    longer of the jerk-limited (`σ2 = N/4, σ1 = 3N/4`) and the
+//!    current-limited estimates.
 //! 2. `N = ⌈N*⌉`: `(σ1, σ2)` by the same Newton with `N` fixed, `v` from
 //!    the integrator equation; the first `N` with `|v| ≤ Umax` is the plan.
 //!
@@ -471,7 +472,9 @@ fn fast_plan(
     // nearly coincident modes that would land worse go to the f64 planner.
     let coupling = (m1.ell.abs() + m2.ell.abs()) / (m1.ell - m2.ell).abs();
     let rel_err = 2.0 * f32::EPSILON * (n_star / m) * coupling;
-    if !(n_star <= MAX_F32_SAMPLES) || (n_star > 3.5 && !(rel_err <= MAX_REL_LANDING_ERROR)) {
+    // (NaN compares false: falls back.)
+    let in_range = n_star <= MAX_F32_SAMPLES && (n_star <= 3.5 || rel_err <= MAX_REL_LANDING_ERROR);
+    if !in_range {
         return Ok(None);
     }
     let first = libm::ceilf(n_star - 5e-3);

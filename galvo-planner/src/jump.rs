@@ -33,7 +33,9 @@ pub enum Method {
     /// minimum-energy input that lands on the target.
     Seed(SeedConfig),
     /// Shortest rest-to-rest move under `|U| ≤ Umax` on the sample grid
-    /// (rigid model only).
+    /// (rigid model only), planned in single precision
+    /// ([`fast_optimal`](crate::fast_optimal); `f64`
+    /// [`optimal`](crate::optimal) where that does not apply).
     TimeOptimal,
     /// Trapezoidal velocity profile (baseline).
     TCurve,

@@ -1,4 +1,9 @@
-//! Time-optimal rest-to-rest planner for the rigid model.
+//! Time-optimal rest-to-rest planner for the rigid model, in `f64`.
+//!
+//! [`Method::TimeOptimal`](crate::jump::Method::TimeOptimal) plans with the
+//! single-precision [`fast_optimal`](crate::fast_optimal) planner (same
+//! plans, microseconds on the M4F); this one is its reference and its
+//! fallback for the galvos the `f32` form does not cover.
 //!
 //! The rigid model has the eigenvalues 0, p1, p2 (real and negative for the
 //! reference galvo: −2.9e3 and −12.7e3 1/s). For real eigenvalues the

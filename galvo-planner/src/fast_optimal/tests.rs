@@ -60,43 +60,17 @@ fn compare_with_reference_planner() {
     }
 }
 
+/// Cost on the M4 is a few hundred instructions per Newton iteration: the
+/// whole plan takes a handful (`cargo xtask bench-m4` measures it).
 #[test]
-fn iteration_counts() {
+fn few_newton_iterations() {
     let d = rigid(10e-6);
     for k in [0.0061, 0.02, 0.1, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 25.0] {
         ITERATIONS.with(|c| c.set(0));
         let p = plan_jump(&d, 0.0, k * DEG, Method::TimeOptimal, 100_000).expect("plan");
-        let crate::jump::PlanInfo::Optimal(i) = p.info() else {
-            panic!()
-        };
-        let md = d.rigid_modes().unwrap().modes;
-        let m = (k * DEG * 0.0115 / (10e-6 * 24.0)) as f32;
-        let sum = (md[0].ell + md[1].ell).abs();
-        let prod = md[0].ell * md[1].ell;
-        let n_di = 2.0 * (m * sum / prod).sqrt() + 1.0 / sum;
-        let n_tri = cbrt_f32(32.0 * m / prod);
-        println!(
-            "{k}° n {} it {} cont {:?} n_di {n_di} n_tri {n_tri} 1/sum {}",
-            p.samples(),
-            ITERATIONS.with(|c| c.get()),
-            i.continuous.map(|c| (
-                c.time_s / 1e-5,
-                (c.time_s - c.switches_s.0) / 1e-5,
-                (c.time_s - c.switches_s.1) / 1e-5
-            )),
-            1.0 / sum
-        );
+        let count = ITERATIONS.with(|c| c.get());
+        let (free, fixed) = (count % 100, count / 100);
+        println!("{k}°: {} samples, Newton {free} + {fixed}", p.samples());
+        assert!(free <= 4 && fixed <= 4, "{k}°: {free} + {fixed} iterations");
     }
-}
-
-#[test]
-fn sizes() {
-    println!(
-        "JumpPlan {} Discrete {} InputLaw {} PlanInfo {} XyJump {}",
-        core::mem::size_of::<JumpPlan<3>>(),
-        core::mem::size_of::<Discrete<3>>(),
-        core::mem::size_of::<InputLaw<3>>(),
-        core::mem::size_of::<PlanInfo>(),
-        core::mem::size_of::<crate::jump::XyJump<3>>()
-    );
 }
