@@ -37,6 +37,9 @@ pub enum Method {
     /// ([`fast_optimal`](crate::fast_optimal); `f64`
     /// [`optimal`](crate::optimal) where that does not apply).
     TimeOptimal,
+    /// The same plan solved in `f64` ([`optimal`](crate::optimal)): the
+    /// reference for comparisons on the host (milliseconds on the M4F).
+    TimeOptimalF64,
     /// Trapezoidal velocity profile (baseline).
     TCurve,
     /// Jerk-limited S-curve profile (baseline).
@@ -56,7 +59,7 @@ impl Method {
     pub fn kind(&self) -> MethodKind {
         match self {
             Method::Seed(_) => MethodKind::Seed,
-            Method::TimeOptimal => MethodKind::TimeOptimal,
+            Method::TimeOptimal | Method::TimeOptimalF64 => MethodKind::TimeOptimal,
             Method::TCurve => MethodKind::TCurve,
             Method::SCurve => MethodKind::SCurve,
         }
@@ -341,6 +344,9 @@ pub fn plan_jump<const S: usize>(
         Method::Seed(cfg) => min_energy::plan_seed(disc, &z0, &z1, cfg, capacity),
         Method::TimeOptimal => {
             crate::fast_optimal::plan_time_optimal_fast(disc, from_rad, to_rad, capacity)
+        }
+        Method::TimeOptimalF64 => {
+            crate::optimal::plan_time_optimal(disc, from_rad, to_rad, capacity)
         }
         Method::TCurve => profile::plan_profile(
             disc,

@@ -28,10 +28,10 @@ proptest! {
             return Ok(());
         };
         let to = if neg { -dist } else { dist };
-        for method in [Method::TimeOptimal, Method::SEED, Method::TCurve, Method::SCurve] {
+        for method in [Method::TimeOptimal, Method::TimeOptimalF64, Method::SEED, Method::TCurve, Method::SCurve] {
             match plan_jump(&d, 0.0, to, method, 20_000) {
                 Ok(plan) => {
-                    let model_based = matches!(method, Method::TimeOptimal | Method::Seed(_));
+                    let model_based = matches!(method, Method::TimeOptimal | Method::TimeOptimalF64 | Method::Seed(_));
                     // Landing relative to the move's own scales.
                     let u = inputs(&plan);
                     let mut z = *plan.start_state();
