@@ -336,10 +336,11 @@ fn valid(s: Switches, n: f32, s2_min: f32) -> Option<Switches> {
     }
 }
 
-/// Smallest `|p·Ts|` of a mode the `f32` form handles: a mode that decays
-/// over more than ~1000 samples is nearly a second integrator, and the
-/// landing equations become too ill-conditioned for single precision.
-const MIN_ABS_ELL: f32 = 1.0e-3;
+/// Smallest `|p·Ts|` of a mode the `f32` form handles: the rounding of the
+/// mode sums grows as `ε/|ℓ|` (≈ 5e-6 of the speed and current scales at
+/// this limit), and a mode that decays over hundreds of samples is nearly
+/// a second integrator. The reference galvo has |ℓ| = 0.029 at Ts = 10 µs.
+const MIN_ABS_ELL: f32 = 3.0e-3;
 
 /// Largest estimated relative landing error (θ, of the move) accepted
 /// from the `f32` solution (see [`fast_plan`]); the reference galvo at
@@ -347,7 +348,7 @@ const MIN_ABS_ELL: f32 = 1.0e-3;
 const MAX_REL_LANDING_ERROR: f32 = 1e-3;
 
 /// Longest move (samples) planned in `f32`; longer ones use `f64`.
-const MAX_F32_SAMPLES: f32 = 4096.0;
+const MAX_F32_SAMPLES: f32 = 1024.0;
 
 /// What the `f32` planner needs of a sampled rigid model, computed once
 /// when the model is discretised (part of [`Discrete`]): the two decaying
