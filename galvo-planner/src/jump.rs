@@ -13,7 +13,7 @@ use crate::error::{Error, finite};
 use crate::linalg::{Vector, at, dot, mat_vec, vec_add, vec_scale};
 use crate::min_energy::{self, SeedConfig, SeedInfo};
 use crate::model::Discrete;
-use crate::optimal::{self, BangBang, OptimalInfo};
+use crate::optimal::{BangBang, OptimalInfo};
 use crate::profile::{self, Profile, ProfileKind};
 
 /// Upper bound on the samples of any plan, whatever capacity the caller
@@ -33,8 +33,13 @@ pub enum Method {
     /// minimum-energy input that lands on the target.
     Seed(SeedConfig),
     /// Shortest rest-to-rest move under `|U| ≤ Umax` on the sample grid
-    /// (rigid model only).
+    /// (rigid model only), planned in single precision
+    /// ([`fast_optimal`](crate::fast_optimal); `f64`
+    /// [`optimal`](crate::optimal) where that does not apply).
     TimeOptimal,
+    /// The same plan solved in `f64` ([`optimal`](crate::optimal)): the
+    /// reference for comparisons on the host (milliseconds on the M4F).
+    TimeOptimalF64,
     /// Trapezoidal velocity profile (baseline).
     TCurve,
     /// Jerk-limited S-curve profile (baseline).
@@ -54,7 +59,7 @@ impl Method {
     pub fn kind(&self) -> MethodKind {
         match self {
             Method::Seed(_) => MethodKind::Seed,
-            Method::TimeOptimal => MethodKind::TimeOptimal,
+            Method::TimeOptimal | Method::TimeOptimalF64 => MethodKind::TimeOptimal,
             Method::TCurve => MethodKind::TCurve,
             Method::SCurve => MethodKind::SCurve,
         }
@@ -114,6 +119,8 @@ pub(crate) enum InputLaw<const S: usize> {
     MinEnergy { lambda: Vector<S> },
     /// Sample-averaged bang-bang with a free last sample.
     BangBang(BangBang),
+    /// Three explicit samples (the dead-beat input), V, in sample order.
+    Explicit3 { u_v: [f64; 3] },
     /// Inverse-dynamics voltage of a profile plus a minimum-norm correction
     /// `(Ad^{N−1−k}·Bd)ᵀ·λ` that makes it land exactly.
     Profile { profile: Profile, lambda: Vector<S> },
@@ -157,6 +164,31 @@ impl<const S: usize> JumpPlan<S> {
         plan.for_each_input_rev(|_, u| peak = peak.max(libm::fabs(u)));
         plan.max_abs_u_v = peak;
         plan
+    }
+
+    /// Builds a plan whose peak voltage the planner already knows (no pass
+    /// over the inputs).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn with_peak(
+        disc: &Discrete<S>,
+        z0: Vector<S>,
+        z1: Vector<S>,
+        samples: usize,
+        law: InputLaw<S>,
+        method: MethodKind,
+        info: PlanInfo,
+        max_abs_u_v: f64,
+    ) -> Self {
+        Self {
+            disc: *disc,
+            z0,
+            z1,
+            samples,
+            law,
+            method,
+            max_abs_u_v,
+            info,
+        }
     }
 
     /// A zero-length plan that holds `z0`.
@@ -239,6 +271,11 @@ impl<const S: usize> JumpPlan<S> {
                     f(k, bb.u_v(k));
                 }
             }
+            InputLaw::Explicit3 { u_v } => {
+                for k in (0..n.min(3)).rev() {
+                    f(k, u_v.get(k).copied().unwrap_or(0.0));
+                }
+            }
             InputLaw::Profile { profile, lambda } => {
                 let drive = self.disc.model().drive();
                 let ts = self.disc.ts_s();
@@ -305,7 +342,12 @@ pub fn plan_jump<const S: usize>(
     let z1 = disc.model().rest_state(to_rad);
     match method {
         Method::Seed(cfg) => min_energy::plan_seed(disc, &z0, &z1, cfg, capacity),
-        Method::TimeOptimal => optimal::plan_time_optimal(disc, from_rad, to_rad, capacity),
+        Method::TimeOptimal => {
+            crate::fast_optimal::plan_time_optimal_fast(disc, from_rad, to_rad, capacity)
+        }
+        Method::TimeOptimalF64 => {
+            crate::optimal::plan_time_optimal(disc, from_rad, to_rad, capacity)
+        }
         Method::TCurve => profile::plan_profile(
             disc,
             from_rad,

@@ -25,7 +25,8 @@
 //! | [`model`] | rigid `(θ, ω, I)` and flexible `(θ, ω, I, φ, ω_φ)` models, exact ZOH discretisation | [`RigidParams::model`], [`FlexParams::model`], [`LinearModel::discretize`] → [`Discrete`] |
 //! | [`jump`] | one plan type for every method, dispatcher, two-axis jumps | [`plan_jump`], [`plan_xy_jump`], [`JumpPlan`], [`Method`], [`JumpSync`] |
 //! | [`min_energy`] | minimum-energy input over N samples; seed bisection planner | [`min_energy::plan_min_energy`], [`min_energy::plan_seed`], [`SeedConfig`] |
-//! | [`optimal`] | time-optimal rest-to-rest (rigid) | [`optimal::plan_time_optimal`] |
+//! | [`fast_optimal`] | time-optimal rest-to-rest (rigid) in `f32`: the default [`Method::TimeOptimal`], µs on the M4F | [`fast_optimal::plan_time_optimal_fast`] |
+//! | [`optimal`] | time-optimal rest-to-rest (rigid) in `f64`: reference and fallback | [`optimal::plan_time_optimal`] |
 //! | [`profile`] | T-curve / S-curve baselines and their inverse-dynamics voltage | [`profile::plan_profile`], [`profile::Profile`], [`profile::ProfileLimits::from_drive`] |
 //! | [`stepper`] | per-sample `f32` state update, move queue, two axes | [`Stepper`], [`XyStepper`] |
 //! | [`path`] | look-ahead marking of lines and arcs in the board plane | [`PathPlanner`], [`MarkLimits`], [`MarkSample`], [`BlockEnd`] |
@@ -101,6 +102,7 @@
 //! ```
 
 pub mod error;
+pub mod fast_optimal;
 pub mod jump;
 pub mod linalg;
 pub mod min_energy;

@@ -298,6 +298,7 @@ impl<const S: usize> LinearModel<S> {
             bd,
             ts_s,
             model: *self,
+            rigid_modes: crate::fast_optimal::RigidModes::new(self, ts_s),
         };
         if disc.controllability_ratio() < CONTROLLABILITY_THRESHOLD {
             return Err(Error::NotControllable);
@@ -318,6 +319,9 @@ pub struct Discrete<const S: usize> {
     bd: Vector<S>,
     ts_s: f64,
     model: LinearModel<S>,
+    /// Modal data for the single-precision time-optimal planner (rigid
+    /// models it covers), rebuilt with the model.
+    rigid_modes: Option<crate::fast_optimal::RigidModes>,
 }
 
 impl<const S: usize> Discrete<S> {
@@ -340,6 +344,11 @@ impl<const S: usize> Discrete<S> {
     /// Voltage limit, V.
     pub fn u_max_v(&self) -> f64 {
         self.model.u_max_v
+    }
+
+    /// Modal data of the single-precision time-optimal planner.
+    pub(crate) fn rigid_modes(&self) -> Option<&crate::fast_optimal::RigidModes> {
+        self.rigid_modes.as_ref()
     }
 
     /// One step: `Ad·z + Bd·u`.

@@ -1,4 +1,9 @@
-//! Time-optimal rest-to-rest planner for the rigid model.
+//! Time-optimal rest-to-rest planner for the rigid model, in `f64`.
+//!
+//! [`Method::TimeOptimal`](crate::jump::Method::TimeOptimal) plans with the
+//! single-precision [`fast_optimal`](crate::fast_optimal) planner (same
+//! plans, microseconds on the M4F); this one is its reference and its
+//! fallback for the galvos the `f32` form does not cover.
 //!
 //! The rigid model has the eigenvalues 0, p1, p2 (real and negative for the
 //! reference galvo: −2.9e3 and −12.7e3 1/s). For real eigenvalues the
@@ -77,6 +82,10 @@ pub struct OptimalInfo {
     pub switch_samples: (f64, f64),
     /// Voltage of the free last sample, V, signed (bang-bang only).
     pub last_sample_v: f64,
+    /// Solved in single precision by
+    /// [`plan_time_optimal_fast`](crate::fast_optimal::plan_time_optimal_fast)
+    /// (microseconds on the M4F) rather than by this module's `f64` solver.
+    pub single_precision: bool,
 }
 
 /// Halvings of the minimum-energy fallback.
@@ -92,13 +101,39 @@ pub(crate) struct BangBang {
     v_last: f64,
     u_max_v: f64,
     sign: f64,
+    /// Samples `k < k1` are `+Umax`, `k1 ≤ k < k2` (after the samples that
+    /// contain a switch) … see [`BangBang::u_v`]; integer cells precomputed
+    /// so that saturated samples cost no floating-point work.
+    k1: usize,
+    k2: usize,
 }
 
 fn overlap(a: f64, b: f64, c: f64, d: f64) -> f64 {
     (b.min(d) - a.max(c)).max(0.0)
 }
 
+/// `⌊x⌋` for `0 ≤ x`, as a sample index.
+fn cell(x: f64) -> usize {
+    if x > 0.0 { x as usize } else { 0 }
+}
+
 impl BangBang {
+    /// `+Umax` on `[0, s1)`, `−Umax` on `[s1, s2)`, `+Umax` on
+    /// `[s2, n−1)` (samples, `0 ≤ s1 ≤ s2 ≤ n−1`), sample averages, last
+    /// sample `v_last`; all times `sign`.
+    pub(crate) fn new(n: usize, s1: f64, s2: f64, v_last: f64, u_max_v: f64, sign: f64) -> Self {
+        Self {
+            n,
+            s1,
+            s2,
+            v_last,
+            u_max_v,
+            sign,
+            k1: cell(s1),
+            k2: cell(s2),
+        }
+    }
+
     /// Voltage of sample `k`.
     pub(crate) fn u_v(&self, k: usize) -> f64 {
         if k + 1 == self.n {
@@ -107,11 +142,41 @@ impl BangBang {
         if k >= self.n {
             return 0.0;
         }
+        // Saturated samples: no switch inside.
+        if k < self.k1 {
+            return self.sign * self.u_max_v;
+        }
+        if k > self.k1 && k < self.k2 {
+            return -self.sign * self.u_max_v;
+        }
+        if k > self.k2 {
+            return self.sign * self.u_max_v;
+        }
         let (a, b) = (k as f64, k as f64 + 1.0);
         let end = (self.n - 1) as f64;
         let avg = overlap(a, b, 0.0, self.s1) - overlap(a, b, self.s1, self.s2)
             + overlap(a, b, self.s2, end);
         self.sign * self.u_max_v * avg
+    }
+
+    /// Largest `|u_k|` over the plan, V, from the few samples that are not
+    /// saturated (no pass over the samples).
+    pub(crate) fn peak_abs_u_v(&self) -> f64 {
+        let last = self.n.saturating_sub(1);
+        if last >= 3 && libm::fabs(self.v_last) <= self.u_max_v {
+            // At most two of the first n−1 ≥ 3 samples hold a switch: one
+            // is saturated, and nothing exceeds Umax.
+            return self.u_max_v;
+        }
+        let saturated = (0..last).len()
+            > usize::from(self.k1 < last) + usize::from(self.k2 < last && self.k2 != self.k1);
+        let mut peak = if saturated { self.u_max_v } else { 0.0 };
+        for k in [self.k1, self.k2, last] {
+            if k < self.n {
+                peak = peak.max(libm::fabs(self.u_v(k)));
+            }
+        }
+        peak
     }
 }
 
@@ -597,6 +662,7 @@ pub fn plan_time_optimal<const S: usize>(
         samples_lower_bound: if cont.is_some() { n_lo } else { 0 },
         switch_samples: (0.0, 0.0),
         last_sample_v: 0.0,
+        single_precision: false,
     };
     if n_lo <= S {
         if S > capacity {
@@ -634,14 +700,7 @@ pub fn plan_time_optimal<const S: usize>(
             if let Some([s1, s2, v]) = sampled_bang_bang(&resp, ts, u_max, d, n, guess, scales) {
                 info.switch_samples = (s1, s2);
                 info.last_sample_v = sign * v;
-                let law = BangBang {
-                    n,
-                    s1,
-                    s2,
-                    v_last: v,
-                    u_max_v: u_max,
-                    sign,
-                };
+                let law = BangBang::new(n, s1, s2, v, u_max, sign);
                 return Ok(JumpPlan::new(
                     disc,
                     z0,

@@ -45,8 +45,11 @@ enum PlanCommand {
 pub(crate) enum MethodArg {
     /// The patent's bisection on the move time with the minimum-energy input.
     Seed,
-    /// Time-optimal bang-bang (rigid model only).
+    /// Time-optimal bang-bang (rigid model only), solved in f32 as on the
+    /// target.
     Optimal,
+    /// The same, solved in f64 (reference).
+    OptimalF64,
     /// Trapezoidal velocity profile (baseline).
     Tcurve,
     /// Jerk-limited S-curve profile (baseline).
@@ -58,6 +61,7 @@ impl MethodArg {
         match self {
             MethodArg::Seed => Method::Seed(SeedConfig { p, bracket_s: None }),
             MethodArg::Optimal => Method::TimeOptimal,
+            MethodArg::OptimalF64 => Method::TimeOptimalF64,
             MethodArg::Tcurve => Method::TCurve,
             MethodArg::Scurve => Method::SCurve,
         }
@@ -66,6 +70,7 @@ impl MethodArg {
         match self {
             MethodArg::Seed => "seed",
             MethodArg::Optimal => "optimal",
+            MethodArg::OptimalF64 => "optimal-f64",
             MethodArg::Tcurve => "tcurve",
             MethodArg::Scurve => "scurve",
         }

@@ -28,10 +28,10 @@ proptest! {
             return Ok(());
         };
         let to = if neg { -dist } else { dist };
-        for method in [Method::TimeOptimal, Method::SEED, Method::TCurve, Method::SCurve] {
+        for method in [Method::TimeOptimal, Method::TimeOptimalF64, Method::SEED, Method::TCurve, Method::SCurve] {
             match plan_jump(&d, 0.0, to, method, 20_000) {
                 Ok(plan) => {
-                    let model_based = matches!(method, Method::TimeOptimal | Method::Seed(_));
+                    let model_based = matches!(method, Method::TimeOptimal | Method::TimeOptimalF64 | Method::Seed(_));
                     // Landing relative to the move's own scales.
                     let u = inputs(&plan);
                     let mut z = *plan.start_state();
@@ -40,9 +40,17 @@ proptest! {
                     }
                     let w_scale = umax / kt;
                     let i_scale = umax / r;
-                    prop_assert!((z[0] - to).abs() <= 1e-6 * dist.max(1e-3), "{method:?}: θ off by {}", z[0] - to);
-                    prop_assert!(z[1].abs() <= 1e-6 * w_scale, "{method:?}: ω {}", z[1]);
-                    prop_assert!(z[2].abs() <= 1e-6 * i_scale, "{method:?}: I {}", z[2]);
+                    // The time-optimal planner solves in f32 (the M4F's FPU)
+                    // and takes the f64 path where its error estimate exceeds
+                    // 1e-3 of the move (the estimate is good to ~2×) or a mode
+                    // decays too slowly: θ within 3e-3 of the move, speed and current within 1e-4 of
+                    // their scales (on the reference galvo ≤ 1.2e-7 rad and
+                    // 4e-4 rad/s, inside the acceptance bounds of 1e-6 rad
+                    // and 1e-3 rad/s, A: optimal::tests).
+                    let (rel, rel_move) = if method == Method::TimeOptimal { (1e-4, 3e-3) } else { (1e-6, 0.0) };
+                    prop_assert!((z[0] - to).abs() <= 1e-6 * dist.max(1e-3) + rel_move * dist, "{method:?}: θ off by {}", z[0] - to);
+                    prop_assert!(z[1].abs() <= rel * w_scale, "{method:?}: ω {}", z[1]);
+                    prop_assert!(z[2].abs() <= rel * i_scale, "{method:?}: I {}", z[2]);
                     if model_based {
                         prop_assert!(plan.max_abs_u_v() <= umax);
                     }

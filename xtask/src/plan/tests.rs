@@ -38,6 +38,10 @@ fn csv_rows_are_the_exact_zoh_simulation() {
         ("jump --from-deg -2 --to-deg 3 --method seed", 6),
         ("jump --from-deg 0 --to-deg 5 --method optimal --ts-us 5", 6),
         (
+            "jump --from-deg 0 --to-deg 5 --method optimal-f64 --ts-us 5",
+            6,
+        ),
+        (
             "jump --from-deg 1 --to-deg -4 --method scurve --model flexible",
             8,
         ),
@@ -95,7 +99,14 @@ fn csv_rows_are_the_exact_zoh_simulation() {
         assert_eq!(first[0], args.from_deg.to_radians());
         assert!(first[1..3].iter().all(|v| *v == 0.0));
         let last = state(rows.last().expect("rows"));
-        assert!((last[0] - args.to_deg.to_radians()).abs() < 1e-9);
+        // The f32 time-optimal planner (the target's) lands within the
+        // acceptance bound of 1e-6 rad; the f64 planners within 1e-9.
+        let tol = if cmd.contains("--method optimal ") {
+            1e-6
+        } else {
+            1e-9
+        };
+        assert!((last[0] - args.to_deg.to_radians()).abs() < tol, "{cmd}");
     }
 }
 

@@ -1,0 +1,76 @@
+extern crate std;
+
+use super::*;
+use crate::jump::{Method, plan_jump};
+use crate::test_support::{DEG, assert_lands, rigid};
+use std::println;
+
+#[test]
+fn expm1_matches_f64() {
+    let mut worst = 0.0f64;
+    let mut z = -30.0f64;
+    while z < 0.5 {
+        let exact = libm::expm1(f64::from(z as f32));
+        let got = f64::from(expm1_f32(z as f32));
+        let rel = ((got - exact) / exact).abs();
+        if exact != 0.0 {
+            worst = worst.max(rel);
+        }
+        z += 0.0137;
+    }
+    assert!(worst < 5e-7, "worst relative error {worst}");
+}
+
+#[test]
+fn sqrt_matches() {
+    for x in [1e-6f32, 0.3, 1.0, 8.0, 1234.5, 3e7] {
+        let y = sqrt_f32(x);
+        assert!((y * y - x).abs() <= 1e-5 * x, "{x}: {y}");
+    }
+    assert_eq!(sqrt_f32(-1.0), 0.0);
+}
+
+#[test]
+fn cbrt_matches() {
+    for x in [1e-6f32, 0.3, 1.0, 8.0, 1234.5, 3e7] {
+        let y = cbrt_f32(x);
+        assert!((y * y * y - x).abs() <= 1e-5 * x, "{x}: {y}");
+    }
+}
+
+#[test]
+fn compare_with_reference_planner() {
+    for ts in [10e-6, 1e-6, 3.3e-6, 25e-6, 0.2e-6, 100e-6] {
+        let d = rigid(ts);
+        let mut k = 1e-4;
+        while k < 26.0 {
+            let fast = plan_jump(&d, 0.0, k * DEG, Method::TimeOptimal, 100_000).expect("fast");
+            let slow = crate::optimal::plan_time_optimal(&d, 0.0, k * DEG, 100_000).expect("slow");
+            let err = assert_lands(&fast, true, "fast");
+            println!(
+                "{k:9.4}° fast {} slow {} err {:?} {:?}",
+                fast.samples(),
+                slow.samples(),
+                err,
+                fast.info()
+            );
+            assert!(fast.samples() <= slow.samples());
+            k *= 1.5;
+        }
+    }
+}
+
+/// Cost on the M4 is a few hundred instructions per Newton iteration: the
+/// whole plan takes a handful (`cargo xtask bench-m4` measures it).
+#[test]
+fn few_newton_iterations() {
+    let d = rigid(10e-6);
+    for k in [0.0061, 0.02, 0.1, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 25.0] {
+        ITERATIONS.with(|c| c.set(0));
+        let p = plan_jump(&d, 0.0, k * DEG, Method::TimeOptimal, 100_000).expect("plan");
+        let count = ITERATIONS.with(|c| c.get());
+        let (free, fixed) = (count % 100, count / 100);
+        println!("{k}°: {} samples, Newton {free} + {fixed}", p.samples());
+        assert!(free <= 4 && fixed <= 4, "{k}°: {free} + {fixed} iterations");
+    }
+}
