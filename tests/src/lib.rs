@@ -73,11 +73,13 @@ pub fn assert_safe_allowing(report: &SimReport, open: &[ViolationKind]) {
 }
 
 /// Task steps over 1 ms of CPU time, tolerated where they are not the
-/// point: the galvo loop plans a long time-optimal jump inside one step
-/// (0.9–1.5 ms of host CPU in the dev profile; on the target jumps must be
-/// planned ahead, see the README), and on a loaded machine under memory
-/// pressure a single poll can show several ms of CPU time (page-fault
-/// handling counts). `safety_checker.rs` checks the path checks' steps.
+/// point: on a loaded machine under memory pressure a single poll can show
+/// several ms of CPU time (page-fault handling and the recorder's growth
+/// count). The step rule itself is enforced by the tests made for it:
+/// `safety_campaign.rs` (`random_sessions_have_short_task_steps`, galvo
+/// jumps included since jumps are planned in single precision),
+/// `safety_checker.rs` (path checks) and `redteam_galvo.rs` (jump planning
+/// at every sample period).
 pub const UNTIL_STEP_FIXES: &[ViolationKind] = &[ViolationKind::LongStep];
 
 /// Every line of the terminal transcript (`> command` for what was sent).

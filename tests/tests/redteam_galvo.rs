@@ -17,7 +17,6 @@ fn longest_poll_of_jumps(ts_us: u32, planner: &str) -> u128 {
 }
 
 #[test]
-#[ignore = "redteam: time-optimal galvo jump planning runs inside one galvo-loop poll and at sample periods of 20-120 us takes 0.7-2.6 ms of host CPU (70 us at 10 us), 30-60x more in soft f64 on the target"]
 fn a_galvo_jump_is_planned_without_holding_the_executor_at_any_sample_period() {
     // SPEC §9: no task step holds the executor for more than 1 ms (on the
     // target; the host is 30–60× faster at f64). At the default 10 µs

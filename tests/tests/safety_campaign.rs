@@ -159,7 +159,6 @@ fn random_sessions_with_faults_and_stalls_are_safe() {
 }
 
 #[test]
-#[ignore = "enable once the galvo loop plans long jumps ahead (a time-optimal jump takes up to 1.5 ms of host CPU in one galvo step)"]
 fn random_sessions_have_short_task_steps() {
     for seed in 0..SESSIONS {
         let report = run_session(seed);
