@@ -40,12 +40,13 @@
 //! stays far inside the acceptance bounds; the stepper lands exactly on the
 //! planned target at the end of every move in any case.
 
-use crate::error::{Error, finite};
-use crate::jump::{InputLaw, JumpPlan, MethodKind, PlanInfo, effective_capacity};
+use crate::error::Error;
+use crate::jump::{InputLaw, JumpPlan, MethodKind, PlanInfo};
 use crate::linalg::at;
 use crate::model::{Discrete, LinearModel, ModelKind};
 use crate::optimal::{
-    BangBang, ContinuousOptimum, OptimalInfo, OptimalStructure, plan_time_optimal,
+    BangBang, ContinuousOptimum, OptimalInfo, OptimalStructure, RigidMove, plan_time_optimal,
+    rigid_move,
 };
 
 /// `e^z − 1` for `z ≤ 0.5` in `f32`, a few ulp: Taylor series near 0,
@@ -529,18 +530,16 @@ pub fn plan_time_optimal_fast<const S: usize>(
     to_rad: f64,
     capacity: usize,
 ) -> Result<JumpPlan<S>, Error> {
-    if S != 3 || disc.model().kind() != ModelKind::Rigid {
-        return Err(Error::UnsupportedModel);
-    }
-    let from_rad = finite("from_rad", from_rad)?;
-    let to_rad = finite("to_rad", to_rad)?;
-    let capacity = effective_capacity(capacity);
-    let model = disc.model();
-    let z0 = model.rest_state(from_rad);
-    let z1 = model.rest_state(to_rad);
-    if from_rad == to_rad {
-        return Ok(JumpPlan::hold(disc, z0));
-    }
+    let RigidMove::Move {
+        from_rad,
+        to_rad,
+        z0,
+        z1,
+        capacity,
+    } = rigid_move(disc, from_rad, to_rad, capacity)?
+    else {
+        return Ok(JumpPlan::hold(disc, disc.model().rest_state(from_rad)));
+    };
     let delta = to_rad - from_rad;
     let (d, sign) = if delta < 0.0 {
         (-delta, -1.0)

@@ -605,6 +605,53 @@ fn sampled_bang_bang(
     }
 }
 
+/// A checked rest-to-rest move of the rigid model (both time-optimal
+/// planners start here).
+pub(crate) enum RigidMove<const S: usize> {
+    /// Start and target are the same angle: hold.
+    Hold,
+    /// A move to plan.
+    Move {
+        /// Start angle, rad (finite).
+        from_rad: f64,
+        /// Target angle, rad (finite).
+        to_rad: f64,
+        /// Rest state at the start.
+        z0: Vector<S>,
+        /// Rest state at the target.
+        z1: Vector<S>,
+        /// Usable stepper capacity, samples.
+        capacity: usize,
+    },
+}
+
+/// Checks a time-optimal request: a rigid model, finite angles.
+///
+/// Errors: [`Error::UnsupportedModel`], [`Error::NonFinite`].
+pub(crate) fn rigid_move<const S: usize>(
+    disc: &Discrete<S>,
+    from_rad: f64,
+    to_rad: f64,
+    capacity: usize,
+) -> Result<RigidMove<S>, Error> {
+    if S != 3 || disc.model().kind() != ModelKind::Rigid {
+        return Err(Error::UnsupportedModel);
+    }
+    let from_rad = finite("from_rad", from_rad)?;
+    let to_rad = finite("to_rad", to_rad)?;
+    if from_rad == to_rad {
+        return Ok(RigidMove::Hold);
+    }
+    let model = disc.model();
+    Ok(RigidMove::Move {
+        from_rad,
+        to_rad,
+        z0: model.rest_state(from_rad),
+        z1: model.rest_state(to_rad),
+        capacity: crate::jump::effective_capacity(capacity),
+    })
+}
+
 /// How many sample counts above the continuous bound are tried.
 const EXTRA_SAMPLE_COUNTS: usize = 12;
 
@@ -616,18 +663,17 @@ pub fn plan_time_optimal<const S: usize>(
     to_rad: f64,
     capacity: usize,
 ) -> Result<JumpPlan<S>, Error> {
-    if S != 3 || disc.model().kind() != ModelKind::Rigid {
-        return Err(Error::UnsupportedModel);
-    }
-    let from_rad = finite("from_rad", from_rad)?;
-    let to_rad = finite("to_rad", to_rad)?;
-    let capacity = crate::jump::effective_capacity(capacity);
+    let RigidMove::Move {
+        from_rad,
+        to_rad,
+        z0,
+        z1,
+        capacity,
+    } = rigid_move(disc, from_rad, to_rad, capacity)?
+    else {
+        return Ok(JumpPlan::hold(disc, disc.model().rest_state(from_rad)));
+    };
     let model = disc.model();
-    let z0 = model.rest_state(from_rad);
-    let z1 = model.rest_state(to_rad);
-    if from_rad == to_rad {
-        return Ok(JumpPlan::hold(disc, z0));
-    }
     let delta = to_rad - from_rad;
     let (d, sign) = (libm::fabs(delta), if delta < 0.0 { -1.0 } else { 1.0 });
     let drive = model.drive();
