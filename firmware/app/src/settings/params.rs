@@ -110,7 +110,7 @@ pub const MIN_CODES_PER_RAD: f64 = 1_000.0;
 pub const MAX_CODES_PER_RAD: f64 = 120_000.0;
 
 /// The parameter table (also the order of `params` and of the saved record).
-pub const PARAMS: &[ParamSpec] = &[
+pub static PARAMS: &[ParamSpec] = &[
     real!(
         "oq_cm",
         5.0,
