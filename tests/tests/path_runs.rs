@@ -396,11 +396,25 @@ fn figure_strategy() -> impl Strategy<Value = Figure> {
     let round = |v: f64| (v * 100.0).round() / 100.0;
     let rp = move |(x, y): (f64, f64)| (round(x), round(y));
     prop_oneof![
-        (point.clone(), point.clone()).prop_map(move |(a, b)| Figure::Line(rp(a), rp(b))),
+        // Figures the command line accepts: a line at least 0.1 cm long,
+        // rect sides at least 0.1 cm.
+        (point.clone(), point.clone())
+            .prop_map(move |(a, b)| (rp(a), rp(b)))
+            .prop_filter("a line at least 0.1 cm long", |(a, b)| {
+                (b.0 - a.0).abs().max((b.1 - a.1).abs()) >= 0.1
+            })
+            .prop_map(|(a, b)| Figure::Line(a, b)),
         ((-6.0f64..6.0, -4.0f64..4.0), 0.5f64..4.0, any::<bool>())
             .prop_map(move |(c, r, ccw)| Figure::Circle(rp(c), round(r), ccw)),
-        (point.clone(), (-6.0f64..6.0, -4.0f64..4.0))
-            .prop_map(move |(a, d)| Figure::Rect(rp(a), rp((a.0 + d.0, a.1 + d.1)))),
+        (
+            point.clone(),
+            (0.2f64..6.0, 0.2f64..4.0),
+            any::<(bool, bool)>()
+        )
+            .prop_map(move |(a, (w, h), (left, down))| {
+                let d = (if left { -w } else { w }, if down { -h } else { h });
+                Figure::Rect(rp(a), rp((a.0 + d.0, a.1 + d.1)))
+            }),
     ]
 }
 

@@ -4,9 +4,8 @@
 //! switches, `set`s in the middle of runs, host stalls (`@stall-read`,
 //! `@type-ahead`) and servo faults (silent servos, corrupted responses).
 //!
-//! Long task steps are tolerated (`UNTIL_STEP_FIXES`): the galvo loop
-//! plans a long time-optimal jump inside one step (up to 1.5 ms of host
-//! CPU); the ignored test demands short steps too.
+//! The campaigns tolerate long task steps (`UNTIL_STEP_FIXES`, host
+//! noise); `random_sessions_have_short_task_steps` demands them.
 
 use laser_sim::safety::{check, report_text};
 use laser_sim::servo_port::{BusFaults, SilentWindow};
@@ -158,14 +157,27 @@ fn random_sessions_with_faults_and_stalls_are_safe() {
     );
 }
 
+/// Runs of a session before a long step counts: the simulation is
+/// deterministic, so a step that really does too much work is long in
+/// every run, while host noise (page faults, other tests' threads) is not.
+const STEP_RUNS: usize = 3;
+
 #[test]
 fn random_sessions_have_short_task_steps() {
     for seed in 0..SESSIONS {
-        let report = run_session(seed);
-        let violations = check(&report);
+        let mut violations = check(&run_session(seed));
+        for _ in 1..STEP_RUNS {
+            if violations.is_empty() {
+                break;
+            }
+            let again = check(&run_session(seed));
+            if again.len() < violations.len() {
+                violations = again;
+            }
+        }
         assert!(
             violations.is_empty(),
-            "session {seed}:\n{}",
+            "session {seed}, in each of {STEP_RUNS} runs:\n{}",
             report_text(&violations)
         );
     }

@@ -7,6 +7,10 @@ use crate::settings::{JumpPlanner, LaserMode, find_param};
 
 /// Largest board coordinate accepted anywhere, cm.
 pub const BOARD_LIMIT_CM: f64 = 200.0;
+
+/// Smallest extent of a drawn figure, cm: a line's length, a rect's sides
+/// (as a circle's radius and the tuning figure's size).
+pub const MIN_FIGURE_CM: f64 = 0.1;
 /// Largest grid index magnitude accepted by the parser (the sequencer
 /// checks against the configured grid).
 const GRID_INDEX_LIMIT: i32 = 20;
@@ -132,17 +136,23 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
         // home, corner, horizontal, vertical, visit-all
         Pattern::Grid(grid)
     } else if is("line") {
-        Pattern::Line {
-            from: point(&mut args, "x0_cm", "y0_cm")?,
-            to: point(&mut args, "x1_cm", "y1_cm")?,
+        let (from, to) = (
+            point(&mut args, "x0_cm", "y0_cm")?,
+            point(&mut args, "x1_cm", "y1_cm")?,
+        );
+        if libm::fabs(to.x_cm - from.x_cm).max(libm::fabs(to.y_cm - from.y_cm)) < MIN_FIGURE_CM {
+            return Err(CommandError::Rejected(
+                "a line needs end points at least 0.1 cm apart (goto holds a single point)",
+            ));
         }
+        Pattern::Line { from, to }
     } else if is("tuning") {
         // Optional centre and size; defaults: a 4 cm figure at the origin.
         let mut peek = args.clone();
         match peek.next_word() {
             Some(w) if !w.eq_ignore_ascii_case("once") => Pattern::Tuning {
                 centre: point(&mut args, "cx_cm", "cy_cm")?,
-                size_cm: args.number("size_cm", 0.1, BOARD_LIMIT_CM)?,
+                size_cm: args.number("size_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?,
             },
             _ => Pattern::Tuning {
                 centre: PointCm {
@@ -153,13 +163,19 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
             },
         }
     } else if is("rect") {
-        Pattern::Rect {
-            a: point(&mut args, "x0_cm", "y0_cm")?,
-            b: point(&mut args, "x1_cm", "y1_cm")?,
+        let (a, b) = (
+            point(&mut args, "x0_cm", "y0_cm")?,
+            point(&mut args, "x1_cm", "y1_cm")?,
+        );
+        if libm::fabs(b.x_cm - a.x_cm).min(libm::fabs(b.y_cm - a.y_cm)) < MIN_FIGURE_CM {
+            return Err(CommandError::Rejected(
+                "a rect needs a width and a height of at least 0.1 cm (use line for one side)",
+            ));
         }
+        Pattern::Rect { a, b }
     } else if is("circle") {
         let centre = point(&mut args, "cx_cm", "cy_cm")?;
-        let radius_cm = args.number("radius_cm", 0.1, BOARD_LIMIT_CM)?;
+        let radius_cm = args.number("radius_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?;
         let mut peek = args.clone();
         let rotation = match peek.next_word() {
             Some(w) if w.eq_ignore_ascii_case("cw") => {
@@ -275,6 +291,31 @@ mod tests {
             parse_line("~~~").map_err(|e| e.to_string()),
             Err("unknown command '~~~'".to_string())
         );
+    }
+
+    #[test]
+    fn degenerate_figures_are_refused() {
+        for line in [
+            "pattern line 1 1 1 1",
+            "pattern line 1 1 1.05 0.95 once",
+            "pattern rect 0 0 0 0",
+            "pattern rect 0 0 5 0.05",
+            "pattern rect -3 2 -3 7 once",
+        ] {
+            match parse_line(line) {
+                Err(CommandError::Rejected(why)) => assert!(why.contains("0.1 cm"), "{why}"),
+                other => panic!("{line:?} → {other:?}"),
+            }
+        }
+        // At the limit they draw.
+        assert!(matches!(
+            ok("pattern line 1 1 1.1 1"),
+            Command::Pattern { .. }
+        ));
+        assert!(matches!(
+            ok("pattern rect 0 0 0.1 -0.1 once"),
+            Command::Pattern { .. }
+        ));
     }
 
     #[test]
