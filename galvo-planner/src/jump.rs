@@ -150,16 +150,7 @@ impl<const S: usize> JumpPlan<S> {
         method: MethodKind,
         info: PlanInfo,
     ) -> Self {
-        let mut plan = Self {
-            disc: *disc,
-            z0,
-            z1,
-            samples,
-            law,
-            method,
-            max_abs_u_v: 0.0,
-            info,
-        };
+        let mut plan = Self::with_peak(disc, z0, z1, samples, law, method, info, 0.0);
         let mut peak = 0.0f64;
         plan.for_each_input_rev(|_, u| peak = peak.max(libm::fabs(u)));
         plan.max_abs_u_v = peak;

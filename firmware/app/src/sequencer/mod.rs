@@ -138,13 +138,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             }
         };
         status.update(|s| s.activity = Activity::Idle);
-        if let Some(galvo) = galvo.filter(|_| crate::galvo::GALVO_OUTPUT) {
-            galvo
-                .config
-                .signal(crate::galvo::config_from(&settings.galvo));
-            galvo.allow_laser(settings.laser_mode != crate::settings::LaserMode::Off);
-        }
-        Self {
+        let mut sequencer = Self {
             link,
             servo,
             galvo,
@@ -163,7 +157,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             last_aim: None,
             measured: None,
             laser_on: false,
-        }
+        };
+        // The galvo loop starts with the loaded parameters and laser mode.
+        sequencer.configure_galvo();
+        sequencer
     }
 
     /// Current settings.
