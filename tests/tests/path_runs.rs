@@ -37,27 +37,16 @@ fn reply_to(report: &SimReport, line: &str) -> (u64, String) {
     (t - lines[sent].0, reply.clone())
 }
 
-/// Runs `script`; the report and the longest executor poll (host CPU).
-/// The simulation is deterministic: a poll that does too much work is long
-/// in every run, host noise (page faults, other tests' threads) is not, so
-/// the run is repeated (up to three times) while its longest poll is over
-/// the limit, and the shortest is kept.
+/// Runs `script`; the report and the longest executor poll (host CPU),
+/// the least noisy of up to three runs (see `least_noisy`).
 fn run_timed(script: &str, options: SimOptions) -> (SimReport, std::time::Duration) {
-    let mut best = (
-        run_with(script, options.clone()),
-        laser_sim::executor::longest_poll(),
-    );
-    for _ in 1..3 {
-        if best.1.as_micros() < LONGEST_POLL_US {
-            break;
-        }
-        let report = run_with(script, options.clone());
-        let longest = laser_sim::executor::longest_poll();
-        if longest < best.1 {
-            best = (report, longest);
-        }
-    }
-    best
+    system_tests::least_noisy(
+        || {
+            let report = run_with(script, options.clone());
+            (report, laser_sim::executor::longest_poll())
+        },
+        |(_, longest)| longest.as_micros().saturating_sub(LONGEST_POLL_US - 1),
+    )
 }
 
 #[test]

@@ -11,7 +11,8 @@ use laser_sim::safety::{check, report_text};
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::{
-    UNTIL_STEP_FIXES, XorShift, assert_safe_allowing, random_meaningful_commands, run_with,
+    NOISE_RUNS, UNTIL_STEP_FIXES, XorShift, assert_safe_allowing, least_noisy,
+    random_meaningful_commands, run_with,
 };
 
 /// Random sessions per campaign.
@@ -157,27 +158,14 @@ fn random_sessions_with_faults_and_stalls_are_safe() {
     );
 }
 
-/// Runs of a session before a long step counts: the simulation is
-/// deterministic, so a step that really does too much work is long in
-/// every run, while host noise (page faults, other tests' threads) is not.
-const STEP_RUNS: usize = 3;
-
 #[test]
 fn random_sessions_have_short_task_steps() {
     for seed in 0..SESSIONS {
-        let mut violations = check(&run_session(seed));
-        for _ in 1..STEP_RUNS {
-            if violations.is_empty() {
-                break;
-            }
-            let again = check(&run_session(seed));
-            if again.len() < violations.len() {
-                violations = again;
-            }
-        }
+        // A long step must recur in every run (see `least_noisy`).
+        let violations = least_noisy(|| check(&run_session(seed)), |v| v.len() as u128);
         assert!(
             violations.is_empty(),
-            "session {seed}, in each of {STEP_RUNS} runs:\n{}",
+            "session {seed}, in each of {NOISE_RUNS} runs:\n{}",
             report_text(&violations)
         );
     }
