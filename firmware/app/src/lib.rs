@@ -7,6 +7,9 @@
 //! [`sequencer`] (task body that runs commands and patterns) →
 //! [`servo`] (servo task body and FashionStar codec) and [`galvo`] (the
 //! galvo loop body feeding the DAC).
+//! The vocabulary below them all — board points, cm ↔ mm, patterns and
+//! path figures, actuators, targets, the aiming chain and the checks — is
+//! [`domain`].
 //! Text handling lives in [`cli`], parameters in [`settings`], shared
 //! state for LEDs/watchdog/simulator in [`status`], the master laser gate
 //! that no laser command or sample stream can override in [`laser_gate`].
@@ -14,6 +17,7 @@
 pub mod build_info;
 pub mod cli;
 pub mod command;
+pub mod domain;
 pub mod galvo;
 pub mod laser_gate;
 mod log;

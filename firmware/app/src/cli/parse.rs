@@ -2,7 +2,8 @@
 
 use super::args::Args;
 use super::error::{CommandError, word};
-use crate::command::{Actuator, AimModel, Command, GridPattern, Pattern, PointCm, Rotation};
+use crate::command::Command;
+use crate::domain::{Actuator, AimModel, Figure, GridPattern, Pattern, PointCm, Rotation};
 use crate::settings::{JumpPlanner, LaserMode, find_param};
 
 /// Largest board coordinate accepted anywhere, cm.
@@ -145,22 +146,22 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
                 "a line needs end points at least 0.1 cm apart (goto holds a single point)",
             ));
         }
-        Pattern::Line { from, to }
+        Pattern::Path(Figure::Line { from, to })
     } else if is("tuning") {
         // Optional centre and size; defaults: a 4 cm figure at the origin.
         let mut peek = args.clone();
         match peek.next_word() {
-            Some(w) if !w.eq_ignore_ascii_case("once") => Pattern::Tuning {
+            Some(w) if !w.eq_ignore_ascii_case("once") => Pattern::Path(Figure::Tuning {
                 centre: point(&mut args, "cx_cm", "cy_cm")?,
                 size_cm: args.number("size_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?,
-            },
-            _ => Pattern::Tuning {
+            }),
+            _ => Pattern::Path(Figure::Tuning {
                 centre: PointCm {
                     x_cm: 0.0,
                     y_cm: 0.0,
                 },
                 size_cm: 4.0,
-            },
+            }),
         }
     } else if is("rect") {
         let (a, b) = (
@@ -172,7 +173,7 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
                 "a rect needs a width and a height of at least 0.1 cm (use line for one side)",
             ));
         }
-        Pattern::Rect { a, b }
+        Pattern::Path(Figure::Rect { a, b })
     } else if is("circle") {
         let centre = point(&mut args, "cx_cm", "cy_cm")?;
         let radius_cm = args.number("radius_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?;
@@ -188,11 +189,11 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
             }
             _ => Rotation::Ccw,
         };
-        Pattern::Circle {
+        Pattern::Path(Figure::Circle {
             centre,
             radius_cm,
             rotation,
-        }
+        })
     } else {
         return Err(CommandError::InvalidArgument {
             expected: "home|corner|horizontal|vertical|visit-all|grid-full|line|circle|rect|tuning",
@@ -354,21 +355,21 @@ mod tests {
         assert_eq!(
             ok("pattern circle 0 0 5 cw once"),
             Command::Pattern {
-                pattern: Pattern::Circle {
+                pattern: Pattern::Path(Figure::Circle {
                     centre: PointCm {
                         x_cm: 0.0,
                         y_cm: 0.0
                     },
                     radius_cm: 5.0,
                     rotation: Rotation::Cw
-                },
+                }),
                 once: true
             }
         );
         assert_eq!(
             ok("pattern line -5 1 5 -1"),
             Command::Pattern {
-                pattern: Pattern::Line {
+                pattern: Pattern::Path(Figure::Line {
                     from: PointCm {
                         x_cm: -5.0,
                         y_cm: 1.0
@@ -377,7 +378,7 @@ mod tests {
                         x_cm: 5.0,
                         y_cm: -1.0
                     }
-                },
+                }),
                 once: false
             }
         );

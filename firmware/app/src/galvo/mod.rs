@@ -19,7 +19,6 @@
 //! the simulator feeds a simulated DAC. Not wired yet: the target's
 //! timer-triggered DAC DMA (see the README's status).
 
-mod path;
 mod scan;
 
 /// Whether this build drives a galvo (cargo feature `galvo`). The
@@ -28,32 +27,20 @@ mod scan;
 /// the sequencer is compiled out (`target galvo|both` is refused).
 pub const GALVO_OUTPUT: bool = cfg!(feature = "galvo");
 
-pub use path::GalvoPath;
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, Phase};
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 
 use galvo_planner::{Method, RigidParams};
-use kinematics_core::{DacAxis, Galvo, GalvoGeometry};
 
+use crate::domain::Figure;
 use crate::settings::{GalvoSettings, JumpPlanner};
 
 /// The loop configuration for the user's galvo parameters.
 pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
-    let dac = |codes_per_rad: f64, offset_code: f64| DacAxis {
-        codes_per_rad: codes_per_rad as f32,
-        offset_code: offset_code as f32,
-    };
     GalvoConfig {
         sample_period_s: settings.sample_period_us * 1e-6,
-        galvo: Galvo {
-            geometry: GalvoGeometry {
-                d_mm: settings.d_mm as f32,
-                e_mm: settings.e_mm as f32,
-            },
-            dac_x: dac(settings.x_codes_per_rad, settings.x_offset_code),
-            dac_y: dac(settings.y_codes_per_rad, settings.y_offset_code),
-        },
+        galvo: settings.galvo(),
         mirrors: RigidParams {
             kt_nm_per_a: settings.kt_nm_per_a,
             j_kg_m2: settings.j_kg_m2,
@@ -162,8 +149,8 @@ pub enum GalvoRequest {
     Path {
         /// Request number.
         seq: u32,
-        /// What to draw.
-        path: GalvoPath,
+        /// What to draw (board cm; the loop takes its strokes in mm).
+        path: Figure,
     },
     /// Drop queued jobs, laser off at once; the mirrors finish the jump in
     /// flight (a jump is rest to rest) or brake along the stroke being

@@ -10,8 +10,8 @@ use galvo_planner::{
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
-use super::path::GalvoPath;
 use super::{DacSample, DacStream, GalvoEvent, GalvoLink, GalvoRequest, Half};
+use crate::domain::{Figure, Unit};
 use crate::laser_gate::LaserGate;
 use crate::log;
 use crate::settings::GalvoSettings;
@@ -112,8 +112,8 @@ pub enum Phase {
 enum Job {
     /// Jump to a point and dwell there (µs).
     Point { target_mm: PointMm, dwell_us: u32 },
-    /// Mark a path, stroke by stroke.
-    Path(GalvoPath),
+    /// Mark a path, stroke by stroke (in mm, see [`Unit::GalvoMm`]).
+    Path(Figure),
 }
 
 /// The job being run.
@@ -259,7 +259,7 @@ impl GalvoLoop {
         match job {
             Job::Point { target_mm, .. } => self.angles_for(*target_mm).map(|_| ()),
             Job::Path(path) => {
-                for [x_mm, y_mm] in path.bounds_mm() {
+                for [x_mm, y_mm] in path.bounds(Unit::GalvoMm) {
                     self.angles_for(PointMm { x_mm, y_mm })?;
                 }
                 Ok(())
@@ -461,7 +461,9 @@ impl GalvoLoop {
                 Phase::Dwelling => a.enter(Phase::LaserOffDelay, self.off_delay_samples),
                 Phase::LaserOffDelay | Phase::Idle => {
                     let next_stroke = match a.job {
-                        Job::Path(path) => path.stroke(a.stroke + 1).map(|_| a.stroke + 1),
+                        Job::Path(path) => path
+                            .stroke(a.stroke + 1, Unit::GalvoMm)
+                            .map(|_| a.stroke + 1),
                         Job::Point { .. } => None,
                     };
                     let Some(stroke) = next_stroke else {
@@ -487,8 +489,8 @@ impl GalvoLoop {
         let Some(a) = self.active else { return false };
         let target_mm = match a.job {
             Job::Point { target_mm, .. } => target_mm,
-            Job::Path(path) => match path.stroke(a.stroke) {
-                Some(([x_mm, y_mm], _)) => PointMm { x_mm, y_mm },
+            Job::Path(path) => match path.stroke(a.stroke, Unit::GalvoMm) {
+                Some(stroke) => PointMm::new(stroke.start[0], stroke.start[1]),
                 None => return false,
             },
         };

@@ -1,13 +1,13 @@
 //! Command handling: each command gets its reply here, and changes state
 //! only when it is accepted.
 
-use super::targets::{self, PatternError, Target};
 use super::{LaserSwitch, Phase, Run, Sequencer, SettingsStore};
 use crate::build_info;
 use crate::cli::format::Fixed;
 use crate::cli::parse::HELP_LINES;
-use crate::command::{Actuator, ReplyText, reply_text};
-use crate::command::{AimModel, Command, Pattern, PointCm};
+use crate::command::{Command, ReplyText, reply_text};
+use crate::domain::check_target;
+use crate::domain::{Actuator, AimModel, Pattern, PatternCheck, PatternError, PointCm, Target};
 use crate::galvo::GALVO_OUTPUT;
 use crate::settings::{PARAMS, ParamLine};
 use crate::status::{Activity, Snapshot};
@@ -54,7 +54,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 Err(reason) => link.error(reason),
             },
             Command::Goto(point) => self.goto(Target { point, grid: None }),
-            Command::Grid { xi, yi } => match targets::grid_point(&self.settings, xi, yi) {
+            Command::Grid { xi, yi } => match self.aimer.grid_point(xi, yi) {
                 Ok(target) => self.goto(target),
                 Err(reason) => link.error(reason),
             },
@@ -90,6 +90,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             }
             Command::Model(model) => {
                 self.model = model;
+                self.aimer = self.settings.aimer(model);
                 // Re-aim the current point with the new model; on the
                 // galvo the new job replaces the one running (a dwell or
                 // a hold), it does not queue behind it.
@@ -102,20 +103,24 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 link.ok();
             }
             Command::Set { param, value } => {
-                let before = self.settings;
+                let (before, aimer_before) = (self.settings, self.aimer);
                 match self.settings.set(param, value) {
-                    Ok(()) => match self.check_current_run().await {
-                        Ok(()) => {
-                            if GALVO_OUTPUT && before.galvo != self.settings.galvo {
-                                self.configure_galvo();
+                    Ok(()) => {
+                        self.aimer = self.settings.aimer(self.model);
+                        match self.check_current_run().await {
+                            Ok(()) => {
+                                if GALVO_OUTPUT && before.galvo != self.settings.galvo {
+                                    self.configure_galvo();
+                                }
+                                link.ok()
                             }
-                            link.ok()
+                            Err(reason) => {
+                                self.settings = before;
+                                self.aimer = aimer_before;
+                                link.error(reason);
+                            }
                         }
-                        Err(reason) => {
-                            self.settings = before;
-                            link.error(reason);
-                        }
-                    },
+                    }
                     Err(e) => link.error(e),
                 }
             }
@@ -153,7 +158,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
 
     /// Aims at one target and holds it; refuses unreachable targets.
     fn goto(&mut self, target: Target) {
-        match targets::check_target(&self.settings, self.model, self.actuator, &target) {
+        match check_target(&self.aimer, self.actuator, &target) {
             Ok(_) => {
                 self.start(Run::new(None, Some(target), true));
                 self.link.ok();
@@ -163,12 +168,12 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     }
 
     /// `pattern` must be reachable at its probe points before it starts
-    /// (see [`targets::PatternCheck`]; the run checks every other point
+    /// (see [`PatternCheck`]; the run checks every other point
     /// before it goes there). A few points per executor step: the other
     /// tasks run in between.
     async fn check_pattern(&self, pattern: &Pattern) -> Result<(), PatternError> {
-        let mut check = targets::PatternCheck::new(pattern, &self.settings, self.actuator)?;
-        while !check.step(&self.settings, self.model, self.actuator, CHECKS_PER_STEP)? {
+        let mut check = PatternCheck::new(pattern, &self.aimer, self.actuator)?;
+        while !check.step(&self.aimer, self.actuator, CHECKS_PER_STEP)? {
             embassy_futures::yield_now().await;
         }
         Ok(())
@@ -186,7 +191,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             Some(Run {
                 single: Some(target),
                 ..
-            }) => targets::check_target(&self.settings, self.model, self.actuator, &target),
+            }) => check_target(&self.aimer, self.actuator, &target),
             _ => Ok(()),
         }
     }

@@ -3,9 +3,9 @@
 
 use core::sync::atomic::Ordering;
 
-use super::targets::{self, Target};
 use super::{LaserSwitch, Phase, Sequencer, SettingsStore};
 use crate::cli::format::Shortest;
+use crate::domain::Target;
 use crate::galvo::{GALVO_OUTPUT, GalvoEvent, GalvoRequest, config_from};
 use crate::log;
 use crate::settings::LaserMode;
@@ -63,10 +63,11 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             None => HOLD_US,
             Some(_) => (self.settings.dwell_ms * 1000.0) as u32,
         };
+        let [x_mm, y_mm] = target.point.galvo_mm();
         let sent = self.send_galvo_job(|seq| GalvoRequest::Point {
             seq,
-            x_mm: (target.point.x_cm * 10.0) as f32,
-            y_mm: (target.point.y_cm * 10.0) as f32,
+            x_mm,
+            y_mm,
             dwell_us,
         });
         if !sent {
@@ -83,10 +84,7 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     /// Sends the running path pattern to the galvo as one job.
     pub(super) fn begin_galvo_path(&mut self) {
         self.allow_galvo_laser();
-        let path = self
-            .run
-            .and_then(|r| r.pattern)
-            .and_then(|p| targets::galvo_path(&p));
+        let path = self.run.and_then(|r| r.pattern).and_then(|p| p.figure());
         let Some(path) = path else {
             self.stop("not a path");
             return;

@@ -11,15 +11,14 @@ mod commands;
 mod faults;
 mod galvo;
 mod laser;
-pub mod targets;
 
 use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::laser::{LaserEvent, LaserSwitch, laser_wanted};
-use self::targets::{Aim, PathCursor, Target};
 use crate::cli::format::Fixed;
-use crate::command::{Actuator, AimModel, CommandLink, Pattern};
+use crate::command::CommandLink;
+use crate::domain::{Actuator, Aim, AimModel, Aimer, PathCursor, Pattern, Target};
 use crate::galvo::GalvoLink;
 use crate::laser_gate::LaserGate;
 use crate::log;
@@ -60,6 +59,8 @@ pub struct Sequencer<'a, L: LaserSwitch, S: SettingsStore> {
     store: S,
     settings: Settings,
     model: AimModel,
+    /// The geometry of `settings` and `model` (rebuilt when they change).
+    aimer: Aimer,
     /// Which actuator(s) draw.
     actuator: Actuator,
     booted_at: Instant,
@@ -147,6 +148,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             gate,
             gate_generation,
             store,
+            aimer: settings.aimer(AimModel::Exact),
             settings,
             model: AimModel::Exact,
             actuator: Actuator::Gimbal,
@@ -260,7 +262,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         let run = self.run?;
         match (run.pattern, run.path) {
             (Some(_), Some(path)) => Some(path.target()),
-            (Some(pattern), None) => targets::grid_target(&pattern, run.index, &self.settings),
+            (Some(pattern), None) => self.aimer.grid_target(&pattern, run.index),
             (None, _) => run.single,
         }
     }
@@ -273,7 +275,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         if self.actuator.uses_galvo() {
             return None;
         }
-        PathCursor::start(&pattern, &self.settings)?.ok()
+        PathCursor::start(&pattern, &self.aimer)?.ok()
     }
 
     /// Whether the run is a path marked by the galvo alone (one job per
@@ -329,7 +331,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     /// Aims the gimbal at `target` and sends the servo move; on an
     /// unreachable target stops with an error notice.
     fn begin_gimbal_move(&mut self, target: Target) -> bool {
-        let aim = match targets::aim(&self.settings, self.model, target.point) {
+        let aim = match self.aimer.aim(target.point) {
             Ok(aim) => aim,
             Err(e) => {
                 let why = crate::command::reply_text(format_args!("{e}"));
@@ -455,8 +457,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         let more = match run.path.as_mut() {
             Some(path) => path.advance(),
             None => {
-                !self.is_galvo_path_run()
-                    && targets::grid_target(&pattern, run.index, &self.settings).is_some()
+                !self.is_galvo_path_run() && self.aimer.grid_target(&pattern, run.index).is_some()
             }
         };
         if !more {

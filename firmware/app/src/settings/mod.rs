@@ -12,6 +12,7 @@
 //! `params.rs` holds the table, `record.rs` the saved form, `store.rs` where
 //! it is kept (two flash sectors, power-fail safe).
 
+mod geometry;
 mod params;
 mod record;
 pub mod store;

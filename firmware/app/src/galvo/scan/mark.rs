@@ -6,8 +6,8 @@ use galvo_planner::{MarkLimits, MarkSample, PathPlanner};
 use kinematics_core::PointMm;
 
 use super::{GalvoError, GalvoLoop, JUNCTION_DEVIATION_MM, Phase};
+use crate::domain::{Figure, Rotation, Segment, Unit};
 use crate::galvo::GalvoEvent;
-use crate::galvo::path::{GalvoPath, Segment};
 
 /// The spot while marking or braking: position (mm) and its change over
 /// the last sample (mm per sample).
@@ -105,18 +105,20 @@ impl GalvoLoop {
         }
     }
 
-    /// Loads stroke `stroke` of `path` into the path planner and starts
-    /// marking; `false` (with `Refused`) when the planner refuses it.
+    /// Loads stroke `stroke` of `path`, laid out in the galvo's mm, into
+    /// the path planner and starts marking; `false` (with `Refused`) when
+    /// the planner refuses it.
     pub(super) fn start_marking(
         &mut self,
-        path: GalvoPath,
+        path: Figure,
         stroke: usize,
         on_event: &mut impl FnMut(GalvoEvent),
     ) -> bool {
         let Some(a) = self.active else { return false };
-        let Some((start, segments)) = path.stroke(stroke) else {
+        let Some(stroke) = path.stroke(stroke, Unit::GalvoMm) else {
             return false;
         };
+        let start = stroke.start;
         let limits = MarkLimits {
             speed_mm_s: self.config.mark_speed_mm_s,
             accel_mm_s2: self.config.mark_accel_mm_s2,
@@ -124,10 +126,14 @@ impl GalvoLoop {
             ts_s: self.config.sample_period_s,
         };
         let loaded = PathPlanner::new(limits, start).and_then(|mut planner| {
-            for segment in &segments {
+            for segment in &stroke.segments {
                 match *segment {
-                    Segment::Line(to) => planner.line_to(to)?,
-                    Segment::Arc { end, centre, ccw } => planner.arc_to(end, centre, ccw)?,
+                    Segment::Line { to } => planner.line_to(to)?,
+                    Segment::Arc {
+                        end,
+                        centre,
+                        rotation,
+                    } => planner.arc_to(end, centre, rotation == Rotation::Ccw)?,
                 }
             }
             Ok(planner)
