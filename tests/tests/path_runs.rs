@@ -2,7 +2,7 @@
 //! tasks up, unreachable figures are refused or stop dark, and the laser
 //! is lit only on the figure (travel to it is dark).
 
-use laser_app::domain::{Actuator, AimModel, Figure, Pattern, PointCm, check_pattern, pass_points};
+use laser_app::domain::{self, Actuator, AimModel, Pattern, PointCm, check_pattern, pass_points};
 use laser_app::settings::Settings;
 use laser_sim::recorder::{Direction, SpotSample};
 use laser_sim::world::{SimOptions, SimReport};
@@ -214,7 +214,7 @@ fn limit_between_probes(pattern: &Pattern) -> (&'static str, f64) {
 #[test]
 fn a_figure_unreachable_between_checked_points_stops_dark_at_the_first_bad_point() {
     let (x0, x1, y) = (-60.0, 47.0, 20.0);
-    let pattern = Pattern::Path(Figure::Line {
+    let pattern = Pattern::Path(domain::Figure::Line {
         from: PointCm { x_cm: x0, y_cm: y },
         to: PointCm { x_cm: x1, y_cm: y },
     });
