@@ -27,11 +27,12 @@
 //! Separate paths are joined by jumps ([`PathPlanner::move_to`]); the
 //! sampler reports a jump as [`MarkSample::Jump`] and pauses, so the caller
 //! can run the mirror jump (in angle space, with the laser off) with the
-//! [`jump`](crate::jump) planner and [`XyStepper`](crate::stepper::XyStepper).
+//! [`jump`](crate::jump) planner and [`XyIntegrator`](crate::integrator::XyIntegrator).
 //! The planner works in board coordinates only; converting them to mirror
 //! angles is the caller's job (galvo kinematics live in another crate).
 
-use crate::error::{Error, clamp, finite, positive};
+use crate::error::{Error, positive};
+use kinematics_core::numeric::{clamp, finite};
 
 /// Limits and sample period of the path planner.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -48,9 +49,9 @@ pub struct MarkLimits {
 
 impl MarkLimits {
     fn validate(&self) -> Result<(), Error> {
-        positive("speed_mm_s", self.speed_mm_s)?;
-        positive("accel_mm_s2", self.accel_mm_s2)?;
-        let jd = finite("junction_deviation_mm", self.junction_deviation_mm)?;
+        positive(self.speed_mm_s, "speed_mm_s")?;
+        positive(self.accel_mm_s2, "accel_mm_s2")?;
+        let jd = finite(self.junction_deviation_mm, "junction_deviation_mm")?;
         if jd < 0.0 {
             return Err(Error::NotPositive {
                 name: "junction_deviation_mm",
@@ -318,7 +319,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
 
     /// Marking speed for the following segments (capped at the limit).
     pub fn set_feed_mm_s(&mut self, feed_mm_s: f64) -> Result<(), Error> {
-        let f = positive("feed_mm_s", feed_mm_s)?;
+        let f = positive(feed_mm_s, "feed_mm_s")?;
         self.feed_mm_s = f.min(self.limits.speed_mm_s);
         Ok(())
     }
@@ -866,8 +867,8 @@ fn cos_sin_small(delta: f32) -> (f32, f32) {
 }
 
 fn finite_point(name: &'static str, p: [f64; 2]) -> Result<[f64; 2], Error> {
-    finite(name, p[0])?;
-    finite(name, p[1])?;
+    finite(p[0], name)?;
+    finite(p[1], name)?;
     Ok(p)
 }
 
