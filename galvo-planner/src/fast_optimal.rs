@@ -44,6 +44,7 @@ mod newton;
 
 use crate::bang_bang::{BangBang, ContinuousOptimum, OptimalInfo, OptimalStructure};
 use crate::error::Error;
+use crate::linalg::Vector;
 use crate::model::Discrete;
 use crate::optimal::{RigidMove, plan_time_optimal, rigid_move};
 use crate::plan::{InputLaw, JumpPlan, MethodKind, PlanInfo};
@@ -135,10 +136,7 @@ fn fast_plan(
                 capacity,
             });
         }
-        let (l1, l2) = (1.0 + m1.mu, 1.0 + m2.mu);
-        let k = m * u_max / (m1.mu * m2.mu);
-        let u = [k * l1 * l2, -k * (l1 + l2), k];
-        if u.iter().all(|x| x.abs() <= u_max) {
+        if let Some(u) = dead_beat(modes, m, u_max) {
             return Ok(Some(FastSolution {
                 n: 3,
                 kind: FastKind::DeadBeat(u),
@@ -161,13 +159,39 @@ fn fast_plan(
     if !in_range {
         return Ok(None);
     }
+    let guess = cont.unwrap_or(guess);
+    fixed_n_search(modes, m, n_star, guess, cont, capacity)
+}
+
+/// The unique 3-sample (dead-beat) input for `m` (samples of `Umax`),
+/// reversed (j = 0 is the last sample), V; `None` when it exceeds Umax.
+#[inline(always)]
+fn dead_beat(modes: &[Mode; 2], m: f32, u_max: f32) -> Option<[f32; 3]> {
+    let [m1, m2] = modes;
+    let (l1, l2) = (1.0 + m1.mu, 1.0 + m2.mu);
+    let k = m * u_max / (m1.mu * m2.mu);
+    let u = [k * l1 * l2, -k * (l1 + l2), k];
+    u.iter().all(|x| x.abs() <= u_max).then_some(u)
+}
+
+/// The plan itself: the first whole sample count from `⌈N*⌉` (at least 4)
+/// whose switches, solved with `N` fixed from `guess` stretched along,
+/// leave a last sample within Umax (4 counts are tried).
+#[inline(always)]
+fn fixed_n_search(
+    modes: &[Mode; 2],
+    m: f32,
+    n_star: f32,
+    mut guess: Switches,
+    cont: Option<Switches>,
+    capacity: usize,
+) -> Result<Option<FastSolution>, Error> {
     let first = libm::ceilf(n_star - 5e-3);
     let first = if first.is_finite() && first >= 1.0 {
         first as usize
     } else {
         1
     };
-    let mut guess = cont.unwrap_or(guess);
     guess.sigma2 = hi(guess.sigma2, 1.0);
     guess.sigma1 = hi(guess.sigma1, guess.sigma2);
     let first = first.max(4);
@@ -242,7 +266,20 @@ pub fn plan_time_optimal_fast<const S: usize>(
     let Some(sol) = fast_plan(&modes, m, u_max32, capacity)? else {
         return plan_time_optimal(disc, from_rad, to_rad, capacity);
     };
-    let ts = fast.ts_s;
+    solution_plan(disc, (z0, z1), sign, u_max, fast.ts_s, sol)
+}
+
+/// The plan of an `f32` solution, moving in the direction `sign`, with its
+/// diagnostics (`ts` the sample period, s, in `f32`).
+#[inline(always)]
+fn solution_plan<const S: usize>(
+    disc: &Discrete<S>,
+    (z0, z1): (Vector<S>, Vector<S>),
+    sign: f64,
+    u_max: f64,
+    ts: f32,
+    sol: FastSolution,
+) -> Result<JumpPlan<S>, Error> {
     let continuous = sol.cont.map(|s| ContinuousOptimum {
         time_s: f64::from(sol.n_star * ts),
         switches_s: (

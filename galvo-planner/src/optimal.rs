@@ -148,29 +148,10 @@ pub fn plan_time_optimal<const S: usize>(
         last_sample_v: 0.0,
         single_precision: false,
     };
-    if n_lo <= S {
-        if S > capacity {
-            return Err(Error::CapacityExceeded {
-                needed: S,
-                capacity,
-            });
-        }
-        if let Some(sol) = min_energy_at(disc, &z0, &z1, S, 2)
-            && sol.max_abs_u_v <= u_max
-        {
-            info.structure = OptimalStructure::DeadBeat;
-            let law = InputLaw::MinEnergy { lambda: sol.lambda };
-            let info = PlanInfo::Optimal(info);
-            return Ok(JumpPlan::new(
-                disc,
-                z0,
-                z1,
-                S,
-                law,
-                MethodKind::TimeOptimal,
-                info,
-            ));
-        }
+    if n_lo <= S
+        && let Some(plan) = dead_beat(disc, (z0, z1), capacity, &mut info)?
+    {
+        return Ok(plan);
     }
     if let Some([t1, t2, _]) = cont {
         let search = SampledSearch {
@@ -192,6 +173,38 @@ pub fn plan_time_optimal<const S: usize>(
     let plan = plan_bisection(disc, &z0, &z1, cfg, capacity)?;
     info.structure = OptimalStructure::MinEnergyFallback;
     Ok(plan.relabel(MethodKind::TimeOptimal, PlanInfo::Optimal(info)))
+}
+
+/// The `S`-sample (dead-beat) minimum-energy input, if it is within Umax.
+fn dead_beat<const S: usize>(
+    disc: &Discrete<S>,
+    (z0, z1): (Vector<S>, Vector<S>),
+    capacity: usize,
+    info: &mut OptimalInfo,
+) -> Result<Option<JumpPlan<S>>, Error> {
+    if S > capacity {
+        return Err(Error::CapacityExceeded {
+            needed: S,
+            capacity,
+        });
+    }
+    match min_energy_at(disc, &z0, &z1, S, 2) {
+        Some(sol) if sol.max_abs_u_v <= disc.u_max_v() => {
+            info.structure = OptimalStructure::DeadBeat;
+            let law = InputLaw::MinEnergy { lambda: sol.lambda };
+            let info = PlanInfo::Optimal(*info);
+            Ok(Some(JumpPlan::new(
+                disc,
+                z0,
+                z1,
+                S,
+                law,
+                MethodKind::TimeOptimal,
+                info,
+            )))
+        }
+        _ => Ok(None),
+    }
 }
 
 /// The closed-form response of a rigid model (`S = 3`).
