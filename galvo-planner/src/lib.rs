@@ -23,14 +23,23 @@
 //! | module | what | key items |
 //! |---|---|---|
 //! | [`model`] | rigid `(θ, ω, I)` and flexible `(θ, ω, I, φ, ω_φ)` models, exact ZOH discretisation | [`RigidParams::model`], [`FlexParams::model`], [`LinearModel::discretize`] → [`Discrete`] |
-//! | [`jump`] | one plan type for every method, dispatcher, two-axis jumps | [`plan_jump`], [`plan_xy_jump`], [`JumpPlan`], [`Method`], [`JumpSync`] |
-//! | [`min_energy`] | minimum-energy input over N samples; seed bisection planner | [`min_energy::plan_min_energy`], [`min_energy::plan_bisection`], [`BisectionConfig`] |
+//! | [`plan`] | one plan type for every method (below the planners) | [`JumpPlan`], [`XyJump`], [`MethodKind`], [`PlanInfo`] |
+//! | [`jump`] | method dispatcher, two-axis jumps (above the planners) | [`plan_jump`], [`plan_xy_jump`], [`Method`], [`JumpSync`] |
+//! | [`min_energy`] | minimum-energy input over N samples ([`gramian`]: its linear algebra) | [`min_energy::plan_min_energy`] |
+//! | [`bisection`] | the patent's bisection planner (user-facing name `seed`) | [`bisection::plan_bisection`], [`BisectionConfig`] |
 //! | [`fast_optimal`] | time-optimal rest-to-rest (rigid) in `f32`: the default [`Method::TimeOptimal`], µs on the M4F | [`fast_optimal::plan_time_optimal_fast`] |
-//! | [`optimal`] | time-optimal rest-to-rest (rigid) in `f64`: reference and fallback | [`optimal::plan_time_optimal`] |
-//! | [`profile`] | T-curve / S-curve baselines and their inverse-dynamics voltage | [`profile::plan_profile`], [`profile::Profile`], [`profile::ProfileLimits::from_drive`] |
+//! | [`optimal`] | time-optimal rest-to-rest (rigid) in `f64`: reference and fallback ([`bang_bang`]: its input law) | [`optimal::plan_time_optimal`] |
+//! | [`profile`] | T-curve / S-curve baselines ([`motion_profile`]: the profiles and their inverse-dynamics voltage) | [`profile::plan_profile`], [`profile::Profile`], [`profile::ProfileLimits::from_drive`] |
 //! | [`integrator`] | per-sample `f32` state update, move queue, two axes | [`Integrator`], [`XyIntegrator`] |
 //! | [`path`] | look-ahead marking of lines and arcs in the board plane | [`PathPlanner`], [`MarkLimits`], [`MarkSample`], [`BlockEnd`] |
 //! | [`linalg`] | small fixed-size matrices, matrix exponential | [`linalg::expm_and_integral`] |
+//!
+//! Modules, bottom to top (each uses only those below it):
+//! `error`, `linalg`, `bang_bang` → `rigid_modes` → `model` → `gramian`,
+//! `motion_profile` → `plan` → `min_energy`, `bisection`, `profile`,
+//! `optimal` → `fast_optimal`, `integrator` → `jump`; `path` stands alone
+//! (board plane, mm). `finite`, `clamp` and the back-substitution come from
+//! `kinematics_core::numeric`.
 //!
 //! # The galvo loop
 //!
