@@ -24,9 +24,9 @@
 
 pub mod motion;
 
-use laser_app::servo::protocol::{
-    Monitor, ReadData, Request, RequestDecoder, Response, SetAngle, SetAngleByInterval,
-    SetAngleByVelocity,
+use fashionstar::{
+    Message, Monitor, MotionCommand, ReadData, Request, RequestDecoder, Response, SetAngle,
+    SetAngleByInterval, SetAngleByVelocity,
 };
 
 use motion::Motion;
@@ -160,28 +160,12 @@ impl SimServo {
     pub fn execute(&mut self, now_us: u64, request: &Request) -> Option<Response> {
         let t = now_us as f64;
         let from = self.angle_deg(now_us);
-        let mine = |id: &u8| *id == self.id;
-        match request {
-            Request::SetAngle(c) if mine(&c.id) => self.set_angle(t, from, c),
-            Request::SetAngleByInterval(c) if mine(&c.id) => self.by_interval(t, from, c),
-            Request::SetAngleByVelocity(c) if mine(&c.id) => self.by_velocity(t, from, c),
-            Request::Damping { id, .. } if mine(id) => self.motion = Motion::hold(from),
-            Request::SyncSetAngle(entries) => {
-                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
-                    self.set_angle(t, from, c);
-                }
-            }
-            Request::SyncSetAngleByInterval(entries) => {
-                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
-                    self.by_interval(t, from, c);
-                }
-            }
-            Request::SyncSetAngleByVelocity(entries) => {
-                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
-                    self.by_velocity(t, from, c);
-                }
-            }
-            _ => {}
+        match request.motion_for(self.id) {
+            Some(MotionCommand::SetAngle(c)) => self.set_angle(t, from, &c),
+            Some(MotionCommand::SetAngleByInterval(c)) => self.by_interval(t, from, &c),
+            Some(MotionCommand::SetAngleByVelocity(c)) => self.by_velocity(t, from, &c),
+            Some(MotionCommand::Damping { .. }) => self.motion = Motion::hold(from),
+            None => {}
         }
         if self.silent || request.id() != Some(self.id) {
             return None;

@@ -1,6 +1,6 @@
-//! The FashionStar servo bus: the frame codec ([`protocol`]) and the servo
-//! task body ([`task`]).
+//! The FashionStar servo bus: the servo task body ([`task`]) speaking the
+//! `fashionstar` frame codec, and the plausibility filter of its angle
+//! readings ([`plausibility`]).
 
 pub mod plausibility;
-pub mod protocol;
 pub mod task;

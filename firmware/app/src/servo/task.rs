@@ -20,8 +20,8 @@ use embassy_time::{Duration, Instant, Timer, with_deadline, with_timeout};
 use embedded_io_async::{Read, Write};
 
 use super::plausibility::{IMPLAUSIBLE_RUN, ReadingFilter, Verdict, WIRE_LIMIT_TENTHS};
-use super::protocol::{MAX_FRAME_LEN, Request, Response, ResponseDecoder, SetAngle};
 use crate::log;
+use fashionstar::{MAX_FRAME_LEN, Message, Request, Response, ResponseDecoder, SetAngle};
 
 /// Servo ids and timing of the servo bus. All durations in ms, angles in
 /// the servo's wire unit (0.1°).
