@@ -284,7 +284,7 @@ fn closing_the_gate_stops_the_loop_even_when_no_stop_request_gets_through() {
         move || *finished.borrow(),
     );
     assert_eq!(end, RunEnd::Stopped);
-    assert_eq!(link.state(), (laser_app::galvo::Phase::Idle, 0));
+    assert_eq!(link.state(), (laser_app::galvo::ScanPhase::Idle, 0));
     let closed_ns = closed_at.borrow().expect("closed");
     let recording = recording.borrow().clone();
     let samples: Vec<(u64, DacSample)> = recording.iter().collect();
