@@ -33,7 +33,7 @@ const JUMP_REFILL: Enforcement = Enforcement::NotYetMet(
     "issue 11 item 3: planning out of the refill (prep stage) and the per-sample loop cost",
 );
 /// What is left per sample is the loop body around the f32 math: its
-/// state machine, phase checks and sample bookkeeping (scan.rs), and the
+/// state machine, phase checks and sample bookkeeping (galvo/scan/samples.rs), and the
 /// Kahan-compensated stepper on jumps.
 const LOOP: Enforcement =
     Enforcement::NotYetMet("issue 11: the loop's per-sample state machine (scan.rs)");
