@@ -19,7 +19,7 @@ impl GalvoLoop {
         {
             return None;
         }
-        // An idle stepper returns its rest position and does not change.
+        // An idle integrator returns its rest position and does not change.
         let [x_rad, y_rad] = self.mirrors.step();
         let (x_code, y_code) = self
             .sample_map
