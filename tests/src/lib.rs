@@ -31,8 +31,7 @@ pub fn run_with(script: &str, options: SimOptions) -> SimReport {
 /// the safety invariants (tolerating [`UNTIL_STEP_FIXES`]) and succeeded
 /// (every line answered `ok`, idle at the end).
 pub fn run_succeeding(script: &str) -> SimReport {
-    let report = run_to_idle(script);
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
+    let report = run_checked_allowing(script, SimOptions::default(), UNTIL_STEP_FIXES);
     assert!(
         report.succeeded(false),
         "{script:?}: {:?}",
