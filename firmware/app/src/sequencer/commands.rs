@@ -42,9 +42,11 @@ impl Core {
                 self.stop("stop command", out);
                 self.ok(out);
             }
-            Command::Pattern { pattern, once } => {
-                self.check(pattern, AfterCheck::Start(Start::Pattern { pattern, once }), out)
-            }
+            Command::Pattern { pattern, once } => self.check(
+                pattern,
+                AfterCheck::Start(Start::Pattern { pattern, once }),
+                out,
+            ),
             Command::Goto(point) => self.goto(Target { point, grid: None }, out),
             Command::Grid { xi, yi } => match targets::grid_point(&self.settings, xi, yi) {
                 Ok(target) => self.goto(target, out),
@@ -187,6 +189,9 @@ impl Core {
     /// Checks up to `points` more points of the pending check (none
     /// pending: nothing); asks for the next step when more are left.
     pub(super) fn check_step(&mut self, points: usize, out: &mut dyn ActionSink) {
+        if !matches!(self.pending, Some(Pending::Check { .. })) {
+            return;
+        }
         let Some(Pending::Check { mut check, then }) = self.pending.take() else {
             return;
         };
@@ -201,7 +206,12 @@ impl Core {
     }
 
     /// Does what follows a check that gave `checked`.
-    fn checked(&mut self, then: AfterCheck, checked: Result<(), PatternError>, out: &mut dyn ActionSink) {
+    fn checked(
+        &mut self,
+        then: AfterCheck,
+        checked: Result<(), PatternError>,
+        out: &mut dyn ActionSink,
+    ) {
         match (then, checked) {
             (AfterCheck::Start(start), Ok(())) => {
                 self.start(start, out);

@@ -11,10 +11,10 @@
 //! whatever the laser mode.
 
 use super::machine::{ActionSink, Core};
-use crate::status::Phase;
 use crate::command::{Command, ReplyText, reply_text};
 use crate::servo::task::{ServoFault, ServoIdSet};
 use crate::settings::Settings;
+use crate::status::Phase;
 
 /// Fault bookkeeping of the sequencer.
 #[derive(Debug, Clone, Copy, Default)]

@@ -363,8 +363,3 @@ impl Core {
         )))));
     }
 }
-
-#[cfg(test)]
-mod proptests;
-#[cfg(test)]
-mod tests;

@@ -12,10 +12,10 @@
 //! view on the [`StatusBoard`].
 
 mod commands;
-mod machine;
 mod faults;
 mod galvo;
 mod laser;
+mod machine;
 mod report;
 mod run;
 pub mod targets;
@@ -23,11 +23,9 @@ pub mod targets;
 use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
-pub use self::machine::{
-    Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings,
-};
 pub use self::galvo::config_from;
 pub use self::laser::{LaserEvent, LaserSwitch, laser_wanted};
+pub use self::machine::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::CommandLink;
 use crate::galvo::{GalvoLink, GalvoRequest};
 use crate::laser_gate::LaserGate;

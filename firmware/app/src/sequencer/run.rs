@@ -3,9 +3,9 @@
 
 use embassy_time::{Duration, Instant};
 
-use super::machine::{Action, ActionSink, Core};
 use super::faults;
 use super::laser::LaserEvent;
+use super::machine::{Action, ActionSink, Core};
 use super::targets::{self, Aim, PathCursor, Target};
 use crate::cli::format::Fixed;
 use crate::command::{GridPattern, Pattern, reply_text};
@@ -265,12 +265,12 @@ impl Core {
         self.next_seq = self.next_seq.wrapping_add(1);
         let seq = self.next_seq;
         out.act(Action::Servo(ServoRequest::Move {
-                seq,
-                yaw_tenths: aim.yaw_wire,
-                pitch_tenths: aim.pitch_wire,
-                interval_ms,
-                ids: (self.settings.yaw.id, self.settings.pitch.id),
-                deadband_tenths: (self.settings.deadband_deg * 10.0) as u16,
+            seq,
+            yaw_tenths: aim.yaw_wire,
+            pitch_tenths: aim.pitch_wire,
+            interval_ms,
+            ids: (self.settings.yaw.id, self.settings.pitch.id),
+            deadband_tenths: (self.settings.deadband_deg * 10.0) as u16,
             ranges_tenths: faults::servo_ranges_tenths(&self.settings),
         }));
         out.act(Action::Note(LaserEvent::GimbalMoveSent));
@@ -367,8 +367,7 @@ impl Core {
                 return;
             }
             RunKind::Grid { pattern, .. } => {
-                targets::grid_target(&Pattern::Grid(*pattern), run.index, &self.settings)
-                    .is_some()
+                targets::grid_target(&Pattern::Grid(*pattern), run.index, &self.settings).is_some()
             }
             RunKind::Path { cursor, .. } => cursor.advance(),
             RunKind::Marked { .. } => false,
