@@ -33,6 +33,7 @@ use crate::status::{Activity, Snapshot};
 
 /// Something that happened, for the core to act on.
 #[derive(Debug, Clone, Copy)]
+#[allow(clippy::large_enum_variant)] // No heap: an event is a stack value for one call.
 pub enum Event {
     /// A command from the console; its reply closes with exactly one
     /// `ok` / `error:` (after follow-up events for a check or a save).
@@ -155,6 +156,7 @@ pub trait ActionSink {
 
 /// A command waiting for a follow-up event before its reply.
 #[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)] // No heap: held in the core's state.
 pub(super) enum Pending {
     /// A pattern check, a few points per [`Event::CheckStep`].
     Check {
@@ -169,6 +171,7 @@ pub(super) enum Pending {
 
 /// What follows a pattern check.
 #[derive(Debug, Clone, Copy)]
+#[allow(clippy::large_enum_variant)] // No heap: held in the core's state.
 pub(super) enum AfterCheck {
     /// `pattern`: start it (or refuse it).
     Start(super::run::Start),
@@ -363,3 +366,8 @@ impl Core {
         )))));
     }
 }
+
+#[cfg(test)]
+mod proptests;
+#[cfg(test)]
+mod tests;

@@ -29,6 +29,7 @@ pub(super) enum Start {
 
 /// What a run does, and where it is in its figure.
 #[derive(Debug, Clone, Copy)]
+#[allow(clippy::large_enum_variant)] // No heap: held in the core's state.
 pub(super) enum RunKind {
     /// A goto or grid target, held until the next command.
     Goto(Target),
