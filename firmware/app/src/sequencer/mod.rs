@@ -129,8 +129,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             core: Core::new(Instant::now()),
             io,
         };
-        // The galvo loop starts with the loaded parameters and laser mode.
-        sequencer.handle(Event::SettingsLoaded(loaded)).await;
+        // The galvo loop starts with the loaded parameters and laser mode
+        // (loading asks for no follow-up: no reply, check or save).
+        let _ = sequencer.dispatch(Event::SettingsLoaded(loaded));
+        sequencer.io.status.publish(sequencer.core.status());
         sequencer
     }
 
@@ -147,7 +149,11 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             if matches!(event, Event::Tick) {
                 housekeeping = Instant::now() + HOUSEKEEPING;
             }
-            self.handle(event).await;
+            let mut follow_up = self.dispatch(event);
+            while follow_up != FollowUp::Nothing {
+                follow_up = self.follow(follow_up).await;
+            }
+            self.io.status.publish(self.core.status());
         }
     }
 
@@ -185,32 +191,44 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         }
     }
 
-    /// Hands `event` to the core, applies its actions and their follow-ups,
-    /// and publishes the status view.
-    async fn handle(&mut self, event: Event) {
-        let mut next = Some(event);
-        while let Some(event) = next.take() {
+    /// Hands `event` to the core and applies its actions (a gate found
+    /// lost meanwhile is handed on at once); returns what must follow.
+    /// Synchronous, and an event is never held across an await: the
+    /// task's future stays small.
+    fn dispatch(&mut self, event: Event) -> FollowUp {
+        let mut event = event;
+        loop {
             let inputs = Inputs {
                 now: Instant::now(),
                 galvo_room: self.io.galvo.requests.free_capacity(),
             };
             self.core.on(inputs, event, &mut self.io);
-            next = match core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing) {
-                FollowUp::Nothing => {
-                    let lost = core::mem::take(&mut self.io.refused) || self.io.gate_lost();
-                    lost.then_some(Event::GateLost)
-                }
-                FollowUp::Yield => {
-                    embassy_futures::yield_now().await;
-                    Some(Event::CheckStep)
-                }
-                FollowUp::Save => {
-                    let record = self.core.settings().to_record();
-                    Some(Event::Saved(self.io.store.save(&record).await))
-                }
-            };
+            let follow_up = core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing);
+            if follow_up != FollowUp::Nothing {
+                return follow_up;
+            }
+            if !(core::mem::take(&mut self.io.refused) || self.io.gate_lost()) {
+                return FollowUp::Nothing;
+            }
+            event = Event::GateLost;
         }
-        self.io.status.publish(self.core.status());
+    }
+
+    /// Does what the last actions asked for (yield during a pattern check,
+    /// save the settings) and hands the result to the core.
+    async fn follow(&mut self, follow_up: FollowUp) -> FollowUp {
+        let event = match follow_up {
+            FollowUp::Nothing => return FollowUp::Nothing,
+            FollowUp::Yield => {
+                embassy_futures::yield_now().await;
+                Event::CheckStep
+            }
+            FollowUp::Save => {
+                let record = self.core.settings().to_record();
+                Event::Saved(self.io.store.save(&record).await)
+            }
+        };
+        self.dispatch(event)
     }
 }
 
