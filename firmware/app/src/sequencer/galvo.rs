@@ -43,7 +43,7 @@ pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
         },
         method: match settings.planner {
             JumpPlanner::Optimal => Method::TimeOptimal,
-            JumpPlanner::Seed => Method::SEED,
+            JumpPlanner::Seed => Method::BISECTION,
         },
         laser_on_delay_us: settings.laser_on_delay_us as u32,
         laser_off_delay_us: settings.laser_off_delay_us as u32,
