@@ -214,7 +214,26 @@ impl Harness {
             // No galvo loop: nothing reports.
             return Ok(());
         }
-        let (event, save_ok) = match *step {
+        let Some((event, save_ok)) = self.event(step) else {
+            return Ok(());
+        };
+        let is_command = matches!(event, Event::Command { .. });
+        let stops = matches!(
+            event,
+            Event::StopRequest
+                | Event::Command {
+                    command: Command::Stop,
+                    ..
+                }
+        );
+        let actions = self.dispatch(event, save_ok);
+        self.check(&actions, is_command, stops)
+    }
+
+    /// The event of `step` and the store's answer to a save (`None`: the
+    /// step only changes the world around the core).
+    fn event(&mut self, step: &Step) -> Option<(Event, bool)> {
+        let event = match *step {
             Step::Command(command, SaveOk(ok)) => {
                 let readings = self.readings();
                 (Event::Command { command, readings }, ok)
@@ -259,7 +278,7 @@ impl Harness {
                 self.galvo_room = GALVO_REQUEST_DEPTH;
                 // Dark at once through the gate; the core learns it with
                 // the next event.
-                return Ok(());
+                return None;
             }
             Step::GalvoUnderrun => {
                 self.underruns_owed -= 1;
@@ -272,7 +291,7 @@ impl Harness {
             }
             Step::GalvoTakes(n) => {
                 self.galvo_room = (self.galvo_room + n).min(GALVO_REQUEST_DEPTH);
-                return Ok(());
+                return None;
             }
             Step::Dwell => match self.core.dwell_deadline() {
                 Some(at) => {
@@ -286,17 +305,7 @@ impl Harness {
                 (Event::Tick, true)
             }
         };
-        let is_command = matches!(event, Event::Command { .. });
-        let stops = matches!(
-            event,
-            Event::StopRequest
-                | Event::Command {
-                    command: Command::Stop,
-                    ..
-                }
-        );
-        let actions = self.dispatch(event, save_ok);
-        self.check(&actions, is_command, stops)
+        Some(event)
     }
 
     /// The request number an outcome reports: the request still owed one
