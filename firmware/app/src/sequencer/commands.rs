@@ -78,11 +78,10 @@ impl Core {
     /// `target`, `planner` and `galvo status`: refused when no galvo loop
     /// serves the link (except `target gimbal`).
     fn galvo_command(&mut self, command: Command, readings: &Readings, out: &mut dyn ActionSink) {
-        let galvo = match (command, readings.galvo) {
-            (Command::Target(Actuator::Gimbal), _) => None,
-            (_, Some(galvo)) => Some(galvo),
-            (_, None) => return self.error(out, NO_GALVO),
-        };
+        let gimbal = command == Command::Target(Actuator::Gimbal);
+        if !gimbal && self.inputs.galvo_room.is_none() {
+            return self.error(out, NO_GALVO);
+        }
         match command {
             Command::Target(actuator) => {
                 // The running pattern or goto stops: it was checked for
@@ -95,11 +94,7 @@ impl Core {
                 self.settings.galvo.planner = planner;
                 self.configure_galvo(out);
             }
-            _ => {
-                if let Some(galvo) = galvo {
-                    self.report_galvo_status(&galvo, out);
-                }
-            }
+            _ => self.report_galvo_status(&readings.galvo, out),
         }
         self.ok(out);
     }

@@ -67,19 +67,21 @@ impl Core {
     /// dropped first, so there is room.
     pub(super) fn stop_galvo(&mut self, out: &mut dyn ActionSink) {
         out.act(Action::Galvo(GalvoRequest::Stop));
-        self.inputs.galvo_room = GALVO_REQUEST_DEPTH - 1;
+        if self.inputs.galvo_room.is_some() {
+            self.inputs.galvo_room = Some(GALVO_REQUEST_DEPTH - 1);
+        }
     }
 
     /// Queues a job for the galvo loop; `false` (with an error notice,
     /// everything stopped) when the loop does not keep up.
     fn send_galvo(&mut self, request: GalvoRequest, out: &mut dyn ActionSink) -> bool {
-        if self.inputs.galvo_room == 0 {
+        let Some(room) = self.inputs.galvo_room.filter(|room| *room > 0) else {
             log::warning!("galvo: request queue full");
             self.notify(out, format_args!("error: galvo not responding; stopped"));
             self.stop("galvo not responding", out);
             return false;
-        }
-        self.inputs.galvo_room -= 1;
+        };
+        self.inputs.galvo_room = Some(room - 1);
         out.act(Action::Galvo(request));
         true
     }
@@ -188,7 +190,8 @@ impl Core {
     }
 
     /// Tells the galvo loop whether the laser mode lets it light (`laser
-    /// off`: it still moves, dark). `laser off` also shuts the gate, so
+    /// off`: it still moves, dark). `laser off` also shuts the gate (where
+    /// a galvo loop runs), so
     /// the halves the loop computed before it (up to three, 384 ms at
     /// 1 ms per sample) go dark at once too; the run goes on and lights
     /// again after `laser auto`.
@@ -204,7 +207,8 @@ impl Core {
             LaserMode::Auto => true,
         };
         out.act(Action::AllowGalvoLaser(allowed));
-        if !allowed {
+        // Only a galvo loop computes halves ahead.
+        if !allowed && self.inputs.galvo_room.is_some() {
             out.act(Action::ShutGate);
         }
     }

@@ -69,9 +69,8 @@ pub enum Event {
 /// What the shell reads from the links when a command arrives.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Readings {
-    /// The galvo loop serving the galvo link; `None` when none runs (no
-    /// galvo on this board): galvo commands are refused.
-    pub galvo: Option<GalvoReadout>,
+    /// The galvo loop's state (all zero when no galvo loop runs).
+    pub galvo: GalvoReadout,
     /// Servo angle readings rejected as implausible since boot.
     pub implausible_readings: u32,
 }
@@ -96,8 +95,9 @@ pub struct Inputs {
     pub now: Instant,
     /// Free slots in the galvo request queue (only the core sends, only
     /// the galvo loop takes: the room can only grow until the core's
-    /// requests are applied).
-    pub galvo_room: usize,
+    /// requests are applied); `None` when no galvo loop serves the link
+    /// (a board without a galvo DAC): galvo commands are refused.
+    pub galvo_room: Option<usize>,
 }
 
 /// Something the core wants done, in order.
@@ -230,7 +230,10 @@ impl Core {
             gate_lost: false,
             heartbeat: 0,
             pending: None,
-            inputs: Inputs { now, galvo_room: 0 },
+            inputs: Inputs {
+                now,
+                galvo_room: None,
+            },
         }
     }
 

@@ -197,10 +197,11 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     /// task's future stays small.
     fn dispatch(&mut self, event: Event) -> FollowUp {
         let mut event = event;
+        let galvo = self.io.galvo;
         loop {
             let inputs = Inputs {
                 now: Instant::now(),
-                galvo_room: self.io.galvo.requests.free_capacity(),
+                galvo_room: galvo.attached().then(|| galvo.requests.free_capacity()),
             };
             self.core.on(inputs, event, &mut self.io);
             let follow_up = core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing);
@@ -237,16 +238,14 @@ impl<L: LaserSwitch, S: SettingsStore> Io<'_, L, S> {
     fn readings(&self) -> Readings {
         use core::sync::atomic::Ordering::Relaxed;
         let galvo = self.galvo;
+        let (phase, queued) = galvo.state();
         Readings {
-            galvo: galvo.attached().then(|| {
-                let (phase, queued) = galvo.state();
-                GalvoReadout {
-                    phase,
-                    queued,
-                    underruns: galvo.underruns.load(Relaxed),
-                    halves: galvo.halves.load(Relaxed),
-                }
-            }),
+            galvo: GalvoReadout {
+                phase,
+                queued,
+                underruns: galvo.underruns.load(Relaxed),
+                halves: galvo.halves.load(Relaxed),
+            },
             implausible_readings: self.servo.implausible_readings.load(Relaxed),
         }
     }

@@ -190,12 +190,12 @@ impl Harness {
 
     fn readings(&self) -> Readings {
         Readings {
-            galvo: self.attached.then_some(GalvoReadout {
+            galvo: GalvoReadout {
                 phase: Phase::Idle,
                 queued: GALVO_REQUEST_DEPTH - self.galvo_room,
                 underruns: 0,
                 halves: 0,
-            }),
+            },
             implausible_readings: 0,
         }
     }
@@ -335,7 +335,7 @@ impl Harness {
             let mut actions = Vec::new();
             let inputs = Inputs {
                 now: self.now,
-                galvo_room: self.galvo_room,
+                galvo_room: self.attached.then_some(self.galvo_room),
             };
             self.core.on(inputs, event, &mut actions);
             let mut follow = None;

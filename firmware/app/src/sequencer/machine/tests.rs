@@ -15,36 +15,37 @@ use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::LaserMode;
 use crate::status::{Activity, Phase};
 
-const NO_GALVO: Readings = Readings {
-    galvo: None,
-    implausible_readings: 0,
-};
+/// Whether a galvo loop serves the link.
+const GALVO: bool = true;
+const NO_GALVO: bool = false;
 
-const GALVO: Readings = Readings {
-    galvo: Some(GalvoReadout {
+const READINGS: Readings = Readings {
+    galvo: GalvoReadout {
         phase: GalvoPhase::Idle,
         queued: 0,
         underruns: 0,
         halves: 0,
-    }),
+    },
     implausible_readings: 0,
 };
 
-fn at(ms: u64) -> Inputs {
-    Inputs {
+fn on_with(core: &mut Core, ms: u64, galvo: bool, event: Event) -> Vec<Action> {
+    let inputs = Inputs {
         now: Instant::from_millis(ms),
-        galvo_room: GALVO_REQUEST_DEPTH,
-    }
-}
-
-fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
+        galvo_room: galvo.then_some(GALVO_REQUEST_DEPTH),
+    };
     let mut out = Vec::new();
-    core.on(at(ms), event, &mut out);
+    core.on(inputs, event, &mut out);
     out
 }
 
-fn command(core: &mut Core, ms: u64, command: Command, readings: Readings) -> Vec<Action> {
-    on(core, ms, Event::Command { command, readings })
+fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
+    on_with(core, ms, NO_GALVO, event)
+}
+
+fn command(core: &mut Core, ms: u64, command: Command, galvo: bool) -> Vec<Action> {
+    let readings = READINGS;
+    on_with(core, ms, galvo, Event::Command { command, readings })
 }
 
 fn move_seq(actions: &[Action]) -> Option<u32> {
