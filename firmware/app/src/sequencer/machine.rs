@@ -25,7 +25,7 @@ use super::laser::{LaserEvent, laser_wanted};
 use super::run::Run;
 use super::targets::{Aim, PatternCheck, Target};
 use crate::command::{Actuator, AimModel, Command, ReplyText, reply_text};
-use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, Phase as GalvoPhase};
+use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, ScanPhase};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{RecordError, Settings};
@@ -79,7 +79,7 @@ pub struct Readings {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GalvoReadout {
     /// Phase after its last half buffer.
-    pub phase: GalvoPhase,
+    pub phase: ScanPhase,
     /// Points queued after its last half buffer.
     pub queued: usize,
     /// Underruns since boot.

@@ -24,7 +24,9 @@ use proptest::prelude::*;
 
 use super::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::{Actuator, AimModel, Command, GridPattern, Pattern, PointCm, Rotation};
-use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoError, GalvoEvent, GalvoRequest, Phase, Underrun};
+use crate::galvo::{
+    GALVO_REQUEST_DEPTH, GalvoError, GalvoEvent, GalvoRequest, ScanPhase, Underrun,
+};
 use crate::servo::task::{ServoFault, ServoOutcome, ServoRequest};
 use crate::settings::{JumpPlanner, LaserMode, PARAMS};
 use crate::status::Activity;
@@ -191,7 +193,7 @@ impl Harness {
     fn readings(&self) -> Readings {
         Readings {
             galvo: GalvoReadout {
-                phase: Phase::Idle,
+                phase: ScanPhase::Idle,
                 queued: GALVO_REQUEST_DEPTH - self.galvo_room,
                 underruns: 0,
                 halves: 0,

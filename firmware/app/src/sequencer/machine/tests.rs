@@ -9,7 +9,7 @@ use embassy_time::Instant;
 
 use super::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::{Actuator, Command, GridPattern, Pattern, PointCm, reply_text};
-use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest, Phase as GalvoPhase};
+use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest, ScanPhase};
 use crate::sequencer::LaserEvent;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::LaserMode;
@@ -21,7 +21,7 @@ const NO_GALVO: bool = false;
 
 const READINGS: Readings = Readings {
     galvo: GalvoReadout {
-        phase: GalvoPhase::Idle,
+        phase: ScanPhase::Idle,
         queued: 0,
         underruns: 0,
         halves: 0,
