@@ -15,6 +15,7 @@ pub mod build_info;
 pub mod cli;
 pub mod command;
 pub mod galvo;
+pub mod grbl;
 pub mod laser_gate;
 mod log;
 pub mod outbound;
