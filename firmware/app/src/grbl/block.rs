@@ -58,7 +58,8 @@ impl Laser {
     /// `$30` (`s_max`): S at or below `s_min` is 0 unless `s_min` is 0, at or
     /// above `s_max` is 1. M5 is 0.
     pub fn fraction(self, s_min: f64, s_max: f64) -> f64 {
-        if self.mode == SpindleMode::Off || self.power <= 0.0 || !(s_max > s_min) {
+        let span = s_max - s_min;
+        if self.mode == SpindleMode::Off || self.power <= 0.0 || span.is_nan() || span <= 0.0 {
             return 0.0;
         }
         ((self.power - s_min) / (s_max - s_min)).clamp(0.0, 1.0)
@@ -139,7 +140,7 @@ impl Arc {
         // A chord over angle θ strays r·(1 − cos(θ/2)) from the arc.
         let max_angle = 2.0 * libm::acos(1.0 - tolerance_mm / r);
         let n = libm::ceil(libm::fabs(self.sweep_rad) / max_angle);
-        if !(n >= 1.0) {
+        if n.is_nan() || n < 1.0 {
             return 1;
         }
         n.min(f64::from(max.max(1))) as u32

@@ -46,6 +46,7 @@ mod tests {
     use super::*;
     use crate::cli::error::CommandError;
     use crate::cli::parse::parse_line;
+    use std::string::ToString;
     use std::vec::Vec;
 
     /// Every command word of the product (cli/parse.rs).
@@ -85,7 +86,7 @@ mod tests {
                 "{word} is not a command"
             );
             for line in [
-                std::format!("{word}"),
+                word.to_string(),
                 std::format!("{word} 1 2"),
                 word.to_uppercase(),
             ] {

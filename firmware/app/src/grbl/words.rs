@@ -72,10 +72,7 @@ impl<'a> Words<'a> {
 
     /// Reads `[+|-]digits[.digits]`.
     fn number(&mut self) -> Result<f64, GrblError> {
-        let negative = match self.next_byte_if(|b| b == b'-' || b == b'+') {
-            Some(b'-') => true,
-            _ => false,
-        };
+        let negative = self.next_byte_if(|b| b == b'-' || b == b'+') == Some(b'-');
         let (mut mantissa, mut significant, mut fraction_digits) = (0u64, 0u32, 0i32);
         let (mut integer_digits, mut any_digit, mut seen_point) = (0u32, false, false);
         while let Some(byte) = self.next_byte_if(|b| b.is_ascii_digit() || b == b'.') {
