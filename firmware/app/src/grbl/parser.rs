@@ -9,11 +9,14 @@
 //! (modal groups, repeated and unused words, axis-command conflicts) would
 //! still have to be written on top, its diagnostics do not map onto grbl's
 //! error numbers, and it reads numbers with `core`'s `str::parse::<f32>`,
-//! linking the float-parsing code this firmware keeps out (~10 KB; see
-//! README "Keeping the image small") at f32 precision. grbl's lexical rules
-//! fit in [`super::words`] (~100 lines), so no crate is used.
-//! (`async-gcode` 0.3 is stream/async oriented, std by default, and has the
-//! same mismatch.)
+//! linking the float-parsing code this firmware keeps out (README, "Keeping
+//! the image small"), at f32 precision. grbl's lexical rules fit in
+//! [`super::words`] (~100 lines), so no crate is used. (`async-gcode` 0.3
+//! is stream/async oriented, std by default, and has the same mismatch.)
+//! Flash cost of this module (parser, jog, `$` commands, every report and
+//! the settings table) measured in a thumbv7em `opt-level = "z"` LTO build:
+//! ~10 KB of its own code, plus `core::fmt`, `ryu`, `libm` and soft-f64
+//! routines the firmware already links.
 
 use super::block::{Arc, Block, Blocks, PointMm};
 use super::collect::{self, AXES, Collected, CoolantWord, NonModal, ProgramFlow};
@@ -79,28 +82,7 @@ impl ParserState {
     fn apply(&mut self, words: &Collected) -> Result<Blocks, GrblError> {
         let mut blocks = Blocks::new();
         let mut used = N | F | S | T;
-        let previous_feed_mode = self.feed_mode;
-        self.feed_mode = words.feed_mode.unwrap_or(self.feed_mode);
-        self.units = words.units.unwrap_or(self.units);
-        self.distance = words.distance.unwrap_or(self.distance);
-        self.motion = words.motion.unwrap_or(self.motion);
-        if let Some(n) = words.value(N) {
-            self.line_number = n as u32;
-        }
-        let block_feed = self.block_feed(words, previous_feed_mode);
-        if let Some(s) = words.value(S) {
-            self.power = s;
-        }
-        if let Some(t) = words.value(T) {
-            self.tool = t as u8;
-        }
-        self.spindle = words.spindle.unwrap_or(self.spindle);
-        match words.coolant {
-            Some(CoolantWord::Mist) => self.coolant.mist = true,
-            Some(CoolantWord::Flood) => self.coolant.flood = true,
-            Some(CoolantWord::Off) => self.coolant = Default::default(),
-            None => {}
-        }
+        let block_feed = self.apply_modes(words);
         if words.non_modal == Some(NonModal::Dwell) {
             let seconds = words.value(P).ok_or(GrblError::ValueWordMissing)?;
             used |= P;
@@ -164,6 +146,33 @@ impl ParserState {
             Some(ProgramFlow::OptionalStop) | None => {}
         }
         Ok(blocks)
+    }
+
+    /// Modal groups, N, F, S, T, M3–M5 and M7–M9 (they cannot fail);
+    /// returns this block's feed (see [`Self::block_feed`]).
+    fn apply_modes(&mut self, words: &Collected) -> f64 {
+        let previous_feed_mode = self.feed_mode;
+        self.feed_mode = words.feed_mode.unwrap_or(self.feed_mode);
+        self.units = words.units.unwrap_or(self.units);
+        self.distance = words.distance.unwrap_or(self.distance);
+        self.motion = words.motion.unwrap_or(self.motion);
+        if let Some(n) = words.value(N) {
+            self.line_number = n as u32;
+        }
+        if let Some(s) = words.value(S) {
+            self.power = s;
+        }
+        if let Some(t) = words.value(T) {
+            self.tool = t as u8;
+        }
+        self.spindle = words.spindle.unwrap_or(self.spindle);
+        match words.coolant {
+            Some(CoolantWord::Mist) => self.coolant.mist = true,
+            Some(CoolantWord::Flood) => self.coolant.flood = true,
+            Some(CoolantWord::Off) => self.coolant = Default::default(),
+            None => {}
+        }
+        self.block_feed(words, previous_feed_mode)
     }
 
     /// This block's feed, mm/min (G94) or 1/min (G93), and the new modal F.

@@ -184,3 +184,15 @@ proptest::proptest! {
         proptest::prop_assert!((rx - x).abs() <= 0.0005 + 1e-9 && (ry - y).abs() <= 0.0005 + 1e-9);
     }
 }
+
+#[test]
+fn default_parser_state_line_is_valid_gcode_for_the_same_state() {
+    // Senders replay `$G` words; grbl's default line must parse back to
+    // the power-up state.
+    let line = text(|w| write_parser_state(w, &ParserState::new()));
+    let words = line.trim_start_matches("[GC:").trim_end_matches(']');
+    let mut state = ParserState::new();
+    state.motion = MotionMode::Linear;
+    state.execute(words).unwrap();
+    assert_eq!(state, ParserState::new());
+}
