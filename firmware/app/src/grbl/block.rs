@@ -182,14 +182,15 @@ pub enum Block {
     Dwell {
         /// Duration, s.
         seconds: f64,
-        /// Laser mode at the dwell (M4: dark, as the speed is 0).
+        /// Laser during the dwell: M5 unless the modal motion is G1/G2/G3
+        /// (grbl's laser mode); M4 means dark too, as the speed is 0.
         laser: Laser,
     },
     /// M0: pause (a feed hold that `~` resumes) after the queue ahead.
     Pause,
     /// M2/M30: program end; the parser's modal state is already reset.
     End,
-    /// `$J=`: a jog move (never changes the parser state), laser dark.
+    /// `$J=`: a jog move (changes no modal state), laser dark.
     Jog {
         /// Start, mm.
         from: PointMm,

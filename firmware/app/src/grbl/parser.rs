@@ -18,7 +18,7 @@
 //! ~10 KB of its own code, plus `core::fmt`, `ryu`, `libm` and soft-f64
 //! routines the firmware already links.
 
-use super::block::{Arc, Block, Blocks, PointMm};
+use super::block::{Arc, Block, Blocks, Laser, PointMm, SpindleMode};
 use super::collect::{self, AXES, Collected, CoolantWord, NonModal, ProgramFlow};
 use super::collect::{F, I, J, K, L, N, P, R, S, T, X, Y};
 use super::error::GrblError;
@@ -49,10 +49,13 @@ impl ParserState {
     }
 
     /// Parses the G-code of a `$J=` jog (the text after `=`): only G20/G21,
-    /// G90/G91, G53, X/Y/Z, F and N are allowed, F is required and the
-    /// parser state does not change. Returns a [`Block::Jog`], or `None`
-    /// when the jog ends where it starts.
-    pub fn jog(&self, text: &str) -> Result<Option<Block>, GrblError> {
+    /// G90/G91, G53, X/Y/Z, F and N are allowed and F is required; the
+    /// modes given apply to this jog only. Returns a [`Block::Jog`] (`None`
+    /// when the jog ends where it starts); as in grbl, the parser position
+    /// becomes the jog target (after a jog cancel the caller sets
+    /// [`ParserState::position`] to where the spot stopped). On error
+    /// nothing changes.
+    pub fn jog(&mut self, text: &str) -> Result<Option<Block>, GrblError> {
         let words = collect::collect(text)?;
         // G53 (group 0), G90/G91 (3), G20/G21 (6); no M words.
         let only_allowed = words.only_groups(1 << 0 | 1 << 3 | 1 << 6)
@@ -71,8 +74,9 @@ impl ParserState {
         probe.units = words.units.unwrap_or(self.units);
         let machine = words.non_modal == Some(NonModal::MachineCoordinates);
         let to = probe.target(&words, machine)?;
-        Ok((to != self.position).then_some(Block::Jog {
-            from: self.position,
+        let from = core::mem::replace(&mut self.position, to);
+        Ok((to != from).then_some(Block::Jog {
+            from,
             to,
             feed_mm_min: feed,
         }))
@@ -86,13 +90,17 @@ impl ParserState {
         if words.non_modal == Some(NonModal::Dwell) {
             let seconds = words.value(P).ok_or(GrblError::ValueWordMissing)?;
             used |= P;
-            push(
-                &mut blocks,
-                Block::Dwell {
-                    seconds,
-                    laser: self.laser(),
-                },
-            );
+            // grbl's laser mode lights a dwell only in G1/G2/G3 state.
+            let feed_state = !matches!(self.motion, MotionMode::Rapid | MotionMode::Cancel);
+            let laser = if feed_state {
+                self.laser()
+            } else {
+                Laser {
+                    mode: SpindleMode::Off,
+                    power: self.power,
+                }
+            };
+            push(&mut blocks, Block::Dwell { seconds, laser });
         }
         let has_axes = words.present & AXES != 0;
         let motion_command = words.motion.is_some_and(|m| m != MotionMode::Cancel);
@@ -156,9 +164,8 @@ impl ParserState {
         self.units = words.units.unwrap_or(self.units);
         self.distance = words.distance.unwrap_or(self.distance);
         self.motion = words.motion.unwrap_or(self.motion);
-        if let Some(n) = words.value(N) {
-            self.line_number = n as u32;
-        }
+        // grbl: a line without N reports line number 0.
+        self.line_number = words.value(N).map_or(0, |n| n as u32);
         if let Some(s) = words.value(S) {
             self.power = s;
         }

@@ -227,7 +227,9 @@ fn accepted_words_of_laser_cam_output() {
         s.execute(line)
             .unwrap_or_else(|e| panic!("{line}: error:{}", e.code()));
     }
-    assert_eq!(s.line_number, 2);
+    assert_eq!(s.line_number, 0, "grbl: a line without N reports 0");
+    s.execute("N7 G0 X0").unwrap();
+    assert_eq!(s.line_number, 7);
     assert_eq!(s.units, Units::Millimetres);
 }
 
@@ -246,6 +248,15 @@ fn dwell_pause_and_program_end() {
             laser
         }]
     );
+    let dark = Laser {
+        mode: SpindleMode::Off,
+        power: 100.0,
+    };
+    let dwell = Block::Dwell {
+        seconds: 1.0,
+        laser: dark,
+    };
+    assert_eq!(run(&mut s, "G0 G4 P1"), [dwell], "G0 state: dark");
     assert_eq!(run(&mut s, "M0"), [Block::Pause]);
     assert_eq!(run(&mut s, "M30"), [Block::End]);
     assert_eq!(s.distance, Distance::Absolute);
@@ -255,34 +266,34 @@ fn dwell_pause_and_program_end() {
 }
 
 #[test]
-fn jogs_use_but_never_change_the_state() {
+fn jogs_move_the_position_but_change_no_mode() {
     let mut s = ParserState::new();
     run(&mut s, "G0 X5 Y5");
-    let before = s;
-    assert_eq!(
-        s.jog("G91 X1 F100"),
+    let jog = |from, to, feed_mm_min| {
         Ok(Some(Block::Jog {
-            from: p(5.0, 5.0),
-            to: p(6.0, 5.0),
-            feed_mm_min: 100.0
+            from,
+            to,
+            feed_mm_min,
         }))
-    );
+    };
+    assert_eq!(s.jog("G91 X1 F100"), jog(p(5.0, 5.0), p(6.0, 5.0), 100.0));
     assert_eq!(
         s.jog("G53 G20 X1 Y0 F10"),
-        Ok(Some(Block::Jog {
-            from: p(5.0, 5.0),
-            to: p(25.4, 0.0),
-            feed_mm_min: 254.0
-        }))
+        jog(p(6.0, 5.0), p(25.4, 0.0), 254.0)
     );
-    assert_eq!(s.jog("X5 Y5 F100"), Ok(None));
-    assert_eq!(s, before);
+    assert_eq!(s.jog("X25.4 Y0 F100"), Ok(None));
+    let moved = ParserState {
+        position: p(25.4, 0.0),
+        ..ParserState::new()
+    };
+    assert_eq!(s, moved, "modes unchanged");
     assert_eq!(s.jog("G91 X1"), Err(GrblError::UndefinedFeedRate));
     assert_eq!(s.jog("G1 X1 F100"), Err(GrblError::InvalidJogCommand));
     assert_eq!(s.jog("X1 F100 S5"), Err(GrblError::InvalidJogCommand));
     assert_eq!(s.jog("M3 X1 F100"), Err(GrblError::InvalidJogCommand));
     assert_eq!(s.jog("G17 X1 F100"), Err(GrblError::InvalidJogCommand));
     assert_eq!(s.jog("F100"), Err(GrblError::InvalidJogCommand));
+    assert_eq!(s, moved, "refused jogs change nothing");
 }
 
 #[test]
