@@ -28,3 +28,6 @@ pub mod words;
 pub use block::{Arc, Block, Blocks, Laser, PointMm, SpindleMode};
 pub use error::{Alarm, GrblError};
 pub use state::ParserState;
+
+#[cfg(test)]
+mod tests;
