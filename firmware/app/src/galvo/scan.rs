@@ -8,6 +8,7 @@ use galvo_planner::{Discrete, Method, PathPlanner, RigidParams, XyIntegrator};
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
+use self::prep::{LoadedStroke, PREP_DEPTH, Prepared};
 use super::path::GalvoPath;
 use super::{DacSample, DacStream, GalvoEvent, GalvoLink, Half};
 use crate::laser_gate::LaserGate;
@@ -140,6 +141,15 @@ pub struct GalvoLoop {
     disc: Discrete<3>,
     mirrors: XyIntegrator<3, INTEGRATOR_CAPACITY>,
     marker: Option<PathPlanner<MARK_BLOCKS>>,
+    /// The running step's stroke, loaded by the prep stage, marked after
+    /// its jump lands.
+    staged: Option<LoadedStroke>,
+    /// Steps planned ahead of the refill by [`GalvoLoop::prep`].
+    prepared: heapless::Deque<Prepared, PREP_DEPTH>,
+    /// Where the running step leaves the mirrors, rad.
+    active_end_rad: [f64; 2],
+    /// Samples held dark for want of a prepared step.
+    unprepared_samples: u32,
     motion: Motion,
     queue: heapless::Deque<(u32, Job), JOB_QUEUE>,
     active: Option<Active>,
@@ -187,6 +197,10 @@ impl GalvoLoop {
             disc,
             mirrors,
             marker: None,
+            staged: None,
+            prepared: heapless::Deque::new(),
+            active_end_rad: angles_rad,
+            unprepared_samples: 0,
             motion: Motion::default(),
             queue: heapless::Deque::new(),
             active: None,
@@ -272,8 +286,10 @@ impl GalvoLoop {
                 release_drawn(&mut drawing, link);
                 continue;
             }
+            // Plan ahead, outside the refill: the refill only steps plans.
+            self.prep();
             let out = &mut half[..n];
-            let computed = self.fill(out, |event| hold_done(&mut drawing, link, event));
+            let computed = self.refill(out, |event| hold_done(&mut drawing, link, event));
             link.publish(self.phase(), self.queue.len());
             if !link.laser_allowed() {
                 // `laser off`: the mirrors still move, dark.
@@ -362,6 +378,7 @@ impl Active {
 
 mod jobs;
 mod mark;
+mod prep;
 mod samples;
 #[cfg(test)]
 mod tests;

@@ -115,6 +115,8 @@ impl GalvoLoop {
     /// and the mirrors hold.
     pub fn stop(&mut self) {
         self.queue.clear();
+        self.prepared.clear();
+        self.staged = None;
         self.active = match self.active {
             Some(a) if a.phase == ScanPhase::Jumping => Some(Active {
                 cancelled: true,

@@ -2,12 +2,12 @@
 //! galvo kinematics to DAC codes, the end of a stroke, and braking along
 //! the path when stopped mid-stroke.
 
-use galvo_planner::{MarkLimits, MarkSample, PathPlanner};
+use galvo_planner::MarkSample;
 use kinematics_core::PointMm;
 
-use super::{GalvoError, GalvoLoop, JUNCTION_DEVIATION_MM, ScanPhase};
+use super::{GalvoError, GalvoLoop, ScanPhase};
 use crate::galvo::GalvoEvent;
-use crate::galvo::path::{GalvoPath, Segment};
+use crate::galvo::path::GalvoPath;
 
 /// The spot while marking or braking: position (mm) and its change over
 /// the last sample (mm per sample).
@@ -105,8 +105,9 @@ impl GalvoLoop {
         }
     }
 
-    /// Loads stroke `stroke` of `path` into the path planner and starts
-    /// marking; `false` (with `Refused`) when the planner refuses it.
+    /// Starts marking stroke `stroke` of `path` with the path planner the
+    /// prep stage loaded for it; `false` (with `Refused`) when the planner
+    /// refused the stroke.
     pub(super) fn start_marking(
         &mut self,
         path: GalvoPath,
@@ -114,25 +115,12 @@ impl GalvoLoop {
         on_event: &mut impl FnMut(GalvoEvent),
     ) -> bool {
         let Some(a) = self.active else { return false };
-        let Some((start, segments)) = path.stroke(stroke) else {
+        let Some((start, _)) = path.stroke(stroke) else {
             return false;
         };
-        let limits = MarkLimits {
-            speed_mm_s: self.config.mark_speed_mm_s,
-            accel_mm_s2: self.config.mark_accel_mm_s2,
-            junction_deviation_mm: JUNCTION_DEVIATION_MM,
-            ts_s: self.config.sample_period_s,
-        };
-        let loaded = PathPlanner::new(limits, start).and_then(|mut planner| {
-            for segment in &segments {
-                match *segment {
-                    Segment::Line(to) => planner.line_to(to)?,
-                    Segment::Arc { end, centre, ccw } => planner.arc_to(end, centre, ccw)?,
-                }
-            }
-            Ok(planner)
-        });
-        match loaded {
+        // Every path step is prepared with its stroke; none staged would
+        // be a lost plan: refused, never marked without one.
+        match self.staged.take().unwrap_or(Err(GalvoError::Planner)) {
             Ok(planner) => {
                 self.marker = Some(planner);
                 let ts = self.config.sample_period_s;
@@ -146,11 +134,8 @@ impl GalvoLoop {
                 }
                 true
             }
-            Err(_) => {
-                on_event(GalvoEvent::Refused {
-                    seq: a.seq,
-                    error: GalvoError::Planner,
-                });
+            Err(error) => {
+                on_event(GalvoEvent::Refused { seq: a.seq, error });
                 false
             }
         }
