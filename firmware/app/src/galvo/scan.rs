@@ -4,11 +4,11 @@
 use core::fmt;
 use core::sync::atomic::Ordering;
 
-use galvo_planner::{Discrete, Method, PathPlanner, RigidParams, XyIntegrator};
+use galvo_planner::{Discrete, Method, RigidParams, XyIntegrator};
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
-use self::prep::{LoadedStroke, PREP_DEPTH, Prepared};
+use self::prep::StepRing;
 use super::path::GalvoPath;
 use super::{DacSample, DacStream, GalvoEvent, GalvoLink, Half};
 use crate::laser_gate::LaserGate;
@@ -140,12 +140,11 @@ pub struct GalvoLoop {
     planning: Galvo<f64>,
     disc: Discrete<3>,
     mirrors: XyIntegrator<3, INTEGRATOR_CAPACITY>,
-    marker: Option<PathPlanner<MARK_BLOCKS>>,
-    /// The running step's stroke, loaded by the prep stage, marked after
-    /// its jump lands.
-    staged: Option<LoadedStroke>,
-    /// Steps planned ahead of the refill by [`GalvoLoop::prep`].
-    prepared: heapless::Deque<Prepared, PREP_DEPTH>,
+    /// The running step (when `running`) and the steps planned ahead of
+    /// the refill by [`GalvoLoop::prep`].
+    steps: StepRing,
+    /// Whether the oldest of `steps` is the running one.
+    running: bool,
     /// Where the running step leaves the mirrors, rad.
     active_end_rad: [f64; 2],
     /// Samples held dark for want of a prepared step.
@@ -196,9 +195,8 @@ impl GalvoLoop {
             planning: config.galvo.cast(),
             disc,
             mirrors,
-            marker: None,
-            staged: None,
-            prepared: heapless::Deque::new(),
+            steps: StepRing::new(),
+            running: false,
             active_end_rad: angles_rad,
             unprepared_samples: 0,
             motion: Motion::default(),

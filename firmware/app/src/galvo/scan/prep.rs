@@ -66,16 +66,22 @@ impl GalvoLoop {
     /// prepared.
     pub fn prep(&mut self) -> usize {
         let mut prepared = 0;
-        while !self.prepared.is_full() {
+        while self.steps.len() - self.started() < PREP_DEPTH {
             let Some(step) = self.next_unprepared_step() else {
                 break;
             };
-            if self.prepared.push_back(step).is_err() {
+            if !self.steps.push_back(step) {
                 break;
             }
             prepared += 1;
         }
         prepared
+    }
+
+    /// Steps at the front of [`Self::steps`] already started: the running
+    /// one (0 or 1).
+    fn started(&self) -> usize {
+        usize::from(self.running && self.steps.len() > 0)
     }
 
     /// Samples the refill held dark because the step it needed was not
@@ -87,7 +93,7 @@ impl GalvoLoop {
     /// Plans the step after the last prepared one (or after the running
     /// step), if there is one.
     fn next_unprepared_step(&self) -> Option<Prepared> {
-        let (after, start_rad) = match (self.prepared.back(), self.active) {
+        let (after, start_rad) = match (self.steps.back(), self.active) {
             (Some(last), _) => (
                 Some((last.seq, last.job, last.stroke, last.continues())),
                 last.end_rad,
@@ -103,7 +109,9 @@ impl GalvoLoop {
         let (seq, job, stroke, starts_job) = match next_in_job {
             Some(step) => step,
             None => {
-                let covered = self.prepared.iter().filter(|p| p.starts_job).count();
+                let covered = (self.started()..self.steps.len())
+                    .filter(|&i| self.steps.get(i).is_some_and(|p| p.starts_job))
+                    .count();
                 let &(seq, job) = self.queue.iter().nth(covered)?;
                 (seq, job, 0, true)
             }
@@ -185,22 +193,24 @@ impl GalvoLoop {
                     Segment::Arc { end, centre, ccw } => planner.arc_to(end, centre, ccw)?,
                 }
             }
+            // The first block's f64 set-up here, not in the refill.
+            planner.prime();
             Ok(planner)
         });
         loaded.map_err(|_| GalvoError::Planner)
     }
 
-    /// Takes the prepared step `stroke` of job `(seq, job)` if it is the
-    /// next one prepared.
-    pub(super) fn take_prepared(&mut self, seq: u32, job: &Job, stroke: usize) -> Option<Prepared> {
-        let front = self.prepared.front()?;
-        if front.seq == seq && front.job == *job && front.stroke == stroke {
-            self.prepared.pop_front()
-        } else {
-            None
-        }
+    /// Whether the first step not started is step `stroke` of job
+    /// `(seq, job)`.
+    pub(super) fn next_prepared_is(&self, seq: u32, job: &Job, stroke: usize) -> bool {
+        self.steps
+            .get(self.started())
+            .is_some_and(|p| p.seq == seq && p.job == *job && p.stroke == stroke)
     }
 }
 
+mod ring;
 #[cfg(test)]
 mod tests;
+
+pub(super) use ring::StepRing;

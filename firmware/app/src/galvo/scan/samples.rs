@@ -164,9 +164,10 @@ impl GalvoLoop {
         }
     }
 
-    /// Starts step `stroke` of job `(seq, job)` from its prepared plan:
-    /// queues the jump and stages the stroke. Plans it first only when
-    /// `on_demand`; otherwise an unprepared step waits.
+    /// Starts step `stroke` of job `(seq, job)` from its prepared plan,
+    /// where it lies: queues the jump; the stroke is marked from the
+    /// step's slot. Plans it first only when `on_demand`; otherwise an
+    /// unprepared step waits.
     fn start_step(
         &mut self,
         seq: u32,
@@ -175,22 +176,31 @@ impl GalvoLoop {
         on_demand: bool,
         on_event: &mut impl FnMut(GalvoEvent),
     ) -> StepStart {
+        if self.running {
+            // The step before this one is over.
+            self.steps.drop_front();
+            self.running = false;
+        }
         for _ in 0..2 {
-            let step = match self.take_prepared(seq, &job, stroke) {
-                Some(step) => step,
-                None if on_demand => {
-                    self.prep();
-                    match self.take_prepared(seq, &job, stroke) {
-                        Some(step) => step,
-                        None => return StepStart::Unprepared,
-                    }
+            if !self.next_prepared_is(seq, &job, stroke) {
+                // None prepared, or not this one: prepare again from here.
+                self.steps.clear();
+                if !on_demand {
+                    return StepStart::Unprepared;
                 }
-                None => return StepStart::Unprepared,
+                self.prep();
+                if !self.next_prepared_is(seq, &job, stroke) {
+                    return StepStart::Unprepared;
+                }
+            }
+            let Some(step) = self.steps.get(0) else {
+                return StepStart::Unprepared;
             };
+            let end_rad = step.end_rad;
             // `Err(None)`: planned from somewhere the mirrors are not (stale).
-            let queued = match step.jump {
-                Err(error) => Err(Some(error)),
-                Ok(jump) => match self.mirrors.queue_jump(&jump) {
+            let queued = match &step.jump {
+                Err(error) => Err(Some(*error)),
+                Ok(jump) => match self.mirrors.queue_jump(jump) {
                     Ok(()) => Ok(()),
                     Err(PlannerError::DiscontinuousMove) => Err(None),
                     Err(_) => Err(Some(GalvoError::Planner)),
@@ -206,15 +216,15 @@ impl GalvoLoop {
                         samples_left: 0,
                         cancelled: false,
                     });
-                    self.staged = step.marker;
-                    self.active_end_rad = step.end_rad;
+                    self.running = true;
+                    self.active_end_rad = end_rad;
                     return StepStart::Started;
                 }
-                Err(None) => {
-                    // Re-plan from where the mirrors are.
-                    self.prepared.clear();
-                }
+                Err(None) => self.steps.clear(),
                 Err(Some(error)) => {
+                    // Refused: the steps after it were planned from where
+                    // the mirrors stay.
+                    self.steps.drop_front();
                     on_event(GalvoEvent::Refused { seq, error });
                     return StepStart::Refused;
                 }
