@@ -207,7 +207,8 @@ impl GalvoLoop {
 
     /// What the mirrors and laser are doing now.
     pub fn phase(&self) -> ScanPhase {
-        self.active.map_or(ScanPhase::Idle, |a| a.phase)
+        // By reference: this runs several times per sample.
+        self.active.as_ref().map_or(ScanPhase::Idle, |a| a.phase)
     }
 
     /// Jobs waiting behind the current one.

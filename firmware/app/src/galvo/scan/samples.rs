@@ -96,6 +96,19 @@ impl GalvoLoop {
     /// produce, or the next step is not prepared (`on_demand`: prepares
     /// it).
     fn advance(&mut self, on_event: &mut impl FnMut(GalvoEvent), on_demand: bool) -> Advance {
+        // The common case, without copying the job out and back: the
+        // current phase still has samples (the loop's first pass below
+        // returns at once in these cases too).
+        if let Some(a) = self.active.as_ref() {
+            let busy = match a.phase {
+                ScanPhase::Marking | ScanPhase::Braking => true,
+                ScanPhase::Jumping => !self.mirrors.is_idle(),
+                _ => a.samples_left > 0,
+            };
+            if busy {
+                return Advance::Ready;
+            }
+        }
         loop {
             let Some(mut a) = self.active else {
                 if let Some(event) = self.apply_pending_config(false) {
