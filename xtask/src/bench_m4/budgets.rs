@@ -30,11 +30,13 @@ const PLANNING: Enforcement = Enforcement::Enforced;
 /// The refill steps only what the prep stage prepared (galvo/scan/prep.rs):
 /// met, enforced.
 const REFILL: Enforcement = Enforcement::Enforced;
-/// What is left per sample is the loop body around the f32 math: its
-/// state machine, phase checks and sample bookkeeping (galvo/scan/samples.rs), and the
-/// Kahan-compensated integrator on jumps.
-const LOOP: Enforcement =
-    Enforcement::NotYetMet("issue 11: the loop's per-sample state machine (scan.rs)");
+/// What is left per sample: the f32 galvo IK (two `atanf`, ≈ 220
+/// instructions with the DAC mapping), the path sampler (90–140), the
+/// Kahan-compensated integrator on jumps (204) and the loop's per-sample
+/// state machine around them (galvo/scan/samples.rs, ≈ 70–120).
+const LOOP: Enforcement = Enforcement::NotYetMet(
+    "issue 11 item 2: galvo IK, integrator and the loop's per-sample state machine (scan/samples.rs)",
+);
 /// Preparing a step (jump planning, f64 IK of its target, stroke setup in
 /// the f64 look-ahead planner) between halves.
 const PREP: Enforcement = Enforcement::Enforced;
