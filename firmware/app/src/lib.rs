@@ -11,6 +11,7 @@
 //! state for LEDs/watchdog/simulator in [`status`], the master laser gate
 //! that no laser command or sample stream can override in [`laser_gate`].
 
+pub mod app;
 pub mod build_info;
 pub mod cli;
 pub mod command;

@@ -16,8 +16,8 @@ use embassy_sync::pipe::Pipe;
 use embassy_sync::signal::Signal;
 use embassy_time::Timer;
 
+use crate::panel::ButtonContacts;
 use crate::script::Step;
-use laser_app::command::CommandLink;
 
 /// Host → firmware bytes.
 pub type ToDevice = Pipe<CriticalSectionRawMutex, 256>;
@@ -101,13 +101,13 @@ impl UsbHost {
     }
 }
 
-/// Runs one script step; `@button` presses `button`'s stop request (the
-/// interactive terminal has no button).
-async fn run_step(host: &UsbHost, step: Step, button: Option<&CommandLink>) {
+/// Runs one script step; `@button` presses `button` (the interactive
+/// terminal has no button).
+async fn run_step(host: &UsbHost, step: Step, button: Option<&ButtonContacts>) {
     match step {
         Step::StopButton => {
-            if let Some(link) = button {
-                link.stop_request.signal(());
+            if let Some(button) = button {
+                button.press();
             }
         }
         Step::WaitMs(ms) => Timer::after_millis(ms).await,
@@ -121,10 +121,10 @@ async fn run_step(host: &UsbHost, step: Step, button: Option<&CommandLink>) {
 }
 
 /// Types the script: each command line, then waits for its closing reply;
-/// `@button` steps press the board's stop button (`link`'s stop request).
-pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, link: &CommandLink) {
+/// `@button` steps press the board's stop `button`.
+pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, button: Rc<ButtonContacts>) {
     for step in steps {
-        run_step(&host, step, Some(link)).await;
+        run_step(&host, step, Some(&button)).await;
     }
     host.replies_read().await;
     host.transcript.borrow_mut().script_done = true;
@@ -249,8 +249,8 @@ mod tests {
             false,
             10_000_000,
             move |spawner| {
-                let link: &'static CommandLink = Box::leak(Box::new(CommandLink::new()));
-                executor::spawn(&spawner, script_task(steps, h1, link));
+                let button = Rc::new(ButtonContacts::default());
+                executor::spawn(&spawner, script_task(steps, h1, button));
                 executor::spawn(&spawner, terminal_task(h2));
                 executor::spawn(&spawner, echo_ok_device(h3));
             },

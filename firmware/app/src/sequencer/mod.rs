@@ -113,7 +113,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     pub async fn new(
         link: &'a CommandLink,
         servo: &'a ServoLink,
-        galvo: Option<&'a GalvoLink>,
+        galvo: &'a GalvoLink,
         status: &'a StatusBoard,
         mut laser: L,
         gate: &'a LaserGate,
@@ -141,7 +141,9 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         let mut sequencer = Self {
             link,
             servo,
-            galvo,
+            // Until the link says whether a loop serves it, this build's
+            // `galvo` feature does.
+            galvo: Some(galvo).filter(|_| crate::galvo::GALVO_OUTPUT),
             status,
             laser,
             gate,
