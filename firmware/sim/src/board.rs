@@ -193,3 +193,6 @@ impl Spawn<SimBoard> for SimSpawner {
         self.firmware("watchdog", task.run());
     }
 }
+
+#[cfg(test)]
+mod tests;
