@@ -10,6 +10,8 @@
 //! Text handling lives in [`cli`], parameters in [`settings`], shared
 //! state for LEDs/watchdog/simulator in [`status`], the master laser gate
 //! that no laser command or sample stream can override in [`laser_gate`].
+//! On top, [`app`] says what a board provides and wires every task once,
+//! for the target and the simulator alike.
 
 pub mod app;
 pub mod build_info;

@@ -5,13 +5,13 @@
 //! it, so the simulator runs the target's task graph.
 //!
 //! ```text
-//!  console port ──bytes──▶ console ──Command──▶ sequencer ──ServoRequest──▶ servo bus ──▶ UART
-//!  (USB CDC-ACM)   ◀──lines── task  ◀─replies── (CommandLink)◀──ServoOutcome──  task
-//!                                     stop button ─stop─┘ │ └──GalvoRequest──▶ galvo loop ──▶ DAC
-//!                                                         ▼      (GalvoLink) ◀──GalvoEvent──┘
-//!                                        StatusBoard ──▶ indicators (LEDs), watchdog
-//!                                        LaserGate: closed by every stop; ANDed into every laser output
+//! console port ─▶ console ─CommandLink─▶ sequencer ─ServoLink─▶ servo bus ─▶ servo UART
+//!                      stop button ─┘     │  │  └─GalvoLink─▶ galvo loop ─▶ galvo DAC (if any)
+//!                                         │  └─▶ laser pin (every laser behind the LaserGate)
+//!                                         └─StatusBoard─▶ indicators (LEDs), watchdog
 //! ```
+//!
+//! See `ARCHITECTURE.md` for what a board provides and how to add one.
 
 mod board;
 mod tasks;
