@@ -10,12 +10,14 @@
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
+use embassy_executor::Spawner;
 use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::pipe::Pipe;
 use embassy_sync::signal::Signal;
 use embassy_time::Timer;
 
+use crate::executor::{self, TaskKind};
 use crate::panel::ButtonContacts;
 use crate::script::Step;
 
@@ -146,6 +148,48 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
         }
     }
     host.transcript.borrow_mut().script_done = true;
+}
+
+/// Starts the simulated host: the script (or the interactive terminal)
+/// typing (from stdin when `interactive`), and the terminal reading;
+/// `@button` presses `button`.
+pub fn host_tasks(
+    interactive: bool,
+    script: Vec<Step>,
+    host: Rc<UsbHost>,
+    button: Rc<ButtonContacts>,
+) -> impl FnOnce(&Spawner) + 'static {
+    move |spawner| {
+        if interactive {
+            let (send, lines) = std::sync::mpsc::channel();
+            std::thread::spawn(move || {
+                for line in std::io::stdin().lines().map_while(Result::ok) {
+                    if send.send(line).is_err() {
+                        break;
+                    }
+                }
+            });
+            executor::spawn_task(
+                spawner,
+                "host (interactive)",
+                TaskKind::Simulator,
+                interactive_task(lines, host.clone()),
+            );
+        } else {
+            executor::spawn_task(
+                spawner,
+                "host (script)",
+                TaskKind::Simulator,
+                script_task(script, host.clone(), button),
+            );
+        }
+        executor::spawn_task(
+            spawner,
+            "host (terminal)",
+            TaskKind::Simulator,
+            terminal_task(host),
+        );
+    }
 }
 
 /// Types one command line (its reply is then outstanding).

@@ -32,7 +32,7 @@ use crate::script::Step;
 use crate::servo_model::SimServoBus;
 use crate::servo_port::{BusFaults, SimServoPort};
 use crate::spot::{RecordingLaser, gimbal_spot_cm, spot_sampler};
-use crate::usb_host::{Transcript, UsbHost, interactive_task, script_task, terminal_task};
+use crate::usb_host::{Transcript, UsbHost, host_tasks};
 
 /// Samples per galvo DAC half buffer (1.28 ms at 100 kHz).
 pub const GALVO_HALF_LEN: usize = 128;
@@ -268,7 +268,12 @@ impl World {
     /// Wires the firmware onto the simulated board (the terminal plugged
     /// into its console), then starts the spot sampler.
     fn start(&self, spawner: Spawner, options: &SimOptions) {
-        let host_tasks = host_tasks(options, self.host.clone(), self.button.clone());
+        let host_tasks = host_tasks(
+            options.interactive,
+            options.script.clone(),
+            self.host.clone(),
+            self.button.clone(),
+        );
         let mut sim_spawner = SimSpawner::new(spawner, host_tasks);
         wire(self.board(options), self.links, &mut sim_spawner);
         executor::spawn_task(
@@ -326,47 +331,6 @@ impl World {
         let mut panel = self.panel.borrow().clone();
         panel.watchdog = panel.watchdog.at_end(end_time_us);
         panel
-    }
-}
-
-/// Starts the simulated host: the script (or the interactive terminal)
-/// typing, and the terminal reading; `@button` presses `button`.
-fn host_tasks(
-    options: &SimOptions,
-    host: Rc<UsbHost>,
-    button: Rc<ButtonContacts>,
-) -> impl FnOnce(&Spawner) + 'static {
-    let (interactive, script) = (options.interactive, options.script.clone());
-    move |spawner| {
-        if interactive {
-            let (send, lines) = std::sync::mpsc::channel();
-            std::thread::spawn(move || {
-                for line in std::io::stdin().lines().map_while(Result::ok) {
-                    if send.send(line).is_err() {
-                        break;
-                    }
-                }
-            });
-            executor::spawn_task(
-                spawner,
-                "host (interactive)",
-                TaskKind::Simulator,
-                interactive_task(lines, host.clone()),
-            );
-        } else {
-            executor::spawn_task(
-                spawner,
-                "host (script)",
-                TaskKind::Simulator,
-                script_task(script, host.clone(), button),
-            );
-        }
-        executor::spawn_task(
-            spawner,
-            "host (terminal)",
-            TaskKind::Simulator,
-            terminal_task(host),
-        );
     }
 }
 
