@@ -9,7 +9,7 @@
 //! | servo UART    | the simulated FashionStar bus ([`SimServoPort`])  |
 //! | laser pin     | the recording gated pin ([`RecordingLaser`])      |
 //! | settings      | sectors 10 and 11 of the simulated flash          |
-//! | galvo DAC     | the simulated double-buffered DAC ([`SimDac`])    |
+//! | galvo DAC     | the simulated double-buffered DAC ([`SimDac`]), or none |
 //! | LEDs, button, watchdog | recorded models ([`crate::panel`])       |
 
 use std::convert::Infallible;
@@ -40,8 +40,8 @@ pub struct SimBoard {
     pub laser: RecordingLaser,
     /// The settings store.
     pub settings: FlashSettingsStore<SettingsFlash>,
-    /// The galvo DAC.
-    pub galvo_dac: SimDac,
+    /// The galvo DAC, if the board has one.
+    pub galvo_dac: Option<SimDac>,
     /// The status LEDs.
     pub leds: SimLeds,
     /// The stop button.
@@ -72,7 +72,7 @@ impl Board for SimBoard {
             servo_tx: PortHandle(self.servo_port),
             laser: self.laser,
             settings: self.settings,
-            galvo_dac: Some(self.galvo_dac),
+            galvo_dac: self.galvo_dac,
             indicators: self.leds,
             stop_button: self.stop_button,
             watchdog: self.watchdog,

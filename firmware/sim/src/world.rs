@@ -106,6 +106,9 @@ pub struct SimOptions {
     /// Galvo loop compute time charged per DAC sample, ns (0: the loop
     /// is instant; above the sample period it underruns).
     pub galvo_cost_ns_per_sample: u64,
+    /// The board has a galvo DAC (`false`: a board like the target's,
+    /// which has none yet, so no galvo loop runs).
+    pub galvo_dac: bool,
 }
 
 impl Default for SimOptions {
@@ -125,6 +128,7 @@ impl Default for SimOptions {
             settings_flash_cut: None,
             physical: PhysicalGimbal::default(),
             galvo_cost_ns_per_sample: 0,
+            galvo_dac: true,
         }
     }
 }
@@ -250,12 +254,14 @@ impl World {
             servo_port: self.port.clone(),
             laser,
             settings: settings_store(self.flash.clone()),
-            galvo_dac: SimDac::new(
-                GALVO_HALF_LEN,
-                period_ns,
-                options.galvo_cost_ns_per_sample,
-                self.dac.clone(),
-            ),
+            galvo_dac: options.galvo_dac.then(|| {
+                SimDac::new(
+                    GALVO_HALF_LEN,
+                    period_ns,
+                    options.galvo_cost_ns_per_sample,
+                    self.dac.clone(),
+                )
+            }),
             leds: SimLeds(self.panel.clone()),
             stop_button: SimStopButton {
                 contacts: self.button.clone(),

@@ -14,8 +14,6 @@ pub(super) enum Slot {
     Count(fn(&mut Settings) -> &mut u8),
     Sign(fn(&mut Settings) -> &mut i8),
     Laser,
-    // Only in builds with galvo output.
-    #[cfg_attr(not(feature = "galvo"), allow(dead_code))]
     Planner,
 }
 
@@ -311,7 +309,6 @@ pub static PARAMS: &[ParamSpec] = &[
         5,
         "error-model coefficient c5 of y^2, 1/mm"
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.d_mm",
         50.0,
@@ -320,7 +317,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo Y mirror to board distance d, mm",
         |s| s.galvo.d_mm
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.e_mm",
         0.0,
@@ -329,7 +325,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo mirror separation e, mm",
         |s| s.galvo.e_mm
     ),
-    #[cfg(feature = "galvo")]
     ParamSpec {
         name: "galvo.x_codes_per_rad",
         min: -MAX_CODES_PER_RAD,
@@ -339,7 +334,6 @@ pub static PARAMS: &[ParamSpec] = &[
         help: "galvo X DAC codes/rad, |v| >= 1000, sign = direction",
         slot: Slot::Real(|s| &mut s.galvo.x_codes_per_rad),
     },
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.x_offset_code",
         0.0,
@@ -348,7 +342,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo X DAC code at angle 0",
         |s| s.galvo.x_offset_code
     ),
-    #[cfg(feature = "galvo")]
     ParamSpec {
         name: "galvo.y_codes_per_rad",
         min: -MAX_CODES_PER_RAD,
@@ -358,7 +351,6 @@ pub static PARAMS: &[ParamSpec] = &[
         help: "galvo Y DAC codes/rad, |v| >= 1000, sign = direction",
         slot: Slot::Real(|s| &mut s.galvo.y_codes_per_rad),
     },
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.y_offset_code",
         0.0,
@@ -367,7 +359,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo Y DAC code at angle 0",
         |s| s.galvo.y_offset_code
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.kt_nm_per_a",
         1e-4,
@@ -375,7 +366,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo motor torque constant Kt, N*m/A",
         |s| s.galvo.kt_nm_per_a
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.j_kg_m2",
         1e-10,
@@ -383,11 +373,9 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo rotor+mirror inertia J, kg*m^2",
         |s| s.galvo.j_kg_m2
     ),
-    #[cfg(feature = "galvo")]
     real!("galvo.l_h", 1e-6, 0.1, "galvo coil inductance L, H", |s| s
         .galvo
         .l_h),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.r_ohm",
         0.1,
@@ -395,7 +383,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo coil resistance R, ohm",
         |s| s.galvo.r_ohm
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.u_max_v",
         1.0,
@@ -403,7 +390,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo drive voltage limit Umax, V",
         |s| s.galvo.u_max_v
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.ts_us",
         5.0,
@@ -411,7 +397,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo DAC sample period, us",
         |s| s.galvo.sample_period_us
     ),
-    #[cfg(feature = "galvo")]
     choice!(
         "galvo.planner",
         0.0,
@@ -419,7 +404,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo jump planner: 0 optimal, 1 seed",
         Slot::Planner
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.laser_on_delay_us",
         0.0,
@@ -427,7 +411,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo hold before laser on after a jump, us",
         |s| s.galvo.laser_on_delay_us
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.laser_off_delay_us",
         0.0,
@@ -435,7 +418,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo hold after laser off before a jump, us",
         |s| s.galvo.laser_off_delay_us
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.mark_speed_mm_s",
         1.0,
@@ -443,7 +425,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo marking speed of paths, mm/s",
         |s| s.galvo.mark_speed_mm_s
     ),
-    #[cfg(feature = "galvo")]
     real!(
         "galvo.mark_accel_mm_s2",
         100.0,

@@ -104,3 +104,36 @@ fn the_watchdog_is_fed_every_second_and_would_never_reset() {
         dog.feeds
     );
 }
+
+#[test]
+fn a_board_without_a_galvo_dac_runs_no_galvo_loop_and_refuses_the_galvo() {
+    let script = "target galvo\ntarget gimbal\npattern corner once\n";
+    let without = run_script(
+        script,
+        SimOptions {
+            galvo_dac: false,
+            ..SimOptions::default()
+        },
+    );
+    assert!(without.task_steps.iter().all(|t| t.name != "galvo"));
+    let replies: Vec<&str> = without
+        .transcript
+        .lines
+        .iter()
+        .map(|(_, line)| line.as_str())
+        .collect();
+    assert_eq!(
+        replies[..4],
+        [
+            "> target galvo",
+            "error: this build has no galvo output",
+            "> target gimbal",
+            "ok"
+        ]
+    );
+    assert!(without.dac.is_empty());
+    assert!(without.recording.dwells.len() >= 4, "the gimbal drew");
+    let with = run_script(script, SimOptions::default());
+    assert!(with.task_steps.iter().any(|t| t.name == "galvo"));
+    assert_eq!(with.transcript.lines[1].1, "ok");
+}
