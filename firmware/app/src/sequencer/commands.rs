@@ -4,13 +4,13 @@
 use super::targets::{self, PatternError, Target};
 use super::{LaserSwitch, Phase, Run, Sequencer, SettingsStore};
 use crate::build_info;
-use crate::cli::format::Fixed;
 use crate::cli::parse::HELP_LINES;
 use crate::command::{Actuator, ReplyText, reply_text};
 use crate::command::{AimModel, Command, Pattern, PointCm};
 use crate::galvo::GALVO_OUTPUT;
 use crate::settings::{PARAMS, ParamLine};
 use crate::status::{Activity, Snapshot};
+use crate::text::Fixed;
 
 impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
     /// Runs one command and sends its reply.

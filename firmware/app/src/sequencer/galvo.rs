@@ -5,10 +5,10 @@ use core::sync::atomic::Ordering;
 
 use super::targets::{self, Target};
 use super::{LaserSwitch, Phase, Sequencer, SettingsStore};
-use crate::cli::format::Shortest;
 use crate::galvo::{GALVO_OUTPUT, GalvoEvent, GalvoRequest, config_from};
 use crate::log;
 use crate::settings::LaserMode;
+use crate::text::Shortest;
 
 /// Dwell of a goto on the galvo: held until the next command, µs.
 const HOLD_US: u32 = u32::MAX;

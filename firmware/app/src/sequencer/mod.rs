@@ -18,7 +18,6 @@ use embassy_time::{Duration, Instant, Timer};
 
 pub use self::laser::{LaserEvent, LaserSwitch, laser_wanted};
 use self::targets::{Aim, PathCursor, Target};
-use crate::cli::format::Fixed;
 use crate::command::{Actuator, AimModel, CommandLink, Pattern};
 use crate::galvo::GalvoLink;
 use crate::laser_gate::LaserGate;
@@ -26,6 +25,7 @@ use crate::log;
 use crate::servo::task::{ServoLink, ServoOutcome, ServoRequest};
 use crate::settings::{RecordError, Settings};
 use crate::status::{Activity, Phase, StatusBoard};
+use crate::text::Fixed;
 
 /// Where settings are saved: [`crate::settings::store::FlashSettingsStore`]
 /// over the target's flash sectors 10 and 11, or over the simulator's model

@@ -4,7 +4,7 @@ use core::fmt;
 
 use super::{LaserMode, Settings};
 use crate::cli::error::CommandError;
-use crate::cli::format::Shortest;
+use crate::text::Shortest;
 use kinematics_core::error_model::COEF_LIMITS;
 
 /// How a parameter's value is stored.
