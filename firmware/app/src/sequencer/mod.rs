@@ -121,12 +121,17 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     ) -> Self {
         laser.set(false);
         let gate_generation = gate.close();
-        let mut record = [0u8; crate::settings::RECORD_LEN];
+        let mut record = [0u8; crate::settings::MAX_RECORD_LEN];
         let n = store.load(&mut record).await;
-        let settings = match Settings::from_record(record.get(..n).unwrap_or(&[])) {
-            Ok(s) => {
-                log::info!("settings loaded from flash");
-                s
+        let settings = match Settings::load_record(record.get(..n).unwrap_or(&[])) {
+            Ok(loaded) => {
+                log::info!(
+                    "settings loaded from flash ({:?} layout; {} unknown entries skipped, {} parameters defaulted)",
+                    loaded.layout,
+                    loaded.unknown,
+                    loaded.defaulted
+                );
+                loaded.settings
             }
             Err(RecordError::Missing) => {
                 log::info!("no saved settings, using defaults");

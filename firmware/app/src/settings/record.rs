@@ -1,14 +1,60 @@
-//! The saved form of the settings: a versioned, CRC-checked record.
+//! The saved form of the settings: a versioned, CRC-checked record of
+//! (parameter id, value) entries.
+//!
+//! Layout of version 3 (all fields little-endian):
+//!
+//! | bytes              | field                                          |
+//! |--------------------|------------------------------------------------|
+//! | 0..4               | magic `LPS1`                                   |
+//! | 4..6               | version, u16: 3                                |
+//! | 6..8               | entry count n, u16                             |
+//! | 8..8+10n           | n entries: parameter id u16, value f64; ids strictly ascending |
+//! | 8+10n..12+10n      | CRC-32 of bytes 0..8+10n                       |
+//!
+//! A record is exactly these bytes: its length must match its count, so a
+//! corrupted count cannot move where the checksum is read. Values are in
+//! the parameter's unit, encoded as [`Settings::get`] returns them.
+//!
+//! Loading skips entries whose id this build has no parameter for (and
+//! counts them), leaves parameters without an entry at their defaults (and
+//! counts them), and checks every value as `set` would: adding, removing or
+//! compiling out a parameter never changes how the others are stored or
+//! read. Records of version 2 (positional, written before parameters had
+//! ids) still load, through `legacy.rs`.
 
-use super::params::check_value;
+use super::legacy;
+use super::params::param_by_id;
+use super::spec::{ParamSpec, check_value};
 use super::{PARAMS, Settings};
 
-/// Saved-record layout version; bump when [`PARAMS`] changes.
-pub const RECORD_VERSION: u16 = 2;
-/// Record magic.
-const RECORD_MAGIC: [u8; 4] = *b"LPS1";
-/// Bytes of a saved record: magic, version, count, values, CRC-32.
-pub const RECORD_LEN: usize = 4 + 2 + 2 + 8 * PARAMS.len() + 4;
+/// Version of the record framing. Parameters come and go without a new
+/// version (they are keyed by id); bump it only when the framing changes.
+pub const RECORD_VERSION: u16 = 3;
+/// Record magic (the same for every version).
+pub(super) const RECORD_MAGIC: [u8; 4] = *b"LPS1";
+/// Bytes before the first entry: magic, version, count.
+pub(super) const HEADER_LEN: usize = 8;
+/// Bytes of one entry: id, value.
+const ENTRY_LEN: usize = 2 + 8;
+/// Bytes of the checksum at the end.
+pub(super) const CRC_LEN: usize = 4;
+
+/// Bytes of a record of `entries` entries.
+pub const fn record_len(entries: usize) -> usize {
+    HEADER_LEN + ENTRY_LEN * entries + CRC_LEN
+}
+
+/// Bytes of the record this build writes (one entry per parameter).
+pub const RECORD_LEN: usize = record_len(PARAMS.len());
+/// The most entries a record may have to be loaded by this build: room for
+/// records of later builds with more parameters (their unknown entries are
+/// skipped).
+pub const MAX_RECORD_ENTRIES: usize = 100;
+/// Bytes of the longest record this build loads, of either version: the
+/// size of a buffer to load a record into.
+pub const MAX_RECORD_LEN: usize = record_len(MAX_RECORD_ENTRIES);
+
+const _: () = assert!(PARAMS.len() <= MAX_RECORD_ENTRIES && legacy::MAX_LEN <= MAX_RECORD_LEN);
 
 /// Why a saved record was not loaded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -16,89 +62,212 @@ pub const RECORD_LEN: usize = 4 + 2 + 2 + 8 * PARAMS.len() + 4;
 pub enum RecordError {
     /// Too short or wrong magic: nothing saved yet.
     Missing,
-    /// Saved by another firmware version (layout differs).
+    /// A version this firmware cannot read.
     WrongVersion(u16),
-    /// Checksum mismatch.
+    /// Checksum or length mismatch.
     Corrupt,
-    /// A value is out of range.
+    /// A value is out of range, or the entries are not in the written form.
     Invalid,
+}
+
+/// How a loaded record was laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RecordLayout {
+    /// Version 3: (id, value) entries.
+    IdKeyed,
+    /// Version 2: values by position in the parameter table of that time.
+    Positional,
+}
+
+/// A record that loaded, and what loading it had to make up for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoadedRecord {
+    /// The settings it holds.
+    pub settings: Settings,
+    /// Its layout (a positional one is migrated by the next `save`).
+    pub layout: RecordLayout,
+    /// Entries skipped because this build has no parameter with their id.
+    pub unknown: usize,
+    /// Parameters it has no entry for, left at their defaults.
+    pub defaulted: usize,
+}
+
+impl LoadedRecord {
+    /// Whether saving the loaded settings writes the same record again
+    /// (an id-keyed record with exactly this build's parameters).
+    pub fn is_exact(&self) -> bool {
+        self.layout == RecordLayout::IdKeyed && self.unknown == 0 && self.defaulted == 0
+    }
 }
 
 impl Settings {
     /// Serialises into the versioned, checksummed record.
     pub fn to_record(&self) -> [u8; RECORD_LEN] {
         let mut out = [0u8; RECORD_LEN];
-        let mut w = Cursor {
-            buf: &mut out,
-            at: 0,
-        };
-        w.put(&RECORD_MAGIC);
-        w.put(&RECORD_VERSION.to_le_bytes());
-        w.put(&(PARAMS.len() as u16).to_le_bytes());
-        for p in PARAMS {
-            w.put(&self.get(p).to_le_bytes());
-        }
-        let body = RECORD_LEN - 4;
-        let crc = crc32(out.get(..body).unwrap_or(&[]));
-        if let Some(tail) = out.get_mut(body..) {
-            tail.copy_from_slice(&crc.to_le_bytes());
-        }
+        encode(PARAMS, self, &mut out);
         out
     }
 
-    /// Parses a record; every value goes through [`Settings::set`], so a
-    /// record can never load values the command line would refuse.
+    /// Parses a record; every value goes through the checks of
+    /// [`Settings::set`], so a record can never load values the command
+    /// line would refuse. See [`Settings::load_record`].
     pub fn from_record(bytes: &[u8]) -> Result<Self, RecordError> {
-        if bytes.len() < 8 || bytes.get(..4) != Some(&RECORD_MAGIC[..]) {
-            return Err(RecordError::Missing);
+        Self::load_record(bytes).map(|loaded| loaded.settings)
+    }
+
+    /// Parses a record of either version (exactly `bytes`), counting the
+    /// entries it skipped and the parameters it left at their defaults.
+    pub fn load_record(bytes: &[u8]) -> Result<LoadedRecord, RecordError> {
+        decode(PARAMS, bytes)
+    }
+}
+
+/// Writes `settings` as a record of `table`'s parameters (ascending ids)
+/// into the start of `out`; returns its length, [`record_len`] of
+/// `table.len()` (`out` must have room for it).
+pub(super) fn encode(table: &[ParamSpec], settings: &Settings, out: &mut [u8]) -> usize {
+    let mut w = Cursor { buf: out, at: 0 };
+    w.put(&RECORD_MAGIC);
+    w.put(&RECORD_VERSION.to_le_bytes());
+    w.put(&(table.len() as u16).to_le_bytes());
+    for p in table {
+        w.put(&p.id.to_le_bytes());
+        w.put(&settings.get(p).to_le_bytes());
+    }
+    let body = w.at;
+    let crc = crc32(w.buf.get(..body).unwrap_or(&[]));
+    w.put(&crc.to_le_bytes());
+    w.at
+}
+
+/// Parses a record of either version against `table`.
+pub(super) fn decode(table: &[ParamSpec], bytes: &[u8]) -> Result<LoadedRecord, RecordError> {
+    if bytes.len() < HEADER_LEN || bytes.get(..4) != Some(&RECORD_MAGIC[..]) {
+        return Err(RecordError::Missing);
+    }
+    let field = |at: usize| bytes.get(at..at + 2).and_then(le_u16).unwrap_or(0);
+    let (version, count) = (field(4), usize::from(field(6)));
+    match version {
+        RECORD_VERSION => decode_entries(table, bytes, count),
+        legacy::VERSION => legacy::decode(table, bytes, count),
+        other => Err(RecordError::WrongVersion(other)),
+    }
+}
+
+/// The entries of a version-3 record of `count` entries.
+fn decode_entries(
+    table: &[ParamSpec],
+    bytes: &[u8],
+    count: usize,
+) -> Result<LoadedRecord, RecordError> {
+    let body = checked_body(bytes, record_len(count))?;
+    let mut loading = Loading::new(table);
+    let mut last_id = None;
+    let entries = body.get(HEADER_LEN..).unwrap_or(&[]);
+    for entry in entries.chunks_exact(ENTRY_LEN) {
+        let (id, value) = entry.split_at(2);
+        let id = le_u16(id).ok_or(RecordError::Corrupt)?;
+        // Ascending ids: one encoding per settings, no id twice.
+        if last_id.is_some_and(|last| id <= last) {
+            return Err(RecordError::Invalid);
         }
-        let field = |at: usize| {
-            u16::from_le_bytes([
-                bytes.get(at).copied().unwrap_or(0),
-                bytes.get(at + 1).copied().unwrap_or(0),
-            ])
+        last_id = Some(id);
+        loading.entry(id, le_f64(value).ok_or(RecordError::Corrupt)?)?;
+    }
+    loading.finish(RecordLayout::IdKeyed)
+}
+
+/// Everything before the checksum, when `bytes` is exactly `len` bytes
+/// long and its checksum matches.
+pub(super) fn checked_body(bytes: &[u8], len: usize) -> Result<&[u8], RecordError> {
+    if bytes.len() != len {
+        return Err(RecordError::Corrupt);
+    }
+    let (body, crc) = bytes
+        .split_at_checked(len.saturating_sub(CRC_LEN))
+        .ok_or(RecordError::Corrupt)?;
+    if crc32(body).to_le_bytes()[..] != *crc {
+        return Err(RecordError::Corrupt);
+    }
+    Ok(body)
+}
+
+/// Settings being loaded from a record, value by value.
+pub(super) struct Loading<'t> {
+    table: &'t [ParamSpec],
+    settings: Settings,
+    known: usize,
+    unknown: usize,
+}
+
+impl<'t> Loading<'t> {
+    /// Starts from the defaults.
+    pub(super) fn new(table: &'t [ParamSpec]) -> Self {
+        Self {
+            table,
+            settings: Settings::default(),
+            known: 0,
+            unknown: 0,
+        }
+    }
+
+    /// Loads the value of parameter `id` (each id at most once), or counts
+    /// it as unknown when `table` has no such parameter.
+    pub(super) fn entry(&mut self, id: u16, value: f64) -> Result<(), RecordError> {
+        let Some(param) = param_by_id(self.table, id) else {
+            self.unknown += 1;
+            return Ok(());
         };
-        let (version, count) = (field(4), field(6));
-        if version != RECORD_VERSION || usize::from(count) != PARAMS.len() {
-            return Err(RecordError::WrongVersion(version));
+        check_value(param, value).map_err(|_| RecordError::Invalid)?;
+        self.settings.apply(param, value);
+        // Only the encoding `to_record` writes loads (e.g. not −0 for an
+        // id), so a loaded record re-saves byte for byte.
+        if self.settings.get(param).to_bits() != value.to_bits() {
+            return Err(RecordError::Invalid);
         }
-        let record = bytes.get(..RECORD_LEN).ok_or(RecordError::Corrupt)?;
-        let (body, crc) = record.split_at(RECORD_LEN - 4);
-        if crc32(body).to_le_bytes() != crc {
-            return Err(RecordError::Corrupt);
-        }
-        let mut settings = Settings::default();
-        for (i, p) in PARAMS.iter().enumerate() {
-            let at = 8 + 8 * i;
-            let mut le = [0u8; 8];
-            le.copy_from_slice(body.get(at..at + 8).ok_or(RecordError::Corrupt)?);
-            let value = f64::from_le_bytes(le);
-            check_value(p, value).map_err(|_| RecordError::Invalid)?;
-            settings.apply(p, value);
-            // Only the encoding `to_record` writes loads (e.g. not −0 for
-            // an id), so a loaded record re-saves byte for byte.
-            if settings.get(p).to_bits() != value.to_bits() {
-                return Err(RecordError::Invalid);
-            }
-        }
-        // Cross-parameter rules apply to the loaded set as a whole.
-        settings.validate().map_err(|_| RecordError::Invalid)?;
-        Ok(settings)
+        self.known += 1;
+        Ok(())
+    }
+
+    /// The loaded settings, once the rules between parameters hold for
+    /// them as a whole.
+    pub(super) fn finish(self, layout: RecordLayout) -> Result<LoadedRecord, RecordError> {
+        self.settings.validate().map_err(|_| RecordError::Invalid)?;
+        Ok(LoadedRecord {
+            settings: self.settings,
+            layout,
+            unknown: self.unknown,
+            defaulted: self.table.len().saturating_sub(self.known),
+        })
     }
 }
 
 /// Length of the record at the start of `bytes` when it is complete and its
 /// checksum matches, whatever its version (the length comes from its own
-/// parameter count); `None` for anything else. Tells a record written by an
-/// older firmware straight into flash from erased or partly written flash.
+/// count); `None` for anything else. Tells a record an earlier firmware
+/// wrote straight into flash from erased or partly written flash.
 pub fn intact_record_len(bytes: &[u8]) -> Option<usize> {
     if bytes.get(..4)? != RECORD_MAGIC {
         return None;
     }
-    let count = u16::from_le_bytes([*bytes.get(6)?, *bytes.get(7)?]);
-    let len = 4 + 2 + 2 + 8 * usize::from(count) + 4;
-    let (body, crc) = bytes.get(..len)?.split_at(len - 4);
-    (crc32(body).to_le_bytes() == crc).then_some(len)
+    let version = le_u16(bytes.get(4..6)?)?;
+    let count = usize::from(le_u16(bytes.get(6..8)?)?);
+    let len = match version {
+        RECORD_VERSION => record_len(count),
+        _ => legacy::len(count),
+    };
+    checked_body(bytes.get(..len)?, len).ok().map(|_| len)
+}
+
+/// A little-endian u16 from exactly two bytes.
+fn le_u16(bytes: &[u8]) -> Option<u16> {
+    Some(u16::from_le_bytes(bytes.try_into().ok()?))
+}
+
+/// A little-endian f64 from exactly eight bytes.
+pub(super) fn le_f64(bytes: &[u8]) -> Option<f64> {
+    Some(f64::from_le_bytes(bytes.try_into().ok()?))
 }
 
 struct Cursor<'a> {
@@ -126,115 +295,4 @@ pub fn crc32(bytes: &[u8]) -> u32 {
         }
     }
     !crc
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::settings::{AxisSettings, LaserMode};
-
-    #[test]
-    fn crc32_matches_the_standard_check_value() {
-        assert_eq!(crc32(b"123456789"), 0xCBF4_3926);
-    }
-
-    #[test]
-    fn record_round_trips_every_parameter() {
-        let mut err_dy = [0.0; 6];
-        err_dy[5] = -7.5e-6;
-        let s = Settings {
-            oq_cm: 31.25,
-            err_dx: [0.1, -0.002, 0.003, 1e-5, -2e-5, 3e-6],
-            err_dy,
-            laser_mode: LaserMode::Dwell,
-            pitch: AxisSettings {
-                direction: -1,
-                ..Settings::default().pitch
-            },
-            grid_cols: 10,
-            ..Settings::default()
-        };
-        let record = s.to_record();
-        assert_eq!(Settings::from_record(&record), Ok(s));
-    }
-
-    #[test]
-    fn intact_record_len_accepts_only_whole_checksummed_records() {
-        let record = Settings::default().to_record();
-        let mut flash = [0xFFu8; RECORD_LEN + 64];
-        flash[..RECORD_LEN].copy_from_slice(&record);
-        assert_eq!(intact_record_len(&flash), Some(RECORD_LEN));
-        // Cut short (a write interrupted at any byte) or truncated input.
-        for cut in 0..RECORD_LEN {
-            let mut partial = [0xFFu8; RECORD_LEN + 64];
-            partial[..cut].copy_from_slice(&record[..cut]);
-            assert_eq!(intact_record_len(&partial), None, "cut at {cut}");
-            assert_eq!(intact_record_len(&record[..cut]), None);
-        }
-        // Any single flipped bit.
-        for bit in 0..RECORD_LEN * 8 {
-            let mut flipped = record;
-            flipped[bit / 8] ^= 1 << (bit % 8);
-            assert_eq!(intact_record_len(&flipped), None, "bit {bit}");
-        }
-    }
-
-    #[test]
-    fn corrupt_old_or_missing_records_are_refused() {
-        let record = Settings::default().to_record();
-        assert_eq!(
-            Settings::from_record(&[0xff; RECORD_LEN]),
-            Err(RecordError::Missing)
-        );
-        assert_eq!(Settings::from_record(&[]), Err(RecordError::Missing));
-        let mut flipped = record;
-        flipped[20] ^= 0x10;
-        assert_eq!(Settings::from_record(&flipped), Err(RecordError::Corrupt));
-        let mut old = record;
-        old[4] = 0;
-        assert!(matches!(
-            Settings::from_record(&old),
-            Err(RecordError::WrongVersion(0))
-        ));
-        // A well-formed record with an out-of-range value (checksum fixed up).
-        let bad = Settings {
-            dwell_ms: -5.0,
-            ..Settings::default()
-        };
-        assert_eq!(
-            Settings::from_record(&bad.to_record()),
-            Err(RecordError::Invalid)
-        );
-    }
-
-    #[test]
-    fn only_the_written_encoding_loads() {
-        // −0 where an id, a mode or the planner is stored: check_value
-        // takes it (−0 == 0), but it would load as +0 and re-save
-        // differently. Found by the settings_record fuzz target's property
-        // (tests/fuzz/artifacts/settings_record/).
-        for name in ["yaw.id", "laser.mode", "galvo.planner"] {
-            let Some(at) = PARAMS.iter().position(|p| p.name == name) else {
-                continue;
-            };
-            let mut record = Settings::default().to_record();
-            let field = 8 + 8 * at;
-            record[field..field + 8].copy_from_slice(&(-0.0f64).to_le_bytes());
-            let body = RECORD_LEN - 4;
-            let crc = crc32(&record[..body]);
-            record[body..].copy_from_slice(&crc.to_le_bytes());
-            assert_eq!(
-                Settings::from_record(&record),
-                Err(RecordError::Invalid),
-                "{name} = -0"
-            );
-        }
-        // −0 in a real-valued parameter is stored as is and loads.
-        let s = Settings {
-            x_offset_cm: -0.0,
-            ..Settings::default()
-        };
-        let loaded = Settings::from_record(&s.to_record()).unwrap();
-        assert_eq!(loaded.x_offset_cm.to_bits(), (-0.0f64).to_bits());
-    }
 }

@@ -23,16 +23,17 @@ use embedded_storage_async::nor_flash::{MultiwriteNorFlash, NorFlash};
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapStorage};
 
-use super::record::{RECORD_LEN, intact_record_len};
+use super::record::{MAX_RECORD_LEN, intact_record_len};
 use crate::log;
 use crate::sequencer::SettingsStore;
 
 /// Map key of the settings record (the only item).
 const RECORD_KEY: u8 = 1;
 
-/// Scratch buffer for one map item (key byte + record), padded to the
-/// largest flash word `sequential-storage` supports (32 bytes).
-const ITEM_BUFFER_LEN: usize = (1 + RECORD_LEN).next_multiple_of(32);
+/// Scratch buffer for one map item (key byte + the longest record this
+/// build loads, of either layout), padded to the largest flash word
+/// `sequential-storage` supports (32 bytes).
+const ITEM_BUFFER_LEN: usize = (1 + MAX_RECORD_LEN).next_multiple_of(32);
 
 /// Bytes read at a time when checking that a sector is erased.
 const ERASED_CHECK_CHUNK: usize = 64;
