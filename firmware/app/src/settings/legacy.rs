@@ -4,7 +4,8 @@
 //! `save` writes the id-keyed layout).
 
 use super::record::{
-    CRC_LEN, HEADER_LEN, LoadedRecord, Loading, RecordError, RecordLayout, checked_body, le_f64,
+    CRC_LEN, HEADER_LEN, LoadedRecord, Loading, RecordError, RecordLayout, VALUE_LEN, checked_body,
+    le_f64,
 };
 use super::spec::ParamSpec;
 
@@ -32,7 +33,7 @@ const GIMBAL_VALUES: usize = 37;
 
 /// Bytes of a positional record of `values` values.
 pub(super) const fn len(values: usize) -> usize {
-    HEADER_LEN + 8 * values + CRC_LEN
+    HEADER_LEN + VALUE_LEN * values + CRC_LEN
 }
 
 /// Bytes of the longest version-2 record.
@@ -49,7 +50,10 @@ pub(super) fn decode(
         return Err(RecordError::WrongVersion(VERSION));
     }
     let body = checked_body(bytes, len(count))?;
-    let values = body.get(HEADER_LEN..).unwrap_or(&[]).chunks_exact(8);
+    let values = body
+        .get(HEADER_LEN..)
+        .unwrap_or(&[])
+        .chunks_exact(VALUE_LEN);
     let mut loading = Loading::new(table);
     for (&id, value) in V2_ORDER.iter().zip(values) {
         loading.entry(id, le_f64(value).ok_or(RecordError::Corrupt)?)?;

@@ -27,8 +27,8 @@ mod tests;
 pub use error::SettingsError;
 pub use params::{MAX_CODES_PER_RAD, MIN_CODES_PER_RAD, PARAMS, find_param};
 pub use record::{
-    LoadedRecord, MAX_RECORD_ENTRIES, MAX_RECORD_LEN, RECORD_LEN, RECORD_VERSION, RecordError,
-    RecordLayout, crc32, intact_record_len, record_len,
+    LoadedRecord, MAX_RECORD_LEN, RECORD_LEN, RECORD_VERSION, RecordError, RecordLayout,
+    claimed_record_len, crc32, intact_record_len,
 };
 pub use spec::{ParamLine, ParamSpec, Precision};
 

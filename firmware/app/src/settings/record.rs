@@ -1,22 +1,29 @@
 //! The saved form of the settings: a versioned, CRC-checked record of
-//! (parameter id, value) entries.
+//! values keyed by parameter id.
 //!
 //! Layout of version 3 (all fields little-endian):
 //!
-//! | bytes              | field                                          |
-//! |--------------------|------------------------------------------------|
-//! | 0..4               | magic `LPS1`                                   |
-//! | 4..6               | version, u16: 3                                |
-//! | 6..8               | entry count n, u16                             |
-//! | 8..8+10n           | n entries: parameter id u16, value f64; ids strictly ascending |
-//! | 8+10n..12+10n      | CRC-32 of bytes 0..8+10n                       |
+//! | bytes      | field                                                   |
+//! |------------|---------------------------------------------------------|
+//! | 0..4       | magic `LPS1`                                            |
+//! | 4..6       | version, u16: 3                                         |
+//! | 6..8       | length L of the whole record, u16                       |
+//! | 8..        | runs: id of the first value u16, value count k u8 (1..=255), k values f64 (ids first, first+1, …) |
+//! | ..L-4      | 0–3 zero bytes: the CRC starts on a whole 32-bit word   |
+//! | L-4..L     | CRC-32 of bytes 0..L-4                                  |
 //!
-//! A record is exactly these bytes: its length must match its count, so a
-//! corrupted count cannot move where the checksum is read. Values are in
-//! the parameter's unit, encoded as [`Settings::get`] returns them.
+//! Each value is keyed by its parameter's id; consecutive ids share one run
+//! head (3 bytes per run instead of 2 per value keeps the record of 54
+//! parameters at 488 bytes: more than 250 saves fill a 128 KiB sector, and
+//! two records fit the scaled sectors of the power-cut tests). The length
+//! is a whole number of words, as the positional records' always was.
+//! Runs are maximal and ascending (the one encoding of a set of values), a
+//! record is exactly its length, so a corrupted length cannot move where
+//! the checksum is read. Values are in the parameter's unit, as
+//! [`Settings::get`] returns them.
 //!
-//! Loading skips entries whose id this build has no parameter for (and
-//! counts them), leaves parameters without an entry at their defaults (and
+//! Loading skips values whose id this build has no parameter for (and
+//! counts them), leaves parameters without a value at their defaults (and
 //! counts them), and checks every value as `set` would: adding, removing or
 //! compiling out a parameter never changes how the others are stored or
 //! read. Records of version 2 (positional, written before parameters had
@@ -32,29 +39,52 @@ use super::{PARAMS, Settings};
 pub const RECORD_VERSION: u16 = 3;
 /// Record magic (the same for every version).
 pub(super) const RECORD_MAGIC: [u8; 4] = *b"LPS1";
-/// Bytes before the first entry: magic, version, count.
+/// Bytes before the first run: magic, version, length.
 pub(super) const HEADER_LEN: usize = 8;
-/// Bytes of one entry: id, value.
-const ENTRY_LEN: usize = 2 + 8;
+/// Bytes of a run head: first id, value count.
+const RUN_HEAD_LEN: usize = 3;
+/// Most values in one run.
+const MAX_RUN: usize = u8::MAX as usize;
+/// Bytes of one value.
+pub(super) const VALUE_LEN: usize = 8;
 /// Bytes of the checksum at the end.
 pub(super) const CRC_LEN: usize = 4;
+/// The checksum starts at a multiple of this (a 32-bit word).
+const WORD: usize = 4;
 
-/// Bytes of a record of `entries` entries.
-pub const fn record_len(entries: usize) -> usize {
-    HEADER_LEN + ENTRY_LEN * entries + CRC_LEN
+/// End (exclusive) of the run of `table` (ids ascending) that starts at
+/// index `start`: the stretch of consecutive ids, at most [`MAX_RUN`].
+const fn run_end(table: &[ParamSpec], start: usize) -> usize {
+    let mut end = start + 1;
+    while end < table.len()
+        && end - start < MAX_RUN
+        && table[end].id as usize == table[end - 1].id as usize + 1
+    {
+        end += 1;
+    }
+    end
 }
 
-/// Bytes of the record this build writes (one entry per parameter).
-pub const RECORD_LEN: usize = record_len(PARAMS.len());
-/// The most entries a record may have to be loaded by this build: room for
-/// records of later builds with more parameters (their unknown entries are
-/// skipped).
-pub const MAX_RECORD_ENTRIES: usize = 100;
-/// Bytes of the longest record this build loads, of either version: the
-/// size of a buffer to load a record into.
-pub const MAX_RECORD_LEN: usize = record_len(MAX_RECORD_ENTRIES);
+/// Bytes of the record of `table`'s parameters (ids ascending).
+pub(super) const fn record_len(table: &[ParamSpec]) -> usize {
+    let mut len = HEADER_LEN + CRC_LEN;
+    let mut start = 0;
+    while start < table.len() {
+        let end = run_end(table, start);
+        len += RUN_HEAD_LEN + VALUE_LEN * (end - start);
+        start = end;
+    }
+    len.next_multiple_of(WORD)
+}
 
-const _: () = assert!(PARAMS.len() <= MAX_RECORD_ENTRIES && legacy::MAX_LEN <= MAX_RECORD_LEN);
+/// Bytes of the record this build writes (all its parameters).
+pub const RECORD_LEN: usize = record_len(PARAMS);
+/// Bytes of the longest record this build loads, of either version (the
+/// size of a buffer to load a record into): room for records of later
+/// builds with more parameters, whose unknown values are skipped.
+pub const MAX_RECORD_LEN: usize = 1024;
+
+const _: () = assert!(RECORD_LEN <= MAX_RECORD_LEN && legacy::MAX_LEN <= MAX_RECORD_LEN);
 
 /// Why a saved record was not loaded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -123,17 +153,28 @@ impl Settings {
     }
 }
 
-/// Writes `settings` as a record of `table`'s parameters (ascending ids)
-/// into the start of `out`; returns its length, [`record_len`] of
-/// `table.len()` (`out` must have room for it).
+/// Writes `settings` as a record of `table`'s parameters (ids ascending)
+/// into the start of `out`; returns its length, `record_len(table)` (`out`
+/// must have room for it).
 pub(super) fn encode(table: &[ParamSpec], settings: &Settings, out: &mut [u8]) -> usize {
     let mut w = Cursor { buf: out, at: 0 };
     w.put(&RECORD_MAGIC);
     w.put(&RECORD_VERSION.to_le_bytes());
-    w.put(&(table.len() as u16).to_le_bytes());
-    for p in table {
-        w.put(&p.id.to_le_bytes());
-        w.put(&settings.get(p).to_le_bytes());
+    w.put(&(record_len(table) as u16).to_le_bytes());
+    let mut start = 0;
+    while start < table.len() {
+        let end = run_end(table, start);
+        let run = table.get(start..end).unwrap_or(&[]);
+        let first = run.first().map_or(0, |p| p.id);
+        w.put(&first.to_le_bytes());
+        w.put(&[run.len() as u8]);
+        for p in run {
+            w.put(&settings.get(p).to_le_bytes());
+        }
+        start = end;
+    }
+    while w.at % WORD != 0 {
+        w.put(&[0]);
     }
     let body = w.at;
     let crc = crc32(w.buf.get(..body).unwrap_or(&[]));
@@ -147,33 +188,51 @@ pub(super) fn decode(table: &[ParamSpec], bytes: &[u8]) -> Result<LoadedRecord, 
         return Err(RecordError::Missing);
     }
     let field = |at: usize| bytes.get(at..at + 2).and_then(le_u16).unwrap_or(0);
-    let (version, count) = (field(4), usize::from(field(6)));
-    match version {
-        RECORD_VERSION => decode_entries(table, bytes, count),
-        legacy::VERSION => legacy::decode(table, bytes, count),
+    match field(4) {
+        RECORD_VERSION => decode_runs(table, bytes, usize::from(field(6))),
+        legacy::VERSION => legacy::decode(table, bytes, usize::from(field(6))),
         other => Err(RecordError::WrongVersion(other)),
     }
 }
 
-/// The entries of a version-3 record of `count` entries.
-fn decode_entries(
-    table: &[ParamSpec],
-    bytes: &[u8],
-    count: usize,
-) -> Result<LoadedRecord, RecordError> {
-    let body = checked_body(bytes, record_len(count))?;
+/// The runs of a version-3 record of `len` bytes.
+fn decode_runs(table: &[ParamSpec], bytes: &[u8], len: usize) -> Result<LoadedRecord, RecordError> {
+    let body = checked_body(bytes, len)?;
+    let mut runs = body.get(HEADER_LEN..).unwrap_or(&[]);
     let mut loading = Loading::new(table);
-    let mut last_id = None;
-    let entries = body.get(HEADER_LEN..).unwrap_or(&[]);
-    for entry in entries.chunks_exact(ENTRY_LEN) {
-        let (id, value) = entry.split_at(2);
-        let id = le_u16(id).ok_or(RecordError::Corrupt)?;
-        // Ascending ids: one encoding per settings, no id twice.
-        if last_id.is_some_and(|last| id <= last) {
+    // The id after the previous run, and whether it was full.
+    let mut next: Option<(u32, bool)> = None;
+    // A run has at least one value: fewer bytes than a word are padding.
+    while runs.len() >= WORD {
+        let (head, rest) = runs
+            .split_at_checked(RUN_HEAD_LEN)
+            .ok_or(RecordError::Corrupt)?;
+        let (first, count) = match head {
+            [lo, hi, count] => (u16::from_le_bytes([*lo, *hi]), usize::from(*count)),
+            _ => return Err(RecordError::Corrupt),
+        };
+        // Ascending, maximal, non-empty runs: one encoding per settings.
+        let canonical = count > 0
+            && usize::from(first) + count <= usize::from(u16::MAX) + 1
+            && next.is_none_or(|(after, full)| {
+                u32::from(first) > after || (u32::from(first) == after && full)
+            });
+        if !canonical {
             return Err(RecordError::Invalid);
         }
-        last_id = Some(id);
-        loading.entry(id, le_f64(value).ok_or(RecordError::Corrupt)?)?;
+        let (values, rest) = rest
+            .split_at_checked(VALUE_LEN * count)
+            .ok_or(RecordError::Corrupt)?;
+        for (id, value) in (first..=u16::MAX).zip(values.chunks_exact(VALUE_LEN)) {
+            loading.entry(id, le_f64(value).ok_or(RecordError::Corrupt)?)?;
+        }
+        next = Some((u32::from(first) + count as u32, count == MAX_RUN));
+        runs = rest;
+    }
+    // The checksum is word-aligned (`checked_body` took `len`), so what is
+    // left is exactly the padding.
+    if len % WORD != 0 || runs.iter().any(|b| *b != 0) {
+        return Err(RecordError::Invalid);
     }
     loading.finish(RecordLayout::IdKeyed)
 }
@@ -248,16 +307,23 @@ impl<'t> Loading<'t> {
 /// count); `None` for anything else. Tells a record an earlier firmware
 /// wrote straight into flash from erased or partly written flash.
 pub fn intact_record_len(bytes: &[u8]) -> Option<usize> {
-    if bytes.get(..4)? != RECORD_MAGIC {
+    let len = claimed_record_len(bytes)?;
+    checked_body(bytes.get(..len)?, len).ok().map(|_| len)
+}
+
+/// The length the record starting with `header` has by its magic, version
+/// and length or count field (version 3: its length; any other: the
+/// positional layout of its value count), whether or not the rest is there.
+pub fn claimed_record_len(header: &[u8]) -> Option<usize> {
+    if header.get(..4)? != RECORD_MAGIC {
         return None;
     }
-    let version = le_u16(bytes.get(4..6)?)?;
-    let count = usize::from(le_u16(bytes.get(6..8)?)?);
-    let len = match version {
-        RECORD_VERSION => record_len(count),
-        _ => legacy::len(count),
-    };
-    checked_body(bytes.get(..len)?, len).ok().map(|_| len)
+    let version = le_u16(header.get(4..6)?)?;
+    let field = usize::from(le_u16(header.get(6..8)?)?);
+    Some(match version {
+        RECORD_VERSION => field,
+        _ => legacy::len(field),
+    })
 }
 
 /// A little-endian u16 from exactly two bytes.

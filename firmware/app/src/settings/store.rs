@@ -76,6 +76,8 @@ impl<F: MultiwriteNorFlash> FlashSettingsStore<F> {
     /// `buf`, if there is one.
     async fn read_legacy(&mut self, buf: &mut [u8; ITEM_BUFFER_LEN]) -> Option<usize> {
         let at = self.legacy_offset();
+        // A record in the earlier layout lies within the last sector.
+        let buf = buf.get_mut(..F::ERASE_SIZE.min(ITEM_BUFFER_LEN))?;
         self.map.flash().read(at, buf).await.ok()?;
         intact_record_len(buf)
     }

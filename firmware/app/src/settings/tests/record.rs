@@ -6,7 +6,7 @@ extern crate std;
 
 use std::vec::Vec;
 
-use super::super::record::{decode, encode};
+use super::super::record::{decode, encode, record_len};
 use crate::settings::*;
 
 /// Every parameter's id as it was given (ids never change): a parameter
@@ -138,17 +138,52 @@ fn has_galvo() -> bool {
     find_param("galvo.d_mm").is_some()
 }
 
-/// A version-3 record of `entries`, built by hand from the layout.
+/// A version-3 record of `entries` in the given order, built by hand from
+/// the layout: each stretch of consecutive ids (at most 255) is one run.
 fn record_of(entries: &[(u16, f64)]) -> Vec<u8> {
     let mut out = Vec::from(*b"LPS1");
     out.extend_from_slice(&3u16.to_le_bytes());
-    out.extend_from_slice(&(entries.len() as u16).to_le_bytes());
-    for (id, value) in entries {
-        out.extend_from_slice(&id.to_le_bytes());
-        out.extend_from_slice(&value.to_le_bytes());
+    out.extend_from_slice(&[0, 0]);
+    let mut rest = entries;
+    while let Some(&(first, _)) = rest.first() {
+        let run = (1..rest.len().min(255))
+            .find(|&i| u32::from(rest[i].0) != u32::from(rest[i - 1].0) + 1)
+            .unwrap_or(rest.len().min(255));
+        out.extend_from_slice(&first.to_le_bytes());
+        out.push(run as u8);
+        for (_, value) in &rest[..run] {
+            out.extend_from_slice(&value.to_le_bytes());
+        }
+        rest = &rest[run..];
     }
-    let crc = crc32(&out);
-    out.extend_from_slice(&crc.to_le_bytes());
+    out.resize(out.len().next_multiple_of(4), 0);
+    let len = (out.len() + 4) as u16;
+    out[6..8].copy_from_slice(&len.to_le_bytes());
+    with_crc(out)
+}
+
+/// `body` with its CRC-32 appended.
+fn with_crc(mut body: Vec<u8>) -> Vec<u8> {
+    let crc = crc32(&body);
+    body.extend_from_slice(&crc.to_le_bytes());
+    body
+}
+
+/// The (id, value bits) a version-3 record holds, read by hand.
+fn values_in(record: &[u8]) -> Vec<(u16, u64)> {
+    let mut out = Vec::new();
+    let mut runs = &record[8..record.len() - 4];
+    while runs.len() >= 4 {
+        let first = u16::from_le_bytes([runs[0], runs[1]]);
+        let count = usize::from(runs[2]);
+        for i in 0..count {
+            let at = 3 + 8 * i;
+            let bits = u64::from_le_bytes(runs[at..at + 8].try_into().unwrap());
+            out.push((first + i as u16, bits));
+        }
+        runs = &runs[3 + 8 * count..];
+    }
+    assert!(runs.iter().all(|b| *b == 0), "zero padding");
     out
 }
 
@@ -159,7 +194,7 @@ fn entries_of(table: &[ParamSpec], settings: &Settings) -> Vec<(u16, f64)> {
 
 /// `table`'s record of `settings`.
 fn encoded(table: &[ParamSpec], settings: &Settings) -> Vec<u8> {
-    let mut out = std::vec![0u8; record_len(table.len())];
+    let mut out = std::vec![0u8; record_len(table)];
     assert_eq!(encode(table, settings, &mut out), out.len());
     out
 }
@@ -193,8 +228,17 @@ fn ids_are_stable_unique_and_ascending() {
 fn the_record_is_magic_version_count_id_value_entries_and_crc() {
     let s = fixture_settings();
     assert_eq!(s.to_record()[..], record_of(&entries_of(PARAMS, &s))[..]);
-    assert_eq!(RECORD_LEN, 8 + 10 * PARAMS.len() + 4);
+    let values: Vec<(u16, u64)> = entries_of(PARAMS, &s)
+        .iter()
+        .map(|(id, v)| (*id, v.to_bits()))
+        .collect();
+    assert_eq!(values_in(&s.to_record()), values);
     assert!(MAX_RECORD_LEN >= RECORD_LEN && MAX_RECORD_LEN >= V2_GALVO.len());
+    if has_galvo() {
+        // 14 runs of 54 values, 2 bytes of padding: small enough that more
+        // than 250 saves fill a 128 KiB sector (tests/tests/settings_sim.rs).
+        assert_eq!(RECORD_LEN, 8 + 14 * 3 + 54 * 8 + 2 + 4);
+    }
 }
 
 #[test]
@@ -286,15 +330,11 @@ fn a_compiled_out_parameter_leaves_the_others_as_they_are() {
         .collect();
     let full = encoded(PARAMS, &s);
     let reduced = encoded(&without, &s);
-    // The other entries are stored byte for byte as before.
-    let dwell_entry = entries_of(PARAMS, &s)
-        .iter()
-        .position(|(id, _)| *id == dwell.id)
-        .unwrap();
-    let entry = |i: usize| 8 + 10 * i..8 + 10 * (i + 1);
-    let mut full_others = full[8..full.len() - 4].to_vec();
-    full_others.drain(entry(dwell_entry).start - 8..entry(dwell_entry).end - 8);
-    assert_eq!(full_others, reduced[8..reduced.len() - 4]);
+    // The others are stored with the same id and the same value bits.
+    let mut others = values_in(&full);
+    others.retain(|(id, _)| *id != dwell.id);
+    assert_eq!(values_in(&reduced), others);
+    assert_eq!(reduced.len(), full.len() - 8);
     let without_dwell = Settings {
         dwell_ms: Settings::default().dwell_ms,
         ..s
@@ -357,13 +397,57 @@ fn a_record_is_exactly_its_length() {
     let mut longer = record.to_vec();
     longer.push(0);
     assert_eq!(Settings::from_record(&longer), Err(RecordError::Corrupt));
-    // Fewer entries than the count says, checksum fixed up.
-    let mut short = record_of(&entries_of(&PARAMS[1..], &Settings::default()));
-    short[6..8].copy_from_slice(&(PARAMS.len() as u16).to_le_bytes());
-    let body = short.len() - 4;
-    let crc = crc32(&short[..body]);
-    short[body..].copy_from_slice(&crc.to_le_bytes());
-    assert_eq!(Settings::from_record(&short), Err(RecordError::Corrupt));
+    // A length field that disagrees with the bytes (checksum fixed up).
+    let mut wrong = record[..RECORD_LEN - 4].to_vec();
+    wrong[6..8].copy_from_slice(&((RECORD_LEN + 8) as u16).to_le_bytes());
+    let wrong = with_crc(wrong);
+    assert_eq!(Settings::from_record(&wrong), Err(RecordError::Corrupt));
+    // A run that claims more values than the record holds.
+    let mut overrun = record[..RECORD_LEN - 4].to_vec();
+    overrun[10] += 1;
+    assert_eq!(
+        Settings::from_record(&with_crc(overrun)),
+        Err(RecordError::Corrupt)
+    );
+}
+
+#[test]
+fn runs_are_maximal_and_not_empty_and_padding_is_zero() {
+    // The values of ids 10 and 11 as two runs instead of one.
+    let mut split = Vec::from(&Settings::default().to_record()[..8]);
+    for (id, value) in entries_of(PARAMS, &Settings::default()) {
+        split.extend_from_slice(&id.to_le_bytes());
+        split.push(1);
+        split.extend_from_slice(&value.to_le_bytes());
+    }
+    split.resize(split.len().next_multiple_of(4), 0);
+    let len = (split.len() + 4) as u16;
+    split[6..8].copy_from_slice(&len.to_le_bytes());
+    assert_eq!(
+        Settings::from_record(&with_crc(split)),
+        Err(RecordError::Invalid)
+    );
+    // One value: 19 bytes of header and run, one byte of padding.
+    let one = record_of(&entries_of(&PARAMS[..1], &Settings::default()));
+    assert_eq!(one.len(), 24);
+    assert_eq!(
+        Settings::load_record(&one).map(|l| l.defaulted),
+        Ok(PARAMS.len() - 1)
+    );
+    let mut padded = one[..20].to_vec();
+    padded[19] = 1;
+    assert_eq!(
+        Settings::from_record(&with_crc(padded)),
+        Err(RecordError::Invalid)
+    );
+    let mut empty = record_of(&[]);
+    empty.truncate(8);
+    empty.extend_from_slice(&[10, 0, 0, 0]);
+    empty[6..8].copy_from_slice(&16u16.to_le_bytes());
+    assert_eq!(
+        Settings::from_record(&with_crc(empty)),
+        Err(RecordError::Invalid)
+    );
 }
 
 #[test]
