@@ -173,7 +173,7 @@ pub(super) fn encode(table: &[ParamSpec], settings: &Settings, out: &mut [u8]) -
         }
         start = end;
     }
-    while w.at % WORD != 0 {
+    while !w.at.is_multiple_of(WORD) {
         w.put(&[0]);
     }
     let body = w.at;
@@ -231,7 +231,7 @@ fn decode_runs(table: &[ParamSpec], bytes: &[u8], len: usize) -> Result<LoadedRe
     }
     // The checksum is word-aligned (`checked_body` took `len`), so what is
     // left is exactly the padding.
-    if len % WORD != 0 || runs.iter().any(|b| *b != 0) {
+    if !len.is_multiple_of(WORD) || runs.iter().any(|b| *b != 0) {
         return Err(RecordError::Invalid);
     }
     loading.finish(RecordLayout::IdKeyed)
