@@ -27,17 +27,9 @@ use crate::settings::{RecordError, Settings};
 use crate::status::{Activity, Phase, StatusBoard};
 use crate::text::Fixed;
 
-/// Where settings are saved: [`crate::settings::store::FlashSettingsStore`]
-/// over the target's flash sectors 10 and 11, or over the simulator's model
-/// of them.
-#[allow(async_fn_in_trait)]
-pub trait SettingsStore {
-    /// Reads the saved record into `buf`; returns the bytes read (0 when
-    /// nothing is saved).
-    async fn load(&mut self, buf: &mut [u8]) -> usize;
-    /// Replaces the saved record; `Err` carries a message for the user.
-    async fn save(&mut self, record: &[u8]) -> Result<(), &'static str>;
-}
+/// Where settings are saved (defined with the settings; named here too,
+/// as the sequencer's store).
+pub use crate::settings::store::SettingsStore;
 
 /// Period of the housekeeping tick (liveness for the watchdog).
 const HOUSEKEEPING: Duration = Duration::from_millis(250);

@@ -25,7 +25,17 @@ use sequential_storage::map::{MapConfig, MapStorage};
 
 use super::record::{MAX_RECORD_LEN, intact_record_len};
 use crate::log;
-use crate::sequencer::SettingsStore;
+
+/// Where settings are saved: [`FlashSettingsStore`] over the target's flash
+/// sectors 10 and 11, or over the simulator's model of them.
+#[allow(async_fn_in_trait)]
+pub trait SettingsStore {
+    /// Reads the saved record into `buf`; returns the bytes read (0 when
+    /// nothing is saved).
+    async fn load(&mut self, buf: &mut [u8]) -> usize;
+    /// Replaces the saved record; `Err` carries a message for the user.
+    async fn save(&mut self, record: &[u8]) -> Result<(), &'static str>;
+}
 
 /// Map key of the settings record (the only item).
 const RECORD_KEY: u8 = 1;
