@@ -1,4 +1,4 @@
-//! Planning time per jump for each method, per-sample stepper cost (f32),
+//! Planning time per jump for each method, per-sample integrator cost (f32),
 //! path-planner cost per added segment and per sample.
 //!
 //! `cargo bench -p galvo-planner -- --warm-up-time 1 --measurement-time 3`
@@ -6,10 +6,10 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
+use galvo_planner::integrator::Integrator;
 use galvo_planner::jump::{Method, plan_jump};
 use galvo_planner::model::{Discrete, FlexParams, RigidParams};
 use galvo_planner::path::{MarkLimits, PathPlanner};
-use galvo_planner::stepper::Stepper;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 
@@ -33,7 +33,7 @@ fn planning(c: &mut Criterion) {
         let d = rigid(ts);
         for (method, name) in [
             (Method::TimeOptimal, "optimal"),
-            (Method::SEED, "seed"),
+            (Method::BISECTION, "seed"),
             (Method::TCurve, "tcurve"),
             (Method::SCurve, "scurve"),
         ] {
@@ -48,19 +48,21 @@ fn planning(c: &mut Criterion) {
     }
     let f = flex(10e-6);
     g.bench_function("seed/20deg/10us/flexible", |b| {
-        b.iter(|| plan_jump(&f, 0.0, black_box(20.0 * DEG), Method::SEED, 100_000).expect("plan"))
+        b.iter(|| {
+            plan_jump(&f, 0.0, black_box(20.0 * DEG), Method::BISECTION, 100_000).expect("plan")
+        })
     });
     g.finish();
 }
 
 fn stepping(c: &mut Criterion) {
     const BLOCK: usize = 64;
-    let mut g = c.benchmark_group("stepper");
+    let mut g = c.benchmark_group("integrator");
     g.throughput(Throughput::Elements(BLOCK as u64));
     let d = rigid(10e-6);
-    let plan = plan_jump(&d, -10.0 * DEG, 10.0 * DEG, Method::SEED, 4096).expect("plan");
+    let plan = plan_jump(&d, -10.0 * DEG, 10.0 * DEG, Method::BISECTION, 4096).expect("plan");
     assert!(plan.samples() >= BLOCK);
-    let mut st: Stepper<3, 1024> = Stepper::new(&d, -10.0 * DEG).expect("stepper");
+    let mut st: Integrator<3, 1024> = Integrator::new(&d, -10.0 * DEG).expect("integrator");
     st.queue(&plan).expect("queue");
     g.bench_function("rigid_f32/block64", |b| {
         b.iter_batched_ref(
@@ -70,8 +72,8 @@ fn stepping(c: &mut Criterion) {
         )
     });
     let f = flex(10e-6);
-    let plan = plan_jump(&f, -10.0 * DEG, 10.0 * DEG, Method::SEED, 4096).expect("plan");
-    let mut sf: Stepper<5, 1024> = Stepper::new(&f, -10.0 * DEG).expect("stepper");
+    let plan = plan_jump(&f, -10.0 * DEG, 10.0 * DEG, Method::BISECTION, 4096).expect("plan");
+    let mut sf: Integrator<5, 1024> = Integrator::new(&f, -10.0 * DEG).expect("integrator");
     sf.queue(&plan).expect("queue");
     g.bench_function("flexible_f32/block64", |b| {
         b.iter_batched_ref(
@@ -80,7 +82,7 @@ fn stepping(c: &mut Criterion) {
             BatchSize::SmallInput,
         )
     });
-    let idle: Stepper<3, 1024> = Stepper::new(&d, 0.1).expect("stepper");
+    let idle: Integrator<3, 1024> = Integrator::new(&d, 0.1).expect("integrator");
     g.bench_function("rigid_idle_hold/block64", |b| {
         b.iter_batched_ref(
             || (idle.clone(), [0.0f32; BLOCK]),

@@ -2,6 +2,8 @@
 
 use core::fmt;
 
+use kinematics_core::numeric::{NonFinite, finite};
+
 /// Everything that can go wrong when building a model, planning a move,
 /// queueing it or adding a path segment. Invalid input is always reported
 /// with one of these, never with a panic.
@@ -60,11 +62,11 @@ pub enum Error {
     /// An iterative solver did not converge (should not happen for valid
     /// parameters; reported instead of returning a wrong plan).
     NoConvergence,
-    /// The stepper's move queue or sample ring has no room for this move.
+    /// The integrator's move queue or sample ring has no room for this move.
     QueueFull,
-    /// The stepper is still moving; it can only be re-seated when idle.
-    StepperBusy,
-    /// A plan made for a different sampled model than the stepper's.
+    /// The integrator is still moving; it can only be re-seated when idle.
+    IntegratorBusy,
+    /// A plan made for a different sampled model than the integrator's.
     ModelMismatch,
     /// A queued move does not start where the previously queued move ends.
     DiscontinuousMove,
@@ -113,11 +115,11 @@ impl fmt::Display for Error {
                 "bisection bracket [{t_min_s}, {t_max_s}] s is empty or its upper end is not feasible"
             ),
             Error::NoConvergence => write!(f, "the planner's solver did not converge"),
-            Error::QueueFull => write!(f, "the stepper queue is full"),
-            Error::StepperBusy => write!(f, "the stepper is still executing a move"),
+            Error::QueueFull => write!(f, "the integrator queue is full"),
+            Error::IntegratorBusy => write!(f, "the integrator is still executing a move"),
             Error::ModelMismatch => write!(
                 f,
-                "the plan was made for a different sampled model than the stepper's"
+                "the plan was made for a different sampled model than the integrator's"
             ),
             Error::DiscontinuousMove => write!(
                 f,
@@ -137,32 +139,15 @@ impl fmt::Display for Error {
 
 impl core::error::Error for Error {}
 
-/// `v` limited to `[lo, hi]`; NaN stays NaN (so solvers still see a
-/// diverged iterate). Unlike `f64::clamp` it cannot panic, and it links no
-/// float formatting into the firmware (`f64::clamp`'s panic message
-/// formats its bounds).
-pub(crate) fn clamp<F: PartialOrd>(v: F, lo: F, hi: F) -> F {
-    if v < lo {
-        lo
-    } else if v > hi {
-        hi
-    } else {
-        v
-    }
-}
-
-/// Checks that `value` is finite; names it in the error otherwise.
-pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, Error> {
-    if value.is_finite() {
-        Ok(value)
-    } else {
-        Err(Error::NonFinite { name })
+impl From<NonFinite> for Error {
+    fn from(e: NonFinite) -> Self {
+        Error::NonFinite { name: e.name }
     }
 }
 
 /// Checks that `value` is finite and strictly positive.
-pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, Error> {
-    let value = finite(name, value)?;
+pub(crate) fn positive(value: f64, name: &'static str) -> Result<f64, Error> {
+    let value = finite(value, name)?;
     if value > 0.0 {
         Ok(value)
     } else {
@@ -175,16 +160,6 @@ mod tests {
     extern crate std;
     use super::*;
     use std::string::ToString;
-
-    #[test]
-    fn clamp_keeps_nan_and_never_panics() {
-        assert_eq!(clamp(5.0, 0.0, 1.0), 1.0);
-        assert_eq!(clamp(-5.0f32, 0.0, 1.0), 0.0);
-        assert_eq!(clamp(0.25, 0.0, 1.0), 0.25);
-        assert!(clamp(f64::NAN, 0.0, 1.0).is_nan());
-        // Misordered bounds (f64::clamp would panic): no panic.
-        assert_eq!(clamp(0.5, 1.0, 0.0), 1.0);
-    }
 
     #[test]
     fn display_names_the_value() {
@@ -202,19 +177,19 @@ mod tests {
 
     #[test]
     fn validators() {
-        assert_eq!(positive("x", 2.0), Ok(2.0));
+        assert_eq!(positive(2.0, "x"), Ok(2.0));
         assert_eq!(
-            positive("x", 0.0),
+            positive(0.0, "x"),
             Err(Error::NotPositive {
                 name: "x",
                 value: 0.0
             })
         );
-        assert_eq!(positive("x", f64::NAN), Err(Error::NonFinite { name: "x" }));
+        assert_eq!(positive(f64::NAN, "x"), Err(Error::NonFinite { name: "x" }));
         assert_eq!(
-            finite("y", f64::INFINITY),
+            finite(f64::INFINITY, "y").map_err(Error::from),
             Err(Error::NonFinite { name: "y" })
         );
-        assert_eq!(finite("y", -3.0), Ok(-3.0));
+        assert_eq!(finite(-3.0, "y"), Ok(-3.0));
     }
 }

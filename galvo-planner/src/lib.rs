@@ -10,10 +10,10 @@
 )]
 //! Model-based galvo trajectories: the patent's bisection planner made
 //! exact, a time-optimal planner, T/S-curve baselines, GRBL-style look-ahead
-//! path marking, and the per-sample state-update stepper.
+//! path marking, and the per-sample state-update integrator.
 //!
 //! `no_std` + `libm`; nothing allocates. Planning math is `f64`; the
-//! per-sample stepper and path sampler are `f32` (the Cortex-M4F FPU is
+//! per-sample integrator and path sampler are `f32` (the Cortex-M4F FPU is
 //! single precision). Invalid input returns [`Error`], never panics. All
 //! quantities are SI with the unit in the name (`theta_rad`, `ts_s`, `u_v`,
 //! …) except the board plane of the path planner, which is in mm.
@@ -23,18 +23,27 @@
 //! | module | what | key items |
 //! |---|---|---|
 //! | [`model`] | rigid `(θ, ω, I)` and flexible `(θ, ω, I, φ, ω_φ)` models, exact ZOH discretisation | [`RigidParams::model`], [`FlexParams::model`], [`LinearModel::discretize`] → [`Discrete`] |
-//! | [`jump`] | one plan type for every method, dispatcher, two-axis jumps | [`plan_jump`], [`plan_xy_jump`], [`JumpPlan`], [`Method`], [`JumpSync`] |
-//! | [`min_energy`] | minimum-energy input over N samples; seed bisection planner | [`min_energy::plan_min_energy`], [`min_energy::plan_seed`], [`SeedConfig`] |
+//! | [`plan`] | one plan type for every method (below the planners) | [`JumpPlan`], [`XyJump`], [`MethodKind`], [`PlanInfo`] |
+//! | [`jump`] | method dispatcher, two-axis jumps (above the planners) | [`plan_jump`], [`plan_xy_jump`], [`Method`], [`JumpSync`] |
+//! | [`min_energy`] | minimum-energy input over N samples ([`gramian`]: its linear algebra) | [`min_energy::plan_min_energy`] |
+//! | [`bisection`] | the patent's bisection planner (user-facing name `seed`) | [`bisection::plan_bisection`], [`BisectionConfig`] |
 //! | [`fast_optimal`] | time-optimal rest-to-rest (rigid) in `f32`: the default [`Method::TimeOptimal`], µs on the M4F | [`fast_optimal::plan_time_optimal_fast`] |
-//! | [`optimal`] | time-optimal rest-to-rest (rigid) in `f64`: reference and fallback | [`optimal::plan_time_optimal`] |
-//! | [`profile`] | T-curve / S-curve baselines and their inverse-dynamics voltage | [`profile::plan_profile`], [`profile::Profile`], [`profile::ProfileLimits::from_drive`] |
-//! | [`stepper`] | per-sample `f32` state update, move queue, two axes | [`Stepper`], [`XyStepper`] |
+//! | [`optimal`] | time-optimal rest-to-rest (rigid) in `f64`: reference and fallback ([`bang_bang`]: its input law) | [`optimal::plan_time_optimal`] |
+//! | [`profile`] | T-curve / S-curve baselines ([`motion_profile`]: the profiles and their inverse-dynamics voltage) | [`profile::plan_profile`], [`profile::Profile`], [`profile::ProfileLimits::from_drive`] |
+//! | [`integrator`] | per-sample `f32` state update, move queue, two axes | [`Integrator`], [`XyIntegrator`] |
 //! | [`path`] | look-ahead marking of lines and arcs in the board plane | [`PathPlanner`], [`MarkLimits`], [`MarkSample`], [`BlockEnd`] |
 //! | [`linalg`] | small fixed-size matrices, matrix exponential | [`linalg::expm_and_integral`] |
 //!
+//! Modules, bottom to top (each uses only those below it):
+//! `error`, `linalg`, `bang_bang` → `rigid_modes` → `model` → `gramian`,
+//! `motion_profile` → `plan` → `min_energy`, `bisection`, `profile`,
+//! `optimal` → `fast_optimal`, `integrator` → `jump`; `path` stands alone
+//! (board plane, mm). `finite`, `clamp` and the back-substitution come from
+//! `kinematics_core::numeric`.
+//!
 //! # The galvo loop
 //!
-//! Jumps (laser off) run in mirror-angle space through an [`XyStepper`];
+//! Jumps (laser off) run in mirror-angle space through an [`XyIntegrator`];
 //! marked paths run in the board plane through a [`PathPlanner`], whose
 //! samples the caller converts to mirror angles with the galvo kinematics
 //! (another crate; a small-angle stand-in below). Per sample or per DMA
@@ -42,7 +51,7 @@
 //!
 //! ```
 //! use galvo_planner::{
-//!     BlockEnd, JumpSync, MarkLimits, Method, PathPlanner, RigidParams, XyStepper, plan_xy_jump,
+//!     BlockEnd, JumpSync, MarkLimits, Method, PathPlanner, RigidParams, XyIntegrator, plan_xy_jump,
 //! };
 //!
 //! // Stand-in for the galvo kinematics: board mm → mechanical mirror angles.
@@ -51,7 +60,7 @@
 //! }
 //!
 //! let disc = RigidParams::REFERENCE.model()?.discretize(10e-6)?;
-//! let mut mirrors: XyStepper<3, 1024> = XyStepper::new(&disc, &disc, [0.0, 0.0])?;
+//! let mut mirrors: XyIntegrator<3, 1024> = XyIntegrator::new(&disc, &disc, [0.0, 0.0])?;
 //! let limits = MarkLimits {
 //!     speed_mm_s: 1000.0,
 //!     accel_mm_s2: 1.0e5,
@@ -101,22 +110,29 @@
 //! # Ok::<(), galvo_planner::Error>(())
 //! ```
 
+pub mod bang_bang;
+pub mod bisection;
 pub mod error;
 pub mod fast_optimal;
+pub mod gramian;
+pub mod integrator;
 pub mod jump;
 pub mod linalg;
 pub mod min_energy;
 pub mod model;
+pub mod motion_profile;
 pub mod optimal;
 pub mod path;
+pub mod plan;
 pub mod profile;
-pub mod stepper;
+pub(crate) mod rigid_modes;
 #[cfg(test)]
 mod test_support;
 
+pub use bisection::BisectionConfig;
 pub use error::Error;
-pub use jump::{JumpPlan, JumpSync, Method, MethodKind, PlanInfo, XyJump, plan_jump, plan_xy_jump};
-pub use min_energy::SeedConfig;
+pub use integrator::{Integrator, XyIntegrator};
+pub use jump::{JumpSync, Method, plan_jump, plan_xy_jump};
 pub use model::{Discrete, FlexParams, LinearModel, ModelKind, RigidParams};
 pub use path::{ArcRotor, BlockEnd, MarkLimits, MarkSample, PathPlanner};
-pub use stepper::{Stepper, XyStepper};
+pub use plan::{JumpPlan, MethodKind, PlanInfo, XyJump};

@@ -3,9 +3,9 @@ extern crate std;
 
 use std::vec::Vec;
 
-use crate::jump::JumpPlan;
 use crate::linalg::Vector;
 use crate::model::{Discrete, FlexParams, RigidParams};
+use crate::plan::JumpPlan;
 
 /// Property-test configuration with `default` cases, or `PROPTEST_CASES`
 /// when set (for stress runs).

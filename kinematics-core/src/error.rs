@@ -2,6 +2,8 @@
 
 use core::fmt;
 
+use crate::numeric::NonFinite;
+
 /// A gimbal joint (servo axis).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Joint {
@@ -161,19 +163,9 @@ fn write_hundredths(f: &mut fmt::Formatter<'_>, v: f64) -> fmt::Result {
     write!(f, "{sign}{}.{:02}", units / 100, units % 100)
 }
 
-/// `v` limited to `[lo, hi]` for finite, ordered bounds. Unlike
-/// `f64::clamp` it cannot panic, so it links no float formatting (the
-/// panic message formats the bounds): the firmware's flash budget.
-pub(crate) fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
-    v.max(lo).min(hi)
-}
-
-/// Returns `Err(NonFinite)` unless `v` is finite.
-pub(crate) fn finite(v: f64, what: &'static str) -> Result<f64, Error> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(Error::NonFinite { what })
+impl From<NonFinite> for Error {
+    fn from(e: NonFinite) -> Self {
+        Error::NonFinite { what: e.name }
     }
 }
 
@@ -206,12 +198,12 @@ mod tests {
     }
 
     #[test]
-    fn finite_rejects_nan_and_infinity() {
-        assert_eq!(finite(1.5, "a"), Ok(1.5));
-        assert_eq!(finite(f64::NAN, "a"), Err(Error::NonFinite { what: "a" }));
-        assert_eq!(
-            finite(f64::NEG_INFINITY, "b"),
-            Err(Error::NonFinite { what: "b" })
-        );
+    fn a_non_finite_value_keeps_its_name() {
+        let e: Error = crate::numeric::finite(f64::NAN, "a").unwrap_err().into();
+        assert_eq!(e, Error::NonFinite { what: "a" });
+        let e: Error = crate::numeric::finite(f64::NEG_INFINITY, "b")
+            .unwrap_err()
+            .into();
+        assert_eq!(e, Error::NonFinite { what: "b" });
     }
 }

@@ -7,7 +7,8 @@
 //! from the gimbal), board y = G's z (up). With no pose error,
 //! `x_g = OQ, y_g = −x_b, z_g = y_b`.
 
-use crate::error::{Error, finite};
+use crate::error::Error;
+use crate::numeric::finite;
 use crate::real::Real;
 
 /// Centimetres per millimetre.

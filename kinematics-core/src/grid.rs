@@ -6,9 +6,9 @@
 //! `(xi, yi)` is the board point `(xi·pitch + x_offset, yi·pitch + y_offset)`
 //! (the seed's `MoveToGrid`).
 
-use crate::error::{Error, clamp, finite};
+use crate::error::Error;
 use crate::frames::BoardPoint;
-use crate::pattern::{Pattern, PatternIndices};
+use crate::numeric::{clamp, finite};
 
 /// SPEC default grid pitch (measured; nominal 2 cm), cm.
 pub const DEFAULT_PITCH_CM: f64 = 1.916;
@@ -137,12 +137,6 @@ impl Grid {
             xi: nearest(p.x_cm, self.x_offset_cm, self.max_xi()),
             yi: nearest(p.y_cm, self.y_offset_cm, self.max_yi()),
         })
-    }
-
-    /// Every grid index, row by row from the top (`yi = rows/2` down), each
-    /// row left to right: the [`Pattern::FullRaster`] order.
-    pub fn indices(&self) -> PatternIndices {
-        Pattern::FullRaster.indices(self)
     }
 }
 

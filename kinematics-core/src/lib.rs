@@ -59,6 +59,7 @@ pub mod frames;
 pub mod galvo;
 pub mod gimbal;
 pub mod grid;
+pub mod numeric;
 pub mod path;
 pub mod pattern;
 pub mod real;

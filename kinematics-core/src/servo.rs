@@ -5,7 +5,8 @@
 //! `[min_deg, max_deg]` and quantised to the servo's 0.1° resolution: the
 //! wire value is `round(10 · servo_deg)` as an `i16` (tenths of a degree).
 
-use crate::error::{Error, Joint, clamp, finite};
+use crate::error::{Error, Joint};
+use crate::numeric::{clamp, finite};
 
 /// Wire units (FashionStar angle field) per degree: the field is in 0.1°.
 pub const WIRE_PER_DEG: f64 = 10.0;

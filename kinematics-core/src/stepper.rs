@@ -7,7 +7,8 @@
 //! OL = 0, so a stepper pan/tilt uses [`crate::gimbal::exact`] with
 //! `ol_cm = 0` for its joint angles and this module for the steps.
 
-use crate::error::{Error, finite};
+use crate::error::Error;
+use crate::numeric::finite;
 use crate::servo::Direction;
 
 /// The seed's motor: 1.8° full step.

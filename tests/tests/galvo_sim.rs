@@ -2,7 +2,7 @@
 //! galvo loop → simulated DAC, spot from the DAC codes through the exact
 //! two-mirror kinematics.
 
-use galvo_planner::{JumpSync, Method, RigidParams, XyStepper, plan_xy_jump};
+use galvo_planner::{JumpSync, Method, RigidParams, XyIntegrator, plan_xy_jump};
 use kinematics_core::{Galvo, PointMm};
 use laser_app::galvo::DacSample;
 use laser_sim::world::{SimOptions, SimReport};
@@ -130,14 +130,14 @@ fn planned_jump(from_mm: (f64, f64), to_mm: (f64, f64), method: Method) -> (usiz
         4096,
     )
     .expect("plan");
-    let mut stepper: XyStepper<3, 4096> =
-        XyStepper::new(&disc, &disc, angles(from_mm)).expect("stepper");
-    stepper.queue_jump(&jump).expect("queue");
+    let mut integrator: XyIntegrator<3, 4096> =
+        XyIntegrator::new(&disc, &disc, angles(from_mm)).expect("integrator");
+    integrator.queue_jump(&jump).expect("queue");
     let f32_galvo = Galvo::<f32>::default();
     let mut last: Option<(u16, u16)> = None;
     let mut max_step = 0;
     for _ in 0..jump.samples() {
-        let [x_rad, y_rad] = stepper.step();
+        let [x_rad, y_rad] = integrator.step();
         let c = f32_galvo
             .angles_to_codes(kinematics_core::MirrorAngles { x_rad, y_rad })
             .expect("codes");
@@ -175,7 +175,10 @@ fn assert_no_step_beyond_a_planned_jump(samples: &[DacSample]) {
 #[test]
 fn jumps_take_the_planned_time_with_either_planner() {
     let corner = (-6.0 * PITCH_MM, 4.0 * PITCH_MM);
-    for (planner, method) in [("optimal", Method::TimeOptimal), ("seed", Method::SEED)] {
+    for (planner, method) in [
+        ("optimal", Method::TimeOptimal),
+        ("seed", Method::BISECTION),
+    ] {
         let report = run_to_idle(&format!(
             "target galvo\nplanner {planner}\nset dwell_ms 5\npattern home once\nwait 20\npattern corner once\nwait 40\n"
         ));

@@ -65,7 +65,7 @@ const JUMP_REFILL: Enforcement = Enforcement::NotYetMet(
 );
 /// What is left per sample is the loop body around the f32 math: its
 /// state machine, phase checks and sample bookkeeping (scan.rs), and the
-/// Kahan-compensated stepper on jumps.
+/// Kahan-compensated integrator on jumps.
 const LOOP: Enforcement =
     Enforcement::NotYetMet("issue 11: the loop's per-sample state machine (scan.rs)");
 /// A stroke's first half also loads it into the f64 look-ahead planner.
@@ -110,7 +110,7 @@ pub const ROWS: &[Row] = &[
     },
     Row {
         id: "loop.jump.steady",
-        what: "loop, jumping (stepper + DAC)",
+        what: "loop, jumping (integrator + DAC)",
         unit: "sample",
         budget: Some((0.10 * SAMPLE_US, "10 % of the 10 µs sample", LOOP)),
     },
@@ -151,8 +151,8 @@ pub const ROWS: &[Row] = &[
         budget: None,
     },
     Row {
-        id: "stepper.xy.step",
-        what: "stepper, both axes moving",
+        id: "integrator.xy.step",
+        what: "integrator, both axes moving",
         unit: "sample",
         budget: None,
     },

@@ -20,8 +20,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
+use galvo_planner::BisectionConfig;
 use galvo_planner::jump::{Method, plan_jump};
-use galvo_planner::min_energy::SeedConfig;
 use galvo_planner::model::{Discrete, FlexParams, RigidParams};
 use serde::Serialize;
 
@@ -59,7 +59,7 @@ pub(crate) enum MethodArg {
 impl MethodArg {
     pub(crate) fn method(self, p: u32) -> Method {
         match self {
-            MethodArg::Seed => Method::Seed(SeedConfig { p, bracket_s: None }),
+            MethodArg::Seed => Method::Bisection(BisectionConfig { p, bracket_s: None }),
             MethodArg::Optimal => Method::TimeOptimal,
             MethodArg::OptimalF64 => Method::TimeOptimalF64,
             MethodArg::Tcurve => Method::TCurve,
@@ -390,7 +390,7 @@ fn jump_rows<const S: usize>(
 /// The exact ZOH simulation of the plan's voltages from its start state.
 pub(crate) fn simulate_rows<const S: usize>(
     disc: &Discrete<S>,
-    plan: &galvo_planner::jump::JumpPlan<S>,
+    plan: &galvo_planner::JumpPlan<S>,
 ) -> Result<Vec<Row>, String> {
     let mut u = vec![0.0; plan.samples()];
     plan.write_u_v(&mut u).map_err(|e| e.to_string())?;

@@ -27,7 +27,7 @@ fn galvo_loop(c: &mut Criterion) {
         (
             "jump 160 mm, seed plan + samples",
             GalvoConfig {
-                method: galvo_planner::Method::SEED,
+                method: galvo_planner::Method::BISECTION,
                 ..GalvoConfig::default()
             },
         ),

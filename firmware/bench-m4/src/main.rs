@@ -27,7 +27,7 @@ use core::hint::black_box;
 use cortex_m_rt::entry;
 use galvo_planner::model::RIGID_STATES;
 use galvo_planner::{
-    Discrete, JumpSync, MarkLimits, Method, PathPlanner, RigidParams, XyStepper, plan_jump,
+    Discrete, JumpSync, MarkLimits, Method, PathPlanner, RigidParams, XyIntegrator, plan_jump,
     plan_xy_jump,
 };
 use kinematics_core::{BoardPoint, DacAxis, ErrorModel, Galvo, Gimbal, MirrorAngles, PointMm};
@@ -40,7 +40,7 @@ use semihosting::Out;
 
 /// Samples per DMA half buffer (1.28 ms at 100 kHz).
 const HALF: usize = 128;
-/// Jump input samples the stepper holds (the loop's `STEPPER_CAPACITY`).
+/// Jump input samples the integrator holds (the loop's `INTEGRATOR_CAPACITY`).
 const CAPACITY: usize = 1024;
 /// Iterations of the calibration loop (2 instructions each).
 const CALIBRATION_ITERATIONS: u32 = 1_000_000;
@@ -129,7 +129,7 @@ fn main() -> ! {
 
     self_checks(&mut b);
     kinematics(&mut b);
-    stepper_and_path(&mut b);
+    integrator_and_path(&mut b);
     loop_halves(&mut b);
     planning(&mut b);
 
@@ -290,16 +290,16 @@ fn reference_plant_at_10us() -> Result<Discrete<RIGID_STATES>, galvo_planner::Er
         .and_then(|m| m.discretize(10e-6))
 }
 
-/// The per-sample stepper during a jump, the path sampler on lines and
+/// The per-sample integrator during a jump, the path sampler on lines and
 /// arcs, and adding a segment to the look-ahead planner.
-fn stepper_and_path(b: &mut Bench) {
+fn integrator_and_path(b: &mut Bench) {
     let disc = match reference_plant_at_10us() {
         Ok(d) => d,
-        Err(e) => return b.fail("stepper.setup", e),
+        Err(e) => return b.fail("integrator.setup", e),
     };
-    let mut mirrors: XyStepper<3, CAPACITY> = match XyStepper::new(&disc, &disc, [0.0, 0.0]) {
+    let mut mirrors: XyIntegrator<3, CAPACITY> = match XyIntegrator::new(&disc, &disc, [0.0, 0.0]) {
         Ok(m) => m,
-        Err(e) => return b.fail("stepper.setup", e),
+        Err(e) => return b.fail("integrator.setup", e),
     };
     // Four queued jumps back and forth, both axes moving; the window
     // covers the samples while both run.
@@ -316,14 +316,14 @@ fn stepper_and_path(b: &mut Bench) {
         )
         .and_then(|jump| mirrors.queue_jump(&jump));
         if let Err(e) = queued {
-            return b.fail("stepper.setup", e);
+            return b.fail("integrator.setup", e);
         }
     }
     let steps = mirrors
         .x
         .remaining_samples()
         .min(mirrors.y.remaining_samples()) as u32;
-    b.repeat("stepper.xy.step", steps, || mirrors.step());
+    b.repeat("integrator.xy.step", steps, || mirrors.step());
 
     let limits = MarkLimits {
         speed_mm_s: 1000.0,
@@ -611,7 +611,7 @@ fn planning(b: &mut Bench) {
     let mut name = heapless_name::Name::new();
     for (method_id, method) in [
         ("plan.optimal", Method::TimeOptimal),
-        ("plan.seed", Method::SEED),
+        ("plan.seed", Method::BISECTION),
         ("plan.tcurve", Method::TCurve),
         ("plan.scurve", Method::SCurve),
     ] {

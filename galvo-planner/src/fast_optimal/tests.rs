@@ -2,6 +2,7 @@ extern crate std;
 
 use super::*;
 use crate::jump::{Method, plan_jump};
+use crate::rigid_modes::expm1_f32;
 use crate::test_support::{DEG, assert_lands, rigid};
 use std::println;
 

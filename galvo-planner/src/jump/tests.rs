@@ -28,10 +28,10 @@ proptest! {
             return Ok(());
         };
         let to = if neg { -dist } else { dist };
-        for method in [Method::TimeOptimal, Method::TimeOptimalF64, Method::SEED, Method::TCurve, Method::SCurve] {
+        for method in [Method::TimeOptimal, Method::TimeOptimalF64, Method::BISECTION, Method::TCurve, Method::SCurve] {
             match plan_jump(&d, 0.0, to, method, 20_000) {
                 Ok(plan) => {
-                    let model_based = matches!(method, Method::TimeOptimal | Method::TimeOptimalF64 | Method::Seed(_));
+                    let model_based = matches!(method, Method::TimeOptimal | Method::TimeOptimalF64 | Method::Bisection(_));
                     // Landing relative to the move's own scales.
                     let u = inputs(&plan);
                     let mut z = *plan.start_state();
@@ -98,7 +98,7 @@ fn xy_jump_plans_both_axes_and_validates_periods() {
             &other,
             [0.0; 2],
             [0.1; 2],
-            Method::SEED,
+            Method::BISECTION,
             JumpSync::Independent,
             1000
         ),
@@ -109,9 +109,9 @@ fn xy_jump_plans_both_axes_and_validates_periods() {
 #[test]
 fn plan_accessors_are_consistent() {
     let d = rigid(10e-6);
-    let plan = plan_jump(&d, 0.1, 0.2, Method::SEED, 1000).expect("plan");
-    assert_eq!(plan.method(), MethodKind::Seed);
-    assert_eq!(plan.method().name(), Method::SEED.name());
+    let plan = plan_jump(&d, 0.1, 0.2, Method::BISECTION, 1000).expect("plan");
+    assert_eq!(plan.method(), MethodKind::Bisection);
+    assert_eq!(plan.method().name(), Method::BISECTION.name());
     assert!((plan.move_time_s() - plan.samples() as f64 * 10e-6).abs() < 1e-18);
     let u = inputs(&plan);
     let peak = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));

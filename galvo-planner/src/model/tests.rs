@@ -1,6 +1,8 @@
 #![allow(clippy::needless_range_loop)] // index-heavy reference computations read better with ranges
 extern crate std;
 use super::*;
+use crate::error::Error;
+use crate::linalg::{Matrix, Vector, mat_vec};
 use proptest::prelude::*;
 
 fn rigid() -> LinearModel<3> {

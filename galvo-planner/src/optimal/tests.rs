@@ -2,9 +2,10 @@
 extern crate std;
 
 use super::*;
-use crate::jump::{Method, PlanInfo, plan_jump};
+use crate::jump::{Method, plan_jump};
 use crate::linalg::{Vector, mat_vec};
 use crate::model::RigidParams;
+use crate::plan::PlanInfo;
 use crate::test_support::{DEG, STEPS_DEG, assert_lands, flex, inputs, rigid};
 use proptest::prelude::*;
 use std::vec::Vec;
@@ -354,7 +355,7 @@ fn seed_is_slower_by_about_a_fifth() {
     let d = rigid(10e-6);
     for step in [1.0, 5.0, 20.0] {
         let opt = plan_jump(&d, 0.0, step * DEG, Method::TimeOptimal, 10_000).expect("opt");
-        let seed = plan_jump(&d, 0.0, step * DEG, Method::SEED, 10_000).expect("seed");
+        let seed = plan_jump(&d, 0.0, step * DEG, Method::BISECTION, 10_000).expect("seed");
         let ratio = seed.move_time_s() / opt.move_time_s();
         assert!(
             (1.05..1.45).contains(&ratio),
@@ -382,7 +383,7 @@ fn underdamped_coil_falls_back_to_min_energy() {
         OptimalStructure::MinEnergyFallback
     );
     assert_lands(&plan, true, "fallback");
-    let seed = plan_jump(&d, 0.0, 1.0, Method::SEED, 100_000).expect("seed");
+    let seed = plan_jump(&d, 0.0, 1.0, Method::BISECTION, 100_000).expect("seed");
     assert!(plan.samples() <= seed.samples());
 }
 

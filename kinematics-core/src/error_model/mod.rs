@@ -10,8 +10,9 @@ mod fit;
 
 pub use fit::{AxisFit, FitReport, MeasuredPoint, fit, sse_of};
 
-use crate::error::{Error, finite};
+use crate::error::Error;
 use crate::frames::{BoardPoint, PointMm};
+use crate::numeric::finite;
 
 /// Number of coefficients per axis.
 pub const N_COEF: usize = 6;
@@ -55,7 +56,7 @@ impl Quadratic {
                 what: "error-model coefficient",
             });
         }
-        finite(self.value(x_mm, y_mm), "error-model value")
+        Ok(finite(self.value(x_mm, y_mm), "error-model value")?)
     }
 
     /// Δ without checks (callers validated), Horner-style.

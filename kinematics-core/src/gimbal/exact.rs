@@ -9,8 +9,9 @@
 //! `β = π/2 − (atan2(z, h) + acos(OL / √(h² + z²)))`.
 
 use super::JointAngles;
-use crate::error::{Error, clamp, finite};
+use crate::error::Error;
 use crate::frames::GlobalPoint;
+use crate::numeric::{clamp, finite};
 
 /// Joint angles that put the spot on the global point `p` (cm).
 ///

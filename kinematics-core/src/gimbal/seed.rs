@@ -13,8 +13,9 @@
 
 use super::JointAngles;
 use super::exact::{MIN_BEAM_X, check_ol};
-use crate::error::{Error, clamp, finite};
+use crate::error::Error;
 use crate::frames::GlobalPoint;
+use crate::numeric::{clamp, finite};
 
 /// Seed IK: joint angles for the global point `p` (cm), `ol_cm` = OL (cm).
 ///

@@ -32,7 +32,8 @@ pub use line::LineSteps;
 pub use rect::RectSteps;
 pub use sampler::{Segment, UniformSampler};
 
-use crate::error::{Error, finite};
+use crate::error::Error;
+use crate::numeric::finite;
 
 /// Most unit moves one interpolation may take.
 pub const MAX_STEPS: u32 = 1 << 24;

@@ -4,8 +4,9 @@ use core::f64::consts::TAU;
 use core::iter::FusedIterator;
 
 use super::{MAX_STEPS, Rotation};
-use crate::error::{Error, finite};
+use crate::error::Error;
 use crate::frames::BoardPoint;
+use crate::numeric::finite;
 
 /// A path segment in the board plane (cm).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,8 +2,8 @@
 
 use std::process::ExitCode;
 
-use galvo_planner::jump::{JumpPlan, Method, plan_jump};
 use galvo_planner::model::Discrete;
+use galvo_planner::{JumpPlan, Method, plan_jump};
 use serde::Serialize;
 
 use super::{Built, MethodArg, ModelArg, ModelArgs, fail, print_json};

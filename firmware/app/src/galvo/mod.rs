@@ -4,7 +4,7 @@
 //! The DAC outputs one [`DacSample`] per sample period from a double
 //! buffer; the loop wakes once per half buffer ([`DacStream::write_half`])
 //! and fills the free half with the next samples: mirror angles from the
-//! planner's per-sample stepper (`Z(k+1) = Ad·Z(k) + Bd·U(k)` per axis),
+//! planner's per-sample integrator (`Z(k+1) = Ad·Z(k) + Bd·U(k)` per axis),
 //! converted to 12-bit codes by the galvo DAC mapping, plus the laser bit.
 //! Each requested point is a jump (laser off, planned by `galvo-planner`,
 //! time-optimal or the patent's bisection method), a settling delay, a
@@ -63,7 +63,7 @@ pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
         },
         method: match settings.planner {
             JumpPlanner::Optimal => Method::TimeOptimal,
-            JumpPlanner::Seed => Method::SEED,
+            JumpPlanner::Seed => Method::BISECTION,
         },
         laser_on_delay_us: settings.laser_on_delay_us as u32,
         laser_off_delay_us: settings.laser_off_delay_us as u32,

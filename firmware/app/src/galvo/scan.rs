@@ -5,7 +5,7 @@ use core::fmt;
 use core::sync::atomic::Ordering;
 
 use galvo_planner::{
-    Discrete, JumpSync, Method, PathPlanner, RigidParams, XyStepper, plan_xy_jump,
+    Discrete, JumpSync, Method, PathPlanner, RigidParams, XyIntegrator, plan_xy_jump,
 };
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
@@ -16,9 +16,9 @@ use crate::laser_gate::LaserGate;
 use crate::log;
 use crate::settings::GalvoSettings;
 
-/// Jump input samples the stepper holds per axis (10.24 ms at 100 kHz,
+/// Jump input samples the integrator holds per axis (10.24 ms at 100 kHz,
 /// longer than any full-range time-optimal jump of the reference galvo).
-pub const STEPPER_CAPACITY: usize = 1024;
+pub const INTEGRATOR_CAPACITY: usize = 1024;
 /// Longest half buffer the loop fills, samples.
 pub const MAX_HALF_LEN: usize = 512;
 /// Jobs queued inside the loop (beyond the request channel).
@@ -67,7 +67,7 @@ pub enum GalvoError {
     /// The point or path is outside the DAC's range.
     OutOfRange,
     /// The jump or path planner refused (invalid model or limits, jump
-    /// too long for the stepper's buffer, path too short).
+    /// too long for the integrator's buffer, path too short).
     Planner,
     /// More jobs than the loop queues.
     QueueFull,
@@ -139,7 +139,7 @@ pub struct GalvoLoop {
     sample_map: SampleMap,
     planning: Galvo<f64>,
     disc: Discrete<3>,
-    mirrors: XyStepper<3, STEPPER_CAPACITY>,
+    mirrors: XyIntegrator<3, INTEGRATOR_CAPACITY>,
     marker: Option<PathPlanner<MARK_BLOCKS>>,
     motion: Motion,
     queue: heapless::Deque<(u32, Job), JOB_QUEUE>,
@@ -174,7 +174,8 @@ impl GalvoLoop {
             .model()
             .and_then(|m| m.discretize(config.sample_period_s))
             .map_err(|_| GalvoError::Planner)?;
-        let mirrors = XyStepper::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
+        let mirrors =
+            XyIntegrator::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
         let [x_rad, y_rad] = angles_rad;
         let sample_map = SampleMap::new(&config.galvo).map_err(|_| GalvoError::Kinematics)?;
         let codes = sample_map
@@ -355,7 +356,7 @@ impl GalvoLoop {
         {
             return None;
         }
-        // An idle stepper returns its rest position and does not change.
+        // An idle integrator returns its rest position and does not change.
         let [x_rad, y_rad] = self.mirrors.step();
         let (x_code, y_code) = self
             .sample_map

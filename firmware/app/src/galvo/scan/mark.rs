@@ -86,7 +86,7 @@ impl GalvoLoop {
         }
     }
 
-    /// Re-seats the (idle) jump stepper at rest where marking left the
+    /// Re-seats the (idle) jump integrator at rest where marking left the
     /// spot, so the next jump starts there.
     fn hold_at_motion(&mut self, on_event: &mut impl FnMut(GalvoEvent)) {
         let [x, y] = self.motion.position_mm;

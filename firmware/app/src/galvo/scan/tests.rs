@@ -2,7 +2,7 @@ extern crate std;
 
 use std::vec::Vec;
 
-use galvo_planner::{JumpSync, Method, XyStepper, plan_xy_jump};
+use galvo_planner::{JumpSync, Method, XyIntegrator, plan_xy_jump};
 use kinematics_core::{Galvo, MirrorAngles, PointMm};
 
 use super::*;
@@ -53,7 +53,7 @@ fn a_point_is_a_planned_jump_a_delay_a_dwell_and_a_delay() {
     assert_eq!(galvo.request(point(1, 60.0, -35.0, 500)), None);
     let (samples, _) = run(&mut galvo, done(1));
 
-    // The jump is exactly the planner's: same input, same f32 stepper.
+    // The jump is exactly the planner's: same input, same f32 integrator.
     let disc = config.mirrors.model().unwrap().discretize(10e-6).unwrap();
     let target = Galvo::<f64>::default()
         .geometry
@@ -69,11 +69,11 @@ fn a_point_is_a_planned_jump_a_delay_a_dwell_and_a_delay() {
         [target.x_rad, target.y_rad],
         Method::TimeOptimal,
         JumpSync::Independent,
-        STEPPER_CAPACITY,
+        INTEGRATOR_CAPACITY,
     )
     .unwrap();
-    let mut reference: XyStepper<3, STEPPER_CAPACITY> =
-        XyStepper::new(&disc, &disc, [0.0, 0.0]).unwrap();
+    let mut reference: XyIntegrator<3, INTEGRATOR_CAPACITY> =
+        XyIntegrator::new(&disc, &disc, [0.0, 0.0]).unwrap();
     reference.queue_jump(&jump).unwrap();
     let n_jump = jump.samples();
     assert!(n_jump > 10, "a 70 mm jump takes {n_jump} samples");
@@ -113,7 +113,7 @@ fn a_point_is_a_planned_jump_a_delay_a_dwell_and_a_delay() {
 #[test]
 fn points_run_in_order_and_the_seed_planner_lands_them_too() {
     let mut galvo = GalvoLoop::new(GalvoConfig {
-        method: Method::SEED,
+        method: Method::BISECTION,
         ..GalvoConfig::default()
     })
     .unwrap();

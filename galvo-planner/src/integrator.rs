@@ -1,7 +1,7 @@
-//! The per-sample state-update stepper: what the galvo loop calls every
+//! The per-sample state-update integrator: what the galvo loop calls every
 //! sample (or once per DMA block).
 //!
-//! A [`Stepper`] owns one axis's commanded state and a ring of queued input
+//! A [`Integrator`] owns one axis's commanded state and a ring of queued input
 //! voltages. Every sample it advances
 //! `Z(k+1) = Z(k) + ((Ad − I)·Z(k) + Bd·U(k))` in `f32` and yields the
 //! commanded motor angle θ. When a move's last sample is reached the state
@@ -31,15 +31,19 @@
 //!
 //! ## Queueing
 //!
-//! Moves are appended with [`Stepper::queue`] while one runs; each must start
+//! Moves are appended with [`Integrator::queue`] while one runs; each must start
 //! at the state where the previously queued one ends
-//! ([`Stepper::end_state`]). Capacity is fixed at compile time: `CAP` input
+//! ([`Integrator::end_state`]). Capacity is fixed at compile time: `CAP` input
 //! samples in the ring and `Q` moves.
 
 use crate::error::Error;
-use crate::jump::{JumpPlan, XyJump};
 use crate::linalg::{Matrix, Vector, at};
 use crate::model::{Discrete, THETA};
+use crate::plan::JumpPlan;
+use kinematics_core::numeric::finite;
+
+mod xy;
+pub use xy::XyIntegrator;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct QueuedMove<const S: usize> {
@@ -49,7 +53,7 @@ struct QueuedMove<const S: usize> {
 
 /// One axis: model, commanded state, queued inputs.
 #[derive(Debug, Clone)]
-pub struct Stepper<const S: usize, const CAP: usize, const Q: usize = 4> {
+pub struct Integrator<const S: usize, const CAP: usize, const Q: usize = 4> {
     a_minus_i: [[f32; S]; S],
     bd: [f32; S],
     ad64: Matrix<S, S>,
@@ -148,10 +152,10 @@ fn advance3(a: [&[f32; 3]; 3], b: &[f32; 3], z: &mut [f32; 3], c: &mut [f32; 3],
 /// Relative tolerance for "the plan starts where the queue ends".
 const CONTINUITY_TOL: f64 = 1e-9;
 
-impl<const S: usize, const CAP: usize, const Q: usize> Stepper<S, CAP, Q> {
-    /// A stepper at rest at `theta_rad` for the sampled model `disc`.
+impl<const S: usize, const CAP: usize, const Q: usize> Integrator<S, CAP, Q> {
+    /// A integrator at rest at `theta_rad` for the sampled model `disc`.
     pub fn new(disc: &Discrete<S>, theta_rad: f64) -> Result<Self, Error> {
-        let theta_rad = crate::error::finite("theta_rad", theta_rad)?;
+        let theta_rad = finite(theta_rad, "theta_rad")?;
         let rest = disc.model().rest_state(theta_rad);
         let ad = disc.ad();
         let a_minus_i = core::array::from_fn(|i| {
@@ -300,14 +304,14 @@ impl<const S: usize, const CAP: usize, const Q: usize> Stepper<S, CAP, Q> {
         at(&self.end_state, THETA)
     }
 
-    /// Re-seats an idle stepper at rest at `theta_rad` (e.g. where a marked
+    /// Re-seats an idle integrator at rest at `theta_rad` (e.g. where a marked
     /// path, which drives the mirrors directly, left them), so the next jump
     /// is planned and queued from there. Fails with
-    /// [`Error::StepperBusy`] while a move is queued.
+    /// [`Error::IntegratorBusy`] while a move is queued.
     pub fn hold_at(&mut self, theta_rad: f64) -> Result<(), Error> {
-        let theta_rad = crate::error::finite("theta_rad", theta_rad)?;
+        let theta_rad = finite(theta_rad, "theta_rad")?;
         if !self.is_idle() {
-            return Err(Error::StepperBusy);
+            return Err(Error::IntegratorBusy);
         }
         let mut rest = self.end_state;
         for (i, v) in rest.iter_mut().enumerate() {
@@ -345,74 +349,6 @@ impl<const S: usize, const CAP: usize, const Q: usize> Stepper<S, CAP, Q> {
             self.end_state = m.target;
         }
         dropped
-    }
-}
-
-/// Both mirror axes of a galvo scanner, stepped together.
-#[derive(Debug, Clone)]
-pub struct XyStepper<const S: usize, const CAP: usize, const Q: usize = 4> {
-    /// X mirror.
-    pub x: Stepper<S, CAP, Q>,
-    /// Y mirror.
-    pub y: Stepper<S, CAP, Q>,
-}
-
-impl<const S: usize, const CAP: usize, const Q: usize> XyStepper<S, CAP, Q> {
-    /// Both axes at rest at `theta_rad = [θx, θy]`.
-    pub fn new(
-        disc_x: &Discrete<S>,
-        disc_y: &Discrete<S>,
-        theta_rad: [f64; 2],
-    ) -> Result<Self, Error> {
-        let [tx, ty] = theta_rad;
-        Ok(Self {
-            x: Stepper::new(disc_x, tx)?,
-            y: Stepper::new(disc_y, ty)?,
-        })
-    }
-
-    /// Queues both axes of a jump, or neither.
-    pub fn queue_jump(&mut self, jump: &XyJump<S>) -> Result<(), Error> {
-        self.x.check_queue(&jump.x)?;
-        self.y.check_queue(&jump.y)?;
-        self.x.queue(&jump.x)?;
-        self.y.queue(&jump.y)
-    }
-
-    /// One sample of both axes: `[θx, θy]`, rad.
-    #[inline]
-    pub fn step(&mut self) -> [f32; 2] {
-        [self.x.step(), self.y.step()]
-    }
-
-    /// Fills a block of `[θx, θy]` samples.
-    pub fn fill(&mut self, out: &mut [[f32; 2]]) {
-        for o in out.iter_mut() {
-            *o = self.step();
-        }
-    }
-
-    /// True when both axes hold position.
-    pub fn is_idle(&self) -> bool {
-        self.x.is_idle() && self.y.is_idle()
-    }
-
-    /// Re-seats both idle axes at rest at `theta_rad = [θx, θy]` (see
-    /// [`Stepper::hold_at`]); neither moves if one is busy.
-    pub fn hold_at(&mut self, theta_rad: [f64; 2]) -> Result<(), Error> {
-        if !self.is_idle() {
-            return Err(Error::StepperBusy);
-        }
-        let [tx, ty] = theta_rad;
-        crate::error::finite("theta_rad", tx)?;
-        crate::error::finite("theta_rad", ty)?;
-        self.x.hold_at(tx)?;
-        self.y.hold_at(ty)
-    }
-
-    /// Where the queued jumps end, `[θx, θy]`, rad.
-    pub fn end_position_rad(&self) -> [f64; 2] {
-        [self.x.end_position_rad(), self.y.end_position_rad()]
     }
 }
 

@@ -6,11 +6,11 @@ use crate::test_support::{DEG, flex, rigid, simulate};
 use proptest::prelude::*;
 use std::vec::Vec;
 
-/// Runs the plan through a fresh stepper and the f64 ZOH simulation and
+/// Runs the plan through a fresh integrator and the f64 ZOH simulation and
 /// returns the largest θ difference over the move.
 fn tracking_error<const S: usize>(plan: &JumpPlan<S>) -> f64 {
-    let mut st: Stepper<S, 4096> =
-        Stepper::new(plan.discrete(), plan.start_state()[0]).expect("stepper");
+    let mut st: Integrator<S, 4096> =
+        Integrator::new(plan.discrete(), plan.start_state()[0]).expect("integrator");
     st.queue(plan).expect("queue");
     let (states, _) = simulate(plan);
     let mut worst = 0.0f64;
@@ -25,12 +25,12 @@ fn tracking_error<const S: usize>(plan: &JumpPlan<S>) -> f64 {
 }
 
 #[test]
-fn f32_stepper_tracks_the_f64_plan() {
+fn f32_integrator_tracks_the_f64_plan() {
     for ts in [10e-6, 1e-6] {
         let d = rigid(ts);
         for method in [
             Method::TimeOptimal,
-            Method::SEED,
+            Method::BISECTION,
             Method::SCurve,
             Method::TCurve,
         ] {
@@ -41,7 +41,7 @@ fn f32_stepper_tracks_the_f64_plan() {
             }
         }
         let df = flex(ts);
-        let plan = plan_jump(&df, -10.0 * DEG, 10.0 * DEG, Method::SEED, 4096).expect("plan");
+        let plan = plan_jump(&df, -10.0 * DEG, 10.0 * DEG, Method::BISECTION, 4096).expect("plan");
         let e = tracking_error(&plan);
         assert!(e <= 1e-6, "flex Ts {ts}: {e} rad");
     }
@@ -50,7 +50,7 @@ fn f32_stepper_tracks_the_f64_plan() {
 #[test]
 fn queue_while_moving_then_hold() {
     let d = rigid(10e-6);
-    let mut st: Stepper<3, 256> = Stepper::new(&d, 0.0).expect("stepper");
+    let mut st: Integrator<3, 256> = Integrator::new(&d, 0.0).expect("integrator");
     let a = plan_jump(&d, 0.0, 5.0 * DEG, Method::TimeOptimal, 256).expect("a");
     st.queue(&a).expect("queue a");
     assert!(!st.is_idle());
@@ -60,7 +60,14 @@ fn queue_while_moving_then_hold() {
     }
     // Queue the next move from where the queue ends, mid-move.
     assert_eq!(st.end_position_rad(), 5.0 * DEG);
-    let b = plan_jump(&d, st.end_position_rad(), -2.0 * DEG, Method::SEED, 256).expect("b");
+    let b = plan_jump(
+        &d,
+        st.end_position_rad(),
+        -2.0 * DEG,
+        Method::BISECTION,
+        256,
+    )
+    .expect("b");
     st.queue(&b).expect("queue b");
     assert_eq!(st.queued_moves(), 2);
     while !st.is_idle() {
@@ -80,8 +87,8 @@ fn queue_while_moving_then_hold() {
 #[test]
 fn fill_equals_stepping() {
     let d = rigid(10e-6);
-    let plan = plan_jump(&d, 0.0, 7.0 * DEG, Method::SEED, 512).expect("plan");
-    let mut a: Stepper<3, 512> = Stepper::new(&d, 0.0).expect("stepper");
+    let plan = plan_jump(&d, 0.0, 7.0 * DEG, Method::BISECTION, 512).expect("plan");
+    let mut a: Integrator<3, 512> = Integrator::new(&d, 0.0).expect("integrator");
     a.queue(&plan).expect("queue");
     let mut b = a.clone();
     let mut block = [0.0f32; 32];
@@ -97,9 +104,9 @@ fn fill_equals_stepping() {
 #[test]
 fn queue_errors() {
     let d = rigid(10e-6);
-    let mut st: Stepper<3, 40, 2> = Stepper::new(&d, 0.0).expect("stepper");
+    let mut st: Integrator<3, 40, 2> = Integrator::new(&d, 0.0).expect("integrator");
     // Does not start where the queue ends.
-    let off = plan_jump(&d, 1.0 * DEG, 2.0 * DEG, Method::SEED, 64).expect("plan");
+    let off = plan_jump(&d, 1.0 * DEG, 2.0 * DEG, Method::BISECTION, 64).expect("plan");
     assert_eq!(st.queue(&off), Err(Error::DiscontinuousMove));
     // Too many samples for the ring.
     let long = plan_jump(&d, 0.0, 20.0 * DEG, Method::TimeOptimal, 1000).expect("plan");
@@ -117,16 +124,16 @@ fn queue_errors() {
     let p = plan_jump(&other, 0.2 * DEG, 0.3 * DEG, Method::TimeOptimal, 64).expect("plan");
     assert_eq!(st.check_queue(&p), Err(Error::ModelMismatch));
     // Zero-length moves are accepted and change nothing.
-    let hold = plan_jump(&d, 0.2 * DEG, 0.2 * DEG, Method::SEED, 0).expect("hold");
+    let hold = plan_jump(&d, 0.2 * DEG, 0.2 * DEG, Method::BISECTION, 0).expect("hold");
     st.queue(&hold).expect("hold");
     assert_eq!(st.queued_moves(), 2);
-    assert!(Stepper::<3, 8>::new(&d, f64::NAN).is_err());
+    assert!(Integrator::<3, 8>::new(&d, f64::NAN).is_err());
 }
 
 #[test]
 fn clear_pending_keeps_the_running_move() {
     let d = rigid(10e-6);
-    let mut st: Stepper<3, 512> = Stepper::new(&d, 0.0).expect("stepper");
+    let mut st: Integrator<3, 512> = Integrator::new(&d, 0.0).expect("integrator");
     let a = plan_jump(&d, 0.0, 3.0 * DEG, Method::TimeOptimal, 512).expect("a");
     let b = plan_jump(&d, 3.0 * DEG, 6.0 * DEG, Method::TimeOptimal, 512).expect("b");
     st.queue(&a).expect("a");
@@ -148,7 +155,7 @@ fn xy_jumps() {
     let to = [10.0 * DEG, 0.5 * DEG];
     for sync in [JumpSync::Independent, JumpSync::SameDuration] {
         let jump = plan_xy_jump(&d, &d, from, to, Method::TimeOptimal, sync, 1024).expect("jump");
-        let mut xy: XyStepper<3, 1024> = XyStepper::new(&d, &d, from).expect("xy");
+        let mut xy: XyIntegrator<3, 1024> = XyIntegrator::new(&d, &d, from).expect("xy");
         xy.queue_jump(&jump).expect("queue");
         let mut n = 0;
         let mut y_done_at = None;
@@ -170,7 +177,7 @@ fn xy_jumps() {
         }
     }
     // Atomic: if Y does not fit, X is not queued either.
-    let mut xy: XyStepper<3, 40> = XyStepper::new(&d, &d, from).expect("xy");
+    let mut xy: XyIntegrator<3, 40> = XyIntegrator::new(&d, &d, from).expect("xy");
     let jump = plan_xy_jump(
         &d,
         &d,
@@ -186,21 +193,21 @@ fn xy_jumps() {
 }
 
 #[test]
-fn hold_at_reseats_an_idle_stepper_only() {
+fn hold_at_reseats_an_idle_integrator_only() {
     let d = rigid(10e-6);
-    let mut st: Stepper<3, 256> = Stepper::new(&d, 0.0).expect("stepper");
+    let mut st: Integrator<3, 256> = Integrator::new(&d, 0.0).expect("integrator");
     st.hold_at(0.1).expect("idle");
     assert_eq!(st.state(), &[0.1f32, 0.0, 0.0]);
     assert_eq!(st.step(), 0.1f32);
     let plan = plan_jump(&d, 0.1, 0.2, Method::TimeOptimal, 256).expect("plan");
     st.queue(&plan).expect("queue from the new position");
-    assert_eq!(st.hold_at(0.5), Err(Error::StepperBusy));
+    assert_eq!(st.hold_at(0.5), Err(Error::IntegratorBusy));
     assert!(matches!(st.hold_at(f64::NAN), Err(Error::NonFinite { .. })));
     let df = flex(10e-6);
-    let mut sf: Stepper<5, 64> = Stepper::new(&df, 0.0).expect("stepper");
+    let mut sf: Integrator<5, 64> = Integrator::new(&df, 0.0).expect("integrator");
     sf.hold_at(-0.2).expect("idle");
     assert_eq!(sf.end_state(), &[-0.2, 0.0, 0.0, -0.2, 0.0]);
-    let mut xy: XyStepper<3, 64> = XyStepper::new(&d, &d, [0.0, 0.0]).expect("xy");
+    let mut xy: XyIntegrator<3, 64> = XyIntegrator::new(&d, &d, [0.0, 0.0]).expect("xy");
     xy.hold_at([0.01, -0.02]).expect("idle");
     assert_eq!(xy.end_position_rad(), [0.01, -0.02]);
 }
@@ -213,7 +220,7 @@ proptest! {
     #[test]
     fn no_drift_across_many_moves(targets in proptest::collection::vec(-12.0f64..12.0, 1..30)) {
         let d = rigid(10e-6);
-        let mut st: Stepper<3, 256> = Stepper::new(&d, 0.0).expect("stepper");
+        let mut st: Integrator<3, 256> = Integrator::new(&d, 0.0).expect("integrator");
         for t in targets {
             let plan = plan_jump(&d, st.end_position_rad(), t * DEG, Method::TimeOptimal, 256).expect("plan");
             st.queue(&plan).expect("queue");

@@ -1,0 +1,60 @@
+//! Numeric helpers shared by the math crates (this one and `galvo-planner`):
+//! the finiteness check, a panic-free clamp and the upper-triangular
+//! (back-substitution) solve. Each crate maps [`NonFinite`] into its own
+//! error type (`From`), so `finite(v, "x_cm")?` reads the same in both.
+
+/// A value that must be finite is NaN or infinite.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NonFinite {
+    /// Which value, with its unit in the name, e.g. `"x_cm"`.
+    pub name: &'static str,
+}
+
+/// Returns `value` if it is finite, else [`NonFinite`] naming it.
+#[inline]
+pub fn finite(value: f64, name: &'static str) -> Result<f64, NonFinite> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(NonFinite { name })
+    }
+}
+
+/// `v` limited to `[lo, hi]`; NaN stays NaN (so solvers still see a
+/// diverged iterate), and misordered bounds give `lo` or `hi`, never a
+/// panic. Unlike `f64::clamp` it links no float formatting into the
+/// firmware (`f64::clamp`'s panic message formats its bounds).
+#[inline]
+pub fn clamp<F: PartialOrd>(v: F, lo: F, hi: F) -> F {
+    if v < lo {
+        lo
+    } else if v > hi {
+        hi
+    } else {
+        v
+    }
+}
+
+/// Solves `r · x = b` for upper-triangular `r` by back-substitution (the
+/// entries below the diagonal are not read). A zero diagonal gives a
+/// non-finite `x`; callers that can meet one check the result.
+#[inline]
+pub fn back_substitute<const N: usize>(r: &[[f64; N]; N], b: &[f64; N]) -> [f64; N] {
+    let mut x = [0.0; N];
+    for (k, (row, bk)) in r.iter().zip(b.iter()).enumerate().rev() {
+        let tail: f64 = row
+            .iter()
+            .zip(x.iter())
+            .skip(k + 1)
+            .map(|(r, xv)| r * xv)
+            .sum();
+        let diag = row.get(k).copied().unwrap_or(1.0);
+        if let Some(xk) = x.get_mut(k) {
+            *xk = (bk - tail) / diag;
+        }
+    }
+    x
+}
+
+#[cfg(test)]
+mod tests;
