@@ -3,7 +3,7 @@
 //! answers again; corrupted angle readings that pass the checksum never
 //! declare an arrival.
 
-use laser_app::servo::protocol::{Request, RequestDecoder, Response, ResponseDecoder};
+use fashionstar::{Request, RequestDecoder, Response, ResponseDecoder};
 use laser_sim::recorder::Direction;
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, SimReport};

@@ -17,9 +17,10 @@ pub const RAM_BUDGET_BYTES: u64 = 96 * 1024;
 /// rustup components the project uses (llvm-tools provides `llvm-size`).
 const COMPONENTS: [&str; 3] = ["rustfmt", "clippy", "llvm-tools"];
 /// Crates that build for the host (everything but the firmware binary).
-const HOST_PACKAGES: [&str; 7] = [
+const HOST_PACKAGES: [&str; 8] = [
     "kinematics-core",
     "galvo-planner",
+    "fashionstar",
     "laser-app",
     "laser-sim",
     "xtask",
@@ -27,7 +28,12 @@ const HOST_PACKAGES: [&str; 7] = [
     "fuzz-props",
 ];
 /// `no_std` crates that must also build for the target.
-const TARGET_LIBRARIES: [&str; 3] = ["kinematics-core", "galvo-planner", "laser-app"];
+const TARGET_LIBRARIES: [&str; 4] = [
+    "kinematics-core",
+    "galvo-planner",
+    "fashionstar",
+    "laser-app",
+];
 
 /// Root of the workspace (the parent of `xtask/`).
 pub fn workspace_root() -> PathBuf {

@@ -5,8 +5,8 @@
 //! Dataflow (one module per stage):
 //! [`usb`] (command-line task body) → [`command`] (the command channel) →
 //! [`sequencer`] (task body that runs commands and patterns) →
-//! [`servo`] (servo task body and FashionStar codec) and [`galvo`] (the
-//! galvo loop body feeding the DAC).
+//! [`servo`] (servo task body, speaking the `fashionstar` codec) and
+//! [`galvo`] (the galvo loop body feeding the DAC).
 //! Text handling lives in [`cli`] (number formatting, the bottom layer, in
 //! [`text`]), parameters in [`settings`], shared
 //! state for LEDs/watchdog/simulator in [`status`], the master laser gate

@@ -22,13 +22,15 @@
 //!   longer) and a silent flag (the servo still obeys commands but answers
 //!   nothing, like a broken return line).
 
+mod bus;
 pub mod motion;
 
-use laser_app::servo::protocol::{
-    Monitor, ReadData, Request, RequestDecoder, Response, SetAngle, SetAngleByInterval,
+use fashionstar::{
+    Monitor, MotionCommand, ReadData, Request, Response, SetAngle, SetAngleByInterval,
     SetAngleByVelocity,
 };
 
+pub use bus::{BusDirection, BusFrame, SimServoBus};
 use motion::Motion;
 
 /// Servo bus baud rate, bit/s.
@@ -160,28 +162,12 @@ impl SimServo {
     pub fn execute(&mut self, now_us: u64, request: &Request) -> Option<Response> {
         let t = now_us as f64;
         let from = self.angle_deg(now_us);
-        let mine = |id: &u8| *id == self.id;
-        match request {
-            Request::SetAngle(c) if mine(&c.id) => self.set_angle(t, from, c),
-            Request::SetAngleByInterval(c) if mine(&c.id) => self.by_interval(t, from, c),
-            Request::SetAngleByVelocity(c) if mine(&c.id) => self.by_velocity(t, from, c),
-            Request::Damping { id, .. } if mine(id) => self.motion = Motion::hold(from),
-            Request::SyncSetAngle(entries) => {
-                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
-                    self.set_angle(t, from, c);
-                }
-            }
-            Request::SyncSetAngleByInterval(entries) => {
-                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
-                    self.by_interval(t, from, c);
-                }
-            }
-            Request::SyncSetAngleByVelocity(entries) => {
-                if let Some(c) = entries.iter().find(|c| mine(&c.id)) {
-                    self.by_velocity(t, from, c);
-                }
-            }
-            _ => {}
+        match request.motion_for(self.id) {
+            Some(MotionCommand::SetAngle(c)) => self.set_angle(t, from, &c),
+            Some(MotionCommand::SetAngleByInterval(c)) => self.by_interval(t, from, &c),
+            Some(MotionCommand::SetAngleByVelocity(c)) => self.by_velocity(t, from, &c),
+            Some(MotionCommand::Damping { .. }) => self.motion = Motion::hold(from),
+            None => {}
         }
         if self.silent || request.id() != Some(self.id) {
             return None;
@@ -269,159 +255,6 @@ impl SimServo {
             }
             _ => None,
         }
-    }
-}
-
-/// Direction of a frame on the servo bus.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum BusDirection {
-    /// Controller → servo (request).
-    Tx,
-    /// Servo → controller (response).
-    Rx,
-}
-
-/// One complete frame seen on the bus.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct BusFrame {
-    /// When its first byte started on the wire, µs.
-    pub t_us: u64,
-    /// Direction.
-    pub direction: BusDirection,
-    /// The frame's bytes.
-    pub bytes: Vec<u8>,
-}
-
-/// Several simulated servos sharing one half-duplex line.
-#[derive(Default)]
-pub struct SimServoBus {
-    servos: Vec<SimServo>,
-    decoder: RequestDecoder,
-    /// The line is busy with responses until then, µs.
-    line_free_at_us: u64,
-    frames: Vec<BusFrame>,
-    decode_errors: u64,
-}
-
-impl SimServoBus {
-    /// Servos with the given ids at 0°, each with `slow_factor`.
-    pub fn new(ids: &[u8], slow_factor: f64) -> Self {
-        Self::from_servos(
-            ids.iter()
-                .map(|&id| {
-                    let mut servo = SimServo::new(id);
-                    servo.set_slow_factor(slow_factor);
-                    servo
-                })
-                .collect(),
-        )
-    }
-
-    /// A bus with these servos.
-    pub fn from_servos(servos: Vec<SimServo>) -> Self {
-        Self {
-            servos,
-            ..Self::default()
-        }
-    }
-
-    /// Servo `id`.
-    pub fn servo(&self, id: u8) -> Option<&SimServo> {
-        self.servos.iter().find(|s| s.id == id)
-    }
-
-    /// Servo `id`, mutable (fault injection, test setup).
-    pub fn servo_mut(&mut self, id: u8) -> Option<&mut SimServo> {
-        self.servos.iter_mut().find(|s| s.id == id)
-    }
-
-    /// Silences servo `id` (it answers nothing) or lets it answer again.
-    pub fn set_silent(&mut self, id: u8, silent: bool) {
-        if let Some(servo) = self.servo_mut(id) {
-            servo.set_silent(silent);
-        }
-    }
-
-    /// Sets the slowness factor of every servo.
-    pub fn set_slow_factor(&mut self, factor: f64) {
-        for servo in &mut self.servos {
-            servo.set_slow_factor(factor);
-        }
-    }
-
-    /// True angle of servo `id` at `now_us`, degrees (for drawing).
-    pub fn angle_deg(&self, id: u8, now_us: u64) -> Option<f64> {
-        self.servo(id).map(|s| s.angle_deg(now_us))
-    }
-
-    /// Angle of servo `id` at `now_us` as it reports it, 0.1°.
-    pub fn angle_tenths_at(&self, id: u8, now_us: u64) -> Option<i16> {
-        self.servo(id).map(|s| s.angle_tenths(now_us))
-    }
-
-    /// The servos hear `bytes`, the last of which finished arriving at
-    /// `now_us` (earlier ones [`BYTE_TIME_US`] apart before it). Returns each
-    /// answer as `(ready_at_us, frame bytes)`: `ready_at_us` is when its
-    /// first byte starts on the wire, [`PROCESSING_DELAY_US`] after the
-    /// request's last byte, or later if the line is still busy with an
-    /// earlier answer; each answer then occupies the line for its own byte
-    /// time ([`wire_time_us`]).
-    pub fn receive(&mut self, now_us: u64, bytes: &[u8]) -> Vec<(u64, Vec<u8>)> {
-        let mut answers = Vec::new();
-        let n = bytes.len();
-        for (i, &byte) in bytes.iter().enumerate() {
-            let byte_end_us = now_us.saturating_sub(wire_time_us(n - 1 - i));
-            self.decoder.push(byte);
-            while let Some(event) = self.decoder.poll() {
-                match event {
-                    Ok(request) => self.handle(byte_end_us, &request, &mut answers),
-                    Err(_) => self.decode_errors += 1,
-                }
-            }
-        }
-        answers
-    }
-
-    fn handle(&mut self, end_us: u64, request: &Request, answers: &mut Vec<(u64, Vec<u8>)>) {
-        let frame = request.to_frame().map(|f| f.to_vec()).unwrap_or_default();
-        self.frames.push(BusFrame {
-            t_us: end_us.saturating_sub(wire_time_us(frame.len())),
-            direction: BusDirection::Tx,
-            bytes: frame,
-        });
-        for servo in &mut self.servos {
-            let Some(response) = servo.execute(end_us, request) else {
-                continue;
-            };
-            let Ok(frame) = response.to_frame() else {
-                continue;
-            };
-            let start = (end_us + PROCESSING_DELAY_US).max(self.line_free_at_us);
-            self.line_free_at_us = start + wire_time_us(frame.len());
-            self.frames.push(BusFrame {
-                t_us: start,
-                direction: BusDirection::Rx,
-                bytes: frame.to_vec(),
-            });
-            answers.push((start, frame.to_vec()));
-        }
-    }
-
-    /// Every complete frame seen so far (requests as decoded, responses as
-    /// sent), in order.
-    pub fn frames(&self) -> &[BusFrame] {
-        &self.frames
-    }
-
-    /// Takes the frame log, leaving it empty.
-    pub fn take_frames(&mut self) -> Vec<BusFrame> {
-        std::mem::take(&mut self.frames)
-    }
-
-    /// Request bytes that did not form a valid frame (bad length, bad
-    /// checksum, unknown code) so far.
-    pub fn decode_errors(&self) -> u64 {
-        self.decode_errors
     }
 }
 

@@ -1,6 +1,9 @@
-//! The FashionStar servo bus: the frame codec ([`protocol`]) and the servo
-//! task body ([`task`]).
+//! The FashionStar servo bus: the servo task body ([`task`]) speaking the
+//! `fashionstar` frame codec, what it and the sequencer exchange
+//! ([`link`], [`id_set`]), and the plausibility filter of its angle
+//! readings ([`plausibility`]).
 
+pub mod id_set;
+pub mod link;
 pub mod plausibility;
-pub mod protocol;
 pub mod task;

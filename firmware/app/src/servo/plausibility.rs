@@ -172,7 +172,7 @@ mod tests {
     use std::vec::Vec;
 
     use super::*;
-    use crate::servo::protocol::{Response, ResponseDecoder};
+    use fashionstar::{Message, Response, ResponseDecoder};
     use proptest::prelude::*;
 
     fn at(ms: u64) -> Instant {

@@ -1,16 +1,13 @@
 //! Tests of the simulated servos, driven through real request frames and
 //! checked through real response frames decoded by the firmware decoder.
 
-use laser_app::servo::protocol::{DecodeError, ResponseDecoder, SyncEntries};
+use fashionstar::testing::frame;
+use fashionstar::{DecodeError, ResponseDecoder, SyncEntries};
 use proptest::prelude::*;
 
 use super::*;
 
 const MS: u64 = 1000;
-
-fn frame(r: &Request) -> Vec<u8> {
-    r.to_frame().unwrap().to_vec()
-}
 
 fn set(id: u8, angle_tenths_deg: i16, interval_ms: u16) -> Request {
     Request::SetAngle(SetAngle {

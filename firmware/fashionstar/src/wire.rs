@@ -3,7 +3,7 @@
 
 use heapless::Vec;
 
-use super::{EncodeError, FRAME_OVERHEAD, MAX_PAYLOAD_LEN};
+use crate::{EncodeError, FRAME_OVERHEAD, MAX_PAYLOAD_LEN};
 
 /// A payload under construction.
 pub(crate) type Payload = Vec<u8, MAX_PAYLOAD_LEN>;
@@ -14,16 +14,16 @@ pub fn checksum(bytes: &[u8]) -> u8 {
     bytes.iter().fold(0u8, |sum, b| sum.wrapping_add(*b))
 }
 
-/// Appends little-endian fields to a payload. Every message type has a
-/// payload of at most [`MAX_PAYLOAD_LEN`] bytes by construction; a write
-/// past the end is recorded and turned into an error by [`Writer::finish`]
-/// rather than panicking.
-pub(crate) struct Writer {
+/// Appends little-endian fields to a payload ([`crate::Message::write_payload`]).
+/// Every message type has a payload of at most [`MAX_PAYLOAD_LEN`] bytes by
+/// construction; a write past the end is recorded and turned into an
+/// [`EncodeError`] when the frame is built, rather than panicking.
+pub struct PayloadWriter {
     payload: Payload,
     overflow: bool,
 }
 
-impl Writer {
+impl PayloadWriter {
     pub(crate) const fn new() -> Self {
         Self {
             payload: Vec::new(),
@@ -31,25 +31,30 @@ impl Writer {
         }
     }
 
-    pub(crate) fn bytes(&mut self, bytes: &[u8]) {
+    /// Appends `bytes` as they are.
+    pub fn bytes(&mut self, bytes: &[u8]) {
         if self.payload.extend_from_slice(bytes).is_err() {
             self.overflow = true;
         }
     }
 
-    pub(crate) fn u8(&mut self, v: u8) {
+    /// Appends one byte.
+    pub fn u8(&mut self, v: u8) {
         self.bytes(&[v]);
     }
 
-    pub(crate) fn u16(&mut self, v: u16) {
+    /// Appends a little-endian `u16`.
+    pub fn u16(&mut self, v: u16) {
         self.bytes(&v.to_le_bytes());
     }
 
-    pub(crate) fn i16(&mut self, v: i16) {
+    /// Appends a little-endian `i16`.
+    pub fn i16(&mut self, v: i16) {
         self.bytes(&v.to_le_bytes());
     }
 
-    pub(crate) fn i32(&mut self, v: i32) {
+    /// Appends a little-endian `i32`.
+    pub fn i32(&mut self, v: i32) {
         self.bytes(&v.to_le_bytes());
     }
 
@@ -175,10 +180,10 @@ mod tests {
 
     #[test]
     fn writer_overflow_is_an_error() {
-        let mut w = Writer::new();
+        let mut w = PayloadWriter::new();
         w.bytes(&[0; MAX_PAYLOAD_LEN]);
         assert!(w.finish().is_ok());
-        let mut w = Writer::new();
+        let mut w = PayloadWriter::new();
         w.bytes(&[0; MAX_PAYLOAD_LEN]);
         w.u8(1);
         assert!(w.finish().is_err());

@@ -15,12 +15,8 @@
 
 use heapless::Vec;
 
-use super::decoder::Message;
-use super::wire::{Reader, Writer, write_frame};
-use super::{
-    DecodeError, EncodeError, FRAME_OVERHEAD, MAX_FRAME_LEN, MAX_READ_DATA_LEN, RESPONSE_HEADER,
-    Request, code,
-};
+use crate::wire::{PayloadWriter, Reader};
+use crate::{DecodeError, MAX_READ_DATA_LEN, Message, RESPONSE_HEADER, Request, code};
 
 /// Monitor data of one servo (code 22 response, 16 bytes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -81,16 +77,6 @@ pub enum Response {
 }
 
 impl Response {
-    /// Command code of the frame.
-    pub fn code(&self) -> u8 {
-        match self {
-            Self::Ping { .. } => code::PING,
-            Self::Angle { .. } => code::QUERY_ANGLE,
-            Self::Monitor(_) => code::QUERY_MONITOR,
-            Self::ReadData(_) => code::READ_DATA,
-        }
-    }
-
     /// Id of the answering servo.
     pub fn id(&self) -> u8 {
         match self {
@@ -113,9 +99,22 @@ impl Response {
             _ => false,
         }
     }
+}
 
-    fn payload(&self) -> Result<super::wire::Payload, EncodeError> {
-        let mut w = Writer::new();
+impl Message for Response {
+    const HEADER: [u8; 2] = RESPONSE_HEADER;
+
+    /// Command code of the frame.
+    fn code(&self) -> u8 {
+        match self {
+            Self::Ping { .. } => code::PING,
+            Self::Angle { .. } => code::QUERY_ANGLE,
+            Self::Monitor(_) => code::QUERY_MONITOR,
+            Self::ReadData(_) => code::READ_DATA,
+        }
+    }
+
+    fn write_payload(&self, w: &mut PayloadWriter) {
         match self {
             Self::Ping { id } => w.u8(*id),
             Self::Angle {
@@ -141,32 +140,7 @@ impl Response {
                 w.bytes(&d.data);
             }
         }
-        w.finish()
     }
-
-    /// Frame length on the wire, bytes.
-    pub fn encoded_len(&self) -> usize {
-        self.payload()
-            .map_or(MAX_FRAME_LEN, |p| p.len() + FRAME_OVERHEAD)
-    }
-
-    /// Writes the frame into `out`; returns its length in bytes (at most
-    /// [`MAX_FRAME_LEN`]).
-    pub fn encode(&self, out: &mut [u8]) -> Result<usize, EncodeError> {
-        write_frame(RESPONSE_HEADER, self.code(), &self.payload()?, out)
-    }
-
-    /// The frame as a vector.
-    pub fn to_frame(&self) -> Result<Vec<u8, MAX_FRAME_LEN>, EncodeError> {
-        let mut buf = [0u8; MAX_FRAME_LEN];
-        let len = self.encode(&mut buf)?;
-        Vec::from_slice(buf.get(..len).unwrap_or(&[]))
-            .map_err(|_| EncodeError::BufferTooSmall { needed: len })
-    }
-}
-
-impl Message for Response {
-    const HEADER: [u8; 2] = RESPONSE_HEADER;
 
     fn payload_len(code: u8) -> Option<(usize, usize)> {
         match code {
@@ -219,123 +193,7 @@ impl Message for Response {
         r.end().ok_or(bad_len)?;
         Ok(response)
     }
-
-    fn encode(&self, out: &mut [u8]) -> Result<usize, EncodeError> {
-        Response::encode(self, out)
-    }
 }
 
 #[cfg(test)]
-mod tests {
-    //! Known-answer frames, checksums summed by hand in the comments.
-    extern crate std;
-    use super::*;
-    use std::vec::Vec as StdVec;
-
-    fn frame(r: &Response) -> StdVec<u8> {
-        let f = r.to_frame().unwrap();
-        assert_eq!(f.len(), r.encoded_len());
-        f.to_vec()
-    }
-
-    #[test]
-    fn ping() {
-        // 05+1C+01+01+01 = 0x24
-        assert_eq!(
-            frame(&Response::Ping { id: 1 }),
-            [0x05, 0x1C, 0x01, 0x01, 0x01, 0x24]
-        );
-    }
-
-    #[test]
-    fn angle() {
-        // id 0, -12.3° = -123 = 0xFF85: 05+1C+0A+03+00+85+FF = 0x1B2 → 0xB2
-        assert_eq!(
-            frame(&Response::Angle {
-                id: 0,
-                angle_tenths_deg: -123
-            }),
-            [0x05, 0x1C, 0x0A, 0x03, 0x00, 0x85, 0xFF, 0xB2]
-        );
-    }
-
-    #[test]
-    fn monitor() {
-        // id 1, 7400 mV (E8 1C), 120 mA (78 00), 888 mW (78 03),
-        // raw 1854 (3E 07), status 1, angle 900 (84 03 00 00), turns 0:
-        // 05+1C+16+10 = 47; +01 = 48; +E8+1C = 14C; +78+00 = 1C4;
-        // +78+03 = 23F; +3E+07 = 284; +01 = 285; +84+03+00+00 = 30C;
-        // +00+00 → 0x0C
-        let m = Monitor {
-            id: 1,
-            voltage_mv: 7400,
-            current_ma: 120,
-            power_mw: 888,
-            temperature_raw: 1854,
-            status: 1,
-            angle_tenths_deg: 900,
-            turns: 0,
-        };
-        assert_eq!(
-            frame(&Response::Monitor(m)),
-            [
-                0x05, 0x1C, 0x16, 0x10, 0x01, 0xE8, 0x1C, 0x78, 0x00, 0x78, 0x03, 0x3E, 0x07, 0x01,
-                0x84, 0x03, 0x00, 0x00, 0x00, 0x00, 0x0C
-            ]
-        );
-    }
-
-    #[test]
-    fn read_data() {
-        // id 0, address 1 (voltage), 7400 mV (E8 1C):
-        // 05+1C+03+04 = 28; +00+01 = 29; +E8+1C = 12D → 0x2D
-        let d = ReadData {
-            id: 0,
-            address: 1,
-            data: Vec::from_slice(&[0xE8, 0x1C]).unwrap(),
-        };
-        assert_eq!(
-            frame(&Response::ReadData(d)),
-            [0x05, 0x1C, 0x03, 0x04, 0x00, 0x01, 0xE8, 0x1C, 0x2D]
-        );
-    }
-
-    #[test]
-    fn answers_matches_kind_id_and_address() {
-        let angle = Response::Angle {
-            id: 1,
-            angle_tenths_deg: 0,
-        };
-        assert!(angle.answers(&Request::QueryAngle { id: 1 }));
-        assert!(!angle.answers(&Request::QueryAngle { id: 0 }));
-        assert!(!angle.answers(&Request::Ping { id: 1 }));
-        assert!(Response::Ping { id: 0 }.answers(&Request::Ping { id: 0 }));
-        let d = Response::ReadData(ReadData {
-            id: 0,
-            address: 5,
-            data: Vec::new(),
-        });
-        assert!(d.answers(&Request::ReadData { id: 0, address: 5 }));
-        assert!(!d.answers(&Request::ReadData { id: 0, address: 4 }));
-        assert_eq!(d.id(), 0);
-        assert_eq!(d.code(), code::READ_DATA);
-    }
-
-    #[test]
-    fn parse_rejects_wrong_lengths_and_codes() {
-        assert!(matches!(
-            Response::parse(code::QUERY_ANGLE, &[0, 0]),
-            Err(DecodeError::BadLength { .. })
-        ));
-        assert!(matches!(
-            Response::parse(code::PING, &[0, 0]),
-            Err(DecodeError::BadLength { .. })
-        ));
-        assert_eq!(
-            Response::parse(8, &[0]),
-            Err(DecodeError::UnknownCode { code: 8 })
-        );
-        assert!(Response::parse(code::READ_DATA, &[0; 2 + MAX_READ_DATA_LEN]).is_ok());
-        assert!(Response::parse(code::READ_DATA, &[0; 3 + MAX_READ_DATA_LEN]).is_err());
-    }
-}
+mod tests;

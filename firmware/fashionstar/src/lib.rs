@@ -1,7 +1,18 @@
+#![no_std]
 //! FashionStar serial-bus servo protocol: typed requests and responses,
 //! byte-exact frame encoders and streaming, resynchronising decoders for
 //! both directions (the firmware decodes responses, the simulated servo
 //! decodes requests). `no_std`, no allocation, fixed buffers.
+//!
+//! The code follows the frame (SPEC §7): [`Message`] is one direction's
+//! frame type (its header, a code, a payload) and derives the framing,
+//! length and checksum for every message once ([`Message::encode`],
+//! [`Message::to_frame`], [`Message::encoded_len`]); [`Request`] and
+//! [`Response`] only say how their payloads are laid out. The per-servo
+//! moves ([`SetAngle`], [`SetAngleByInterval`], [`SetAngleByVelocity`])
+//! have one layout (`id, angle, u16 fields`) whether they travel alone or
+//! as entries of a sync frame. [`StreamDecoder`] turns bytes back into
+//! messages of either direction.
 //!
 //! # Frame layout
 //!
@@ -31,17 +42,23 @@
 //!   and are rejected as [`DecodeError::BadLength`].
 
 mod decoder;
+mod entry;
+mod message;
 mod request;
 mod response;
 mod wire;
 
 #[cfg(test)]
 mod proptests;
+#[cfg(any(test, feature = "testing"))]
+pub mod testing;
 
-pub use decoder::{Decoded, Message, RequestDecoder, ResponseDecoder, StreamDecoder};
-pub use request::{Request, SetAngle, SetAngleByInterval, SetAngleByVelocity, SyncEntries};
+pub use decoder::{Decoded, RequestDecoder, ResponseDecoder, StreamDecoder};
+pub use entry::{SetAngle, SetAngleByInterval, SetAngleByVelocity, SyncEntries};
+pub use message::{Frame, Message};
+pub use request::{MotionCommand, Request};
 pub use response::{Monitor, ReadData, Response};
-pub use wire::checksum;
+pub use wire::{PayloadWriter, checksum};
 
 /// First two bytes of every request frame (controller → servo).
 pub const REQUEST_HEADER: [u8; 2] = [0x12, 0x4C];

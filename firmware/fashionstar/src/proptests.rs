@@ -10,6 +10,7 @@ use proptest::collection::vec;
 use proptest::prelude::*;
 
 use super::*;
+use crate::testing;
 
 fn set_angle() -> impl Strategy<Value = SetAngle> {
     (any::<u8>(), any::<i16>(), any::<u16>(), any::<u16>()).prop_map(|(id, a, i, p)| SetAngle {
@@ -99,12 +100,6 @@ fn response() -> impl Strategy<Value = Response> {
     ]
 }
 
-fn bytes_of<M: Message>(m: &M) -> Vec<u8> {
-    let mut out = [0u8; MAX_FRAME_LEN];
-    let n = m.encode(&mut out).unwrap();
-    out[..n].to_vec()
-}
-
 /// Feeds `bytes` in chunks of the given sizes (cycled), collecting every
 /// event and checking the buffer bound after each chunk.
 fn decode_chunked<M: Message>(bytes: &[u8], sizes: &[usize]) -> Vec<Result<M, DecodeError>> {
@@ -150,7 +145,7 @@ proptest! {
 
     #[test]
     fn request_roundtrip(r in request(), sizes in vec(1usize..8, 1..8)) {
-        let f = bytes_of(&r);
+        let f = testing::frame(&r);
         prop_assert_eq!(f.len(), r.encoded_len());
         prop_assert!(f.len() <= MAX_FRAME_LEN);
         prop_assert_eq!(&f[..2], &REQUEST_HEADER);
@@ -160,7 +155,7 @@ proptest! {
 
     #[test]
     fn response_roundtrip(r in response(), sizes in vec(1usize..8, 1..8)) {
-        let f = bytes_of(&r);
+        let f = testing::frame(&r);
         prop_assert_eq!(f.len(), r.encoded_len());
         prop_assert_eq!(&f[..2], &RESPONSE_HEADER);
         prop_assert_eq!(f[f.len() - 1], checksum(&f[..f.len() - 1]));
@@ -175,7 +170,7 @@ proptest! {
         garbage in vec(vec(any::<u8>().prop_filter("no header start", |b| *b != 0x05), 0..20), 6),
         sizes in vec(1usize..24, 1..8),
     ) {
-        let frames: Vec<_> = rs.iter().map(bytes_of).collect();
+        let frames: Vec<_> = rs.iter().map(testing::frame).collect();
         let stream = interleave(&frames, &garbage);
         prop_assert_eq!(decode_chunked::<Response>(&stream, &sizes), rs.into_iter().map(Ok).collect::<Vec<_>>());
     }
@@ -186,7 +181,7 @@ proptest! {
         garbage in vec(vec(any::<u8>().prop_filter("no header start", |b| *b != 0x12), 0..20), 6),
         sizes in vec(1usize..24, 1..8),
     ) {
-        let frames: Vec<_> = rs.iter().map(bytes_of).collect();
+        let frames: Vec<_> = rs.iter().map(testing::frame).collect();
         let stream = interleave(&frames, &garbage);
         prop_assert_eq!(decode_chunked::<Request>(&stream, &sizes), rs.into_iter().map(Ok).collect::<Vec<_>>());
     }
@@ -202,7 +197,7 @@ proptest! {
         rs in vec(response(), 1..4),
         sizes in vec(1usize..24, 1..8),
     ) {
-        let frames: Vec<_> = rs.iter().map(bytes_of).collect();
+        let frames: Vec<_> = rs.iter().map(testing::frame).collect();
         let mut stream = std::vec![0x05, 0x1C, code, len];
         stream.extend(&filler);
         stream.extend(interleave(&frames, &[]));
@@ -232,7 +227,7 @@ proptest! {
         flip in 1u8..=255,
         sizes in vec(1usize..24, 1..8),
     ) {
-        let mut frames: Vec<_> = rs.iter().map(bytes_of).collect();
+        let mut frames: Vec<_> = rs.iter().map(testing::frame).collect();
         let k = which.index(frames.len());
         let pos = at.index(frames[k].len());
         prop_assume!(pos != 3);
@@ -258,13 +253,13 @@ proptest! {
         flips in vec((any::<prop::sample::Index>(), 1u8..=255), 1..4),
         sizes in vec(1usize..24, 1..8),
     ) {
-        let mut stream = interleave(&rs.iter().map(bytes_of).collect::<Vec<_>>(), &[]);
+        let mut stream = interleave(&rs.iter().map(testing::frame).collect::<Vec<_>>(), &[]);
         for (at, flip) in flips {
             let i = at.index(stream.len());
             stream[i] ^= flip;
         }
         for r in oks(decode_chunked::<Request>(&stream, &sizes)) {
-            prop_assert!(contains(&stream, &bytes_of(&r)));
+            prop_assert!(contains(&stream, &testing::frame(&r)));
         }
     }
 
@@ -272,10 +267,10 @@ proptest! {
     #[test]
     fn random_bytes(bytes in vec(any::<u8>(), 0..600), sizes in vec(1usize..64, 1..8)) {
         for r in oks(decode_chunked::<Response>(&bytes, &sizes)) {
-            prop_assert!(contains(&bytes, &bytes_of(&r)));
+            prop_assert!(contains(&bytes, &testing::frame(&r)));
         }
         for r in oks(decode_chunked::<Request>(&bytes, &sizes)) {
-            prop_assert!(contains(&bytes, &bytes_of(&r)));
+            prop_assert!(contains(&bytes, &testing::frame(&r)));
         }
     }
 
@@ -286,10 +281,10 @@ proptest! {
         bytes in vec(prop_oneof![Just(0x05u8), Just(0x1C), Just(0x12), Just(0x4C), 0u8..30, any::<u8>()], 0..600),
     ) {
         for r in oks(decode_chunked::<Response>(&bytes, &[7])) {
-            prop_assert!(contains(&bytes, &bytes_of(&r)));
+            prop_assert!(contains(&bytes, &testing::frame(&r)));
         }
         for r in oks(decode_chunked::<Request>(&bytes, &[5])) {
-            prop_assert!(contains(&bytes, &bytes_of(&r)));
+            prop_assert!(contains(&bytes, &testing::frame(&r)));
         }
     }
 
@@ -307,7 +302,7 @@ proptest! {
         frame.extend(payload);
         frame.push(checksum(&frame));
         match decode_chunked::<Request>(&frame, &[3]).as_slice() {
-            [Ok(r)] => prop_assert_eq!(bytes_of(r), frame),
+            [Ok(r)] => prop_assert_eq!(testing::frame(r), frame),
             [Err(DecodeError::BadSync { .. })] => prop_assert_eq!(code, code::SYNC),
             other => prop_assert!(false, "unexpected {:?}", other),
         }
@@ -325,6 +320,6 @@ proptest! {
         let events = decode_chunked::<Response>(&frame, &[2]);
         prop_assert_eq!(events.len(), 1);
         let r = events.into_iter().next().unwrap().unwrap();
-        prop_assert_eq!(bytes_of(&r), frame);
+        prop_assert_eq!(testing::frame(&r), frame);
     }
 }

@@ -1,0 +1,184 @@
+//! What the sequencer and the servo task say to each other: the bus
+//! configuration, the requests, the faults and outcomes, and the channels
+//! that carry them ([`ServoLink`]).
+
+use core::sync::atomic::AtomicU32;
+
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::channel::Channel;
+
+use super::plausibility::WIRE_LIMIT_TENTHS;
+
+/// Servo ids and timing of the servo bus. All durations in ms, angles in
+/// the servo's wire unit (0.1°).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ServoBusConfig {
+    /// Bus id of the yaw servo.
+    pub yaw_id: u8,
+    /// Bus id of the pitch servo.
+    pub pitch_id: u8,
+    /// Arrived when both measured angles are within this many 0.1° steps.
+    pub deadband_tenths: u16,
+    /// How long to wait for a response frame, ms.
+    pub response_timeout_ms: u16,
+    /// Extra attempts after a query got no valid response.
+    pub retries: u8,
+    /// Period of angle polls while waiting for arrival, ms.
+    pub poll_period_ms: u16,
+    /// Arrival deadline beyond the commanded interval, ms (plus 50 % of
+    /// the interval); a move not finished by then is a fault.
+    pub arrival_margin_ms: u16,
+    /// Period of the health check while no move runs (both angles are
+    /// queried, so a servo that stops answering during a dwell or a held
+    /// goto is a fault within this period plus the retries), ms.
+    pub health_check_ms: u16,
+    /// Configured angle range of the yaw and the pitch servo, 0.1°
+    /// (`(min, max)`; readings outside are implausible).
+    pub ranges_tenths: [(i16, i16); 2],
+}
+
+impl Default for ServoBusConfig {
+    fn default() -> Self {
+        Self {
+            yaw_id: 0,
+            pitch_id: 1,
+            deadband_tenths: 5,
+            response_timeout_ms: 20,
+            retries: 2,
+            poll_period_ms: 10,
+            arrival_margin_ms: 300,
+            health_check_ms: 100,
+            ranges_tenths: [(-WIRE, WIRE); 2],
+        }
+    }
+}
+
+/// What the sequencer asks of the servo task. `seq` ties the outcome to
+/// the request.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ServoRequest {
+    /// Start both servos towards the given wire angles (0.1°) together,
+    /// taking `interval_ms`, and report when both have arrived.
+    Move {
+        /// Request number.
+        seq: u32,
+        /// Yaw servo target, 0.1°.
+        yaw_tenths: i16,
+        /// Pitch servo target, 0.1°.
+        pitch_tenths: i16,
+        /// Commanded travel time, ms.
+        interval_ms: u16,
+        /// Bus ids `(yaw, pitch)` (from the settings; used from now on).
+        ids: (u8, u8),
+        /// Arrival deadband, 0.1° (used from now on).
+        deadband_tenths: u16,
+        /// Configured range `(min, max)` of the yaw and the pitch servo,
+        /// 0.1° (used from now on by the plausibility filter).
+        ranges_tenths: [(i16, i16); 2],
+    },
+}
+
+impl ServoRequest {
+    /// The request number.
+    pub fn seq(&self) -> u32 {
+        match self {
+            ServoRequest::Move { seq, .. } => *seq,
+        }
+    }
+}
+
+/// Why a servo is considered faulty.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ServoFault {
+    /// No valid response after all retries.
+    NoResponse,
+    /// Still away from the target at the arrival deadline (measured angle,
+    /// 0.1°).
+    NotArrived {
+        /// Last measured angle, 0.1°.
+        at_tenths: i16,
+        /// Target angle, 0.1°.
+        target_tenths: i16,
+    },
+    /// Writing to the UART failed.
+    BusError,
+    /// [`IMPLAUSIBLE_RUN`](super::plausibility::IMPLAUSIBLE_RUN) angle readings in a row were physically
+    /// impossible (outside the range, or a jump no servo can make): the
+    /// bus delivers corrupted frames that pass the checksum.
+    ImplausibleReading {
+        /// The last rejected reading, 0.1°.
+        at_tenths: i16,
+    },
+}
+
+/// What the servo task reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ServoOutcome {
+    /// Both servos are within the deadband of the targets of `Move` `seq`.
+    Arrived {
+        /// Request number.
+        seq: u32,
+        /// Measured yaw angle, 0.1°.
+        yaw_tenths: i16,
+        /// Measured pitch angle, 0.1°.
+        pitch_tenths: i16,
+    },
+    /// Request `seq` failed because servo `id` is faulty.
+    Fault {
+        /// Request number.
+        seq: u32,
+        /// Bus id of the faulty servo.
+        id: u8,
+        /// What went wrong.
+        fault: ServoFault,
+    },
+    /// Request `seq` was abandoned because a newer request arrived.
+    Superseded {
+        /// Request number.
+        seq: u32,
+    },
+    /// A previously faulty servo answers again (found while idle).
+    Recovered {
+        /// Bus id.
+        id: u8,
+    },
+}
+
+/// Channels between the sequencer and the servo task.
+pub struct ServoLink {
+    /// Sequencer → servo task.
+    pub requests: Channel<CriticalSectionRawMutex, ServoRequest, 1>,
+    /// Servo task → sequencer.
+    pub outcomes: Channel<CriticalSectionRawMutex, ServoOutcome, 4>,
+    /// Incremented by the servo task at least every
+    /// [`IDLE_TICK`](super::task::IDLE_TICK)
+    /// (liveness for the watchdog).
+    pub alive: AtomicU32,
+    /// Angle readings rejected as physically impossible since boot.
+    pub implausible_readings: AtomicU32,
+}
+
+impl ServoLink {
+    /// Empty channels (usable in a `static`).
+    pub const fn new() -> Self {
+        Self {
+            requests: Channel::new(),
+            outcomes: Channel::new(),
+            alive: AtomicU32::new(0),
+            implausible_readings: AtomicU32::new(0),
+        }
+    }
+}
+
+impl Default for ServoLink {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Largest single-turn angle, 0.1° (default range before the first move).
+const WIRE: i16 = WIRE_LIMIT_TENTHS as i16;
