@@ -9,6 +9,7 @@ use std::sync::atomic::Ordering;
 
 use kinematics_core::Galvo;
 use laser_app::galvo::{DacSample, GalvoConfig, GalvoEvent, GalvoLink, GalvoLoop, GalvoRequest};
+use laser_app::laser_gate::LaserGate;
 use laser_sim::dac::{DacRecording, SimDac};
 use laser_sim::executor::{self, RunEnd};
 
@@ -28,49 +29,66 @@ struct Run {
     end: RunEnd,
 }
 
-fn run(compute_ns_per_sample: u64) -> Run {
-    let link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
-    let recording = Rc::new(RefCell::new(DacRecording::default()));
-    let events: Rc<RefCell<Vec<GalvoEvent>>> = Rc::default();
+/// Runs the galvo loop (default configuration) on `dac` with `link` and
+/// `gate` beside the `driver` task, until the driver returns or
+/// `limit_us` of simulated time have passed.
+fn run_loop(
+    dac: SimDac,
+    link: &'static GalvoLink,
+    gate: &'static LaserGate,
+    limit_us: u64,
+    driver: impl Future<Output = ()> + 'static,
+) -> RunEnd {
     let finished = Rc::new(RefCell::new(false));
-    let gate = laser_sim::laser::recorded_gate(&recording);
-    let (rec, ev, fin) = (recording.clone(), events.clone(), finished.clone());
-    let end = executor::run(
+    let fin = finished.clone();
+    executor::run(
         false,
-        2_000_000,
+        limit_us,
         move |spawner| {
             executor::spawn(&spawner, async move {
-                let mut dac = SimDac::new(128, 10_000, compute_ns_per_sample, rec);
+                let mut dac = dac;
                 let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
                 galvo.run(&mut dac, link, gate).await;
             });
             executor::spawn(&spawner, async move {
-                for (i, &(x_mm, y_mm)) in POINTS.iter().enumerate() {
-                    link.requests
-                        .send(GalvoRequest::Point {
-                            seq: i as u32,
-                            x_mm,
-                            y_mm,
-                            dwell_us: 2_000,
-                        })
-                        .await;
-                }
-                // Until every point is done or refused, or an underrun.
-                let mut closed = 0;
-                while closed < POINTS.len() {
-                    let event = link.events.receive().await;
-                    ev.borrow_mut().push(event);
-                    match event {
-                        GalvoEvent::Underrun(_) => break,
-                        _ => closed += 1,
-                    }
-                }
-                embassy_time::Timer::after_millis(5).await;
+                driver.await;
                 *fin.borrow_mut() = true;
             });
         },
         move || *finished.borrow(),
-    );
+    )
+}
+
+fn run(compute_ns_per_sample: u64) -> Run {
+    let link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
+    let recording = Rc::new(RefCell::new(DacRecording::default()));
+    let events: Rc<RefCell<Vec<GalvoEvent>>> = Rc::default();
+    let gate = laser_sim::laser::recorded_gate(&recording);
+    let dac = SimDac::new(128, 10_000, compute_ns_per_sample, recording.clone());
+    let ev = events.clone();
+    let end = run_loop(dac, link, gate, 2_000_000, async move {
+        for (i, &(x_mm, y_mm)) in POINTS.iter().enumerate() {
+            link.requests
+                .send(GalvoRequest::Point {
+                    seq: i as u32,
+                    x_mm,
+                    y_mm,
+                    dwell_us: 2_000,
+                })
+                .await;
+        }
+        // Until every point is done or refused, or an underrun.
+        let mut closed = 0;
+        while closed < POINTS.len() {
+            let event = link.events.receive().await;
+            ev.borrow_mut().push(event);
+            match event {
+                GalvoEvent::Underrun(_) => break,
+                _ => closed += 1,
+            }
+        }
+        embassy_time::Timer::after_millis(5).await;
+    });
     let recording = recording.borrow().clone();
     let events = events.borrow().clone();
     Run {
@@ -159,41 +177,27 @@ fn an_underrun_mid_dwell_replays_dark_and_the_laser_is_dark_at_once() {
     let dac = SimDac::new(128, 10_000, 0, recording.clone());
     let cost = dac.compute_cost();
     let slowed_at = Rc::new(RefCell::new(None));
-    let finished = Rc::new(RefCell::new(false));
-    let (fin, slowed) = (finished.clone(), slowed_at.clone());
-    let end = executor::run(
-        false,
-        2_000_000,
-        move |spawner| {
-            executor::spawn(&spawner, async move {
-                let mut dac = dac;
-                let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
-                galvo.run(&mut dac, link, gate).await;
-            });
-            executor::spawn(&spawner, async move {
-                link.requests
-                    .send(GalvoRequest::Point {
-                        seq: 1,
-                        x_mm: 20.0,
-                        y_mm: 10.0,
-                        dwell_us: 30_000,
-                    })
-                    .await;
-                embassy_time::Timer::after_millis(10).await;
-                cost.set(15_000);
-                *slowed.borrow_mut() = Some(embassy_time::Instant::now().as_micros() * 1000);
-                loop {
-                    if let GalvoEvent::Underrun(_) = link.events.receive().await {
-                        break;
-                    }
-                }
-                // Still too slow, but idle: it must hold quietly.
-                embassy_time::Timer::after_millis(200).await;
-                *fin.borrow_mut() = true;
-            });
-        },
-        move || *finished.borrow(),
-    );
+    let slowed = slowed_at.clone();
+    let end = run_loop(dac, link, gate, 2_000_000, async move {
+        link.requests
+            .send(GalvoRequest::Point {
+                seq: 1,
+                x_mm: 20.0,
+                y_mm: 10.0,
+                dwell_us: 30_000,
+            })
+            .await;
+        embassy_time::Timer::after_millis(10).await;
+        cost.set(15_000);
+        *slowed.borrow_mut() = Some(embassy_time::Instant::now().as_micros() * 1000);
+        loop {
+            if let GalvoEvent::Underrun(_) = link.events.receive().await {
+                break;
+            }
+        }
+        // Still too slow, but idle: it must hold quietly.
+        embassy_time::Timer::after_millis(200).await;
+    });
     assert_eq!(end, RunEnd::Stopped);
     let recording = recording.borrow().clone();
     let slowed_ns = slowed_at.borrow().expect("slowed down");
@@ -248,43 +252,29 @@ fn closing_the_gate_stops_the_loop_even_when_no_stop_request_gets_through() {
     let recording = Rc::new(RefCell::new(DacRecording::default()));
     let gate = laser_sim::laser::recorded_gate(&recording);
     let closed_at = Rc::new(RefCell::new(None));
-    let finished = Rc::new(RefCell::new(false));
-    let (fin, closed) = (finished.clone(), closed_at.clone());
-    let rec = recording.clone();
-    let end = executor::run(
-        false,
-        5_000_000,
-        move |spawner| {
-            executor::spawn(&spawner, async move {
-                let mut dac = SimDac::new(128, 10_000, 0, rec);
-                let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
-                galvo.run(&mut dac, link, gate).await;
-            });
-            executor::spawn(&spawner, async move {
-                for seq in 0..5 {
-                    link.requests
-                        .send(GalvoRequest::Point {
-                            seq,
-                            x_mm: 8.0 * seq as f32,
-                            y_mm: -5.0,
-                            dwell_us: 500_000,
-                        })
-                        .await;
-                }
-                while link.state().1 < 4 {
-                    embassy_time::Timer::after_millis(1).await;
-                }
-                embassy_time::Timer::after_millis(20).await;
-                *closed.borrow_mut() = Some(embassy_time::Instant::now().as_micros() * 1000);
-                gate.close();
-                embassy_time::Timer::after_millis(2000).await;
-                *fin.borrow_mut() = true;
-            });
-        },
-        move || *finished.borrow(),
-    );
+    let closed = closed_at.clone();
+    let dac = SimDac::new(128, 10_000, 0, recording.clone());
+    let end = run_loop(dac, link, gate, 5_000_000, async move {
+        for seq in 0..5 {
+            link.requests
+                .send(GalvoRequest::Point {
+                    seq,
+                    x_mm: 8.0 * seq as f32,
+                    y_mm: -5.0,
+                    dwell_us: 500_000,
+                })
+                .await;
+        }
+        while link.state().1 < 4 {
+            embassy_time::Timer::after_millis(1).await;
+        }
+        embassy_time::Timer::after_millis(20).await;
+        *closed.borrow_mut() = Some(embassy_time::Instant::now().as_micros() * 1000);
+        gate.close();
+        embassy_time::Timer::after_millis(2000).await;
+    });
     assert_eq!(end, RunEnd::Stopped);
-    assert_eq!(link.state(), (laser_app::galvo::Phase::Idle, 0));
+    assert_eq!(link.state(), (laser_app::galvo::ScanPhase::Idle, 0));
     let closed_ns = closed_at.borrow().expect("closed");
     let recording = recording.borrow().clone();
     let samples: Vec<(u64, DacSample)> = recording.iter().collect();

@@ -7,8 +7,8 @@ use kinematics_core::{Galvo, PointMm};
 use laser_app::galvo::DacSample;
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::{
-    UNTIL_STEP_FIXES, assert_safe_allowing, lit_sample_times_ns, run_to_idle, run_with,
-    run_with_galvo_cost, sent_at, spec_patterns, terminal_lines,
+    UNTIL_STEP_FIXES, assert_safe_allowing, lit_sample_times_ns, run_succeeding, run_to_idle,
+    run_with, run_with_galvo_cost, sent_at, spec_patterns, terminal_lines,
 };
 
 /// SPEC grid pitch, mm.
@@ -47,11 +47,9 @@ fn check_galvo_pattern(name: &str, expected: Vec<(i8, i8)>) {
     // Each point takes ~21 ms; the DAC outputs what the loop computed up
     // to two half buffers after the loop reported the last point done.
     let wait_ms = expected.len() * 25 + 10;
-    let report = run_to_idle(&format!(
+    let report = run_succeeding(&format!(
         "target galvo\nset dwell_ms 20\npattern {name} once\nwait {wait_ms}\n"
     ));
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false), "{name}: {:?}", report.transcript);
     assert_eq!(report.galvo_underruns, 0);
     let samples = samples(&report);
     let runs = lit_runs(&samples);
@@ -179,11 +177,9 @@ fn jumps_take_the_planned_time_with_either_planner() {
         ("optimal", Method::TimeOptimal),
         ("seed", Method::BISECTION),
     ] {
-        let report = run_to_idle(&format!(
+        let report = run_succeeding(&format!(
             "target galvo\nplanner {planner}\nset dwell_ms 5\npattern home once\nwait 20\npattern corner once\nwait 40\n"
         ));
-        assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-        assert!(report.succeeded(false));
         let samples = samples(&report);
         let runs = lit_runs(&samples);
         // From the end of home's laser-off delay to the start of the
@@ -217,9 +213,7 @@ fn jumps_take_the_planned_time_with_either_planner() {
 
 #[test]
 fn both_actuators_visit_the_same_points_together() {
-    let report = run_to_idle("target both\nset dwell_ms 50\npattern corner once\nwait 1500\n");
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let report = run_succeeding("target both\nset dwell_ms 50\npattern corner once\nwait 1500\n");
     let gimbal: Vec<(i8, i8)> = report
         .recording
         .dwells
@@ -240,10 +234,9 @@ fn both_actuators_visit_the_same_points_together() {
 
 #[test]
 fn switching_pattern_mid_dwell_stops_the_galvo_cleanly() {
-    let report =
-        run_to_idle("target galvo\npattern visit-all\nwait 2500\npattern home once\nwait 1010\n");
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false));
+    let report = run_succeeding(
+        "target galvo\npattern visit-all\nwait 2500\npattern home once\nwait 1010\n",
+    );
     let samples = samples(&report);
     assert_no_step_beyond_a_planned_jump(&samples);
     let last_lit = lit_runs(&samples).last().map(|r| r.2).expect("lit");
@@ -291,11 +284,9 @@ fn galvo_commands_refuse_what_it_cannot_do() {
 fn the_galvo_marks_paths_from_the_command_line() {
     // Circle of 3 cm about (1, -1) cm, counter-clockwise, then the tuning
     // figure (square of 5 cm with its circle and cross).
-    let report = run_to_idle(
+    let report = run_succeeding(
         "target galvo\npattern circle 1 -1 3 ccw once\nwait 300\npattern tuning 0 0 5 once\nwait 500\n",
     );
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false), "{:?}", report.transcript);
     let samples = samples(&report);
     let runs = lit_runs(&samples);
     assert_eq!(runs.len(), 1 + 4, "one circle stroke, four tuning strokes");
@@ -327,11 +318,9 @@ fn the_galvo_marks_paths_from_the_command_line() {
 
 #[test]
 fn switching_pattern_mid_path_brakes_dark_and_moves_on() {
-    let report = run_to_idle(
+    let report = run_succeeding(
         "target galvo\npattern rect -4 3 4 -3\nwait 20\npattern home once\nwait 1100\n",
     );
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false));
     let samples = samples(&report);
     let runs = lit_runs(&samples);
     assert_eq!(runs.len(), 2, "the interrupted rectangle, then home");
@@ -359,9 +348,7 @@ fn a_galvo_loop_too_slow_for_the_sample_rate_is_reported_and_stopped() {
 
 #[test]
 fn a_galvo_goto_holds_the_point_lit_until_the_next_command() {
-    let report = run_to_idle("target galvo\ngoto 2 1\nwait 50\nstatus\nstop\nwait 10\n");
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let report = run_succeeding("target galvo\ngoto 2 1\nwait 50\nstatus\nstop\nwait 10\n");
     let lines = terminal_lines(&report);
     assert!(
         lines.contains(&"state: goto") && lines.contains(&"phase: holding"),

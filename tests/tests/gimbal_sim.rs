@@ -5,8 +5,8 @@ use laser_sim::recorder::Direction;
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::SimOptions;
 use system_tests::{
-    UNTIL_STEP_FIXES, assert_safe_allowing, run_to_idle, run_with, sent_at, spec_patterns,
-    terminal_lines,
+    UNTIL_STEP_FIXES, assert_safe_allowing, run_succeeding, run_to_idle, run_with, sent_at,
+    spec_patterns, terminal_lines,
 };
 
 /// Pointing tolerance of the exact model, cm (0.5 mm).
@@ -15,9 +15,7 @@ const TOLERANCE_CM: f64 = 0.05;
 const PITCH_CM: f64 = 1.916;
 
 fn check_pattern(name: &str, expected: Vec<(i8, i8)>) {
-    let report = run_to_idle(&format!("set dwell_ms 50\npattern {name} once\n"));
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false), "{name}: {:?}", report.transcript);
+    let report = run_succeeding(&format!("set dwell_ms 50\npattern {name} once\n"));
     let visited: Vec<(i8, i8)> = report
         .recording
         .dwells
@@ -70,9 +68,7 @@ fn full_grid_raster_and_serpentine() {
 #[test]
 fn full_grid_with_one_second_dwells_runs_fast_in_virtual_time() {
     let wall = std::time::Instant::now();
-    let report = run_to_idle("pattern grid-full once\n");
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false));
+    let report = run_succeeding("pattern grid-full once\n");
     assert_eq!(report.recording.dwells.len(), 13 * 9);
     assert!(report.end_time_us > 117_000_000, "117 dwells of 1 s each");
     // Generous bound: the point is that virtual time does not sleep.
@@ -82,9 +78,7 @@ fn full_grid_with_one_second_dwells_runs_fast_in_virtual_time() {
 #[test]
 fn switching_pattern_mid_dwell_takes_effect_within_one_servo_frame() {
     // The first corner is reached after ~0.3 s; at 1.0 s the gimbal dwells.
-    let report = run_to_idle("pattern corner\nwait 1000\npattern home once\n");
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false));
+    let report = run_succeeding("pattern corner\nwait 1000\npattern home once\n");
     let switched_at = sent_at(&report, "pattern home once");
     let first_frame_after = report
         .recording
@@ -109,9 +103,7 @@ fn switching_pattern_mid_dwell_takes_effect_within_one_servo_frame() {
 
 #[test]
 fn stop_turns_the_laser_off_at_once() {
-    let report = run_to_idle("pattern visit-all\nwait 2500\nstop\n");
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false));
+    let report = run_succeeding("pattern visit-all\nwait 2500\nstop\n");
     let stop_at = sent_at(&report, "stop");
     let (t_off, on) = *report
         .recording
@@ -270,9 +262,7 @@ fn a_thousand_random_command_lines_never_wedge_the_command_line() {
 #[test]
 fn a_circle_is_drawn_on_its_path_and_closes() {
     // Radius 4 cm about (2, 1) cm, 0.2 cm steps, no dwell between steps.
-    let report = run_to_idle("pattern circle 2 1 4 ccw once\nwait 2500\n");
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false), "{:?}", report.transcript);
+    let report = run_succeeding("pattern circle 2 1 4 ccw once\nwait 2500\n");
     let drawn: Vec<_> = report.recording.spot.iter().filter(|s| s.laser).collect();
     let first_on_circle = drawn
         .iter()
@@ -461,9 +451,7 @@ fn a_servo_that_answers_again_is_reported_recovered_and_patterns_run_again() {
 #[test]
 fn laser_stays_off_while_idle_and_in_dwell_mode_lights_only_the_points() {
     let report =
-        run_to_idle("laser on\nwait 300\nlaser dwell\nset dwell_ms 100\npattern corner once\n");
-    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    assert!(report.succeeded(false));
+        run_succeeding("laser on\nwait 300\nlaser dwell\nset dwell_ms 100\npattern corner once\n");
     let started = sent_at(&report, "pattern corner once");
     assert!(
         report

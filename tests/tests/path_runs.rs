@@ -8,7 +8,7 @@ use laser_app::settings::Settings;
 use laser_sim::recorder::{Direction, SpotSample};
 use laser_sim::world::{SimOptions, SimReport};
 use proptest::prelude::*;
-use system_tests::{run_with, sent_at, terminal_lines};
+use system_tests::{reply_to, run_with, sent_at, terminal_lines};
 
 /// Host CPU time one executor poll may take, µs. The old pattern check
 /// walked a 40 000-point path from its start for every point (8.5 s in
@@ -21,21 +21,6 @@ const LONGEST_POLL_US: u128 = 5_000;
 /// How long a command may wait for its reply while a path runs, µs of
 /// simulated time.
 const REPLY_WITHIN_US: u64 = 5_000;
-
-/// Simulated time from sending `line` to its closing reply, µs, and the
-/// reply.
-fn reply_to(report: &SimReport, line: &str) -> (u64, String) {
-    let lines = &report.transcript.lines;
-    let sent = lines
-        .iter()
-        .position(|(_, l)| l.strip_prefix("> ") == Some(line))
-        .unwrap_or_else(|| panic!("{line:?} was not sent"));
-    let (t, reply) = lines[sent..]
-        .iter()
-        .find(|(_, l)| l == "ok" || l.starts_with("error:"))
-        .unwrap_or_else(|| panic!("no reply to {line:?}"));
-    (t - lines[sent].0, reply.clone())
-}
 
 /// Runs `script`; the report and the longest executor poll (host CPU),
 /// the least noisy of up to three runs (see `least_noisy`).

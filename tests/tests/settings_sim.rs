@@ -7,7 +7,7 @@ use laser_sim::world::{
     SETTINGS_FLASH_OFFSET, SETTINGS_SECTOR_BYTES, SETTINGS_SECTORS, SettingsFlash, SimOptions,
     SimReport, settings_store,
 };
-use system_tests::{run_with, sent_at, terminal_lines};
+use system_tests::{reply_to, run_with, terminal_lines};
 
 use embassy_futures::block_on;
 use laser_app::settings::Settings;
@@ -20,20 +20,6 @@ fn value_of(report: &SimReport, param: &str) -> String {
         .into_iter()
         .find_map(|l| l.strip_prefix(&prefix).map(str::to_owned))
         .unwrap_or_else(|| panic!("no `{param}` line: {:?}", terminal_lines(report)))
-}
-
-/// The closing reply to the command line `line` and when it came, µs.
-fn reply_to(report: &SimReport, line: &str) -> (u64, String) {
-    let lines = &report.transcript.lines;
-    let sent = lines
-        .iter()
-        .position(|(_, l)| l.strip_prefix("> ") == Some(line))
-        .unwrap_or_else(|| panic!("{line:?} not sent"));
-    lines[sent + 1..]
-        .iter()
-        .find(|(_, l)| l == "ok" || l.starts_with("error:"))
-        .cloned()
-        .unwrap_or_else(|| panic!("no reply to {line:?}"))
 }
 
 fn boot_from(image: Vec<u8>, script: &str) -> SimReport {
@@ -53,7 +39,7 @@ fn saved_settings_survive_a_reset_and_later_saves_replace_them() {
         SimOptions::default(),
     );
     assert_eq!(reply_to(&first, "save").1, "ok");
-    let took_us = reply_to(&first, "save").0 - sent_at(&first, "save");
+    let took_us = reply_to(&first, "save").0;
     eprintln!("save: `ok` {took_us} µs after the line was sent");
     // Word programming (16 µs a word) yields to the other tasks; the reply
     // still comes within a few milliseconds.
@@ -124,7 +110,7 @@ fn a_record_of_the_earlier_layout_loads_and_the_first_save_migrates_it() {
     assert_eq!(reply_to(&first, "save").1, "ok");
     // The erase of sector 10 stalled the CPU for a second.
     assert_eq!(first.settings_flash_stats.erases, 1);
-    let took_us = reply_to(&first, "save").0 - sent_at(&first, "save");
+    let took_us = reply_to(&first, "save").0;
     assert!(took_us >= 1_000_000, "{took_us} µs");
 
     let second = boot_from(first.settings_flash, "get dwell_ms\nget oq_cm\n");

@@ -18,39 +18,8 @@ pub fn read_points(mut input: impl Read) -> Result<Vec<MeasuredPoint>, String> {
     input
         .read_to_end(&mut bytes)
         .map_err(|e| format!("cannot read: {e}"))?;
-    // csv ends a comment at LF only, so with CR-only (old Mac) line ends a
-    // comment line would swallow the rows after it: make lone CRs LFs
-    // (same length, so positions stay) and lines read and count alike.
-    let lone_crs: Vec<usize> = bytes
-        .iter()
-        .enumerate()
-        .filter(|&(i, &b)| b == b'\r' && bytes.get(i + 1) != Some(&b'\n'))
-        .map(|(i, _)| i)
-        .collect();
-    for i in lone_crs {
-        if let Some(b) = bytes.get_mut(i) {
-            *b = b'\n';
-        }
-    }
-    // 1-based line where the record at `pos` starts. csv positions a record
-    // at the blank or comment lines it skipped before it, so skip those too.
-    let line_of = |pos: &csv::Position| {
-        let mut at = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
-        loop {
-            match bytes.get(at) {
-                Some(b'\n' | b'\r') => at += 1,
-                Some(b'#') => {
-                    let rest = bytes.get(at..).unwrap_or_default();
-                    at += rest
-                        .iter()
-                        .position(|&b| b == b'\n')
-                        .map_or(rest.len(), |i| i + 1);
-                }
-                _ => break,
-            }
-        }
-        1 + bytes.iter().take(at).filter(|&&b| b == b'\n').count()
-    };
+    lone_crs_to_lfs(&mut bytes);
+    let record_line = |pos: &csv::Position| line_of(&bytes, pos);
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(false)
         .flexible(true)
@@ -61,10 +30,10 @@ pub fn read_points(mut input: impl Read) -> Result<Vec<MeasuredPoint>, String> {
     let mut header_seen = false;
     for record in reader.records() {
         let record = record.map_err(|e| match e.position() {
-            Some(pos) => format!("line {}: {e}", line_of(pos)),
+            Some(pos) => format!("line {}: {e}", record_line(pos)),
             None => e.to_string(),
         })?;
-        let line = record.position().map_or(0, line_of);
+        let line = record.position().map_or(0, record_line);
         if !header_seen {
             if record.iter().ne(HEADER) {
                 let found: Vec<&str> = record.iter().collect();
@@ -76,41 +45,83 @@ pub fn read_points(mut input: impl Read) -> Result<Vec<MeasuredPoint>, String> {
             header_seen = true;
             continue;
         }
-        if record.len() != HEADER.len() {
-            return Err(format!(
-                "line {line}: expected 4 fields (x,y,dx,dy), found {}",
-                record.len()
-            ));
-        }
-        let mut v = [0.0; 4];
-        for ((slot, text), name) in v.iter_mut().zip(record.iter()).zip(HEADER) {
-            *slot = text
-                .parse::<f64>()
-                .map_err(|_| format!("line {line}: column {name}: `{text}` is not a number"))?;
-            if !slot.is_finite() {
-                return Err(format!(
-                    "line {line}: column {name}: `{text}` is not a finite number"
-                ));
-            }
-            if slot.abs() > MAX_MEASURED_MM {
-                return Err(format!(
-                    "line {line}: column {name}: {text} mm is beyond +-{MAX_MEASURED_MM} mm (10 m); \
-                     check the units (mm) of the CSV"
-                ));
-            }
-        }
-        let [x_mm, y_mm, dx_mm, dy_mm] = v;
-        points.push(MeasuredPoint {
-            x_mm,
-            y_mm,
-            dx_mm,
-            dy_mm,
-        });
+        points.push(point(&record, line)?);
     }
     if !header_seen {
         return Err("line 1: empty file, expected the header `x,y,dx,dy`".into());
     }
     Ok(points)
+}
+
+/// csv ends a comment at LF only, so with CR-only (old Mac) line ends a
+/// comment line would swallow the rows after it: make lone CRs LFs
+/// (same length, so positions stay) and lines read and count alike.
+fn lone_crs_to_lfs(bytes: &mut [u8]) {
+    let lone_crs: Vec<usize> = bytes
+        .iter()
+        .enumerate()
+        .filter(|&(i, &b)| b == b'\r' && bytes.get(i + 1) != Some(&b'\n'))
+        .map(|(i, _)| i)
+        .collect();
+    for i in lone_crs {
+        if let Some(b) = bytes.get_mut(i) {
+            *b = b'\n';
+        }
+    }
+}
+
+/// 1-based line where the record at `pos` starts. csv positions a record
+/// at the blank or comment lines it skipped before it, so skip those too.
+fn line_of(bytes: &[u8], pos: &csv::Position) -> usize {
+    let mut at = usize::try_from(pos.byte()).unwrap_or(usize::MAX);
+    loop {
+        match bytes.get(at) {
+            Some(b'\n' | b'\r') => at += 1,
+            Some(b'#') => {
+                let rest = bytes.get(at..).unwrap_or_default();
+                at += rest
+                    .iter()
+                    .position(|&b| b == b'\n')
+                    .map_or(rest.len(), |i| i + 1);
+            }
+            _ => break,
+        }
+    }
+    1 + bytes.iter().take(at).filter(|&&b| b == b'\n').count()
+}
+
+/// The measured point of one data record on `line`.
+fn point(record: &csv::StringRecord, line: usize) -> Result<MeasuredPoint, String> {
+    if record.len() != HEADER.len() {
+        return Err(format!(
+            "line {line}: expected 4 fields (x,y,dx,dy), found {}",
+            record.len()
+        ));
+    }
+    let mut v = [0.0; 4];
+    for ((slot, text), name) in v.iter_mut().zip(record.iter()).zip(HEADER) {
+        *slot = text
+            .parse::<f64>()
+            .map_err(|_| format!("line {line}: column {name}: `{text}` is not a number"))?;
+        if !slot.is_finite() {
+            return Err(format!(
+                "line {line}: column {name}: `{text}` is not a finite number"
+            ));
+        }
+        if slot.abs() > MAX_MEASURED_MM {
+            return Err(format!(
+                "line {line}: column {name}: {text} mm is beyond +-{MAX_MEASURED_MM} mm (10 m); \
+                 check the units (mm) of the CSV"
+            ));
+        }
+    }
+    let [x_mm, y_mm, dx_mm, dy_mm] = v;
+    Ok(MeasuredPoint {
+        x_mm,
+        y_mm,
+        dx_mm,
+        dy_mm,
+    })
 }
 
 #[cfg(test)]

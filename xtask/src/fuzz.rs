@@ -7,13 +7,18 @@
 //!
 //! Installs the nightly toolchain and cargo-fuzz when they are missing.
 
-use std::io::{BufRead, BufReader, Write};
-use std::path::{Path, PathBuf};
+mod corpus;
+mod libfuzzer;
+
+use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
 use anyhow::{Context, Result, bail};
 
 use crate::toolchain::{run, target_dir, workspace_root};
+
+use corpus::{list_files, minimise_corpus};
+use libfuzzer::{RunStats, parse_run_stats, run_fuzzer};
 
 /// Longest input generated, bytes: longer than a console line burst, a
 /// settings record or a measurement file needs.
@@ -48,15 +53,6 @@ struct Outcome {
     added: usize,
     /// `None` when the run held; the reason (and the log) when it did not.
     failure: Option<String>,
-}
-
-/// Executions and wall time of one libFuzzer run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct RunStats {
-    /// Inputs executed.
-    pub executions: u64,
-    /// Seconds fuzzed (`None` when the run ended early without saying).
-    pub seconds: Option<u64>,
 }
 
 fn fuzz_dir() -> PathBuf {
@@ -188,7 +184,7 @@ fn list_targets() -> Result<Vec<String>> {
 }
 
 /// The fuzz binary of `target` built by `cargo fuzz build`.
-fn fuzz_binary(target: &str) -> PathBuf {
+pub(super) fn fuzz_binary(target: &str) -> PathBuf {
     target_dir().join(FUZZ_TRIPLE).join("release").join(target)
 }
 
@@ -280,188 +276,4 @@ fn fuzz_target(target: &str, seconds: u64) -> Result<Outcome> {
         added,
         failure,
     })
-}
-
-/// Replaces the committed corpus with its seeds (`seed-*`, kept always),
-/// the other corpus files that reach edges the seeds do not, and the new
-/// `found` inputs that reach edges none of those do (libFuzzer's merge,
-/// edges only: hit counts would keep hundreds of near-duplicates).
-/// Returns the new corpus's file names.
-fn minimise_corpus(target: &str, corpus: &Path, found: &Path, work: &Path) -> Result<Vec<String>> {
-    let merged = work.join("merged");
-    std::fs::create_dir_all(&merged)
-        .with_context(|| format!("cannot create {}", merged.display()))?;
-    let old = work.join("old");
-    std::fs::create_dir_all(&old).with_context(|| format!("cannot create {}", old.display()))?;
-    for name in list_files(corpus) {
-        let into = if name.starts_with("seed-") {
-            &merged
-        } else {
-            &old
-        };
-        std::fs::copy(corpus.join(&name), into.join(&name))
-            .with_context(|| format!("cannot copy {name}"))?;
-    }
-    let options = [
-        "-merge=1".to_owned(),
-        "-use_counters=0".to_owned(),
-        format!("-max_len={MAX_INPUT_LEN}"),
-    ];
-    // The old corpus first, then the new inputs: a new input is kept only
-    // for edges the corpus does not reach yet, so unchanged coverage keeps
-    // the committed files as they are.
-    for (step, from) in [("old", old.as_path()), ("new", found)] {
-        let log_path = work.join(format!("merge-{step}.log"));
-        let (ok, log) = run_fuzzer(target, &options, &[&merged, from], &log_path)?;
-        if !ok {
-            bail!(
-                "merging the corpus of `{target}` failed (log {}):\n{}",
-                log_path.display(),
-                log.lines().rev().take(20).collect::<Vec<_>>().join("\n")
-            );
-        }
-    }
-    let keep = list_files(&merged);
-    for name in list_files(corpus) {
-        if !keep.contains(&name) {
-            std::fs::remove_file(corpus.join(&name))
-                .with_context(|| format!("cannot remove {name} from the corpus"))?;
-        }
-    }
-    for name in &keep {
-        let to = corpus.join(name);
-        if !to.exists() {
-            std::fs::copy(merged.join(name), &to)
-                .with_context(|| format!("cannot add {name} to the corpus"))?;
-        }
-    }
-    Ok(keep)
-}
-
-/// Sorted names of the files in `dir` (none when it does not exist).
-fn list_files(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map(|entries| {
-            entries
-                .filter_map(Result::ok)
-                .filter(|e| e.path().is_file())
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .collect()
-        })
-        .unwrap_or_default();
-    names.sort();
-    names
-}
-
-/// Runs the fuzz binary of `target` with libFuzzer `options` on corpus
-/// `dirs` (new inputs go to the first), its output saved in `log_path`
-/// (libFuzzer is chatty; the progress lines are echoed); returns whether
-/// it held and its output.
-fn run_fuzzer(
-    target: &str,
-    options: &[String],
-    dirs: &[&Path],
-    log_path: &Path,
-) -> Result<(bool, String)> {
-    let binary = fuzz_binary(target);
-    let mut args: Vec<String> = options.to_vec();
-    args.extend(dirs.iter().map(|d| d.to_string_lossy().into_owned()));
-    println!("$ {} {}", binary.display(), args.join(" "));
-    let output = Command::new(&binary)
-        .args(&args)
-        .current_dir(workspace_root())
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .with_context(|| format!("could not start {}", binary.display()))?;
-    let mut child = output;
-    let mut log = std::fs::File::create(log_path)
-        .with_context(|| format!("cannot write {}", log_path.display()))?;
-    // libFuzzer reports on stderr; drain stdout on a thread so neither
-    // pipe can fill up.
-    let stdout = child.stdout.take().context("no stdout pipe")?;
-    let out_thread = std::thread::spawn(move || {
-        let mut text = String::new();
-        for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-            text.push_str(&line);
-            text.push('\n');
-        }
-        text
-    });
-    let mut text = String::new();
-    if let Some(stderr) = child.stderr.take() {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            writeln!(log, "{line}").ok();
-            if line.contains("INITED") || line.contains("pulse") || line.starts_with("Done ") {
-                println!("   {line}");
-            }
-            text.push_str(&line);
-            text.push('\n');
-        }
-    }
-    let status = child.wait().context("the fuzzer did not finish")?;
-    let stdout = out_thread.join().unwrap_or_default();
-    write!(log, "{stdout}").ok();
-    text.push_str(&stdout);
-    Ok((status.success(), text))
-}
-
-/// Executions and seconds of a libFuzzer run, from its final statistics
-/// (`stat::number_of_executed_units`) or its `Done N runs in S second(s)`
-/// line.
-pub fn parse_run_stats(log: &str) -> Option<RunStats> {
-    let done = log.lines().rev().find_map(|line| {
-        let rest = line.strip_prefix("Done ")?;
-        let (runs, rest) = rest.split_once(" runs in ")?;
-        let (secs, _) = rest.split_once(' ')?;
-        Some(RunStats {
-            executions: runs.trim().parse().ok()?,
-            seconds: Some(secs.trim().parse().ok()?),
-        })
-    });
-    let executed = log.lines().rev().find_map(|line| {
-        line.strip_prefix("stat::number_of_executed_units:")
-            .and_then(|n| n.trim().parse::<u64>().ok())
-    });
-    // A run that crashed has no `Done` line: its time is not known.
-    done.or(executed.map(|executions| RunStats {
-        executions,
-        seconds: None,
-    }))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn reads_executions_from_a_finished_run() {
-        let log = "#1048576\tpulse  cov: 812 ft: 3012 corp: 140/9Kb exec/s: 34952 rss: 61Mb\n\
-                   Done 2093113 runs in 61 second(s)\n\
-                   stat::number_of_executed_units: 2093113\n\
-                   stat::average_exec_per_sec:     34313\n";
-        assert_eq!(
-            parse_run_stats(log),
-            Some(RunStats {
-                executions: 2_093_113,
-                seconds: Some(61)
-            })
-        );
-    }
-
-    #[test]
-    fn reads_executions_from_a_crashed_run() {
-        // A crash ends the run without `Done`; the final stats remain.
-        let log = "==123== ERROR: libFuzzer: deadly signal\n\
-                   stat::number_of_executed_units: 4242\n";
-        assert_eq!(
-            parse_run_stats(log),
-            Some(RunStats {
-                executions: 4242,
-                seconds: None
-            })
-        );
-        assert_eq!(parse_run_stats("no statistics here"), None);
-    }
 }

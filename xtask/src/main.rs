@@ -4,6 +4,7 @@
 mod bench_m4;
 mod calib;
 mod fuzz;
+mod json_out;
 mod kin;
 mod plan;
 mod sim;

@@ -2,14 +2,14 @@
 //! servos, in virtual time, and draw where the laser went.
 
 use std::io::Read as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, Result, bail};
 use laser_sim::executor::RunEnd;
 use laser_sim::script::{DEMO_SCRIPT, parse_script};
 use laser_sim::servo_port::{BusFaults, SilentWindow};
-use laser_sim::world::{SimOptions, run};
+use laser_sim::world::{SimOptions, SimReport, run};
 
 /// Options of `cargo xtask sim`.
 #[derive(clap::Args, Debug)]
@@ -148,15 +148,8 @@ fn read_stdin() -> Result<String> {
     Ok(text)
 }
 
-/// Runs `cargo xtask sim`.
-pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
-    let level: log::LevelFilter = args.log.parse().map_err(|_| {
-        anyhow::anyhow!(
-            "bad --log level {:?} (off, error, warn, info, debug, trace)",
-            args.log
-        )
-    })?;
-    laser_sim::logger::init(level);
+/// The script to run and whether it is the demo (no script given).
+fn script_text(args: &SimArgs) -> Result<(String, bool)> {
     let script_text = match &args.script {
         _ if args.interactive => String::new(),
         Some(path) if path.as_os_str() == "-" => read_stdin()?,
@@ -172,6 +165,19 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
     } else {
         script_text
     };
+    Ok((script_text, demo))
+}
+
+/// Runs `cargo xtask sim`.
+pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
+    let level: log::LevelFilter = args.log.parse().map_err(|_| {
+        anyhow::anyhow!(
+            "bad --log level {:?} (off, error, warn, info, debug, trace)",
+            args.log
+        )
+    })?;
+    laser_sim::logger::init(level);
+    let (script_text, demo) = script_text(&args)?;
     let script = parse_script(&script_text)?;
     let (faults, slow_factor) = parse_faults(&args.faults)?;
     let svg = args
@@ -204,8 +210,21 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         galvo_cost_ns_per_sample: args.galvo_cost_ns,
         ..SimOptions::default()
     });
-    if let Some(path) = &svg {
-        let drawing = laser_sim::render(&report, "laser pointing controller — simulation")?;
+    write_outputs(&args, svg.as_deref(), &report)?;
+    print_summary(&report);
+    let unsafe_run = args.check_safety && !safety_holds(&report);
+    Ok(exit_code(
+        &report,
+        until_idle,
+        args.allow_errors,
+        unsafe_run,
+    ))
+}
+
+/// Writes the drawing and the files the options ask for.
+fn write_outputs(args: &SimArgs, svg: Option<&Path>, report: &SimReport) -> Result<()> {
+    if let Some(path) = svg {
+        let drawing = laser_sim::render(report, "laser pointing controller — simulation")?;
         std::fs::write(path, drawing)
             .with_context(|| format!("cannot write {}", path.display()))?;
         eprintln!("xtask sim: drawing written to {}", path.display());
@@ -222,6 +241,11 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         std::fs::write(path, report.dac.csv())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
+    Ok(())
+}
+
+/// The one-line summary of the run on stderr.
+fn print_summary(report: &SimReport) {
     eprintln!(
         "xtask sim: ended at t = {:.3} s ({:?}); {} dwell points, {} servo frames, {} galvo DAC samples, {} galvo underruns, {} error replies",
         report.end_time_us as f64 / 1e6,
@@ -232,37 +256,49 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         report.galvo_underruns,
         report.transcript.error_replies
     );
-    let mut unsafe_run = false;
-    if args.check_safety {
-        let violations = laser_sim::safety::check(&report);
-        eprint!("xtask sim: {}", laser_sim::safety::report_text(&violations));
-        for task in &report.task_steps {
-            eprintln!(
-                "xtask sim:   {:<18} {:>9} steps, longest {:.3} ms CPU at {:.3} ms",
-                task.name,
-                task.polls,
-                task.max_cpu_ns as f64 / 1e6,
-                task.max_at_us as f64 / 1000.0
-            );
-        }
-        unsafe_run = !violations.is_empty();
+}
+
+/// Checks the run against the safety rules and prints the verdict and
+/// each task's longest step; whether no rule was broken.
+fn safety_holds(report: &SimReport) -> bool {
+    let violations = laser_sim::safety::check(report);
+    eprint!("xtask sim: {}", laser_sim::safety::report_text(&violations));
+    for task in &report.task_steps {
+        eprintln!(
+            "xtask sim:   {:<18} {:>9} steps, longest {:.3} ms CPU at {:.3} ms",
+            task.name,
+            task.polls,
+            task.max_cpu_ns as f64 / 1e6,
+            task.max_at_us as f64 / 1000.0
+        );
     }
+    violations.is_empty()
+}
+
+/// Failure on a livelock, an unfinished or failed run (with
+/// `--until-idle`) or a broken safety rule.
+fn exit_code(
+    report: &SimReport,
+    until_idle: bool,
+    allow_errors: bool,
+    unsafe_run: bool,
+) -> ExitCode {
     if report.end == RunEnd::Livelock {
         eprintln!(
             "xtask sim: a task kept running without letting time pass (busy loop); run stopped"
         );
-        return Ok(ExitCode::FAILURE);
+        return ExitCode::FAILURE;
     }
-    if until_idle && !report.succeeded(args.allow_errors) {
+    if until_idle && !report.succeeded(allow_errors) {
         if !report.idle_at_end {
             eprintln!("xtask sim: the sequencer was still busy when the run ended");
         }
-        return Ok(ExitCode::FAILURE);
+        return ExitCode::FAILURE;
     }
     if unsafe_run {
-        return Ok(ExitCode::FAILURE);
+        return ExitCode::FAILURE;
     }
-    Ok(ExitCode::SUCCESS)
+    ExitCode::SUCCESS
 }
 
 #[cfg(test)]

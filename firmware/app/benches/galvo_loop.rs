@@ -7,7 +7,7 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
-use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoPath, GalvoRequest, Phase};
+use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoPath, GalvoRequest, ScanPhase};
 
 const HALF: usize = 128;
 
@@ -64,7 +64,7 @@ fn galvo_loop(c: &mut Criterion) {
                     },
                 });
                 let mut half = [DacSample::default(); HALF];
-                while galvo.phase() != Phase::Marking {
+                while galvo.phase() != ScanPhase::Marking {
                     galvo.fill(&mut half, |_| {});
                 }
                 (galvo, half)

@@ -31,7 +31,7 @@ use galvo_planner::{
     plan_xy_jump,
 };
 use kinematics_core::{BoardPoint, DacAxis, ErrorModel, Galvo, Gimbal, MirrorAngles, PointMm};
-use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoPath, GalvoRequest, Phase};
+use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoPath, GalvoRequest, ScanPhase};
 
 mod semihosting;
 mod timer;
@@ -389,7 +389,7 @@ fn integrator_and_path(b: &mut Bench) {
 /// Runs the loop until it is idle (not measured).
 fn settle(galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
     for _ in 0..10_000 {
-        if galvo.phase() == Phase::Idle && galvo.queued_points() == 0 {
+        if galvo.phase() == ScanPhase::Idle && galvo.queued_points() == 0 {
             return;
         }
         galvo.fill(half, |_| {});
@@ -404,13 +404,13 @@ fn job_halves(
     id: &str,
     galvo: &mut GalvoLoop,
     half: &mut [DacSample; HALF],
-    steady: Phase,
+    steady: ScanPhase,
     skip: usize,
 ) {
     let (mut steady_max, mut refill_max, mut steady_seen) = (0u32, 0u32, false);
     for n in 0..20_000usize {
         let before = galvo.phase();
-        if before == Phase::Idle && galvo.queued_points() == 0 {
+        if before == ScanPhase::Idle && galvo.queued_points() == 0 {
             break;
         }
         let ticks = window(|| galvo.fill(half, |_| {}));
@@ -557,7 +557,7 @@ fn loop_halves(b: &mut Bench) {
             b.fail(id, refused);
             continue;
         }
-        job_halves(b, id, &mut galvo, &mut half, Phase::Marking, 0);
+        job_halves(b, id, &mut galvo, &mut half, ScanPhase::Marking, 0);
     }
 
     // Jumping (−80, −80) → (80, 80) mm. The refill that starts the job
@@ -591,7 +591,7 @@ fn loop_halves(b: &mut Bench) {
     b.report("loop.jump.refill", ticks, 1);
     counted.fill(&mut half[..1], |_| {});
     let mut n = 0usize;
-    while counted.phase() == Phase::Jumping && n < HALF {
+    while counted.phase() == ScanPhase::Jumping && n < HALF {
         counted.fill(&mut half[..1], |_| {});
         n += 1;
     }

@@ -2,6 +2,7 @@
 //! where the laser was on, faint where it was off), and each dwell point.
 
 use anyhow::{Result, anyhow};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use crate::recorder::Recording;
@@ -29,6 +30,10 @@ pub struct GalvoTrace {
     /// Where the laser was on.
     pub lit: Vec<(f64, f64)>,
 }
+
+/// The chart the run is drawn on: board x and y, cm.
+type BoardChart<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Renders the gimbal's `recording` and the `galvo` trace into an SVG
 /// document.
@@ -59,99 +64,9 @@ pub fn render_svg(
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(|e| anyhow!("{e}"))?;
-
-        let grid_points: Vec<(f64, f64)> = (-grid.half_rows..=grid.half_rows)
-            .flat_map(|yi| {
-                (-grid.half_cols..=grid.half_cols)
-                    .map(move |xi| (f64::from(xi) * grid.pitch_cm, f64::from(yi) * grid.pitch_cm))
-            })
-            .collect();
-        chart
-            .draw_series(
-                grid_points
-                    .iter()
-                    .map(|&p| Circle::new(p, 3, ShapeStyle::from(&BLACK.mix(0.25)).filled())),
-            )
-            .map_err(|e| anyhow!("{e}"))?
-            .label("grid point")
-            .legend(|(x, y)| Circle::new((x + 10, y), 3, BLACK.mix(0.25).filled()));
-
-        // Path, split into runs of equal laser state.
-        let mut runs: Vec<(bool, Vec<(f64, f64)>)> = Vec::new();
-        for s in &recording.spot {
-            match runs.last_mut() {
-                Some((on, pts)) if *on == s.laser => pts.push((s.x_cm, s.y_cm)),
-                _ => {
-                    let mut pts = Vec::new();
-                    if let Some(&p) = runs.last().and_then(|(_, prev)| prev.last()) {
-                        pts.push(p);
-                    }
-                    pts.push((s.x_cm, s.y_cm));
-                    runs.push((s.laser, pts));
-                }
-            }
-        }
-        let mut labelled_on = false;
-        let mut labelled_off = false;
-        for (on, pts) in runs {
-            let style = if on {
-                ShapeStyle::from(&RED).stroke_width(2)
-            } else {
-                ShapeStyle::from(&BLUE.mix(0.25)).stroke_width(1)
-            };
-            let series = chart
-                .draw_series(LineSeries::new(pts, style))
-                .map_err(|e| anyhow!("{e}"))?;
-            if on && !labelled_on {
-                labelled_on = true;
-                series
-                    .label("gimbal spot, laser on")
-                    .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
-            } else if !on && !labelled_off {
-                labelled_off = true;
-                series
-                    .label("gimbal spot, laser off")
-                    .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.mix(0.25)));
-            }
-        }
-
-        if !recording.dwells.is_empty() {
-            chart
-                .draw_series(recording.dwells.iter().map(|d| {
-                    Cross::new(
-                        d.spot_cm,
-                        6,
-                        ShapeStyle::from(&GREEN.mix(0.9)).stroke_width(2),
-                    )
-                }))
-                .map_err(|e| anyhow!("{e}"))?
-                .label("dwell (spot)")
-                .legend(|(x, y)| Cross::new((x + 10, y), 5, GREEN.stroke_width(2)));
-        }
-
-        if galvo.path.len() > 1 {
-            chart
-                .draw_series(LineSeries::new(
-                    galvo.path.iter().copied(),
-                    ShapeStyle::from(&MAGENTA.mix(0.3)).stroke_width(1),
-                ))
-                .map_err(|e| anyhow!("{e}"))?
-                .label("galvo spot, laser off")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], MAGENTA.mix(0.3)));
-        }
-        if !galvo.lit.is_empty() {
-            chart
-                .draw_series(
-                    galvo
-                        .lit
-                        .iter()
-                        .map(|&p| Circle::new(p, 4, ShapeStyle::from(&MAGENTA).filled())),
-                )
-                .map_err(|e| anyhow!("{e}"))?
-                .label("galvo spot, laser on")
-                .legend(|(x, y)| Circle::new((x + 10, y), 4, MAGENTA.filled()));
-        }
-
+        draw_grid(&mut chart, grid)?;
+        draw_gimbal_spot(&mut chart, recording)?;
+        draw_galvo_spot(&mut chart, galvo)?;
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.85))
@@ -162,6 +77,115 @@ pub fn render_svg(
         root.present().map_err(|e| anyhow!("{e}"))?;
     }
     Ok(svg)
+}
+
+/// Every grid point, a faint dot.
+fn draw_grid(chart: &mut BoardChart<'_, '_>, grid: GridView) -> Result<()> {
+    let grid_points: Vec<(f64, f64)> = (-grid.half_rows..=grid.half_rows)
+        .flat_map(|yi| {
+            (-grid.half_cols..=grid.half_cols)
+                .map(move |xi| (f64::from(xi) * grid.pitch_cm, f64::from(yi) * grid.pitch_cm))
+        })
+        .collect();
+    chart
+        .draw_series(
+            grid_points
+                .iter()
+                .map(|&p| Circle::new(p, 3, ShapeStyle::from(&BLACK.mix(0.25)).filled())),
+        )
+        .map_err(|e| anyhow!("{e}"))?
+        .label("grid point")
+        .legend(|(x, y)| Circle::new((x + 10, y), 3, BLACK.mix(0.25).filled()));
+    Ok(())
+}
+
+/// The spot's path split into runs of equal laser state, each run
+/// starting where the one before ended.
+fn laser_runs(recording: &Recording) -> Vec<(bool, Vec<(f64, f64)>)> {
+    let mut runs: Vec<(bool, Vec<(f64, f64)>)> = Vec::new();
+    for s in &recording.spot {
+        match runs.last_mut() {
+            Some((on, pts)) if *on == s.laser => pts.push((s.x_cm, s.y_cm)),
+            _ => {
+                let mut pts = Vec::new();
+                if let Some(&p) = runs.last().and_then(|(_, prev)| prev.last()) {
+                    pts.push(p);
+                }
+                pts.push((s.x_cm, s.y_cm));
+                runs.push((s.laser, pts));
+            }
+        }
+    }
+    runs
+}
+
+/// The gimbal spot's path (red where its laser was on) and its dwells.
+fn draw_gimbal_spot(chart: &mut BoardChart<'_, '_>, recording: &Recording) -> Result<()> {
+    let mut labelled_on = false;
+    let mut labelled_off = false;
+    for (on, pts) in laser_runs(recording) {
+        let style = if on {
+            ShapeStyle::from(&RED).stroke_width(2)
+        } else {
+            ShapeStyle::from(&BLUE.mix(0.25)).stroke_width(1)
+        };
+        let series = chart
+            .draw_series(LineSeries::new(pts, style))
+            .map_err(|e| anyhow!("{e}"))?;
+        if on && !labelled_on {
+            labelled_on = true;
+            series
+                .label("gimbal spot, laser on")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+        } else if !on && !labelled_off {
+            labelled_off = true;
+            series
+                .label("gimbal spot, laser off")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE.mix(0.25)));
+        }
+    }
+
+    if !recording.dwells.is_empty() {
+        chart
+            .draw_series(recording.dwells.iter().map(|d| {
+                Cross::new(
+                    d.spot_cm,
+                    6,
+                    ShapeStyle::from(&GREEN.mix(0.9)).stroke_width(2),
+                )
+            }))
+            .map_err(|e| anyhow!("{e}"))?
+            .label("dwell (spot)")
+            .legend(|(x, y)| Cross::new((x + 10, y), 5, GREEN.stroke_width(2)));
+    }
+    Ok(())
+}
+
+/// The galvo spot: its path (faint) and where its laser was on.
+fn draw_galvo_spot(chart: &mut BoardChart<'_, '_>, galvo: &GalvoTrace) -> Result<()> {
+    if galvo.path.len() > 1 {
+        chart
+            .draw_series(LineSeries::new(
+                galvo.path.iter().copied(),
+                ShapeStyle::from(&MAGENTA.mix(0.3)).stroke_width(1),
+            ))
+            .map_err(|e| anyhow!("{e}"))?
+            .label("galvo spot, laser off")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], MAGENTA.mix(0.3)));
+    }
+    if !galvo.lit.is_empty() {
+        chart
+            .draw_series(
+                galvo
+                    .lit
+                    .iter()
+                    .map(|&p| Circle::new(p, 4, ShapeStyle::from(&MAGENTA).filled())),
+            )
+            .map_err(|e| anyhow!("{e}"))?
+            .label("galvo spot, laser on")
+            .legend(|(x, y)| Circle::new((x + 10, y), 4, MAGENTA.filled()));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -6,7 +6,8 @@ use galvo_planner::model::Discrete;
 use galvo_planner::{JumpPlan, Method, plan_jump};
 use serde::Serialize;
 
-use super::{Built, MethodArg, ModelArg, ModelArgs, fail, print_json};
+use super::{Built, MethodArg, ModelArg, ModelArgs};
+use crate::json_out::{fail, print_json};
 
 /// 0.05° … 20° mechanical.
 pub(crate) const DEFAULT_STEPS_DEG: [f64; 9] = [0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0];

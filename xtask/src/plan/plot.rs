@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use anyhow::anyhow;
+use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::Row;
@@ -49,9 +50,27 @@ struct Panel<'a> {
     series: Vec<(String, Series, RGBColor)>,
 }
 
+/// Draws the jump's position, velocity, current and voltage panels into
+/// an SVG file at `path`.
 pub(crate) fn jump_svg(path: &Path, title: &str, rows: &[Row], u_max: f64) -> anyhow::Result<()> {
     let t_us = |r: &Row| r.t_s * 1e6;
     let t_end = rows.last().map_or(1.0, t_us).max(1e-9);
+    let panels = panels(rows, u_max, t_end);
+    let root = SVGBackend::new(path, (960, 1200)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
+    let root = root
+        .titled(title, ("sans-serif", 22))
+        .map_err(|e| anyhow!("{e}"))?;
+    for (area, panel) in root.split_evenly((4, 1)).iter().zip(panels.iter()) {
+        draw_panel(area, panel, t_end)?;
+    }
+    root.present().map_err(|e| anyhow!("{e}"))?;
+    Ok(())
+}
+
+/// The four panels of the plot, time in µs up to `t_end`.
+fn panels(rows: &[Row], u_max: f64, t_end: f64) -> [Panel<'static>; 4] {
+    let t_us = |r: &Row| r.t_s * 1e6;
     let mut position = vec![(
         "θ motor".to_string(),
         rows.iter()
@@ -88,7 +107,7 @@ pub(crate) fn jump_svg(path: &Path, title: &str, rows: &[Row], u_max: f64) -> an
         voltage.push((t_us(&w[0]), w[0].u_v));
         voltage.push((t_us(&w[1]), w[0].u_v));
     }
-    let panels = [
+    [
         Panel {
             title: "position",
             unit: "deg",
@@ -117,51 +136,51 @@ pub(crate) fn jump_svg(path: &Path, title: &str, rows: &[Row], u_max: f64) -> an
                 ("U (zero-order hold)".into(), voltage, BLUE),
             ],
         },
-    ];
-    let root = SVGBackend::new(path, (960, 1200)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| anyhow!("{e}"))?;
-    let root = root
-        .titled(title, ("sans-serif", 22))
+    ]
+}
+
+/// One panel's chart: its series, axes and legend.
+fn draw_panel(
+    area: &DrawingArea<SVGBackend<'_>, Shift>,
+    panel: &Panel<'_>,
+    t_end: f64,
+) -> anyhow::Result<()> {
+    let (ylo, yhi) = range(
+        panel
+            .series
+            .iter()
+            .flat_map(|(_, s, _)| s.iter().map(|p| p.1)),
+    );
+    let mut chart = ChartBuilder::on(area)
+        .caption(panel.title, ("sans-serif", 16))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..t_end, ylo..yhi)
         .map_err(|e| anyhow!("{e}"))?;
-    for (area, panel) in root.split_evenly((4, 1)).iter().zip(panels.iter()) {
-        let (ylo, yhi) = range(
-            panel
-                .series
-                .iter()
-                .flat_map(|(_, s, _)| s.iter().map(|p| p.1)),
-        );
-        let mut chart = ChartBuilder::on(area)
-            .caption(panel.title, ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(35)
-            .y_label_area_size(70)
-            .build_cartesian_2d(0.0..t_end, ylo..yhi)
+    chart
+        .configure_mesh()
+        .x_desc("t (µs)")
+        .y_desc(panel.unit)
+        .draw()
+        .map_err(|e| anyhow!("{e}"))?;
+    for (label, data, color) in &panel.series {
+        let color = *color;
+        let drawn = chart
+            .draw_series(LineSeries::new(data.iter().copied(), color.stroke_width(2)))
             .map_err(|e| anyhow!("{e}"))?;
-        chart
-            .configure_mesh()
-            .x_desc("t (µs)")
-            .y_desc(panel.unit)
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
-        for (label, data, color) in &panel.series {
-            let color = *color;
-            let drawn = chart
-                .draw_series(LineSeries::new(data.iter().copied(), color.stroke_width(2)))
-                .map_err(|e| anyhow!("{e}"))?;
-            if !label.is_empty() {
-                drawn
-                    .label(label.as_str())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
-            }
+        if !label.is_empty() {
+            drawn
+                .label(label.as_str())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
         }
-        chart
-            .configure_series_labels()
-            .position(legend_corner(&panel.series, t_end, ylo, yhi))
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| anyhow!("{e}"))?;
     }
-    root.present().map_err(|e| anyhow!("{e}"))?;
+    chart
+        .configure_series_labels()
+        .position(legend_corner(&panel.series, t_end, ylo, yhi))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| anyhow!("{e}"))?;
     Ok(())
 }

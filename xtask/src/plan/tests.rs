@@ -1,5 +1,6 @@
 use super::*;
 use clap::Parser;
+use galvo_planner::model::FlexParams;
 
 #[derive(Parser, Debug)]
 struct Cli {

@@ -25,6 +25,17 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
     }
     let mut args = Args::new(text);
     let name = args.word("command")?;
+    if name.eq_ignore_ascii_case("pattern") {
+        return parse_pattern(args).map(Some);
+    }
+    let command = parse_command(name, &mut args)?;
+    args.finish()?;
+    Ok(Some(command))
+}
+
+/// Every command but `pattern`, named `name`, its arguments from `args`
+/// (the caller checks that none are left).
+fn parse_command(name: &str, args: &mut Args<'_>) -> Result<Command, CommandError> {
     let is = |candidate: &str| name.eq_ignore_ascii_case(candidate);
     let command = if is("help") {
         Command::Help
@@ -36,56 +47,16 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
         Command::Stop
     } else if is("params") {
         Command::Params
-    } else if is("target") {
-        Command::Target(keyword(
-            &mut args,
-            "gimbal|galvo|both",
-            &[
-                ("gimbal", Actuator::Gimbal),
-                ("galvo", Actuator::Galvo),
-                ("both", Actuator::Both),
-            ],
-        )?)
-    } else if is("planner") {
-        Command::Planner(keyword(
-            &mut args,
-            "optimal|seed",
-            &[
-                ("optimal", JumpPlanner::Optimal),
-                ("seed", JumpPlanner::Seed),
-            ],
-        )?)
     } else if is("galvo") {
-        keyword(&mut args, "status", &[("status", Command::GalvoStatus)])?
+        keyword(args, "status", &[("status", Command::GalvoStatus)])?
     } else if is("save") {
         Command::Save
-    } else if is("pattern") {
-        return parse_pattern(args).map(Some);
     } else if is("goto") {
-        Command::Goto(point(&mut args, "x_cm", "y_cm")?)
+        Command::Goto(point(args, "x_cm", "y_cm")?)
     } else if is("grid") {
         let xi = args.integer("xi", -GRID_INDEX_LIMIT, GRID_INDEX_LIMIT)? as i8;
         let yi = args.integer("yi", -GRID_INDEX_LIMIT, GRID_INDEX_LIMIT)? as i8;
         Command::Grid { xi, yi }
-    } else if is("laser") {
-        // `on` enables the laser for runs: SPEC §9 keeps it off whenever no
-        // pattern or goto is active, so `on` is `auto`.
-        Command::Laser(keyword(
-            &mut args,
-            "on|off|auto|dwell",
-            &[
-                ("on", LaserMode::Auto),
-                ("off", LaserMode::Off),
-                ("auto", LaserMode::Auto),
-                ("dwell", LaserMode::Dwell),
-            ],
-        )?)
-    } else if is("model") {
-        Command::Model(keyword(
-            &mut args,
-            "exact|seed",
-            &[("exact", AimModel::Exact), ("seed", AimModel::Seed)],
-        )?)
     } else if is("set") {
         let name = args.word("parameter name")?;
         let param = find_param(name).ok_or(CommandError::InvalidArgument {
@@ -100,10 +71,59 @@ pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
             expected: "a parameter name (see 'params')",
             got: word(name),
         })?)
+    } else if let Some(command) = mode_command(name, args)? {
+        command
     } else {
         return Err(CommandError::UnknownCommand(word(name)));
     };
-    args.finish()?;
+    Ok(command)
+}
+
+/// The commands that choose a mode by keyword (`target`, `planner`,
+/// `laser`, `model`); `None` when `name` is none of them.
+fn mode_command(name: &str, args: &mut Args<'_>) -> Result<Option<Command>, CommandError> {
+    let is = |candidate: &str| name.eq_ignore_ascii_case(candidate);
+    let command = if is("target") {
+        Command::Target(keyword(
+            args,
+            "gimbal|galvo|both",
+            &[
+                ("gimbal", Actuator::Gimbal),
+                ("galvo", Actuator::Galvo),
+                ("both", Actuator::Both),
+            ],
+        )?)
+    } else if is("planner") {
+        Command::Planner(keyword(
+            args,
+            "optimal|seed",
+            &[
+                ("optimal", JumpPlanner::Optimal),
+                ("seed", JumpPlanner::Seed),
+            ],
+        )?)
+    } else if is("laser") {
+        // `on` enables the laser for runs: SPEC §9 keeps it off whenever no
+        // pattern or goto is active, so `on` is `auto`.
+        Command::Laser(keyword(
+            args,
+            "on|off|auto|dwell",
+            &[
+                ("on", LaserMode::Auto),
+                ("off", LaserMode::Off),
+                ("auto", LaserMode::Auto),
+                ("dwell", LaserMode::Dwell),
+            ],
+        )?)
+    } else if is("model") {
+        Command::Model(keyword(
+            args,
+            "exact|seed",
+            &[("exact", AimModel::Exact), ("seed", AimModel::Seed)],
+        )?)
+    } else {
+        return Ok(None);
+    };
     Ok(Some(command))
 }
 
@@ -117,88 +137,7 @@ fn point(args: &mut Args<'_>, x: &'static str, y: &'static str) -> Result<PointC
 /// `pattern <name> [args] [once]`.
 fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
     let name = args.word("pattern name (see 'help')")?;
-    let is = |candidate: &str| name.eq_ignore_ascii_case(candidate);
-    let pattern = if is("grid-full") {
-        // Optional order word; anything else is left for `once`.
-        let mut peek = args.clone();
-        match peek.next_word() {
-            Some(w) if w.eq_ignore_ascii_case("serpentine") => {
-                args = peek;
-                Pattern::Grid(GridPattern::FullSerpentine)
-            }
-            Some(w) if w.eq_ignore_ascii_case("raster") => {
-                args = peek;
-                Pattern::Grid(GridPattern::FullRaster)
-            }
-            _ => Pattern::Grid(GridPattern::FullRaster),
-        }
-    } else if let Some(grid) = GridPattern::from_name(name) {
-        // home, corner, horizontal, vertical, visit-all
-        Pattern::Grid(grid)
-    } else if is("line") {
-        let (from, to) = (
-            point(&mut args, "x0_cm", "y0_cm")?,
-            point(&mut args, "x1_cm", "y1_cm")?,
-        );
-        if libm::fabs(to.x_cm - from.x_cm).max(libm::fabs(to.y_cm - from.y_cm)) < MIN_FIGURE_CM {
-            return Err(CommandError::Rejected(
-                "a line needs end points at least 0.1 cm apart (goto holds a single point)",
-            ));
-        }
-        Pattern::Line { from, to }
-    } else if is("tuning") {
-        // Optional centre and size; defaults: a 4 cm figure at the origin.
-        let mut peek = args.clone();
-        match peek.next_word() {
-            Some(w) if !w.eq_ignore_ascii_case("once") => Pattern::Tuning {
-                centre: point(&mut args, "cx_cm", "cy_cm")?,
-                size_cm: args.number("size_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?,
-            },
-            _ => Pattern::Tuning {
-                centre: PointCm {
-                    x_cm: 0.0,
-                    y_cm: 0.0,
-                },
-                size_cm: 4.0,
-            },
-        }
-    } else if is("rect") {
-        let (a, b) = (
-            point(&mut args, "x0_cm", "y0_cm")?,
-            point(&mut args, "x1_cm", "y1_cm")?,
-        );
-        if libm::fabs(b.x_cm - a.x_cm).min(libm::fabs(b.y_cm - a.y_cm)) < MIN_FIGURE_CM {
-            return Err(CommandError::Rejected(
-                "a rect needs a width and a height of at least 0.1 cm (use line for one side)",
-            ));
-        }
-        Pattern::Rect { a, b }
-    } else if is("circle") {
-        let centre = point(&mut args, "cx_cm", "cy_cm")?;
-        let radius_cm = args.number("radius_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?;
-        let mut peek = args.clone();
-        let rotation = match peek.next_word() {
-            Some(w) if w.eq_ignore_ascii_case("cw") => {
-                args = peek;
-                Rotation::Cw
-            }
-            Some(w) if w.eq_ignore_ascii_case("ccw") => {
-                args = peek;
-                Rotation::Ccw
-            }
-            _ => Rotation::Ccw,
-        };
-        Pattern::Circle {
-            centre,
-            radius_cm,
-            rotation,
-        }
-    } else {
-        return Err(CommandError::InvalidArgument {
-            expected: "home|corner|horizontal|vertical|visit-all|grid-full|line|circle|rect|tuning",
-            got: word(name),
-        });
-    };
+    let pattern = pattern_figure(name, &mut args)?;
     let once = match args.next_word() {
         None => false,
         Some(w) if w.eq_ignore_ascii_case("once") => true,
@@ -206,6 +145,118 @@ fn parse_pattern(mut args: Args<'_>) -> Result<Command, CommandError> {
     };
     args.finish()?;
     Ok(Command::Pattern { pattern, once })
+}
+
+/// The pattern named `name` with its arguments from `args` (`once` is
+/// left there).
+fn pattern_figure(name: &str, args: &mut Args<'_>) -> Result<Pattern, CommandError> {
+    let is = |candidate: &str| name.eq_ignore_ascii_case(candidate);
+    if is("grid-full") {
+        Ok(grid_full(args))
+    } else if let Some(grid) = GridPattern::from_name(name) {
+        // home, corner, horizontal, vertical, visit-all
+        Ok(Pattern::Grid(grid))
+    } else if is("line") {
+        line(args)
+    } else if is("tuning") {
+        tuning(args)
+    } else if is("rect") {
+        rect(args)
+    } else if is("circle") {
+        circle(args)
+    } else {
+        Err(CommandError::InvalidArgument {
+            expected: "home|corner|horizontal|vertical|visit-all|grid-full|line|circle|rect|tuning",
+            got: word(name),
+        })
+    }
+}
+
+/// `grid-full [raster|serpentine]`.
+fn grid_full(args: &mut Args<'_>) -> Pattern {
+    // Optional order word; anything else is left for `once`.
+    let mut peek = args.clone();
+    match peek.next_word() {
+        Some(w) if w.eq_ignore_ascii_case("serpentine") => {
+            *args = peek;
+            Pattern::Grid(GridPattern::FullSerpentine)
+        }
+        Some(w) if w.eq_ignore_ascii_case("raster") => {
+            *args = peek;
+            Pattern::Grid(GridPattern::FullRaster)
+        }
+        _ => Pattern::Grid(GridPattern::FullRaster),
+    }
+}
+
+/// `line <x0_cm> <y0_cm> <x1_cm> <y1_cm>`.
+fn line(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
+    let (from, to) = (
+        point(args, "x0_cm", "y0_cm")?,
+        point(args, "x1_cm", "y1_cm")?,
+    );
+    if libm::fabs(to.x_cm - from.x_cm).max(libm::fabs(to.y_cm - from.y_cm)) < MIN_FIGURE_CM {
+        return Err(CommandError::Rejected(
+            "a line needs end points at least 0.1 cm apart (goto holds a single point)",
+        ));
+    }
+    Ok(Pattern::Line { from, to })
+}
+
+/// `tuning [<cx_cm> <cy_cm> <size_cm>]`.
+fn tuning(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
+    // Optional centre and size; defaults: a 4 cm figure at the origin.
+    let mut peek = args.clone();
+    Ok(match peek.next_word() {
+        Some(w) if !w.eq_ignore_ascii_case("once") => Pattern::Tuning {
+            centre: point(args, "cx_cm", "cy_cm")?,
+            size_cm: args.number("size_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?,
+        },
+        _ => Pattern::Tuning {
+            centre: PointCm {
+                x_cm: 0.0,
+                y_cm: 0.0,
+            },
+            size_cm: 4.0,
+        },
+    })
+}
+
+/// `rect <x0_cm> <y0_cm> <x1_cm> <y1_cm>`.
+fn rect(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
+    let (a, b) = (
+        point(args, "x0_cm", "y0_cm")?,
+        point(args, "x1_cm", "y1_cm")?,
+    );
+    if libm::fabs(b.x_cm - a.x_cm).min(libm::fabs(b.y_cm - a.y_cm)) < MIN_FIGURE_CM {
+        return Err(CommandError::Rejected(
+            "a rect needs a width and a height of at least 0.1 cm (use line for one side)",
+        ));
+    }
+    Ok(Pattern::Rect { a, b })
+}
+
+/// `circle <cx_cm> <cy_cm> <radius_cm> [cw|ccw]`.
+fn circle(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
+    let centre = point(args, "cx_cm", "cy_cm")?;
+    let radius_cm = args.number("radius_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?;
+    let mut peek = args.clone();
+    let rotation = match peek.next_word() {
+        Some(w) if w.eq_ignore_ascii_case("cw") => {
+            *args = peek;
+            Rotation::Cw
+        }
+        Some(w) if w.eq_ignore_ascii_case("ccw") => {
+            *args = peek;
+            Rotation::Ccw
+        }
+        _ => Rotation::Ccw,
+    };
+    Ok(Pattern::Circle {
+        centre,
+        radius_cm,
+        rotation,
+    })
 }
 
 /// The next word as one of `choices` (ASCII case-insensitive); `expected`
@@ -252,216 +303,4 @@ pub const HELP_LINES: &[&str] = &[
 ];
 
 #[cfg(test)]
-mod tests {
-    extern crate std;
-    use super::*;
-    use std::string::ToString;
-
-    fn ok(line: &str) -> Command {
-        match parse_line(line) {
-            Ok(Some(c)) => c,
-            other => panic!("{line:?} → {other:?}"),
-        }
-    }
-
-    #[test]
-    fn parses_the_basic_commands_case_insensitively() {
-        assert_eq!(ok("help"), Command::Help);
-        assert_eq!(ok("  VERSION \t"), Command::Version);
-        assert_eq!(ok("Status"), Command::Status);
-        assert_eq!(ok("stop"), Command::Stop);
-        assert_eq!(ok("params"), Command::Params);
-        assert_eq!(ok("save"), Command::Save);
-    }
-
-    #[test]
-    fn blank_lines_and_comments_do_nothing() {
-        assert_eq!(parse_line(""), Ok(None));
-        assert_eq!(parse_line("   \t "), Ok(None));
-        assert_eq!(parse_line("# set err.dx.c0 1.0"), Ok(None));
-    }
-
-    #[test]
-    fn unknown_words_are_named() {
-        assert_eq!(
-            parse_line("frobnicate now"),
-            Err(CommandError::UnknownCommand(word("frobnicate")))
-        );
-        assert_eq!(
-            parse_line("~~~").map_err(|e| e.to_string()),
-            Err("unknown command '~~~'".to_string())
-        );
-    }
-
-    #[test]
-    fn degenerate_figures_are_refused() {
-        for line in [
-            "pattern line 1 1 1 1",
-            "pattern line 1 1 1.05 0.95 once",
-            "pattern rect 0 0 0 0",
-            "pattern rect 0 0 5 0.05",
-            "pattern rect -3 2 -3 7 once",
-        ] {
-            match parse_line(line) {
-                Err(CommandError::Rejected(why)) => assert!(why.contains("0.1 cm"), "{why}"),
-                other => panic!("{line:?} → {other:?}"),
-            }
-        }
-        // At the limit they draw.
-        assert!(matches!(
-            ok("pattern line 1 1 1.1 1"),
-            Command::Pattern { .. }
-        ));
-        assert!(matches!(
-            ok("pattern rect 0 0 0.1 -0.1 once"),
-            Command::Pattern { .. }
-        ));
-    }
-
-    #[test]
-    fn extra_arguments_are_refused() {
-        assert_eq!(
-            parse_line("version 2"),
-            Err(CommandError::UnexpectedArgument(word("2")))
-        );
-        assert!(parse_line("pattern corner twice").is_err());
-        assert!(parse_line("goto 1 2 3").is_err());
-    }
-
-    #[test]
-    fn patterns_with_options() {
-        assert_eq!(
-            ok("pattern corner once"),
-            Command::Pattern {
-                pattern: Pattern::Grid(GridPattern::Corner),
-                once: true
-            }
-        );
-        assert_eq!(
-            ok("pattern grid-full serpentine"),
-            Command::Pattern {
-                pattern: Pattern::Grid(GridPattern::FullSerpentine),
-                once: false
-            }
-        );
-        assert_eq!(
-            ok("pattern grid-full once"),
-            Command::Pattern {
-                pattern: Pattern::Grid(GridPattern::FullRaster),
-                once: true
-            }
-        );
-        assert_eq!(
-            ok("pattern circle 0 0 5 cw once"),
-            Command::Pattern {
-                pattern: Pattern::Circle {
-                    centre: PointCm {
-                        x_cm: 0.0,
-                        y_cm: 0.0
-                    },
-                    radius_cm: 5.0,
-                    rotation: Rotation::Cw
-                },
-                once: true
-            }
-        );
-        assert_eq!(
-            ok("pattern line -5 1 5 -1"),
-            Command::Pattern {
-                pattern: Pattern::Line {
-                    from: PointCm {
-                        x_cm: -5.0,
-                        y_cm: 1.0
-                    },
-                    to: PointCm {
-                        x_cm: 5.0,
-                        y_cm: -1.0
-                    }
-                },
-                once: false
-            }
-        );
-        assert!(matches!(
-            parse_line("pattern spiral"),
-            Err(CommandError::InvalidArgument { .. })
-        ));
-        assert_eq!(
-            parse_line("pattern line 1 2 3"),
-            Err(CommandError::MissingArgument("y1_cm"))
-        );
-        assert!(matches!(
-            parse_line("pattern circle 0 0 0"),
-            Err(CommandError::OutOfRange { .. })
-        ));
-    }
-
-    #[test]
-    fn goto_grid_laser_model_set_get() {
-        assert_eq!(
-            ok("goto 1.5 -2"),
-            Command::Goto(PointCm {
-                x_cm: 1.5,
-                y_cm: -2.0
-            })
-        );
-        assert!(parse_line("goto nan 0").is_err());
-        assert!(parse_line("goto 1e6 0").is_err());
-        assert_eq!(ok("grid -6 4"), Command::Grid { xi: -6, yi: 4 });
-        assert!(parse_line("grid 0.5 1").is_err());
-        assert_eq!(ok("laser DWELL"), Command::Laser(LaserMode::Dwell));
-        assert_eq!(ok("laser on"), Command::Laser(LaserMode::Auto));
-        assert_eq!(ok("laser off"), Command::Laser(LaserMode::Off));
-        assert_eq!(ok("target GALVO"), Command::Target(Actuator::Galvo));
-        assert_eq!(ok("planner seed"), Command::Planner(JumpPlanner::Seed));
-        assert_eq!(ok("galvo status"), Command::GalvoStatus);
-        assert!(parse_line("target laser").is_err());
-        assert!(parse_line("galvo go").is_err());
-        assert!(parse_line("laser maybe").is_err());
-        assert_eq!(ok("model seed"), Command::Model(AimModel::Seed));
-        assert!(parse_line("model exactish").is_err());
-        let Command::Set { param, value } = ok("set dwell_ms 250") else {
-            panic!("not a set");
-        };
-        assert_eq!((param.name, value), ("dwell_ms", 250.0));
-        assert!(matches!(
-            parse_line("set dwell_ms -3"),
-            Err(CommandError::OutOfRange { .. })
-        ));
-        assert!(parse_line("set nosuch 1").is_err());
-        assert!(parse_line("set dwell_ms").is_err());
-        assert!(matches!(ok("get err.dx.c3"), Command::Get(p) if p.name == "err.dx.c3"));
-    }
-
-    #[test]
-    fn every_help_line_names_a_command_that_parses_with_its_example() {
-        let examples = [
-            "pattern home once",
-            "pattern grid-full raster once",
-            "pattern line 0 0 1 1 once",
-            "pattern circle 0 0 1 cw once",
-            "pattern rect 0 0 1 1 once",
-            "pattern tuning once",
-            "stop",
-            "goto 1 1",
-            "grid 1 1",
-            "laser on",
-            "model exact",
-            "target both",
-            "planner seed",
-            "galvo status",
-            "set dwell_ms 1",
-            "get dwell_ms",
-            "params",
-            "save",
-            "status",
-            "version",
-            "help",
-        ];
-        assert_eq!(examples.len(), HELP_LINES.len());
-        for (line, example) in HELP_LINES.iter().zip(examples) {
-            let name = line.split_ascii_whitespace().next().unwrap_or("");
-            assert!(example.starts_with(name));
-            assert!(matches!(parse_line(example), Ok(Some(_))), "{example}");
-        }
-    }
-}
+mod tests;

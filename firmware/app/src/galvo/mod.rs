@@ -29,7 +29,7 @@ mod scan;
 pub const GALVO_OUTPUT: bool = cfg!(feature = "galvo");
 
 pub use path::GalvoPath;
-pub use scan::{GalvoConfig, GalvoError, GalvoLoop, Phase};
+pub use scan::{GalvoConfig, GalvoError, GalvoLoop, ScanPhase};
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 
@@ -213,20 +213,20 @@ pub struct GalvoLink {
     /// Whether the laser mode lets the galvo light at all (`laser off`
     /// clears it); applied to every half buffer computed from then on.
     laser_allowed: AtomicBool,
-    /// [`Phase`] after the last half buffer.
+    /// [`ScanPhase`] after the last half buffer.
     phase: AtomicU8,
     /// Points queued in the loop after the last half buffer.
     queued: AtomicU8,
 }
 
-const PHASES: [Phase; 7] = [
-    Phase::Idle,
-    Phase::Jumping,
-    Phase::Settling,
-    Phase::Dwelling,
-    Phase::Marking,
-    Phase::Braking,
-    Phase::LaserOffDelay,
+const PHASES: [ScanPhase; 7] = [
+    ScanPhase::Idle,
+    ScanPhase::Jumping,
+    ScanPhase::Settling,
+    ScanPhase::Dwelling,
+    ScanPhase::Marking,
+    ScanPhase::Braking,
+    ScanPhase::LaserOffDelay,
 ];
 
 impl GalvoLink {
@@ -244,15 +244,15 @@ impl GalvoLink {
     }
 
     /// The loop's phase and queued points after its last half buffer.
-    pub fn state(&self) -> (Phase, usize) {
+    pub fn state(&self) -> (ScanPhase, usize) {
         let phase = PHASES
             .get(usize::from(self.phase.load(Ordering::Relaxed)))
             .copied()
-            .unwrap_or(Phase::Idle);
+            .unwrap_or(ScanPhase::Idle);
         (phase, usize::from(self.queued.load(Ordering::Relaxed)))
     }
 
-    fn publish(&self, phase: Phase, queued: usize) {
+    fn publish(&self, phase: ScanPhase, queued: usize) {
         let code = PHASES.iter().position(|p| *p == phase).unwrap_or(0);
         self.phase.store(code as u8, Ordering::Relaxed);
         self.queued.store(queued.min(255) as u8, Ordering::Relaxed);

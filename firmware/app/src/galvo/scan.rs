@@ -4,14 +4,12 @@
 use core::fmt;
 use core::sync::atomic::Ordering;
 
-use galvo_planner::{
-    Discrete, JumpSync, Method, PathPlanner, RigidParams, XyIntegrator, plan_xy_jump,
-};
+use galvo_planner::{Discrete, Method, PathPlanner, RigidParams, XyIntegrator};
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
 use super::path::GalvoPath;
-use super::{DacSample, DacStream, GalvoEvent, GalvoLink, GalvoRequest, Half};
+use super::{DacSample, DacStream, GalvoEvent, GalvoLink, Half};
 use crate::laser_gate::LaserGate;
 use crate::log;
 use crate::settings::GalvoSettings;
@@ -87,10 +85,11 @@ impl fmt::Display for GalvoError {
     }
 }
 
-/// What the mirrors and laser are doing.
+/// What the galvo loop's mirrors and laser are doing (the sequencer's
+/// point phase is [`crate::status::Phase`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Phase {
+pub enum ScanPhase {
     /// Holding, laser off, nothing queued.
     Idle,
     /// Jumping to a point or stroke start, laser off.
@@ -123,7 +122,7 @@ struct Active {
     job: Job,
     /// Stroke of a path being drawn.
     stroke: usize,
-    phase: Phase,
+    phase: ScanPhase,
     /// Samples left in a timed phase.
     samples_left: u32,
     /// `stop` arrived: finish the jump (or brake) and hold, dark.
@@ -205,324 +204,13 @@ impl GalvoLoop {
     }
 
     /// What the mirrors and laser are doing now.
-    pub fn phase(&self) -> Phase {
-        self.active.map_or(Phase::Idle, |a| a.phase)
+    pub fn phase(&self) -> ScanPhase {
+        self.active.map_or(ScanPhase::Idle, |a| a.phase)
     }
 
     /// Jobs waiting behind the current one.
     pub fn queued_points(&self) -> usize {
         self.queue.len()
-    }
-
-    /// Takes a request (between half buffers). A refused job is returned
-    /// as its [`GalvoEvent::Refused`].
-    pub fn request(&mut self, request: GalvoRequest) -> Option<GalvoEvent> {
-        let (seq, job) = match request {
-            GalvoRequest::Stop => {
-                self.stop();
-                self.faulted = false;
-                return None;
-            }
-            GalvoRequest::Point {
-                seq,
-                x_mm,
-                y_mm,
-                dwell_us,
-            } => (
-                seq,
-                Job::Point {
-                    target_mm: PointMm {
-                        x_mm: f64::from(x_mm),
-                        y_mm: f64::from(y_mm),
-                    },
-                    dwell_us,
-                },
-            ),
-            GalvoRequest::Path { seq, path } => (seq, Job::Path(path)),
-        };
-        let checked = if self.faulted {
-            Err(GalvoError::Faulted)
-        } else {
-            self.check(&job)
-        };
-        match checked.and_then(|()| {
-            self.queue
-                .push_back((seq, job))
-                .map_err(|_| GalvoError::QueueFull)
-        }) {
-            Ok(()) => None,
-            Err(error) => Some(GalvoEvent::Refused { seq, error }),
-        }
-    }
-
-    /// Checks a job against the current configuration.
-    fn check(&self, job: &Job) -> Result<(), GalvoError> {
-        match job {
-            Job::Point { target_mm, .. } => self.angles_for(*target_mm).map(|_| ()),
-            Job::Path(path) => {
-                for [x_mm, y_mm] in path.bounds_mm() {
-                    self.angles_for(PointMm { x_mm, y_mm })?;
-                }
-                Ok(())
-            }
-        }
-    }
-
-    /// Mirror angles (rad, f64 for planning) of a board point (mm).
-    fn angles_for(&self, target: PointMm) -> Result<[f64; 2], GalvoError> {
-        let codes = self
-            .planning
-            .board_to_codes(target)
-            .map_err(|_| GalvoError::Kinematics)?;
-        if codes.clamped() {
-            return Err(GalvoError::OutOfRange);
-        }
-        let angles = self
-            .planning
-            .geometry
-            .ik(target)
-            .map_err(|_| GalvoError::Kinematics)?;
-        Ok([angles.x_rad, angles.y_rad])
-    }
-
-    /// New parameters, applied at the next job boundary (a new sample
-    /// period at the next half-buffer boundary with no job running).
-    pub fn configure(&mut self, config: GalvoConfig) {
-        self.pending_config = Some(config);
-    }
-
-    /// Applies new parameters if no job is running; a refused
-    /// configuration is reported and dropped.
-    fn apply_pending_config(&mut self, at_half_boundary: bool) -> Option<GalvoEvent> {
-        let config = self.pending_config?;
-        if self.active.is_some()
-            || (!at_half_boundary && config.sample_period_s != self.config.sample_period_s)
-        {
-            return None;
-        }
-        self.pending_config = None;
-        if config == self.config {
-            return None;
-        }
-        match Self::holding_at(config, self.mirrors.end_position_rad()) {
-            Ok(mut fresh) => {
-                fresh.queue = core::mem::take(&mut self.queue);
-                fresh.faulted = self.faulted;
-                *self = fresh;
-                log::info!("galvo: new parameters applied");
-                None
-            }
-            Err(error) => Some(GalvoEvent::ConfigRefused(error)),
-        }
-    }
-
-    /// Drops queued jobs and turns the laser off from the next sample; a
-    /// jump in flight lands, a stroke being marked brakes along the path,
-    /// and the mirrors hold.
-    pub fn stop(&mut self) {
-        self.queue.clear();
-        self.active = match self.active {
-            Some(a) if a.phase == Phase::Jumping => Some(Active {
-                cancelled: true,
-                ..a
-            }),
-            Some(a) if matches!(a.phase, Phase::Marking | Phase::Braking) => {
-                self.marker = None;
-                Some(Active {
-                    cancelled: true,
-                    phase: Phase::Braking,
-                    ..a
-                })
-            }
-            _ => None,
-        };
-    }
-
-    /// Latches an underrun: laser off, jobs dropped and refused until the
-    /// next `Stop`.
-    pub fn underrun(&mut self) {
-        self.stop();
-        self.faulted = true;
-    }
-
-    /// The sample every fill produces while nothing runs (no job, none
-    /// queued, mirrors at rest, no parameters waiting): the mirrors where
-    /// they rest, laser off. `None` otherwise.
-    pub fn hold_sample(&mut self) -> Option<DacSample> {
-        if self.active.is_some()
-            || !self.queue.is_empty()
-            || !self.mirrors.is_idle()
-            || self.pending_config.is_some()
-        {
-            return None;
-        }
-        // An idle integrator returns its rest position and does not change.
-        let [x_rad, y_rad] = self.mirrors.step();
-        let (x_code, y_code) = self
-            .sample_map
-            .angles_to_codes(x_rad, y_rad)
-            .map_or((self.last.x_code, self.last.y_code), |c| {
-                (c.x.code, c.y.code)
-            });
-        Some(DacSample {
-            x_code,
-            y_code,
-            laser: false,
-        })
-    }
-
-    /// Fills `out` with the next samples; `on_event` gets each job's
-    /// `Done` (or `Refused`, when it cannot be planned). Returns how many
-    /// samples it computed: while holding, one, copied into the rest.
-    pub fn fill(&mut self, out: &mut [DacSample], mut on_event: impl FnMut(GalvoEvent)) -> usize {
-        if let Some(hold) = self.hold_sample() {
-            out.fill(hold);
-            self.last = hold;
-            return out.len().min(1);
-        }
-        for slot in out.iter_mut() {
-            self.advance(&mut on_event);
-            let codes = match self.phase() {
-                Phase::Marking => self.mark_sample(&mut on_event),
-                Phase::Braking => self.brake_sample(),
-                _ => {
-                    let [x_rad, y_rad] = self.mirrors.step();
-                    self.sample_map
-                        .angles_to_codes(x_rad, y_rad)
-                        .map(|c| (c.x.code, c.y.code))
-                }
-            };
-            // Angles and marked positions stay inside the checked range;
-            // on a conversion error hold the last codes rather than output
-            // garbage.
-            if let Some((x_code, y_code)) = codes {
-                self.last.x_code = x_code;
-                self.last.y_code = y_code;
-            }
-            self.last.laser = matches!(self.phase(), Phase::Dwelling | Phase::Marking);
-            *slot = self.last;
-            if let Some(a) = self.active.as_mut() {
-                a.samples_left = a.samples_left.saturating_sub(1);
-            }
-        }
-        out.len()
-    }
-
-    /// Moves the state machine on until the current phase has samples to
-    /// produce.
-    fn advance(&mut self, on_event: &mut impl FnMut(GalvoEvent)) {
-        loop {
-            let Some(mut a) = self.active else {
-                if let Some(event) = self.apply_pending_config(false) {
-                    on_event(event);
-                }
-                let Some((seq, job)) = self.queue.pop_front() else {
-                    return;
-                };
-                self.active = Some(Active {
-                    seq,
-                    job,
-                    stroke: 0,
-                    phase: Phase::Idle,
-                    samples_left: 0,
-                    cancelled: false,
-                });
-                if !self.jump_to_job_start(on_event) {
-                    self.active = None;
-                }
-                continue;
-            };
-            match a.phase {
-                Phase::Marking | Phase::Braking => return,
-                Phase::Jumping if !self.mirrors.is_idle() => return,
-                Phase::Jumping if a.cancelled => {
-                    self.active = None;
-                    return;
-                }
-                Phase::Jumping => a.enter(Phase::Settling, self.on_delay_samples),
-                _ if a.samples_left > 0 => return,
-                Phase::Settling => match a.job {
-                    Job::Point { dwell_us: 0, .. } => {
-                        on_event(GalvoEvent::Done { seq: a.seq });
-                        self.active = None;
-                        continue;
-                    }
-                    Job::Point { dwell_us, .. } => a.enter(
-                        Phase::Dwelling,
-                        samples_for(dwell_us, self.config.sample_period_s),
-                    ),
-                    Job::Path(path) => {
-                        self.active = Some(a);
-                        if !self.start_marking(path, a.stroke, on_event) {
-                            self.active = None;
-                        }
-                        continue;
-                    }
-                },
-                Phase::Dwelling => a.enter(Phase::LaserOffDelay, self.off_delay_samples),
-                Phase::LaserOffDelay | Phase::Idle => {
-                    let next_stroke = match a.job {
-                        Job::Path(path) => path.stroke(a.stroke + 1).map(|_| a.stroke + 1),
-                        Job::Point { .. } => None,
-                    };
-                    let Some(stroke) = next_stroke else {
-                        on_event(GalvoEvent::Done { seq: a.seq });
-                        self.active = None;
-                        continue;
-                    };
-                    a.stroke = stroke;
-                    self.active = Some(a);
-                    if !self.jump_to_job_start(on_event) {
-                        self.active = None;
-                    }
-                    continue;
-                }
-            }
-            self.active = Some(a);
-        }
-    }
-
-    /// Plans and queues the jump to the active job's point or stroke
-    /// start; `false` (with `Refused`) when it cannot be planned.
-    fn jump_to_job_start(&mut self, on_event: &mut impl FnMut(GalvoEvent)) -> bool {
-        let Some(a) = self.active else { return false };
-        let target_mm = match a.job {
-            Job::Point { target_mm, .. } => target_mm,
-            Job::Path(path) => match path.stroke(a.stroke) {
-                Some(([x_mm, y_mm], _)) => PointMm { x_mm, y_mm },
-                None => return false,
-            },
-        };
-        let capacity = self
-            .mirrors
-            .x
-            .free_samples()
-            .min(self.mirrors.y.free_samples());
-        let planned = self.angles_for(target_mm).and_then(|target_rad| {
-            plan_xy_jump(
-                &self.disc,
-                &self.disc,
-                self.mirrors.end_position_rad(),
-                target_rad,
-                self.config.method,
-                JumpSync::Independent,
-                capacity,
-            )
-            .and_then(|jump| self.mirrors.queue_jump(&jump))
-            .map_err(|_| GalvoError::Planner)
-        });
-        match planned {
-            Ok(()) => {
-                if let Some(a) = self.active.as_mut() {
-                    a.enter(Phase::Jumping, 0);
-                }
-                true
-            }
-            Err(error) => {
-                on_event(GalvoEvent::Refused { seq: a.seq, error });
-                false
-            }
-        }
     }
 
     /// Runs the loop forever: requests between half buffers, one half per
@@ -564,11 +252,7 @@ impl GalvoLoop {
                 drawing.clear();
                 generation = now;
             }
-            while let Ok(request) = link.requests.try_receive() {
-                if let Some(event) = self.request(request) {
-                    let _ = link.events.try_send(event);
-                }
-            }
+            self.take_requests(link);
             if let Some(config) = link.config.try_take() {
                 self.configure(config);
             }
@@ -589,17 +273,7 @@ impl GalvoLoop {
                 continue;
             }
             let out = &mut half[..n];
-            let computed = self.fill(out, |event| match event {
-                // Output when the half after this one starts.
-                GalvoEvent::Done { .. } => {
-                    if let Err((event, _)) = drawing.push_back((event, 3)) {
-                        let _ = link.events.try_send(event);
-                    }
-                }
-                _ => {
-                    let _ = link.events.try_send(event);
-                }
-            });
+            let computed = self.fill(out, |event| hold_done(&mut drawing, link, event));
             link.publish(self.phase(), self.queue.len());
             if !link.laser_allowed() {
                 // `laser off`: the mirrors still move, dark.
@@ -626,12 +300,19 @@ impl GalvoLoop {
                     underrun.halves
                 );
                 self.underrun();
-                while let Ok(request) = link.requests.try_receive() {
-                    if let Some(event) = self.request(request) {
-                        let _ = link.events.try_send(event);
-                    }
-                }
+                self.take_requests(link);
                 let _ = link.events.try_send(GalvoEvent::Underrun(underrun));
+            }
+        }
+    }
+}
+
+impl GalvoLoop {
+    /// Takes every request waiting in the link; refusals go back as events.
+    fn take_requests(&mut self, link: &GalvoLink) {
+        while let Ok(request) = link.requests.try_receive() {
+            if let Some(event) = self.request(request) {
+                let _ = link.events.try_send(event);
             }
         }
     }
@@ -639,6 +320,26 @@ impl GalvoLoop {
 
 /// `Done` events held until their samples are out.
 const DONE_QUEUE: usize = 8;
+
+/// Reports an event of a computed half: at once, or for `Done`, once the
+/// DAC has output the half after this one (held in `drawing`).
+fn hold_done(
+    drawing: &mut heapless::Deque<(GalvoEvent, u8), DONE_QUEUE>,
+    link: &GalvoLink,
+    event: GalvoEvent,
+) {
+    match event {
+        // Output when the half after this one starts.
+        GalvoEvent::Done { .. } => {
+            if let Err((event, _)) = drawing.push_back((event, 3)) {
+                let _ = link.events.try_send(event);
+            }
+        }
+        _ => {
+            let _ = link.events.try_send(event);
+        }
+    }
+}
 
 /// Counts one half-buffer hand-over down for the held `Done` events and
 /// reports those whose samples the DAC has now output.
@@ -653,12 +354,14 @@ fn release_drawn(drawing: &mut heapless::Deque<(GalvoEvent, u8), DONE_QUEUE>, li
 }
 
 impl Active {
-    fn enter(&mut self, phase: Phase, samples: u32) {
+    fn enter(&mut self, phase: ScanPhase, samples: u32) {
         self.phase = phase;
         self.samples_left = samples;
     }
 }
 
+mod jobs;
 mod mark;
+mod samples;
 #[cfg(test)]
 mod tests;

@@ -5,7 +5,7 @@
 use galvo_planner::{MarkLimits, MarkSample, PathPlanner};
 use kinematics_core::PointMm;
 
-use super::{GalvoError, GalvoLoop, JUNCTION_DEVIATION_MM, Phase};
+use super::{GalvoError, GalvoLoop, JUNCTION_DEVIATION_MM, ScanPhase};
 use crate::galvo::GalvoEvent;
 use crate::galvo::path::{GalvoPath, Segment};
 
@@ -48,7 +48,7 @@ impl GalvoLoop {
         self.marker = None;
         self.hold_at_motion(on_event);
         if let Some(a) = self.active.as_mut() {
-            a.enter(Phase::LaserOffDelay, self.off_delay_samples);
+            a.enter(ScanPhase::LaserOffDelay, self.off_delay_samples);
         }
         self.codes_at(self.motion.position_mm)
     }
@@ -142,7 +142,7 @@ impl GalvoLoop {
                     brake_mm: (self.config.mark_accel_mm_s2 * ts * ts) as f32,
                 };
                 if let Some(a) = self.active.as_mut() {
-                    a.enter(Phase::Marking, 0);
+                    a.enter(ScanPhase::Marking, 0);
                 }
                 true
             }

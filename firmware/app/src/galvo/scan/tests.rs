@@ -6,6 +6,7 @@ use galvo_planner::{JumpSync, Method, XyIntegrator, plan_xy_jump};
 use kinematics_core::{Galvo, MirrorAngles, PointMm};
 
 use super::*;
+use crate::galvo::GalvoRequest;
 
 /// Runs the loop in 128-sample halves until `until` says stop (at most
 /// 1 s of samples); returns every sample and every event with the index
@@ -107,7 +108,7 @@ fn a_point_is_a_planned_jump_a_delay_a_dwell_and_a_delay() {
             "{p:?}"
         );
     }
-    assert_eq!(galvo.phase(), Phase::Idle);
+    assert_eq!(galvo.phase(), ScanPhase::Idle);
 }
 
 #[test]
@@ -158,7 +159,7 @@ fn bad_points_are_refused_and_change_nothing() {
             error: GalvoError::Kinematics
         })
     );
-    assert_eq!(galvo.phase(), Phase::Idle);
+    assert_eq!(galvo.phase(), ScanPhase::Idle);
     let (samples, events) = run(&mut galvo, |_| false);
     assert!(events.is_empty());
     assert!(
@@ -186,7 +187,7 @@ fn stop_turns_the_laser_off_at_the_next_sample() {
     while !half.iter().any(|s| s.laser) {
         galvo.fill(&mut half, |_| {});
     }
-    assert_eq!(galvo.phase(), Phase::Dwelling);
+    assert_eq!(galvo.phase(), ScanPhase::Dwelling);
     let held = half[127];
     galvo.stop();
     let mut events = Vec::new();
@@ -199,7 +200,7 @@ fn stop_turns_the_laser_off_at_the_next_sample() {
         events.is_empty(),
         "the stopped points are not reported done"
     );
-    assert_eq!(galvo.phase(), Phase::Idle);
+    assert_eq!(galvo.phase(), ScanPhase::Idle);
     assert_eq!(galvo.queued_points(), 0);
 }
 
@@ -209,7 +210,7 @@ fn stop_during_a_jump_lands_and_holds_dark() {
     galvo.request(point(1, 90.0, 90.0, 1000));
     let mut half = [DacSample::default(); 8];
     galvo.fill(&mut half, |_| {});
-    assert_eq!(galvo.phase(), Phase::Jumping);
+    assert_eq!(galvo.phase(), ScanPhase::Jumping);
     galvo.stop();
     let (samples, events) = run(&mut galvo, |_| false);
     assert!(events.is_empty());
@@ -219,7 +220,7 @@ fn stop_during_a_jump_lands_and_holds_dark() {
         (last.x_mm - 90.0).abs() < 0.1 && (last.y_mm - 90.0).abs() < 0.1,
         "{last:?}"
     );
-    assert_eq!(galvo.phase(), Phase::Idle);
+    assert_eq!(galvo.phase(), ScanPhase::Idle);
 }
 
 #[test]
@@ -405,13 +406,13 @@ fn stop_while_marking_brakes_dark_without_a_jump() {
         galvo.fill(&mut half, |_| {});
         samples.extend_from_slice(&half);
     }
-    assert_eq!(galvo.phase(), Phase::Marking);
+    assert_eq!(galvo.phase(), ScanPhase::Marking);
     let marking_step = largest_step(&samples[samples.len() - 128..]);
     galvo.stop();
     let (after, events) = run(&mut galvo, |_| false);
     assert!(events.is_empty());
     assert!(after.iter().all(|s| !s.laser), "dark from the next sample");
-    assert_eq!(galvo.phase(), Phase::Idle);
+    assert_eq!(galvo.phase(), ScanPhase::Idle);
     let mut joined = samples[samples.len() - 1..].to_vec();
     joined.extend_from_slice(&after);
     assert!(

@@ -1,0 +1,141 @@
+//! The job queue: requests checked and queued, parameters applied at
+//! job boundaries, stop and underrun.
+
+use kinematics_core::PointMm;
+
+use super::{Active, GalvoConfig, GalvoError, GalvoLoop, Job, ScanPhase};
+use crate::galvo::{GalvoEvent, GalvoRequest};
+use crate::log;
+
+impl GalvoLoop {
+    /// Takes a request (between half buffers). A refused job is returned
+    /// as its [`GalvoEvent::Refused`].
+    pub fn request(&mut self, request: GalvoRequest) -> Option<GalvoEvent> {
+        let (seq, job) = match request {
+            GalvoRequest::Stop => {
+                self.stop();
+                self.faulted = false;
+                return None;
+            }
+            GalvoRequest::Point {
+                seq,
+                x_mm,
+                y_mm,
+                dwell_us,
+            } => (
+                seq,
+                Job::Point {
+                    target_mm: PointMm {
+                        x_mm: f64::from(x_mm),
+                        y_mm: f64::from(y_mm),
+                    },
+                    dwell_us,
+                },
+            ),
+            GalvoRequest::Path { seq, path } => (seq, Job::Path(path)),
+        };
+        let checked = if self.faulted {
+            Err(GalvoError::Faulted)
+        } else {
+            self.check(&job)
+        };
+        match checked.and_then(|()| {
+            self.queue
+                .push_back((seq, job))
+                .map_err(|_| GalvoError::QueueFull)
+        }) {
+            Ok(()) => None,
+            Err(error) => Some(GalvoEvent::Refused { seq, error }),
+        }
+    }
+
+    /// Checks a job against the current configuration.
+    fn check(&self, job: &Job) -> Result<(), GalvoError> {
+        match job {
+            Job::Point { target_mm, .. } => self.angles_for(*target_mm).map(|_| ()),
+            Job::Path(path) => {
+                for [x_mm, y_mm] in path.bounds_mm() {
+                    self.angles_for(PointMm { x_mm, y_mm })?;
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// Mirror angles (rad, f64 for planning) of a board point (mm).
+    pub(super) fn angles_for(&self, target: PointMm) -> Result<[f64; 2], GalvoError> {
+        let codes = self
+            .planning
+            .board_to_codes(target)
+            .map_err(|_| GalvoError::Kinematics)?;
+        if codes.clamped() {
+            return Err(GalvoError::OutOfRange);
+        }
+        let angles = self
+            .planning
+            .geometry
+            .ik(target)
+            .map_err(|_| GalvoError::Kinematics)?;
+        Ok([angles.x_rad, angles.y_rad])
+    }
+
+    /// New parameters, applied at the next job boundary (a new sample
+    /// period at the next half-buffer boundary with no job running).
+    pub fn configure(&mut self, config: GalvoConfig) {
+        self.pending_config = Some(config);
+    }
+
+    /// Applies new parameters if no job is running; a refused
+    /// configuration is reported and dropped.
+    pub(super) fn apply_pending_config(&mut self, at_half_boundary: bool) -> Option<GalvoEvent> {
+        let config = self.pending_config?;
+        if self.active.is_some()
+            || (!at_half_boundary && config.sample_period_s != self.config.sample_period_s)
+        {
+            return None;
+        }
+        self.pending_config = None;
+        if config == self.config {
+            return None;
+        }
+        match Self::holding_at(config, self.mirrors.end_position_rad()) {
+            Ok(mut fresh) => {
+                fresh.queue = core::mem::take(&mut self.queue);
+                fresh.faulted = self.faulted;
+                *self = fresh;
+                log::info!("galvo: new parameters applied");
+                None
+            }
+            Err(error) => Some(GalvoEvent::ConfigRefused(error)),
+        }
+    }
+
+    /// Drops queued jobs and turns the laser off from the next sample; a
+    /// jump in flight lands, a stroke being marked brakes along the path,
+    /// and the mirrors hold.
+    pub fn stop(&mut self) {
+        self.queue.clear();
+        self.active = match self.active {
+            Some(a) if a.phase == ScanPhase::Jumping => Some(Active {
+                cancelled: true,
+                ..a
+            }),
+            Some(a) if matches!(a.phase, ScanPhase::Marking | ScanPhase::Braking) => {
+                self.marker = None;
+                Some(Active {
+                    cancelled: true,
+                    phase: ScanPhase::Braking,
+                    ..a
+                })
+            }
+            _ => None,
+        };
+    }
+
+    /// Latches an underrun: laser off, jobs dropped and refused until the
+    /// next `Stop`.
+    pub fn underrun(&mut self) {
+        self.stop();
+        self.faulted = true;
+    }
+}

@@ -1,0 +1,119 @@
+extern crate std;
+use std::format;
+use std::string::String;
+
+use super::*;
+
+fn drain(out: &Outbound) -> heapless::Vec<OutLine, 256> {
+    let mut lines = heapless::Vec::new();
+    while let Some(line) = out.take() {
+        let _ = lines.push(line);
+    }
+    lines
+}
+
+#[test]
+fn lines_come_out_whole_and_in_order() {
+    let out = Outbound::new();
+    assert!(out.push(LineKind::Notice, "info: servo 1 answering again"));
+    assert!(out.push(LineKind::Data, "dwell_ms = 1000 ms"));
+    assert!(out.push(LineKind::Ok, ""));
+    let lines = drain(&out);
+    let kinds: heapless::Vec<LineKind, 8> = lines.iter().map(|l| l.kind).collect();
+    assert_eq!(
+        kinds.as_slice(),
+        [LineKind::Notice, LineKind::Data, LineKind::Ok]
+    );
+    assert_eq!(lines[1].text.as_str(), "dwell_ms = 1000 ms");
+    assert_eq!(out.queued_bytes(), 0);
+}
+
+#[test]
+fn a_full_queue_drops_whole_data_lines_keeps_notices_and_the_closer_and_says_where() {
+    let out = Outbound::new();
+    out.begin_command();
+    let line = String::from("x").repeat(100);
+    let mut queued = 0;
+    for _ in 0..200 {
+        if out.push(LineKind::Data, &line) {
+            queued += 1;
+        }
+    }
+    assert!(queued > 0 && queued < 200);
+    assert!(out.queued_bytes() <= DATA_LIMIT);
+    assert!(out.push(LineKind::Notice, "error: servo 1 fault (Timeout)"));
+    assert!(out.push(LineKind::Ok, ""));
+    assert!(!out.awaiting_close());
+    let lines = drain(&out);
+    assert_eq!(lines.len(), queued + 3);
+    assert!(lines[..queued].iter().all(|l| l.text.as_str() == line));
+    let report = &lines[queued];
+    assert_eq!(report.kind, LineKind::Notice);
+    assert_eq!(
+        report.text.as_str(),
+        format!(
+            "info: {} reply lines dropped while the host was not reading",
+            200 - queued
+        )
+    );
+    assert_eq!(lines[queued + 1].kind, LineKind::Notice);
+    assert_eq!(lines[queued + 2].kind, LineKind::Ok);
+    assert!(out.unreported_drops().is_empty());
+}
+
+#[test]
+fn notices_fill_only_their_share_and_drops_at_the_end_are_reported_when_empty() {
+    let out = Outbound::new();
+    let notice = String::from("e").repeat(REPLY_LINE_LEN);
+    let mut dropped = 0;
+    for _ in 0..100 {
+        if !out.push(LineKind::Notice, &notice) {
+            dropped += 1;
+        }
+    }
+    assert!(dropped > 0);
+    assert!(out.has_closer_room(), "a closer always fits");
+    assert!(out.push(LineKind::Error, "unknown command"));
+    let lines = drain(&out);
+    let report = &lines[lines.len() - 2];
+    assert!(
+        report
+            .text
+            .starts_with(&format!("error: {dropped} notices dropped")),
+        "{report:?}"
+    );
+    assert_eq!(lines[lines.len() - 1].kind, LineKind::Error);
+    // Drops after the last queued line are reported once it is empty.
+    for _ in 0..100 {
+        out.push(LineKind::Notice, &notice);
+    }
+    out.push(LineKind::Data, "lost");
+    let lines = drain(&out);
+    let last = lines.last().map(|l| l.text.as_str()).unwrap_or("");
+    assert!(last.contains("and 1 reply line dropped"), "{last}");
+    assert!(out.take().is_none());
+}
+
+#[test]
+fn long_text_is_cut_on_a_character_boundary() {
+    let out = Outbound::new();
+    let text = String::from("é").repeat(REPLY_LINE_LEN);
+    assert!(out.push(LineKind::Data, &text));
+    let line = out.take().expect("queued");
+    assert_eq!(line.text.len(), REPLY_LINE_LEN);
+    assert!(line.text.chars().all(|c| c == 'é'));
+}
+
+#[test]
+fn the_longest_reply_fits_a_reading_host() {
+    use crate::settings::{PARAMS, ParamLine, Settings};
+    let out = Outbound::new();
+    let settings = Settings::default();
+    for param in PARAMS {
+        assert!(out.push_fmt(
+            LineKind::Data,
+            format_args!("{}", ParamLine(param, settings.get(param)))
+        ));
+    }
+    assert!(out.queued_bytes() * 3 / 2 < DATA_LIMIT, "room to spare");
+}

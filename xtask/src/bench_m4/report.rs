@@ -1,0 +1,200 @@
+//! The bench's output parsed into the table, printed and checked against
+//! the budgets.
+
+use anyhow::{Context, Result, bail};
+use serde::Serialize;
+
+use super::budgets::{Enforcement, ROWS, plan_row};
+
+/// STM32F407 core clock, MHz.
+pub const CLOCK_MHZ: f64 = 168.0;
+/// Cycles per instruction assumed for the estimate.
+pub const CPI: f64 = 1.3;
+/// Instructions per timer tick the board model implies (1 ns per
+/// instruction, 25 MHz timer); the calibration must agree within 0.5 %.
+const NOMINAL_INSTRUCTIONS_PER_TICK: f64 = 40.0;
+
+/// One measured benchmark.
+#[derive(Debug, Clone, Serialize)]
+pub struct Measured {
+    pub id: String,
+    pub what: String,
+    pub unit: String,
+    /// Guest instructions per unit.
+    pub instructions: f64,
+    /// Estimated µs per unit on the M4 (CPI × instructions / clock).
+    pub est_us: f64,
+    pub budget_us: Option<f64>,
+    pub budget: Option<String>,
+    /// Fraction of the budget used.
+    pub share: Option<f64>,
+    /// "enforced", or "reported, not yet met (…)".
+    pub status: Option<String>,
+    pub over_budget: bool,
+}
+
+/// The run's parsed output.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    pub method: &'static str,
+    pub clock_mhz: f64,
+    pub cpi: f64,
+    pub instructions_per_tick: f64,
+    pub rows: Vec<Measured>,
+}
+
+/// Estimated µs on the M4 for `instructions`.
+pub fn est_us(instructions: f64) -> f64 {
+    instructions * CPI / CLOCK_MHZ
+}
+
+/// Parses the bench's semihosting output into the table.
+pub fn parse(output: &str) -> Result<Report> {
+    let mut ipt = None;
+    let mut overhead_ticks = 0.0;
+    let mut rows = Vec::new();
+    let mut errors = Vec::new();
+    let mut done = false;
+    let mut self_checked = false;
+    for line in output.lines() {
+        let f: Vec<&str> = line.split_whitespace().collect();
+        match f.as_slice() {
+            ["calibration", instr, ticks] => {
+                let instr: f64 = instr.parse().context("calibration instructions")?;
+                let ticks: f64 = ticks.parse().context("calibration ticks")?;
+                if ticks <= 0.0 {
+                    bail!("calibration window read no timer ticks");
+                }
+                let k = instr / ticks;
+                if (k / NOMINAL_INSTRUCTIONS_PER_TICK - 1.0).abs() > 0.005 {
+                    bail!(
+                        "calibration: {k:.3} instructions per timer tick, expected \
+                         {NOMINAL_INSTRUCTIONS_PER_TICK} (is QEMU running with -icount shift=0?)"
+                    );
+                }
+                ipt = Some(k);
+            }
+            ["empty", ticks, n] => {
+                let ticks: f64 = ticks.parse().context("empty ticks")?;
+                let n: f64 = n.parse().context("empty count")?;
+                overhead_ticks = ticks / n.max(1.0);
+            }
+            ["bench", id, ticks, units] => {
+                let k = ipt.context("bench line before calibration")?;
+                let ticks: f64 = ticks.parse().with_context(|| format!("ticks of {id}"))?;
+                let units: f64 = units.parse().with_context(|| format!("units of {id}"))?;
+                let instructions = ((ticks - overhead_ticks).max(0.0) * k) / units.max(1.0);
+                rows.push(measured(id, instructions));
+            }
+            ["error", id, rest @ ..] => errors.push(format!("{id}: {}", rest.join(" "))),
+            ["check", .., "ok", _] => self_checked = true,
+            ["done", _] => done = true,
+            _ => {}
+        }
+    }
+    if !errors.is_empty() {
+        bail!("bench-m4 reported errors: {}", errors.join("; "));
+    }
+    if !done {
+        bail!("bench-m4 did not finish (no `done` line); output:\n{output}");
+    }
+    if !self_checked {
+        bail!("bench-m4 did not report its on-target self-check (VSQRT, DAC conversion)");
+    }
+    for row in ROWS.iter().filter(|r| r.budget.is_some()) {
+        if !rows.iter().any(|m| m.id == row.id) {
+            bail!("bench-m4 did not report `{}`", row.id);
+        }
+    }
+    Ok(Report {
+        method: "QEMU mps2-an386 (Cortex-M4F), -icount shift=0: 1 ns per instruction, \
+                 25 MHz APB timer 0 = 40 instructions per tick, calibrated on an asm loop",
+        clock_mhz: CLOCK_MHZ,
+        cpi: CPI,
+        instructions_per_tick: ipt.unwrap_or(NOMINAL_INSTRUCTIONS_PER_TICK),
+        rows,
+    })
+}
+
+fn measured(id: &str, instructions: f64) -> Measured {
+    let row = ROWS.iter().find(|r| r.id == id);
+    let (what, unit) = match (row, plan_row(id)) {
+        (Some(r), _) => (r.what.to_owned(), r.unit),
+        (None, Some((what, unit))) => (what, unit),
+        (None, None) => (id.to_owned(), "call"),
+    };
+    let us = est_us(instructions);
+    let budget = row.and_then(|r| r.budget);
+    let share = budget.map(|(b, _, _)| us / b);
+    Measured {
+        id: id.to_owned(),
+        what,
+        unit: unit.to_owned(),
+        instructions,
+        est_us: us,
+        budget_us: budget.map(|(b, _, _)| b),
+        budget: budget.map(|(_, text, _)| text.to_owned()),
+        share,
+        status: budget.map(|(_, _, e)| match e {
+            Enforcement::Enforced => "enforced".to_owned(),
+            Enforcement::NotYetMet(why) => format!("reported, not yet met ({why})"),
+        }),
+        over_budget: budget.is_some_and(|(b, _, e)| e == Enforcement::Enforced && us > b),
+    }
+}
+
+/// Prints the table.
+pub fn print(report: &Report) {
+    println!(
+        "M4 instructions (QEMU mps2-an386, -icount; {:.2} instructions/tick); \
+         µs estimated at {} MHz, CPI {}",
+        report.instructions_per_tick, report.clock_mhz, report.cpi
+    );
+    println!(
+        "{:<34} {:<66} {:>12} {:>10} {:>8}  budget",
+        "id", "what", "instr/unit", "est. µs", "share"
+    );
+    for m in &report.rows {
+        let share = m
+            .share
+            .map_or(String::new(), |s| format!("{:.0} %", 100.0 * s));
+        let budget = match (&m.budget, &m.status) {
+            (Some(b), Some(s)) => {
+                format!("{b}: {s}{}", if m.over_budget { " EXCEEDED" } else { "" })
+            }
+            _ => String::new(),
+        };
+        println!(
+            "{:<34} {:<66} {:>12.0} {:>10.2} {:>8}  {}",
+            m.id,
+            format!("{} (per {})", m.what, m.unit),
+            m.instructions,
+            m.est_us,
+            share,
+            budget
+        );
+    }
+}
+
+/// Fails when an enforced budget is exceeded.
+pub fn check(report: &Report) -> Result<()> {
+    let over: Vec<String> = report
+        .rows
+        .iter()
+        .filter(|m| m.over_budget)
+        .map(|m| {
+            format!(
+                "{} ({}): {:.2} µs per {} > {:.2} µs",
+                m.id,
+                m.what,
+                m.est_us,
+                m.unit,
+                m.budget_us.unwrap_or(0.0)
+            )
+        })
+        .collect();
+    if !over.is_empty() {
+        bail!("M4 budgets exceeded:\n  {}", over.join("\n  "));
+    }
+    Ok(())
+}

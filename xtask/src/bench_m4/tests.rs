@@ -1,0 +1,190 @@
+use super::*;
+
+const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
+    check sqrt+dac ok 6960\n\
+    bench loop.holding.steady 40 128\nbench loop.line.steady 100 128\n\
+    bench loop.arc_r40.steady 100 128\nbench loop.jump.steady 10 40\n\
+    bench loop.holding.refill 40 1\nbench loop.line.refill 100 1\n\
+    bench loop.arc_r40.refill 100 1\nbench loop.jump.refill 400000 1\n\
+    bench plan.xy.optimal.1lsb 250 1\nbench plan.xy.optimal.160mm 300 1\n\
+    bench plan.seed.1deg 100 1\ndone 0\n";
+
+#[test]
+fn turns_ticks_into_instructions_and_checks_budgets() {
+    let r = parse(OUT).unwrap();
+    assert_eq!(r.instructions_per_tick, 40.0);
+    let holding = r
+        .rows
+        .iter()
+        .find(|m| m.id == "loop.holding.steady")
+        .unwrap();
+    // 40 ticks · 40 / 128 = 12.5 instructions per sample.
+    assert_eq!(holding.instructions, 12.5);
+    assert!((holding.est_us - 12.5 * 1.3 / 168.0).abs() < 1e-12);
+    assert!(!holding.over_budget);
+    // Planning is within its enforced budget: 300 ticks = 12 000
+    // instructions = 92.9 µs of 100 µs.
+    let plan = r
+        .rows
+        .iter()
+        .find(|m| m.id == "plan.xy.optimal.160mm")
+        .unwrap();
+    assert!(plan.share.unwrap() < 1.0 && !plan.over_budget);
+    assert_eq!(plan.status.as_deref(), Some("enforced"));
+    let seed = r.rows.iter().find(|m| m.id == "plan.seed.1deg").unwrap();
+    assert_eq!(seed.what, "one-axis seed plan, 1deg");
+    assert!(check(&r).is_ok());
+}
+
+#[test]
+fn an_enforced_budget_over_fails() {
+    // 3000 ticks for a holding half: 120 000 instructions, 929 µs of
+    // the 640 µs allowed.
+    let out = OUT.replace(
+        "bench loop.holding.refill 40 1",
+        "bench loop.holding.refill 3000 1",
+    );
+    let r = parse(&out).unwrap();
+    let err = check(&r).unwrap_err().to_string();
+    assert!(err.contains("loop.holding.refill"), "{err}");
+    // A two-axis jump plan over 100 µs (14 000 instructions) fails.
+    let out = OUT.replace(
+        "bench plan.xy.optimal.160mm 300 1",
+        "bench plan.xy.optimal.160mm 350 1",
+    );
+    let err = check(&parse(&out).unwrap()).unwrap_err().to_string();
+    assert!(err.contains("plan.xy.optimal.160mm"), "{err}");
+    // Holding per sample is enforced too: 1000 ticks for 128 samples,
+    // 312.5 instructions (2.4 µs) each, over its 0.5 µs.
+    let holding = OUT.replace(
+        "bench loop.holding.steady 40 128",
+        "bench loop.holding.steady 1000 128",
+    );
+    let err = check(&parse(&holding).unwrap()).unwrap_err().to_string();
+    assert!(err.contains("loop.holding.steady"), "{err}");
+    // A budget not yet met is reported, not failed: 1000 ticks for 40
+    // jump samples, 1000 instructions (7.7 µs) each, over its 1 µs.
+    let jumping = OUT.replace(
+        "bench loop.jump.steady 10 40",
+        "bench loop.jump.steady 1000 40",
+    );
+    let r = parse(&jumping).unwrap();
+    let m = r.rows.iter().find(|m| m.id == "loop.jump.steady").unwrap();
+    assert!(m.share.unwrap() > 1.0 && !m.over_budget);
+    assert!(
+        m.status
+            .as_deref()
+            .unwrap()
+            .starts_with("reported, not yet met")
+    );
+    assert!(check(&r).is_ok());
+}
+
+fn manifest(path: &str) -> toml::Table {
+    let path = workspace_root().join(path);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    text.parse()
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// `[profile.release]` with its per-package overrides.
+fn release_profile(manifest: &toml::Table) -> Option<&toml::Value> {
+    manifest.get("profile")?.get("release")
+}
+
+/// The bench measures the crates as the firmware builds them: its
+/// workspace's release profile (profiles come from the workspace root
+/// only) must equal the root's, overrides included.
+#[test]
+fn bench_release_profile_is_the_firmware_one() {
+    let root = manifest("Cargo.toml");
+    let bench = manifest(MANIFEST);
+    let root_release = release_profile(&root).expect("root [profile.release]");
+    // Not vacuous: the root builds for size, the math crates for speed.
+    assert_eq!(
+        root_release.get("opt-level").and_then(toml::Value::as_str),
+        Some("z")
+    );
+    assert!(
+        root_release
+            .get("package")
+            .and_then(|p| p.get("galvo-planner"))
+            .is_some()
+    );
+    assert_eq!(
+        release_profile(&bench),
+        Some(root_release),
+        "{MANIFEST}'s [profile.release*] differs from the root Cargo.toml's: \
+         copy the root's release profile there"
+    );
+    // A workspace of its own, excluded by the root: otherwise the
+    // linker runs in the root and links the STM32F407 memory map.
+    assert!(bench.get("workspace").is_some_and(toml::Value::is_table));
+    let excluded = root
+        .get("workspace")
+        .and_then(|w| w.get("exclude"))
+        .and_then(toml::Value::as_array)
+        .is_some_and(|e| e.iter().any(|p| p.as_str() == Some("firmware/bench-m4")));
+    assert!(
+        excluded,
+        "the root workspace must exclude firmware/bench-m4"
+    );
+}
+
+/// The bench's own lock file pins the versions the firmware is built
+/// with: every package in it has the same version in the root lock.
+#[test]
+fn bench_lock_pins_the_root_versions() {
+    let versions = |lock: &toml::Table| -> Vec<(String, String)> {
+        lock.get("package")
+            .and_then(toml::Value::as_array)
+            .expect("[[package]] entries")
+            .iter()
+            .filter_map(|p| {
+                Some((
+                    p.get("name")?.as_str()?.to_owned(),
+                    p.get("version")?.as_str()?.to_owned(),
+                ))
+            })
+            .collect()
+    };
+    let root = versions(&manifest("Cargo.lock"));
+    let bench = versions(&manifest("firmware/bench-m4/Cargo.lock"));
+    assert!(bench.iter().any(|(name, _)| name == "cortex-m-rt"));
+    let drifted: Vec<String> = bench
+        .iter()
+        .filter(|(name, version)| {
+            name != "bench-m4" && !root.iter().any(|(n, v)| n == name && v == version)
+        })
+        .map(|(name, version)| format!("{name} {version}"))
+        .collect();
+    assert!(
+        drifted.is_empty(),
+        "firmware/bench-m4/Cargo.lock has versions the root Cargo.lock does not: {drifted:?} \
+         (copy the root Cargo.lock there and build the bench once)"
+    );
+}
+
+#[test]
+fn refuses_bad_runs() {
+    // Without -icount the timer does not tick 40 instructions.
+    let wrong = OUT.replace("calibration 2000000 50000", "calibration 2000000 20000");
+    assert!(parse(&wrong).unwrap_err().to_string().contains("icount"));
+    assert!(parse(&OUT.replace("done 0\n", "")).is_err());
+    let missing = OUT.replace("bench loop.jump.steady 10 40\n", "");
+    assert!(
+        parse(&missing)
+            .unwrap_err()
+            .to_string()
+            .contains("loop.jump.steady")
+    );
+    let error = format!("{OUT}error loop.jump \"setup\"\n");
+    assert!(parse(&error).is_err());
+    let unchecked = OUT.replace("check sqrt+dac ok 6960\n", "");
+    assert!(
+        parse(&unchecked)
+            .unwrap_err()
+            .to_string()
+            .contains("self-check")
+    );
+}
