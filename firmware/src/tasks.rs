@@ -16,6 +16,7 @@ use embassy_time::Timer;
 use embassy_usb::UsbDevice;
 use embassy_usb::class::cdc_acm::{BufferedReceiver, Sender};
 use laser_app::command::CommandLink;
+use laser_app::galvo::GalvoLink;
 use laser_app::laser_gate::LaserGate;
 use laser_app::sequencer::{LaserSwitch, Sequencer};
 use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
@@ -95,8 +96,10 @@ pub async fn sequencer(
     store: FlashSettings,
 ) -> ! {
     let gate = laser.gate;
-    // No galvo output in this build yet (see README, Status).
-    let mut sequencer = Sequencer::new(link, servo, None, status, laser, gate, store).await;
+    // No galvo loop serves this link yet (no DAC output wired, see README,
+    // Status): `target galvo|both` is refused.
+    static GALVO: GalvoLink = GalvoLink::new();
+    let mut sequencer = Sequencer::new(link, servo, &GALVO, status, laser, gate, store).await;
     sequencer.run().await
 }
 

@@ -118,11 +118,9 @@ pub fn test() -> Result<()> {
         "warnings",
     ])?;
 
-    // The libraries for the target, laser-app with its galvo output (the
-    // firmware leaves that out for now, the target build must not rot).
+    // The libraries for the target.
     let mut build_libs = vec!["build", "--target", TARGET, "--release"];
     build_libs.extend(package_args(&TARGET_LIBRARIES));
-    build_libs.extend(["--features", "laser-app/galvo"]);
     run("cargo", &build_libs)?;
 
     // Unit, integration (tests/) and doc tests of every host crate.

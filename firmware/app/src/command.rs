@@ -126,10 +126,9 @@ impl Actuator {
         self != Actuator::Galvo
     }
 
-    /// Whether the galvo takes part (never in a build without galvo
-    /// output, so the compiler drops those paths).
+    /// Whether the galvo takes part.
     pub fn uses_galvo(self) -> bool {
-        crate::galvo::GALVO_OUTPUT && self != Actuator::Gimbal
+        self != Actuator::Gimbal
     }
 }
 

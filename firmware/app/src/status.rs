@@ -1,5 +1,6 @@
-//! The status board: a snapshot of what the firmware is doing, written by
-//! the sequencer and read by the LEDs, the watchdog and the simulator.
+//! The status board: a snapshot of what the firmware is doing, published
+//! by the sequencer (a view of its core's state) and read by the LEDs,
+//! the watchdog and the simulator.
 
 use core::cell::RefCell;
 
@@ -93,6 +94,11 @@ impl StatusBoard {
     /// A copy of the current state.
     pub fn snapshot(&self) -> Snapshot {
         self.inner.lock(|s| *s.borrow())
+    }
+
+    /// Replaces the state (the sequencer publishes its status view).
+    pub fn publish(&self, snapshot: Snapshot) {
+        self.inner.lock(|s| *s.borrow_mut() = snapshot);
     }
 
     /// Changes the state.

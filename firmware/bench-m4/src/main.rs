@@ -15,8 +15,7 @@
 //! semihosting.
 //!
 //! The crates are linked exactly as the firmware builds them: release
-//! profile (the math crates at opt-level 3, the rest for size), FPU on,
-//! laser-app with its `galvo` feature.
+//! profile (the math crates at opt-level 3, the rest for size), FPU on.
 
 #![no_std]
 #![no_main]

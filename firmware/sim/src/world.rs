@@ -343,16 +343,9 @@ pub fn run(options: SimOptions) -> SimReport {
                 };
                 let store = settings_store(flash.clone());
                 executor::spawn_task(&spawner, "sequencer", TaskKind::Firmware, async move {
-                    let mut sequencer = Sequencer::new(
-                        link,
-                        servo_link,
-                        Some(galvo_link),
-                        status,
-                        laser,
-                        gate,
-                        store,
-                    )
-                    .await;
+                    let mut sequencer =
+                        Sequencer::new(link, servo_link, galvo_link, status, laser, gate, store)
+                            .await;
                     sequencer.run().await;
                 });
                 let (dac_recording, cost) = (galvo_dac, options.galvo_cost_ns_per_sample);

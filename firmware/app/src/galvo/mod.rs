@@ -22,56 +22,10 @@
 mod path;
 mod scan;
 
-/// Whether this build drives a galvo (cargo feature `galvo`). The
-/// simulator has it; the firmware leaves it out until the DAC output is
-/// wired and fits the flash budget. Without it every galvo code path in
-/// the sequencer is compiled out (`target galvo|both` is refused).
-pub const GALVO_OUTPUT: bool = cfg!(feature = "galvo");
-
 pub use path::GalvoPath;
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, ScanPhase};
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
-
-use galvo_planner::{Method, RigidParams};
-use kinematics_core::{DacAxis, Galvo, GalvoGeometry};
-
-use crate::settings::{GalvoSettings, JumpPlanner};
-
-/// The loop configuration for the user's galvo parameters.
-pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
-    let dac = |codes_per_rad: f64, offset_code: f64| DacAxis {
-        codes_per_rad: codes_per_rad as f32,
-        offset_code: offset_code as f32,
-    };
-    GalvoConfig {
-        sample_period_s: settings.sample_period_us * 1e-6,
-        galvo: Galvo {
-            geometry: GalvoGeometry {
-                d_mm: settings.d_mm as f32,
-                e_mm: settings.e_mm as f32,
-            },
-            dac_x: dac(settings.x_codes_per_rad, settings.x_offset_code),
-            dac_y: dac(settings.y_codes_per_rad, settings.y_offset_code),
-        },
-        mirrors: RigidParams {
-            kt_nm_per_a: settings.kt_nm_per_a,
-            j_kg_m2: settings.j_kg_m2,
-            l_h: settings.l_h,
-            r_ohm: settings.r_ohm,
-            u_max_v: settings.u_max_v,
-        },
-        method: match settings.planner {
-            JumpPlanner::Optimal => Method::TimeOptimal,
-            JumpPlanner::Seed => Method::BISECTION,
-        },
-        laser_on_delay_us: settings.laser_on_delay_us as u32,
-        laser_off_delay_us: settings.laser_off_delay_us as u32,
-        mark_speed_mm_s: settings.mark_speed_mm_s,
-        mark_accel_mm_s2: settings.mark_accel_mm_s2,
-    }
-}
-
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
@@ -197,10 +151,15 @@ pub enum GalvoEvent {
     ConfigRefused(GalvoError),
 }
 
-/// Channels and counters between the sequencer and the galvo loop.
+/// Depth of the galvo request queue.
+pub const GALVO_REQUEST_DEPTH: usize = 4;
+
+/// Channels and counters between the sequencer and the galvo loop. Every
+/// board has one; a galvo loop serves it only on a board with a galvo DAC
+/// ([`Self::attached`]).
 pub struct GalvoLink {
     /// Sequencer → galvo loop.
-    pub requests: Channel<CriticalSectionRawMutex, GalvoRequest, 4>,
+    pub requests: Channel<CriticalSectionRawMutex, GalvoRequest, GALVO_REQUEST_DEPTH>,
     /// New parameters (the latest wins), applied between points, never
     /// mid-move.
     pub config: Signal<CriticalSectionRawMutex, GalvoConfig>,
@@ -217,6 +176,8 @@ pub struct GalvoLink {
     phase: AtomicU8,
     /// Points queued in the loop after the last half buffer.
     queued: AtomicU8,
+    /// A galvo loop serves the link (set when it starts).
+    attached: AtomicBool,
 }
 
 const PHASES: [ScanPhase; 7] = [
@@ -230,6 +191,17 @@ const PHASES: [ScanPhase; 7] = [
 ];
 
 impl GalvoLink {
+    /// Whether a galvo loop serves the link (a board without a galvo DAC
+    /// runs none: `target galvo|both` is refused).
+    pub fn attached(&self) -> bool {
+        self.attached.load(Ordering::Relaxed)
+    }
+
+    /// Marks the link served ([`GalvoLoop::run`] calls it when it starts).
+    pub fn attach(&self) {
+        self.attached.store(true, Ordering::Relaxed);
+    }
+
     /// Lets the galvo light its dwells and strokes (`true`, laser modes
     /// `auto` and `dwell`) or keeps every sample it computes from now on
     /// dark (`false`, `laser off`). The master gate still decides whether
@@ -271,6 +243,7 @@ impl GalvoLink {
             laser_allowed: AtomicBool::new(true),
             phase: AtomicU8::new(0),
             queued: AtomicU8::new(0),
+            attached: AtomicBool::new(false),
         }
     }
 }

@@ -12,7 +12,6 @@ use super::path::GalvoPath;
 use super::{DacSample, DacStream, GalvoEvent, GalvoLink, Half};
 use crate::laser_gate::LaserGate;
 use crate::log;
-use crate::settings::GalvoSettings;
 
 /// Jump input samples the integrator holds per axis (10.24 ms at 100 kHz,
 /// longer than any full-range time-optimal jump of the reference galvo).
@@ -45,15 +44,6 @@ pub struct GalvoConfig {
     pub mark_speed_mm_s: f64,
     /// Marking acceleration (and braking on stop), mm/s².
     pub mark_accel_mm_s2: f64,
-}
-
-impl Default for GalvoConfig {
-    /// The default galvo parameters ([`GalvoSettings::default`]): 100 kHz,
-    /// SPEC geometry and DAC span, reference mirror drive, time-optimal
-    /// jumps, 100 µs laser delays, marking at 1 m/s.
-    fn default() -> Self {
-        super::config_from(&GalvoSettings::default())
-    }
 }
 
 /// Why the loop cannot be built or a job cannot run.
@@ -236,6 +226,7 @@ impl GalvoLoop {
         link: &GalvoLink,
         gate: &LaserGate,
     ) -> ! {
+        link.attach();
         let n = dac.half_len().clamp(1, MAX_HALF_LEN);
         let mut half = [DacSample::default(); MAX_HALF_LEN];
         let mut period_s = self.config.sample_period_s;

@@ -10,10 +10,11 @@
 //! fault the gimbal laser stays dark until the first arrival is confirmed,
 //! whatever the laser mode.
 
-use super::{LaserSwitch, Phase, Sequencer, SettingsStore};
+use super::machine::{ActionSink, Core};
 use crate::command::{Command, ReplyText, reply_text};
 use crate::servo::task::{ServoFault, ServoIdSet};
 use crate::settings::Settings;
+use crate::status::Phase;
 
 /// Fault bookkeeping of the sequencer.
 #[derive(Debug, Clone, Copy, Default)]
@@ -84,18 +85,22 @@ pub(super) fn servo_ranges_tenths(settings: &Settings) -> [(i16, i16); 2] {
     ]
 }
 
-impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
+impl Core {
     /// The servo task reports servo `id` answering again.
-    pub(super) fn servo_recovered(&mut self, id: u8) {
+    pub(super) fn servo_recovered(&mut self, id: u8, out: &mut dyn ActionSink) {
         self.faults.recovered(id);
-        self.link
-            .notify(format_args!("info: servo {id} answering again"));
-        self.publish();
+        self.notify(out, format_args!("info: servo {id} answering again"));
     }
 
     /// The servo task reports a fault of servo `id` during move `seq` (or
     /// found by its health check after move `seq`).
-    pub(super) fn servo_fault(&mut self, seq: u32, id: u8, fault: ServoFault) {
+    pub(super) fn servo_fault(
+        &mut self,
+        seq: u32,
+        id: u8,
+        fault: ServoFault,
+        out: &mut dyn ActionSink,
+    ) {
         // What a fault says about the servo is never stale: it is dead
         // until it answers again.
         self.faults.mark_dead(id);
@@ -107,20 +112,22 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
                 .run
                 .is_some_and(|r| r.seq != seq && r.phase.is_travel())
         {
-            self.publish();
             return;
         }
         if gimbal_run {
-            self.link.notify(format_args!(
-                "error: servo {id} fault ({fault:?}); pattern stopped, laser off"
-            ));
-            self.stop("servo fault");
+            self.notify(
+                out,
+                format_args!("error: servo {id} fault ({fault:?}); pattern stopped, laser off"),
+            );
+            self.stop("servo fault", out);
         } else {
             // Idle, or a galvo-only run that does not need the servos.
-            self.link.notify(format_args!(
-                "error: servo {id} fault ({fault:?}); gimbal commands refused until it answers"
-            ));
-            self.publish();
+            self.notify(
+                out,
+                format_args!(
+                    "error: servo {id} fault ({fault:?}); gimbal commands refused until it answers"
+                ),
+            );
         }
     }
 

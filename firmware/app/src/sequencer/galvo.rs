@@ -1,51 +1,101 @@
-//! The sequencer's side of the galvo: points to the galvo loop, its
-//! events back, and its status.
+//! The core's side of the galvo: points and paths to the galvo loop, its
+//! events back, its parameters (built here from the settings: the galvo
+//! loop knows nothing of them), and its laser permission.
 
-use core::sync::atomic::Ordering;
+use galvo_planner::{Method, RigidParams};
+use kinematics_core::{DacAxis, Galvo, GalvoGeometry};
 
+use super::machine::{Action, ActionSink, Core, GalvoReadout};
+use super::run::RunKind;
 use super::targets::{self, Target};
-use super::{LaserSwitch, Phase, Sequencer, SettingsStore};
-use crate::galvo::{GALVO_OUTPUT, GalvoEvent, GalvoRequest, config_from};
+use crate::command::Pattern;
+use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoConfig, GalvoEvent, GalvoRequest};
 use crate::log;
-use crate::settings::LaserMode;
+use crate::settings::{GalvoSettings, JumpPlanner, LaserMode};
+use crate::status::Phase;
 use crate::text::Shortest;
 
 /// Dwell of a goto on the galvo: held until the next command, µs.
 const HOLD_US: u32 = u32::MAX;
 
-impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
+/// The loop configuration for the user's galvo parameters.
+pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
+    let dac = |codes_per_rad: f64, offset_code: f64| DacAxis {
+        codes_per_rad: codes_per_rad as f32,
+        offset_code: offset_code as f32,
+    };
+    GalvoConfig {
+        sample_period_s: settings.sample_period_us * 1e-6,
+        galvo: Galvo {
+            geometry: GalvoGeometry {
+                d_mm: settings.d_mm as f32,
+                e_mm: settings.e_mm as f32,
+            },
+            dac_x: dac(settings.x_codes_per_rad, settings.x_offset_code),
+            dac_y: dac(settings.y_codes_per_rad, settings.y_offset_code),
+        },
+        mirrors: RigidParams {
+            kt_nm_per_a: settings.kt_nm_per_a,
+            j_kg_m2: settings.j_kg_m2,
+            l_h: settings.l_h,
+            r_ohm: settings.r_ohm,
+            u_max_v: settings.u_max_v,
+        },
+        method: match settings.planner {
+            JumpPlanner::Optimal => Method::TimeOptimal,
+            JumpPlanner::Seed => Method::BISECTION,
+        },
+        laser_on_delay_us: settings.laser_on_delay_us as u32,
+        laser_off_delay_us: settings.laser_off_delay_us as u32,
+        mark_speed_mm_s: settings.mark_speed_mm_s,
+        mark_accel_mm_s2: settings.mark_accel_mm_s2,
+    }
+}
+
+impl Default for GalvoConfig {
+    /// The default galvo parameters ([`GalvoSettings::default`]): 100 kHz,
+    /// SPEC geometry and DAC span, reference mirror drive, time-optimal
+    /// jumps, 100 µs laser delays, marking at 1 m/s.
+    fn default() -> Self {
+        config_from(&GalvoSettings::default())
+    }
+}
+
+impl Core {
     /// Tells the galvo loop to stop (drop its jobs, laser off, clear an
-    /// underrun latch). Never lost: requests it has not taken yet are
+    /// underrun latch). Never lost: the requests it has not taken yet are
     /// dropped first, so there is room.
-    pub(super) fn stop_galvo(&mut self) {
-        if let Some(galvo) = self.galvo.filter(|_| GALVO_OUTPUT) {
-            while galvo.requests.try_receive().is_ok() {}
-            let _ = galvo.requests.try_send(GalvoRequest::Stop);
+    pub(super) fn stop_galvo(&mut self, out: &mut dyn ActionSink) {
+        out.act(Action::Galvo(GalvoRequest::Stop));
+        if self.inputs.galvo_room.is_some() {
+            self.inputs.galvo_room = Some(GALVO_REQUEST_DEPTH - 1);
         }
     }
 
     /// Queues a job for the galvo loop; `false` (with an error notice,
     /// everything stopped) when the loop does not keep up.
-    fn send_galvo(&mut self, request: GalvoRequest) -> bool {
-        let Some(galvo) = self.galvo else {
+    fn send_galvo(&mut self, request: GalvoRequest, out: &mut dyn ActionSink) -> bool {
+        let Some(room) = self.inputs.galvo_room.filter(|room| *room > 0) else {
+            log::warning!("galvo: request queue full");
+            self.notify(out, format_args!("error: galvo not responding; stopped"));
+            self.stop("galvo not responding", out);
             return false;
         };
-        if galvo.requests.try_send(request).is_ok() {
-            return true;
-        }
-        log::warning!("galvo: request queue full");
-        self.link
-            .notify(format_args!("error: galvo not responding; stopped"));
-        self.stop("galvo not responding");
-        false
+        self.inputs.galvo_room = Some(room - 1);
+        out.act(Action::Galvo(request));
+        true
     }
 
     /// Sends the galvo job built for the next request number and makes
     /// it the run's job in flight.
-    fn send_galvo_job(&mut self, job: impl FnOnce(u32) -> GalvoRequest) -> bool {
+    fn send_galvo_job(
+        &mut self,
+        job: impl FnOnce(u32) -> GalvoRequest,
+        out: &mut dyn ActionSink,
+    ) -> bool {
         self.next_seq = self.next_seq.wrapping_add(1);
         let seq = self.next_seq;
-        if !self.send_galvo(job(seq)) {
+        if !self.send_galvo(job(seq), out) {
             return false;
         }
         if let Some(run) = self.run.as_mut() {
@@ -56,20 +106,20 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
 
     /// Sends the current grid or goto point to the galvo (board cm →
     /// galvo mm). Paths go whole, through [`Self::begin_galvo_path`].
-    pub(super) fn begin_galvo_point(&mut self, target: Target) -> bool {
-        self.allow_galvo_laser();
+    pub(super) fn begin_galvo_point(&mut self, target: Target, out: &mut dyn ActionSink) -> bool {
+        self.allow_galvo_laser(out);
         let Some(run) = self.run else { return false };
-        let dwell_us = match run.pattern {
-            None => HOLD_US,
-            Some(_) => (self.settings.dwell_ms * 1000.0) as u32,
+        let dwell_us = match run.kind {
+            RunKind::Goto(_) => HOLD_US,
+            _ => (self.settings.dwell_ms * 1000.0) as u32,
         };
-        let sent = self.send_galvo_job(|seq| GalvoRequest::Point {
+        let job = |seq| GalvoRequest::Point {
             seq,
             x_mm: (target.point.x_cm * 10.0) as f32,
             y_mm: (target.point.y_cm * 10.0) as f32,
             dwell_us,
-        });
-        if !sent {
+        };
+        if !self.send_galvo_job(job, out) {
             return false;
         }
         log::info!(
@@ -80,18 +130,14 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
         true
     }
 
-    /// Sends the running path pattern to the galvo as one job.
-    pub(super) fn begin_galvo_path(&mut self) {
-        self.allow_galvo_laser();
-        let path = self
-            .run
-            .and_then(|r| r.pattern)
-            .and_then(|p| targets::galvo_path(&p));
-        let Some(path) = path else {
-            self.stop("not a path");
+    /// Sends path `pattern` of the run to the galvo as one job.
+    pub(super) fn begin_galvo_path(&mut self, pattern: Pattern, out: &mut dyn ActionSink) {
+        self.allow_galvo_laser(out);
+        let Some(path) = targets::galvo_path(&pattern) else {
+            self.stop("not a path", out);
             return;
         };
-        if !self.send_galvo_job(|seq| GalvoRequest::Path { seq, path }) {
+        if !self.send_galvo_job(|seq| GalvoRequest::Path { seq, path }, out) {
             return;
         }
         if let Some(run) = self.run.as_mut() {
@@ -101,91 +147,94 @@ impl<L: LaserSwitch, S: SettingsStore> Sequencer<'_, L, S> {
             run.dwell_until = None;
         }
         log::info!("galvo marks the path");
-        self.publish();
     }
 
     /// Handles an event of the galvo loop.
-    pub(super) fn handle_galvo_event(&mut self, event: GalvoEvent) {
+    pub(super) fn galvo_event(&mut self, event: GalvoEvent, out: &mut dyn ActionSink) {
         match event {
             GalvoEvent::Done { seq } => {
                 if let Some(run) = self.run.as_mut().filter(|r| r.galvo_seq == seq) {
                     run.galvo_busy = false;
-                    self.point_finished_if_done();
+                    self.point_finished_if_done(out);
                 }
             }
             GalvoEvent::Refused { seq, error } => {
                 if self.run.is_some_and(|r| r.galvo_seq == seq) {
-                    self.link
-                        .notify(format_args!("error: galvo: {error}; stopped"));
-                    self.stop("galvo refused the point");
+                    self.notify(out, format_args!("error: galvo: {error}; stopped"));
+                    self.stop("galvo refused the point", out);
                 }
             }
             GalvoEvent::Underrun(underrun) => {
-                self.link.notify(format_args!(
-                    "error: galvo underrun ({} half buffers late); stopped, laser off",
-                    underrun.halves
-                ));
-                self.stop("galvo underrun");
+                self.notify(
+                    out,
+                    format_args!(
+                        "error: galvo underrun ({} half buffers late); stopped, laser off",
+                        underrun.halves
+                    ),
+                );
+                self.stop("galvo underrun", out);
             }
             GalvoEvent::ConfigRefused(error) => {
-                self.link.notify(format_args!(
-                    "error: galvo parameters refused: {error}; previous ones kept"
-                ));
+                self.notify(
+                    out,
+                    format_args!("error: galvo parameters refused: {error}; previous ones kept"),
+                );
             }
         }
     }
 
     /// Sends the galvo parameters to the loop (applied between points).
-    pub(super) fn configure_galvo(&mut self) {
-        if let Some(galvo) = self.galvo {
-            galvo.config.signal(config_from(&self.settings.galvo));
-        }
-        self.allow_galvo_laser();
+    pub(super) fn configure_galvo(&mut self, out: &mut dyn ActionSink) {
+        out.act(Action::ConfigureGalvo(config_from(&self.settings.galvo)));
+        self.allow_galvo_laser(out);
     }
 
     /// Tells the galvo loop whether the laser mode lets it light (`laser
-    /// off`: it still moves, dark). `laser off` also shuts the gate, so
+    /// off`: it still moves, dark). `laser off` also shuts the gate (where
+    /// a galvo loop runs), so
     /// the halves the loop computed before it (up to three, 384 ms at
     /// 1 ms per sample) go dark at once too; the run goes on and lights
     /// again after `laser auto`.
     /// `laser dwell` lights only dwells: a marked path (which has none)
     /// stays dark, like the gimbal's.
-    pub(super) fn allow_galvo_laser(&self) {
-        if let Some(galvo) = self.galvo {
-            let marking = self
-                .run
-                .is_some_and(|r| r.pattern.is_some_and(|p| p.is_path()));
-            let allowed = match self.settings.laser_mode {
-                LaserMode::Off => false,
-                LaserMode::Dwell => !marking,
-                LaserMode::Auto => true,
-            };
-            galvo.allow_laser(allowed);
-            if !allowed {
-                self.gate.shut();
-            }
+    pub(super) fn allow_galvo_laser(&self, out: &mut dyn ActionSink) {
+        let marking = self
+            .run
+            .is_some_and(|r| r.kind.pattern().is_some_and(|p| p.is_path()));
+        let allowed = match self.settings.laser_mode {
+            LaserMode::Off => false,
+            LaserMode::Dwell => !marking,
+            LaserMode::Auto => true,
+        };
+        out.act(Action::AllowGalvoLaser(allowed));
+        // Only a galvo loop computes halves ahead.
+        if !allowed && self.inputs.galvo_room.is_some() {
+            out.act(Action::ShutGate);
         }
     }
 
     /// `galvo status` lines.
-    pub(super) fn report_galvo_status(&self) {
-        let link = self.link;
-        let Some(galvo) = self.galvo else {
-            link.data(format_args!("galvo: not in this build"));
-            return;
-        };
-        let (phase, queued) = galvo.state();
+    pub(super) fn report_galvo_status(&self, galvo: &GalvoReadout, out: &mut dyn ActionSink) {
         let g = &self.settings.galvo;
-        link.data(format_args!("galvo: {phase:?}, {queued} points queued"));
-        link.data(format_args!(
-            "planner: {}, sample period {} us",
-            g.planner.name(),
-            Shortest(g.sample_period_us)
-        ));
-        link.data(format_args!(
-            "underruns: {}, half buffers: {}",
-            galvo.underruns.load(Ordering::Relaxed),
-            galvo.halves.load(Ordering::Relaxed)
-        ));
+        let (phase, queued) = (galvo.phase, galvo.queued);
+        self.data(
+            out,
+            format_args!("galvo: {phase:?}, {queued} points queued"),
+        );
+        self.data(
+            out,
+            format_args!(
+                "planner: {}, sample period {} us",
+                g.planner.name(),
+                Shortest(g.sample_period_us)
+            ),
+        );
+        self.data(
+            out,
+            format_args!(
+                "underruns: {}, half buffers: {}",
+                galvo.underruns, galvo.halves
+            ),
+        );
     }
 }

@@ -436,7 +436,7 @@ impl core::fmt::Display for PatternError {
 /// Whether the galvo can reach board point `point` (cm) within its DAC
 /// range.
 pub fn galvo_in_range(settings: &Settings, point: PointCm) -> bool {
-    let galvo = crate::galvo::config_from(&settings.galvo)
+    let galvo = super::galvo::config_from(&settings.galvo)
         .galvo
         .cast::<f64>();
     galvo

@@ -217,7 +217,6 @@ pub static PARAMS: &[ParamSpec] = &[
     err_coef!(83, "err.dy.c3", err_dy, 3),
     err_coef!(84, "err.dy.c4", err_dy, 4),
     err_coef!(85, "err.dy.c5", err_dy, 5),
-    #[cfg(feature = "galvo")]
     real!(
         100,
         "galvo.d_mm",
@@ -227,7 +226,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo Y mirror to board distance d, mm",
         |s| s.galvo.d_mm
     ),
-    #[cfg(feature = "galvo")]
     real!(
         101,
         "galvo.e_mm",
@@ -237,7 +235,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo mirror separation e, mm",
         |s| s.galvo.e_mm
     ),
-    #[cfg(feature = "galvo")]
     ParamSpec {
         id: 110,
         name: "galvo.x_codes_per_rad",
@@ -248,7 +245,6 @@ pub static PARAMS: &[ParamSpec] = &[
         help: "galvo X DAC codes/rad, |v| >= 1000, sign = direction",
         slot: Slot::Real(|s| &mut s.galvo.x_codes_per_rad),
     },
-    #[cfg(feature = "galvo")]
     real!(
         111,
         "galvo.x_offset_code",
@@ -258,7 +254,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo X DAC code at angle 0",
         |s| s.galvo.x_offset_code
     ),
-    #[cfg(feature = "galvo")]
     ParamSpec {
         id: 112,
         name: "galvo.y_codes_per_rad",
@@ -269,7 +264,6 @@ pub static PARAMS: &[ParamSpec] = &[
         help: "galvo Y DAC codes/rad, |v| >= 1000, sign = direction",
         slot: Slot::Real(|s| &mut s.galvo.y_codes_per_rad),
     },
-    #[cfg(feature = "galvo")]
     real!(
         113,
         "galvo.y_offset_code",
@@ -279,7 +273,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo Y DAC code at angle 0",
         |s| s.galvo.y_offset_code
     ),
-    #[cfg(feature = "galvo")]
     real!(
         120,
         "galvo.kt_nm_per_a",
@@ -288,7 +281,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo motor torque constant Kt, N*m/A",
         |s| s.galvo.kt_nm_per_a
     ),
-    #[cfg(feature = "galvo")]
     real!(
         121,
         "galvo.j_kg_m2",
@@ -297,7 +289,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo rotor+mirror inertia J, kg*m^2",
         |s| s.galvo.j_kg_m2
     ),
-    #[cfg(feature = "galvo")]
     real!(
         122,
         "galvo.l_h",
@@ -306,7 +297,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo coil inductance L, H",
         |s| s.galvo.l_h
     ),
-    #[cfg(feature = "galvo")]
     real!(
         123,
         "galvo.r_ohm",
@@ -315,7 +305,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo coil resistance R, ohm",
         |s| s.galvo.r_ohm
     ),
-    #[cfg(feature = "galvo")]
     real!(
         124,
         "galvo.u_max_v",
@@ -324,7 +313,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo drive voltage limit Umax, V",
         |s| s.galvo.u_max_v
     ),
-    #[cfg(feature = "galvo")]
     real!(
         125,
         "galvo.ts_us",
@@ -333,7 +321,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo DAC sample period, us",
         |s| s.galvo.sample_period_us
     ),
-    #[cfg(feature = "galvo")]
     choice!(
         130,
         "galvo.planner",
@@ -342,7 +329,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo jump planner: 0 optimal, 1 seed",
         Slot::Planner
     ),
-    #[cfg(feature = "galvo")]
     real!(
         140,
         "galvo.laser_on_delay_us",
@@ -351,7 +337,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo hold before laser on after a jump, us",
         |s| s.galvo.laser_on_delay_us
     ),
-    #[cfg(feature = "galvo")]
     real!(
         141,
         "galvo.laser_off_delay_us",
@@ -360,7 +345,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo hold after laser off before a jump, us",
         |s| s.galvo.laser_off_delay_us
     ),
-    #[cfg(feature = "galvo")]
     real!(
         150,
         "galvo.mark_speed_mm_s",
@@ -369,7 +353,6 @@ pub static PARAMS: &[ParamSpec] = &[
         "galvo marking speed of paths, mm/s",
         |s| s.galvo.mark_speed_mm_s
     ),
-    #[cfg(feature = "galvo")]
     real!(
         151,
         "galvo.mark_accel_mm_s2",

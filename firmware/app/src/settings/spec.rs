@@ -15,8 +15,6 @@ pub(crate) enum Slot {
     Count(fn(&mut Settings) -> &mut u8),
     Sign(fn(&mut Settings) -> &mut i8),
     Laser,
-    // Only in builds with galvo output.
-    #[cfg_attr(not(feature = "galvo"), allow(dead_code))]
     Planner,
 }
 

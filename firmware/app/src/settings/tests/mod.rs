@@ -90,9 +90,8 @@ fn assert_usable(s: &Settings, what: &str) {
             assert!(survives_f32(v), "{what}: {} = {v} vanishes in f32", p.name);
         }
     }
-    #[cfg(feature = "galvo")]
     {
-        let c = crate::galvo::config_from(&s.galvo);
+        let c = crate::sequencer::config_from(&s.galvo);
         for dac in [c.galvo.dac_x, c.galvo.dac_y] {
             assert!(
                 dac.codes_per_rad.is_finite() && dac.codes_per_rad.abs() >= 1_000.0,

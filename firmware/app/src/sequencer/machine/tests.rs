@@ -1,0 +1,204 @@
+//! The core's event → action contract, one scenario each.
+
+extern crate std;
+
+use std::vec;
+use std::vec::Vec;
+
+use embassy_time::Instant;
+
+use super::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
+use crate::command::{Actuator, Command, GridPattern, Pattern, PointCm, reply_text};
+use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest, ScanPhase};
+use crate::sequencer::LaserEvent;
+use crate::servo::task::{ServoOutcome, ServoRequest};
+use crate::settings::LaserMode;
+use crate::status::{Activity, Phase};
+
+/// Whether a galvo loop serves the link.
+const GALVO: bool = true;
+const NO_GALVO: bool = false;
+
+const READINGS: Readings = Readings {
+    galvo: GalvoReadout {
+        phase: ScanPhase::Idle,
+        queued: 0,
+        underruns: 0,
+        halves: 0,
+    },
+    implausible_readings: 0,
+};
+
+fn on_with(core: &mut Core, ms: u64, galvo: bool, event: Event) -> Vec<Action> {
+    let inputs = Inputs {
+        now: Instant::from_millis(ms),
+        galvo_room: galvo.then_some(GALVO_REQUEST_DEPTH),
+    };
+    let mut out = Vec::new();
+    core.on(inputs, event, &mut out);
+    out
+}
+
+fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
+    on_with(core, ms, NO_GALVO, event)
+}
+
+fn command(core: &mut Core, ms: u64, command: Command, galvo: bool) -> Vec<Action> {
+    let readings = READINGS;
+    on_with(core, ms, galvo, Event::Command { command, readings })
+}
+
+fn move_seq(actions: &[Action]) -> Option<u32> {
+    actions.iter().find_map(|a| match a {
+        Action::Servo(ServoRequest::Move { seq, .. }) => Some(*seq),
+        _ => None,
+    })
+}
+
+fn error(text: &str) -> Action {
+    Action::Line(Line::Error(reply_text(format_args!("{text}"))))
+}
+
+#[test]
+fn a_goto_lights_after_the_arrival_holds_and_a_stop_darkens_everything() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let goto = Command::Goto(PointCm {
+        x_cm: 0.0,
+        y_cm: 0.0,
+    });
+    let started = command(&mut core, 10, goto, NO_GALVO);
+    assert_eq!(started[0], Action::Note(LaserEvent::RunStarted));
+    assert_eq!(started[1], Action::CloseGate);
+    assert_eq!(started[2], Action::Galvo(GalvoRequest::Stop));
+    assert_eq!(started.last(), Some(&Action::Line(Line::Ok)));
+    assert_eq!(core.status().phase, Some(Phase::Approaching));
+    assert!(!core.laser_on(), "travel to the target is dark");
+
+    let seq = move_seq(&started).expect("a servo move");
+    let arrived = ServoOutcome::Arrived {
+        seq,
+        yaw_tenths: 0,
+        pitch_tenths: 0,
+    };
+    let lit = on(&mut core, 500, Event::Servo(arrived));
+    assert!(lit.contains(&Action::GimbalLaser(true)));
+    assert_eq!(core.status().phase, Some(Phase::Dwelling));
+    let deadline = core.dwell_deadline().expect("a dwell");
+    assert!(deadline > Instant::from_millis(500));
+
+    on(&mut core, deadline.as_millis(), Event::DwellEnded);
+    assert_eq!(core.status().phase, Some(Phase::Holding));
+    assert_eq!(core.dwell_deadline(), None);
+    assert!(core.laser_on());
+
+    let stopped = command(&mut core, 2_000, Command::Stop, NO_GALVO);
+    assert_eq!(
+        stopped,
+        vec![
+            Action::Note(LaserEvent::Stopped {
+                why: "stop command"
+            }),
+            Action::CloseGate,
+            Action::Galvo(GalvoRequest::Stop),
+            Action::Line(Line::Ok),
+            Action::GimbalLaser(false),
+        ]
+    );
+    assert_eq!(core.status().activity, Activity::Idle);
+}
+
+#[test]
+fn galvo_commands_are_refused_while_no_galvo_loop_serves_the_link() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let no_galvo = error("this build has no galvo output");
+    for c in [
+        Command::Target(Actuator::Galvo),
+        Command::Target(Actuator::Both),
+        Command::GalvoStatus,
+    ] {
+        assert_eq!(command(&mut core, 1, c, NO_GALVO), vec![no_galvo.clone()]);
+    }
+    let gimbal = command(&mut core, 1, Command::Target(Actuator::Gimbal), NO_GALVO);
+    assert_eq!(gimbal.last(), Some(&Action::Line(Line::Ok)));
+    let galvo = command(&mut core, 1, Command::Target(Actuator::Galvo), GALVO);
+    assert!(galvo.iter().any(|a| matches!(a, Action::ConfigureGalvo(_))));
+    assert_eq!(galvo.last(), Some(&Action::Line(Line::Ok)));
+}
+
+#[test]
+fn a_pattern_check_yields_between_steps_and_replies_once_at_its_end() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let pattern = Command::Pattern {
+        pattern: Pattern::Grid(GridPattern::VisitAll),
+        once: true,
+    };
+    let mut actions = command(&mut core, 1, pattern, NO_GALVO);
+    let mut steps = 1;
+    while actions.last() == Some(&Action::Yield) {
+        assert!(
+            !actions.iter().any(|a| matches!(a, Action::Line(_))),
+            "no reply before the check ends"
+        );
+        assert_eq!(core.status().activity, Activity::Idle, "nothing starts yet");
+        actions = on(&mut core, 1, Event::CheckStep);
+        steps += 1;
+    }
+    assert!(steps > 1, "a check of many points takes several steps");
+    assert_eq!(actions.last(), Some(&Action::Line(Line::Ok)));
+    assert!(matches!(core.status().activity, Activity::Pattern(_)));
+}
+
+#[test]
+fn a_save_replies_with_the_stores_answer_and_is_refused_while_running() {
+    let mut core = Core::new(Instant::from_millis(0));
+    assert_eq!(
+        command(&mut core, 1, Command::Save, NO_GALVO),
+        vec![Action::Save]
+    );
+    assert_eq!(
+        on(&mut core, 2, Event::Saved(Err("flash full"))),
+        vec![error("flash full")]
+    );
+    assert!(
+        on(&mut core, 3, Event::Saved(Ok(()))).is_empty(),
+        "no save pending"
+    );
+    let goto = Command::Goto(PointCm {
+        x_cm: 0.0,
+        y_cm: 0.0,
+    });
+    command(&mut core, 4, goto, NO_GALVO);
+    assert_eq!(
+        command(&mut core, 5, Command::Save, NO_GALVO),
+        vec![error("stop the running pattern or goto before save")]
+    );
+}
+
+#[test]
+fn a_lost_gate_keeps_the_gimbal_laser_dark_until_the_next_run() {
+    let mut core = Core::new(Instant::from_millis(0));
+    command(&mut core, 0, Command::Laser(LaserMode::Auto), NO_GALVO);
+    let goto = Command::Goto(PointCm {
+        x_cm: 0.0,
+        y_cm: 0.0,
+    });
+    let started = command(&mut core, 1, goto, NO_GALVO);
+    let arrived = |seq| {
+        Event::Servo(ServoOutcome::Arrived {
+            seq,
+            yaw_tenths: 0,
+            pitch_tenths: 0,
+        })
+    };
+    on(&mut core, 2, arrived(move_seq(&started).unwrap_or(0)));
+    assert!(core.laser_on());
+    assert_eq!(
+        on(&mut core, 3, Event::GateLost),
+        vec![Action::GimbalLaser(false)]
+    );
+    assert!(on(&mut core, 3_000, Event::DwellEnded).is_empty());
+    assert!(!core.laser_on(), "dark while holding");
+    let again = command(&mut core, 4_000, goto, NO_GALVO);
+    on(&mut core, 4_500, arrived(move_seq(&again).unwrap_or(0)));
+    assert!(core.laser_on(), "a new run lights again");
+}

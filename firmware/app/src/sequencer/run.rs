@@ -1,0 +1,400 @@
+//! A run (a pattern or a goto) point by point: aim → servo move → arrival
+//! → dwell → next point, next pass, or the end.
+
+use embassy_time::{Duration, Instant};
+
+use super::faults;
+use super::laser::LaserEvent;
+use super::machine::{Action, ActionSink, Core};
+use super::targets::{self, Aim, PathCursor, Target};
+use crate::command::{GridPattern, Pattern, reply_text};
+use crate::log;
+use crate::servo::task::{ServoOutcome, ServoRequest};
+use crate::status::Phase;
+use crate::text::Fixed;
+
+/// What a command starts.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Start {
+    /// A goto or grid target, held until the next command.
+    Goto(Target),
+    /// A pattern, repeated until stopped unless `once`.
+    Pattern {
+        /// What runs.
+        pattern: Pattern,
+        /// A single pass.
+        once: bool,
+    },
+}
+
+/// What a run does, and where it is in its figure.
+#[derive(Debug, Clone, Copy)]
+#[allow(clippy::large_enum_variant)] // No heap: held in the core's state.
+pub(super) enum RunKind {
+    /// A goto or grid target, held until the next command.
+    Goto(Target),
+    /// A grid pattern, point `index` looked up in O(1).
+    Grid {
+        /// Which grid pattern.
+        pattern: GridPattern,
+        /// A single pass.
+        once: bool,
+    },
+    /// A path the gimbal (with or without the galvo) draws point by
+    /// point, `cursor` at the current point.
+    Path {
+        /// What runs.
+        pattern: Pattern,
+        /// A single pass.
+        once: bool,
+        /// The interpolator at the current point of this pass (O(1) next).
+        cursor: PathCursor,
+    },
+    /// A path the galvo alone marks, one job per pass.
+    Marked {
+        /// What runs.
+        pattern: Pattern,
+        /// A single pass.
+        once: bool,
+    },
+}
+
+impl RunKind {
+    /// The pattern that runs (`None`: a goto).
+    pub(super) fn pattern(&self) -> Option<Pattern> {
+        match *self {
+            RunKind::Goto(_) => None,
+            RunKind::Grid { pattern, .. } => Some(Pattern::Grid(pattern)),
+            RunKind::Path { pattern, .. } | RunKind::Marked { pattern, .. } => Some(pattern),
+        }
+    }
+
+    /// Whether the run ends after one pass (a goto holds instead).
+    pub(super) fn once(&self) -> bool {
+        match *self {
+            RunKind::Goto(_) => true,
+            RunKind::Grid { once, .. }
+            | RunKind::Path { once, .. }
+            | RunKind::Marked { once, .. } => once,
+        }
+    }
+
+    /// The name in logs and notices.
+    pub(super) fn name(&self) -> &'static str {
+        self.pattern().map_or("goto", |p| p.name())
+    }
+}
+
+/// An active pattern or goto.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Run {
+    pub(super) kind: RunKind,
+    /// Index of the current point within the pass.
+    pub(super) index: usize,
+    /// Completed passes.
+    pub(super) pass: u32,
+    pub(super) phase: Phase,
+    /// Servo move in flight.
+    pub(super) seq: u32,
+    /// End of the dwell.
+    pub(super) dwell_until: Option<Instant>,
+    /// The gimbal has not finished the current point (move + dwell).
+    pub(super) gimbal_busy: bool,
+    /// The galvo has not reported the current point done.
+    pub(super) galvo_busy: bool,
+    /// Request number of the galvo point in flight.
+    pub(super) galvo_seq: u32,
+}
+
+impl Run {
+    fn new(kind: RunKind) -> Self {
+        Self {
+            kind,
+            index: 0,
+            pass: 0,
+            phase: Phase::Moving,
+            seq: 0,
+            dwell_until: None,
+            gimbal_busy: false,
+            galvo_busy: false,
+            galvo_seq: 0,
+        }
+    }
+}
+
+impl Core {
+    /// Starts `start` at its first point.
+    pub(super) fn start(&mut self, start: Start, out: &mut dyn ActionSink) {
+        let (name, once) = match start {
+            Start::Goto(_) => ("goto", true),
+            Start::Pattern { pattern, once } => (pattern.name(), once),
+        };
+        log::info!("start {} (once={})", name, once);
+        out.act(Action::Note(LaserEvent::RunStarted));
+        // Nothing of an earlier run may shine: a new gate generation, and
+        // the galvo drops its points and an underrun latch.
+        self.close_gate(out);
+        self.run = None;
+        match self.run_kind(start) {
+            Some(kind) => {
+                self.run = Some(Run::new(kind));
+                self.begin_point(out);
+            }
+            None => {
+                log::info!("stop {} (pattern has no points)", name);
+                self.stop("pattern has no points", out);
+            }
+        }
+    }
+
+    /// How `start` runs on the current actuator; `None` when it has no
+    /// points (a path that cannot be interpolated, or one the gimbal
+    /// cannot draw).
+    fn run_kind(&self, start: Start) -> Option<RunKind> {
+        let (pattern, once) = match start {
+            Start::Goto(target) => return Some(RunKind::Goto(target)),
+            Start::Pattern { pattern, once } => (pattern, once),
+        };
+        if let Pattern::Grid(pattern) = pattern {
+            return Some(RunKind::Grid { pattern, once });
+        }
+        if self.actuator.uses_galvo() {
+            return (!self.actuator.uses_gimbal()).then_some(RunKind::Marked { pattern, once });
+        }
+        let cursor = self.path_cursor(&pattern)?;
+        Some(RunKind::Path {
+            pattern,
+            once,
+            cursor,
+        })
+    }
+
+    /// The cursor at the first point of a pass of `pattern` (`None` when
+    /// it cannot be interpolated).
+    fn path_cursor(&self, pattern: &Pattern) -> Option<PathCursor> {
+        PathCursor::start(pattern, &self.settings)?.ok()
+    }
+
+    /// Stops whatever runs — and, whatever the core thinks runs, the laser
+    /// and the galvo loop: the gate closes at once and the loop gets
+    /// `Stop`.
+    pub(super) fn stop(&mut self, why: &'static str, out: &mut dyn ActionSink) {
+        out.act(Action::Note(LaserEvent::Stopped { why }));
+        self.close_gate(out);
+        if let Some(run) = self.run.take() {
+            log::info!("stop {} ({})", run.kind.name(), why);
+        }
+    }
+
+    /// The target of the current point of the run (`None`: past the last
+    /// point, or a path the galvo marks whole).
+    fn current_target(&self) -> Option<Target> {
+        let run = self.run?;
+        match run.kind {
+            RunKind::Goto(target) => Some(target),
+            RunKind::Grid { pattern, .. } => {
+                targets::grid_target(&Pattern::Grid(pattern), run.index, &self.settings)
+            }
+            RunKind::Path { cursor, .. } => Some(cursor.target()),
+            RunKind::Marked { .. } => None,
+        }
+    }
+
+    /// Sends the current point to the actuator(s).
+    pub(super) fn begin_point(&mut self, out: &mut dyn ActionSink) {
+        let Some(run) = self.run else { return };
+        if let RunKind::Marked { pattern, .. } = run.kind {
+            self.begin_galvo_path(pattern, out);
+            return;
+        }
+        let Some(target) = self.current_target() else {
+            self.stop("pattern has no points", out);
+            return;
+        };
+        // Travel to the first point of a pass (or to a goto target) is off
+        // the figure: dark in every laser mode. A later pass of a closed
+        // figure starts where the last one ended (arrived there): no travel.
+        let holds = matches!(run.kind, RunKind::Goto(_));
+        let closed = run.pass > 0 && self.last_aim.is_some_and(|(t, _)| t.point == target.point);
+        let approach = holds || (run.index == 0 && !closed);
+        let (gimbal, galvo) = (self.actuator.uses_gimbal(), self.actuator.uses_galvo());
+        let gimbal_started = !gimbal || self.begin_gimbal_move(target, out);
+        let galvo_started = gimbal_started && (!galvo || self.begin_galvo_point(target, out));
+        if !(gimbal_started && galvo_started) {
+            return;
+        }
+        if let Some(run) = self.run.as_mut() {
+            run.phase = if approach {
+                Phase::Approaching
+            } else {
+                Phase::Moving
+            };
+            run.dwell_until = None;
+            run.gimbal_busy = gimbal;
+            // A goto's galvo holds the point, laser on, until the next
+            // command: nothing to wait for.
+            run.galvo_busy = galvo && !holds;
+        }
+        self.point_finished_if_done(out);
+    }
+
+    /// Aims the gimbal at `target` and sends the servo move; on an
+    /// unreachable target stops with an error notice.
+    fn begin_gimbal_move(&mut self, target: Target, out: &mut dyn ActionSink) -> bool {
+        let aim = match targets::aim(&self.settings, self.model, target.point) {
+            Ok(aim) => aim,
+            Err(e) => {
+                let why = reply_text(format_args!("{e}"));
+                log::warning!("target unreachable: {}", why.as_str());
+                // What happened first: the reason may be cut at the
+                // reply line length.
+                let name = self.run.map_or("goto", |r| r.kind.name());
+                self.notify(
+                    out,
+                    format_args!(
+                        "error: {name} stopped, laser off: point ({}, {}) cm unreachable: {}",
+                        Fixed::<2>(target.point.x_cm),
+                        Fixed::<2>(target.point.y_cm),
+                        why
+                    ),
+                );
+                self.stop("unreachable target", out);
+                return false;
+            }
+        };
+        let interval_ms = self.move_interval_ms(&aim);
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let seq = self.next_seq;
+        out.act(Action::Servo(ServoRequest::Move {
+            seq,
+            yaw_tenths: aim.yaw_wire,
+            pitch_tenths: aim.pitch_wire,
+            interval_ms,
+            ids: (self.settings.yaw.id, self.settings.pitch.id),
+            deadband_tenths: (self.settings.deadband_deg * 10.0) as u16,
+            ranges_tenths: faults::servo_ranges_tenths(&self.settings),
+        }));
+        out.act(Action::Note(LaserEvent::GimbalMoveSent));
+        log::info!(
+            "target ({}, {}) cm -> servo {} {} (0.1 deg) over {} ms",
+            target.point.x_cm,
+            target.point.y_cm,
+            aim.yaw_wire,
+            aim.pitch_wire,
+            interval_ms
+        );
+        if let Some(run) = self.run.as_mut() {
+            run.seq = seq;
+        }
+        self.last_aim = Some((target, aim));
+        true
+    }
+
+    /// Travel time for a move at the configured speed, from the largest
+    /// joint change (at least 20 ms, the SDK's minimum ramp).
+    fn move_interval_ms(&self, aim: &Aim) -> u16 {
+        let (from_yaw, from_pitch) = self
+            .measured
+            .or(self.last_aim.map(|(_, a)| (a.yaw_wire, a.pitch_wire)))
+            .unwrap_or((0, 0));
+        let travel_tenths = (i32::from(aim.yaw_wire) - i32::from(from_yaw))
+            .abs()
+            .max((i32::from(aim.pitch_wire) - i32::from(from_pitch)).abs());
+        let travel_deg = f64::from(travel_tenths) / 10.0;
+        let ms = 1000.0 * travel_deg / self.settings.servo_speed_deg_s;
+        (ms as u32).clamp(20, u32::from(u16::MAX)) as u16
+    }
+
+    /// The servo task's report.
+    pub(super) fn servo_outcome(&mut self, outcome: ServoOutcome, out: &mut dyn ActionSink) {
+        match outcome {
+            ServoOutcome::Recovered { id } => self.servo_recovered(id, out),
+            ServoOutcome::Arrived {
+                seq,
+                yaw_tenths,
+                pitch_tenths,
+            } => self.arrived(seq, (yaw_tenths, pitch_tenths), out),
+            ServoOutcome::Fault { seq, id, fault } => self.servo_fault(seq, id, fault, out),
+            ServoOutcome::Superseded { .. } => {}
+        }
+    }
+
+    /// Both servos arrived at move `seq`, measured at `tenths` (yaw,
+    /// pitch; 0.1°): the dwell starts when it is the current move.
+    fn arrived(&mut self, seq: u32, tenths: (i16, i16), out: &mut dyn ActionSink) {
+        self.measured = Some(tenths);
+        // Both servos answered and arrived: they are alive.
+        self.faults
+            .arrived(self.settings.yaw.id, self.settings.pitch.id);
+        let now = self.inputs.now;
+        let dwell_ms = self.settings.dwell_ms;
+        let Some(run) = self.run.as_mut().filter(|r| r.seq == seq) else {
+            return;
+        };
+        run.phase = Phase::Dwelling;
+        out.act(Action::Note(LaserEvent::GimbalArrived));
+        let dwell = if run.kind.pattern().is_some_and(|p| p.is_path()) {
+            0.0
+        } else {
+            dwell_ms
+        };
+        run.dwell_until = Some(now.saturating_add(Duration::from_micros((dwell * 1000.0) as u64)));
+        log::info!("arrived (servo {} {})", tenths.0, tenths.1);
+    }
+
+    /// The dwell on the current point ended: next point, next pass, or done.
+    pub(super) fn dwell_finished(&mut self, out: &mut dyn ActionSink) {
+        if let Some(run) = self.run.as_mut() {
+            run.dwell_until = None;
+            run.gimbal_busy = false;
+        }
+        self.point_finished_if_done(out);
+    }
+
+    /// When every actuator is done with the current point: the next
+    /// point, the next pass, the end — or, for a goto, holding.
+    pub(super) fn point_finished_if_done(&mut self, out: &mut dyn ActionSink) {
+        let Some(mut run) = self.run else { return };
+        if run.gimbal_busy || run.galvo_busy {
+            return;
+        }
+        run.index += 1;
+        let more = match &mut run.kind {
+            RunKind::Goto(_) => {
+                // A goto holds its point until the next command.
+                if let Some(run) = self.run.as_mut() {
+                    run.phase = Phase::Holding;
+                }
+                return;
+            }
+            RunKind::Grid { pattern, .. } => {
+                targets::grid_target(&Pattern::Grid(*pattern), run.index, &self.settings).is_some()
+            }
+            RunKind::Path { cursor, .. } => cursor.advance(),
+            RunKind::Marked { .. } => false,
+        };
+        if !more {
+            run.pass += 1;
+            run.index = 0;
+            if run.kind.once() {
+                self.run = Some(run);
+                self.stop("pattern complete", out);
+                return;
+            }
+            // A new pass takes the path parameters as they are now.
+            if let RunKind::Path {
+                pattern, cursor, ..
+            } = &mut run.kind
+            {
+                let Some(start) = self.path_cursor(pattern) else {
+                    self.run = Some(run);
+                    self.stop("pattern has no points", out);
+                    return;
+                };
+                *cursor = start;
+            }
+        }
+        self.run = Some(run);
+        self.begin_point(out);
+    }
+}
