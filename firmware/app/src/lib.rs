@@ -11,11 +11,14 @@
 //! [`text`]), parameters in [`settings`], shared
 //! state for LEDs/watchdog/simulator in [`status`], the master laser gate
 //! that no laser command or sample stream can override in [`laser_gate`].
+//! The grbl 1.1 G-code protocol (realtime bytes, G-code parser, replies),
+//! pure and not yet wired to the console or a motion queue, is [`grbl`].
 
 pub mod build_info;
 pub mod cli;
 pub mod command;
 pub mod galvo;
+pub mod grbl;
 pub mod laser_gate;
 mod log;
 pub mod outbound;
