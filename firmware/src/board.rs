@@ -1,12 +1,13 @@
 //! Board layer for the STM32F4DISCOVERY (STM32F407VG): clocks and every pin
-//! choice in one place. Porting to another STM32 means changing this file
-//! (and `memory.x`).
+//! choice in one place, and the [`Board`] the application is wired onto
+//! (`laser_app::app::wire`). Porting to another STM32 means changing this
+//! file, `parts.rs` (and `memory.x`).
 //!
 //! | function            | pin(s)            |
 //! |---------------------|-------------------|
 //! | USB OTG FS (CDC-ACM)| PA11 DM, PA12 DP  |
 //! | servo bus USART2    | PA2 TX, PA3 RX    |
-//! | galvo DAC1 X / Y    | PA4 / PA5         |
+//! | galvo DAC1 X / Y    | PA4 / PA5 (not driven yet: no galvo DAC stream, no galvo loop) |
 //! | laser enable        | PB0 (active high) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
@@ -14,21 +15,24 @@
 //! Flash: the image in sectors 0–5 (≤ 256 KiB), the saved settings in
 //! sectors 10 and 11 (`settings_flash`, `memory.x`).
 
+use embassy_executor::Spawner;
 use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::flash::{self, Flash};
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
 use embassy_stm32::mode::Async;
-use embassy_stm32::peripherals::IWDG;
+use embassy_stm32::peripherals::{DMA1_CH5, DMA1_CH6, PA2, PA3, PA11, PA12, USART2, USB_OTG_FS};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
 use embassy_stm32::{Peri, bind_interrupts, dma, exti, pac, peripherals, usb};
+use embassy_time::Instant;
 use embassy_usb::UsbDevice;
-use embassy_usb::class::cdc_acm::{BufferedReceiver, CdcAcmClass, Sender, State};
+use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
+use laser_app::app::{Board, NoGalvoDac, Parts};
 use laser_app::laser_gate::{GateState, LaserGate};
 use static_cell::StaticCell;
 
+use crate::parts::{IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::{FlashSettings, settings_store};
-use crate::tasks::{LaserPin, UsbDriver};
 
 bind_interrupts!(struct Irqs {
     OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
@@ -90,36 +94,56 @@ pub fn laser_gate_changed(state: GateState) {
     }
 }
 
-/// Everything the tasks need, configured.
-pub struct Board {
+/// The board's parts, configured (laser off).
+pub struct Stm32Board {
     /// Laser enable (PB0), low.
     pub laser: LaserPin,
-    /// USB device stack.
-    pub usb_device: UsbDevice<'static, UsbDriver>,
-    /// CDC-ACM transmit half.
-    pub usb_tx: Sender<'static, UsbDriver>,
-    /// CDC-ACM receive half (buffered).
-    pub usb_rx: BufferedReceiver<'static, UsbDriver>,
+    /// The command line on USB CDC-ACM.
+    pub console: UsbConsole,
     /// Servo UART transmit (DMA).
     pub servo_tx: UartTx<'static, Async>,
     /// Servo UART receive (DMA ring buffer).
     pub servo_rx: RingBufferedUartRx<'static>,
-    /// Heartbeat LED (PD12).
-    pub heartbeat_led: Output<'static>,
-    /// Laser LED (PD13).
-    pub laser_led: Output<'static>,
-    /// Fault LED (PD14).
-    pub fault_led: Output<'static>,
+    /// Heartbeat, laser and fault LEDs (PD12–PD14).
+    pub leds: StatusLeds,
     /// User button (PA0).
-    pub button: ExtiInput<'static, Async>,
+    pub button: UserButton,
     /// Settings store (flash sectors 10 and 11).
     pub settings: FlashSettings,
-    /// Independent watchdog.
-    pub iwdg: Peri<'static, IWDG>,
+    /// Independent watchdog (not started).
+    pub watchdog: IndependentDog,
 }
 
-/// Brings the board up: laser off first, then clocks and peripherals.
-pub fn init() -> Board {
+impl Board for Stm32Board {
+    type Console = UsbConsole;
+    type ServoRx = RingBufferedUartRx<'static>;
+    type ServoTx = UartTx<'static, Async>;
+    type Laser = LaserPin;
+    type Settings = FlashSettings;
+    // The DAC1 output is not wired yet (see README, Status).
+    type GalvoDac = NoGalvoDac;
+    type Indicators = StatusLeds;
+    type StopButton = UserButton;
+    type Watchdog = IndependentDog;
+
+    fn into_parts(self) -> Parts<Self> {
+        Parts {
+            console: self.console,
+            servo_rx: self.servo_rx,
+            servo_tx: self.servo_tx,
+            laser: self.laser,
+            settings: self.settings,
+            galvo_dac: None,
+            indicators: self.leds,
+            stop_button: self.button,
+            watchdog: self.watchdog,
+        }
+    }
+}
+
+/// Brings the board up: laser off first, then clocks and peripherals; the
+/// USB device stack runs as a task of its own from here on.
+pub fn init(spawner: Spawner) -> Stm32Board {
     let p = embassy_stm32::init(clock_config());
     // Laser off before anything else can run.
     let laser = LaserPin {
@@ -133,20 +157,40 @@ pub fn init() -> Board {
         laser_app::build_info::GIT_REV,
         SYSCLK_HZ / 1_000_000
     );
+    let (usb_device, console) = usb_console(p.USB_OTG_FS, p.PA12, p.PA11);
+    spawner.spawn(defmt::unwrap!(crate::tasks::usb_device(usb_device)));
+    let (servo_tx, servo_rx) = servo_uart(p.USART2, p.PA3, p.PA2, p.DMA1_CH6, p.DMA1_CH5);
+    Stm32Board {
+        laser,
+        console,
+        servo_tx,
+        servo_rx,
+        leds: StatusLeds {
+            heartbeat: Output::new(p.PD12, Level::Low, Speed::Low),
+            laser: Output::new(p.PD13, Level::Low, Speed::Low),
+            fault: Output::new(p.PD14, Level::Low, Speed::Low),
+        },
+        button: UserButton {
+            input: ExtiInput::new(p.PA0, p.EXTI0, Pull::Down, Irqs),
+            armed_from: Instant::MIN,
+        },
+        settings: settings_store(Flash::new(p.FLASH, Irqs)),
+        watchdog: IndependentDog::new(p.IWDG),
+    }
+}
 
-    // USB CDC-ACM on OTG FS (PA12 DP, PA11 DM).
+/// USB CDC-ACM on OTG FS (PA12 DP, PA11 DM): the device stack and the
+/// console port.
+fn usb_console(
+    otg: Peri<'static, USB_OTG_FS>,
+    dp: Peri<'static, PA12>,
+    dm: Peri<'static, PA11>,
+) -> (UsbDevice<'static, UsbDriver>, UsbConsole) {
     static EP_OUT_BUFFER: StaticCell<[u8; 256]> = StaticCell::new();
     let mut usb_config = usb::Config::default();
     // VBUS sensing (PA9) is not needed: the board is powered from USB.
     usb_config.vbus_detection = false;
-    let driver = usb::Driver::new_fs(
-        p.USB_OTG_FS,
-        Irqs,
-        p.PA12,
-        p.PA11,
-        EP_OUT_BUFFER.init([0; 256]),
-        usb_config,
-    );
+    let driver = usb::Driver::new_fs(otg, Irqs, dp, dm, EP_OUT_BUFFER.init([0; 256]), usb_config);
     let mut device_config = embassy_usb::Config::new(0xc0de, 0xcafe);
     device_config.manufacturer = Some("laser-pointer");
     device_config.product = Some("Laser pointing controller");
@@ -169,47 +213,27 @@ pub fn init() -> Board {
     );
     let class = CdcAcmClass::new(&mut builder, CDC_STATE.init(State::new()), USB_PACKET_BYTES);
     let device = builder.build();
-    let (usb_tx, usb_rx) = class.split();
-    let usb_rx = usb_rx.into_buffered(USB_RX_BUFFER.init([0; USB_PACKET_BYTES as usize]));
+    let (tx, rx) = class.split();
+    let rx = rx.into_buffered(USB_RX_BUFFER.init([0; USB_PACKET_BYTES as usize]));
+    (device, UsbConsole { tx, rx })
+}
 
-    // Servo bus: USART2 (PA2 TX, PA3 RX), DMA1 stream 6 (TX) / 5 (RX).
+/// Servo bus: USART2 (PA2 TX, PA3 RX), DMA1 stream 6 (TX) / 5 (RX).
+fn servo_uart(
+    usart: Peri<'static, USART2>,
+    rx_pin: Peri<'static, PA3>,
+    tx_pin: Peri<'static, PA2>,
+    tx_dma: Peri<'static, DMA1_CH6>,
+    rx_dma: Peri<'static, DMA1_CH5>,
+) -> (UartTx<'static, Async>, RingBufferedUartRx<'static>) {
     let mut uart_config = usart::Config::default();
     uart_config.baudrate = SERVO_BAUD;
     static SERVO_RX_DMA: StaticCell<[u8; 256]> = StaticCell::new();
-    let (servo_tx, servo_rx) = match Uart::new(
-        p.USART2,
-        p.PA3,
-        p.PA2,
-        p.DMA1_CH6,
-        p.DMA1_CH5,
-        Irqs,
-        uart_config,
-    ) {
+    match Uart::new(usart, rx_pin, tx_pin, tx_dma, rx_dma, Irqs, uart_config) {
         Ok(uart) => {
             let (tx, rx) = uart.split();
             (tx, rx.into_ring_buffered(SERVO_RX_DMA.init([0; 256])))
         }
         Err(_) => defmt::panic!("USART2 configuration rejected"),
-    };
-
-    let heartbeat_led = Output::new(p.PD12, Level::Low, Speed::Low);
-    let laser_led = Output::new(p.PD13, Level::Low, Speed::Low);
-    let fault_led = Output::new(p.PD14, Level::Low, Speed::Low);
-    let button = ExtiInput::new(p.PA0, p.EXTI0, Pull::Down, Irqs);
-    let settings = settings_store(Flash::new(p.FLASH, Irqs));
-
-    Board {
-        laser,
-        usb_device: device,
-        usb_tx,
-        usb_rx,
-        servo_tx,
-        servo_rx,
-        heartbeat_led,
-        laser_led,
-        fault_led,
-        button,
-        settings,
-        iwdg: p.IWDG,
     }
 }

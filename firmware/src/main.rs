@@ -1,20 +1,25 @@
 //! Laser pointing controller firmware for the STM32F4DISCOVERY.
 //!
-//! `board::init` brings up clocks and peripherals (laser off first); the
-//! tasks are wired as the dataflow goes: USB device + console → command
-//! channel → sequencer → servo task (USART2); LEDs, stop button and
-//! watchdog alongside.
+//! `board::init` brings up clocks and peripherals (laser off first) and
+//! starts the USB device stack; `laser_app::app::wire` then builds the
+//! application's tasks from the board's parts — the same wiring the host
+//! simulator runs: console → command channel → sequencer → servo bus
+//! (USART2); LEDs, stop button and watchdog alongside. This board has no
+//! galvo DAC output yet, so no galvo loop runs.
 #![no_std]
 #![no_main]
 
 mod board;
 mod panic;
+mod parts;
 mod settings_flash;
 mod tasks;
 
 use defmt_rtt as _;
 use embassy_executor::Spawner;
+use laser_app::app::{Links, wire};
 use laser_app::command::CommandLink;
+use laser_app::galvo::GalvoLink;
 use laser_app::servo::task::ServoLink;
 use laser_app::status::StatusBoard;
 
@@ -22,40 +27,20 @@ use laser_app::status::StatusBoard;
 static COMMAND_LINK: CommandLink = CommandLink::new();
 /// Sequencer ↔ servo task channels.
 static SERVO_LINK: ServoLink = ServoLink::new();
+/// Sequencer ↔ galvo loop channels (no loop serves them on this board).
+static GALVO_LINK: GalvoLink = GalvoLink::new();
 /// Shared state for LEDs and the watchdog.
 static STATUS: StatusBoard = StatusBoard::new();
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
-    let b = board::init();
-    spawner.spawn(defmt::unwrap!(tasks::usb_device(b.usb_device)));
-    spawner.spawn(defmt::unwrap!(tasks::usb_console(
-        b.usb_tx,
-        b.usb_rx,
-        &COMMAND_LINK
-    )));
-    spawner.spawn(defmt::unwrap!(tasks::servo(
-        b.servo_tx,
-        b.servo_rx,
-        &SERVO_LINK
-    )));
-    spawner.spawn(defmt::unwrap!(tasks::sequencer(
-        &COMMAND_LINK,
-        &SERVO_LINK,
-        &STATUS,
-        b.laser,
-        b.settings,
-    )));
-    spawner.spawn(defmt::unwrap!(tasks::leds(
-        b.heartbeat_led,
-        b.laser_led,
-        b.fault_led,
-        &STATUS
-    )));
-    spawner.spawn(defmt::unwrap!(tasks::stop_button(b.button, &COMMAND_LINK)));
-    spawner.spawn(defmt::unwrap!(tasks::watchdog(
-        b.iwdg,
-        &STATUS,
-        &SERVO_LINK
-    )));
+    let board = board::init(spawner);
+    let links = Links {
+        command: &COMMAND_LINK,
+        servo: &SERVO_LINK,
+        galvo: &GALVO_LINK,
+        status: &STATUS,
+        gate: &board::LASER_GATE,
+    };
+    wire(board, links, &mut tasks::TaskSpawner(spawner));
 }

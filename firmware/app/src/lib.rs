@@ -13,7 +13,10 @@
 //! that no laser command or sample stream can override in [`laser_gate`].
 //! The grbl 1.1 G-code protocol (realtime bytes, G-code parser, replies),
 //! pure and not yet wired to the console or a motion queue, is [`grbl`].
+//! On top, [`app`] says what a board provides and wires every task once,
+//! for the target and the simulator alike.
 
+pub mod app;
 pub mod build_info;
 pub mod cli;
 pub mod command;

@@ -395,33 +395,42 @@ fn settle(galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
     }
 }
 
-/// Measures every half of a job: `<id>.steady` is the dearest half that
-/// starts and ends in `steady` (the per-sample figure), `<id>.refill` the
-/// dearest half of the job after the first `skip` halves.
+/// Measures every half of a job as `GalvoLoop::run` runs it: the prep
+/// stage between halves, then the refill. `<id>.steady` is the dearest
+/// refill that starts and ends in `steady` (the per-sample figure),
+/// `<id>.refill` the dearest refill of the job, `<id>.prep` the dearest
+/// prep call that prepared a step (per step).
 fn job_halves(
     b: &mut Bench,
     id: &str,
     galvo: &mut GalvoLoop,
     half: &mut [DacSample; HALF],
     steady: ScanPhase,
-    skip: usize,
 ) {
     let (mut steady_max, mut refill_max, mut steady_seen) = (0u32, 0u32, false);
-    for n in 0..20_000usize {
+    let mut prep_max: Option<(u32, u32)> = None;
+    let unprepared = galvo.unprepared_samples();
+    for _ in 0..20_000usize {
         let before = galvo.phase();
         if before == ScanPhase::Idle && galvo.queued_points() == 0 {
             break;
         }
-        let ticks = window(|| galvo.fill(half, |_| {}));
-        if n >= skip {
-            refill_max = refill_max.max(ticks);
+        let mut steps = 0;
+        let ticks = window(|| steps = galvo.prep());
+        if steps > 0 && prep_max.is_none_or(|(t, n)| ticks / steps as u32 > t / n) {
+            prep_max = Some((ticks, steps as u32));
         }
+        let ticks = window(|| galvo.refill(half, |_| {}));
+        refill_max = refill_max.max(ticks);
         if before == steady && galvo.phase() == steady {
             steady_max = steady_max.max(ticks);
             steady_seen = true;
         }
     }
     let mut name: heapless_name::Name = heapless_name::Name::new();
+    if galvo.unprepared_samples() != unprepared {
+        return b.fail(id, "the refill waited for an unprepared step");
+    }
     if steady_seen {
         name.set(id, ".steady");
         b.report(name.as_str(), steady_max, HALF as u32);
@@ -430,6 +439,11 @@ fn job_halves(
     }
     name.set(id, ".refill");
     b.report(name.as_str(), refill_max, 1);
+    name.set(id, ".prep");
+    match prep_max {
+        Some((ticks, steps)) => b.report(name.as_str(), ticks, steps),
+        None => b.fail(id, "nothing prepared"),
+    }
 }
 
 mod heapless_name {
@@ -556,13 +570,14 @@ fn loop_halves(b: &mut Bench) {
             b.fail(id, refused);
             continue;
         }
-        job_halves(b, id, &mut galvo, &mut half, ScanPhase::Marking, 0);
+        job_halves(b, id, &mut galvo, &mut half, ScanPhase::Marking);
     }
 
-    // Jumping (−80, −80) → (80, 80) mm. The refill that starts the job
-    // plans the jump (`loop.jump.refill`); `loop.jump.steady` covers the
-    // jump's samples after the planning one, counted on one run and
-    // measured on an identical one (the loop is deterministic).
+    // Jumping (−80, −80) → (80, 80) mm, as `GalvoLoop::run` does it: the
+    // prep stage plans the jump (`loop.jump.prep`) before the refill that
+    // starts it (`loop.jump.refill`); `loop.jump.steady` covers the jump's
+    // samples after that refill's first, counted on one run and measured
+    // on an identical one (the loop is deterministic).
     let jumping = |half: &mut [DacSample; HALF]| {
         let mut galvo = GalvoLoop::new(config)?;
         for (seq, [x_mm, y_mm]) in [(200, [-80.0, -80.0]), (201, [80.0, 80.0])] {
@@ -586,17 +601,28 @@ fn loop_halves(b: &mut Bench) {
     let (Ok(mut first), Ok(mut counted), Ok(mut measured)) = runs else {
         return b.fail("loop.jump", "setup");
     };
-    let ticks = window(|| first.fill(&mut half, |_| {}));
+    let mut steps = 0;
+    let ticks = window(|| steps = first.prep());
+    if steps != 1 {
+        return b.fail("loop.jump.prep", ("steps", steps));
+    }
+    b.report("loop.jump.prep", ticks, 1);
+    let ticks = window(|| first.refill(&mut half, |_| {}));
+    if first.unprepared_samples() != 0 {
+        return b.fail("loop.jump.refill", "unprepared");
+    }
     b.report("loop.jump.refill", ticks, 1);
-    counted.fill(&mut half[..1], |_| {});
+    counted.prep();
+    measured.prep();
+    counted.refill(&mut half[..1], |_| {});
     let mut n = 0usize;
     while counted.phase() == ScanPhase::Jumping && n < HALF {
-        counted.fill(&mut half[..1], |_| {});
+        counted.refill(&mut half[..1], |_| {});
         n += 1;
     }
-    measured.fill(&mut half[..1], |_| {});
+    measured.refill(&mut half[..1], |_| {});
     let n = n.max(1);
-    let ticks = window(|| measured.fill(&mut half[..n], |_| {}));
+    let ticks = window(|| measured.refill(&mut half[..n], |_| {}));
     b.report("loop.jump.steady", ticks, n as u32);
 }
 

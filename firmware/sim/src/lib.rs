@@ -2,6 +2,7 @@
 //! bodies (from `laser-app`) on embassy's executor in virtual time, against
 //! simulated FashionStar servos and galvos, and records where the laser went.
 
+pub mod board;
 pub mod clock;
 pub mod dac;
 pub mod drawing;
@@ -9,12 +10,14 @@ pub mod executor;
 pub mod flash;
 pub mod laser;
 pub mod logger;
+pub mod panel;
 pub mod physics;
 pub mod recorder;
 pub mod safety;
 pub mod script;
 pub mod servo_model;
 pub mod servo_port;
+pub mod spot;
 pub mod usb_host;
 pub mod world;
 

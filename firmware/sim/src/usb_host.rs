@@ -10,14 +10,16 @@
 use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
+use embassy_executor::Spawner;
 use embassy_futures::select::{Either, select};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::pipe::Pipe;
 use embassy_sync::signal::Signal;
 use embassy_time::Timer;
 
+use crate::executor::{self, TaskKind};
+use crate::panel::ButtonContacts;
 use crate::script::Step;
-use laser_app::command::CommandLink;
 
 /// Host → firmware bytes.
 pub type ToDevice = Pipe<CriticalSectionRawMutex, 256>;
@@ -101,13 +103,13 @@ impl UsbHost {
     }
 }
 
-/// Runs one script step; `@button` presses `button`'s stop request (the
-/// interactive terminal has no button).
-async fn run_step(host: &UsbHost, step: Step, button: Option<&CommandLink>) {
+/// Runs one script step; `@button` presses `button` (the interactive
+/// terminal has no button).
+async fn run_step(host: &UsbHost, step: Step, button: Option<&ButtonContacts>) {
     match step {
         Step::StopButton => {
-            if let Some(link) = button {
-                link.stop_request.signal(());
+            if let Some(button) = button {
+                button.press();
             }
         }
         Step::WaitMs(ms) => Timer::after_millis(ms).await,
@@ -121,10 +123,10 @@ async fn run_step(host: &UsbHost, step: Step, button: Option<&CommandLink>) {
 }
 
 /// Types the script: each command line, then waits for its closing reply;
-/// `@button` steps press the board's stop button (`link`'s stop request).
-pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, link: &CommandLink) {
+/// `@button` steps press the board's stop `button`.
+pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, button: Rc<ButtonContacts>) {
     for step in steps {
-        run_step(&host, step, Some(link)).await;
+        run_step(&host, step, Some(&button)).await;
     }
     host.replies_read().await;
     host.transcript.borrow_mut().script_done = true;
@@ -146,6 +148,48 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
         }
     }
     host.transcript.borrow_mut().script_done = true;
+}
+
+/// Starts the simulated host: the script (or the interactive terminal)
+/// typing (from stdin when `interactive`), and the terminal reading;
+/// `@button` presses `button`.
+pub fn host_tasks(
+    interactive: bool,
+    script: Vec<Step>,
+    host: Rc<UsbHost>,
+    button: Rc<ButtonContacts>,
+) -> impl FnOnce(&Spawner) + 'static {
+    move |spawner| {
+        if interactive {
+            let (send, lines) = std::sync::mpsc::channel();
+            std::thread::spawn(move || {
+                for line in std::io::stdin().lines().map_while(Result::ok) {
+                    if send.send(line).is_err() {
+                        break;
+                    }
+                }
+            });
+            executor::spawn_task(
+                spawner,
+                "host (interactive)",
+                TaskKind::Simulator,
+                interactive_task(lines, host.clone()),
+            );
+        } else {
+            executor::spawn_task(
+                spawner,
+                "host (script)",
+                TaskKind::Simulator,
+                script_task(script, host.clone(), button),
+            );
+        }
+        executor::spawn_task(
+            spawner,
+            "host (terminal)",
+            TaskKind::Simulator,
+            terminal_task(host),
+        );
+    }
 }
 
 /// Types one command line (its reply is then outstanding).
@@ -249,8 +293,8 @@ mod tests {
             false,
             10_000_000,
             move |spawner| {
-                let link: &'static CommandLink = Box::leak(Box::new(CommandLink::new()));
-                executor::spawn(&spawner, script_task(steps, h1, link));
+                let button = Rc::new(ButtonContacts::default());
+                executor::spawn(&spawner, script_task(steps, h1, button));
                 executor::spawn(&spawner, terminal_task(h2));
                 executor::spawn(&spawner, echo_ok_device(h3));
             },

@@ -1,35 +1,38 @@
-//! Assembles a simulation: the firmware's task bodies (console, sequencer,
-//! servo task — the same code the target runs) wired to a simulated USB
-//! host, simulated FashionStar servos on a simulated UART, a recording
-//! laser, and a sampler that follows the laser spot.
+//! Assembles a simulation: the simulated board ([`crate::board`]: a
+//! simulated USB host's pipes, simulated FashionStar servos on a simulated
+//! UART, a recording laser, a simulated galvo DAC, recorded LEDs, button
+//! and watchdog) wired to the firmware's task bodies by the same function
+//! the target calls ([`laser_app::app::wire`]), and a sampler that follows
+//! the laser spot.
 
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use embassy_time::Timer;
 use std::sync::atomic::Ordering;
 
+use embassy_executor::Spawner;
+use laser_app::app::{Links, wire};
 use laser_app::command::CommandLink;
-use laser_app::galvo::{GalvoConfig, GalvoLink, GalvoLoop};
-use laser_app::sequencer::{LaserEvent, LaserSwitch, Sequencer, SettingsStore};
-use laser_app::servo::task::{ServoBus, ServoBusConfig, ServoLink};
+use laser_app::galvo::{GalvoConfig, GalvoLink};
+use laser_app::sequencer::SettingsStore;
+use laser_app::servo::task::ServoLink;
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::status::{Activity, Phase, StatusBoard};
 use sequential_storage::map::MapConfig;
 
+use crate::board::{SimBoard, SimSpawner};
 use crate::dac::{DacRecording, SimDac};
-use crate::executor::TaskKind;
-use crate::executor::{self, RunEnd};
+use crate::executor::{self, RunEnd, TaskKind};
 use crate::flash::{FlashStats, FlashTiming, PowerCut, SimFlash};
 use crate::laser::{GatedLaserPin, recorded_gate};
+use crate::panel::{ButtonContacts, PanelRecord, SharedPanel, SimLeds, SimStopButton, SimWatchdog};
 use crate::physics::PhysicalGimbal;
-use crate::recorder::{
-    DwellRecord, EventRecord, Recording, SequencerEvent, ServoSample, ServoState, SpotSample,
-};
+use crate::recorder::{Recording, SpotSample};
 use crate::script::Step;
 use crate::servo_model::SimServoBus;
-use crate::servo_port::{BusFaults, PortHandle, SimServoPort};
-use crate::usb_host::{Transcript, UsbHost, interactive_task, script_task, terminal_task};
+use crate::servo_port::{BusFaults, SimServoPort};
+use crate::spot::{RecordingLaser, gimbal_spot_cm, spot_sampler};
+use crate::usb_host::{Transcript, UsbHost, host_tasks};
 
 /// Samples per galvo DAC half buffer (1.28 ms at 100 kHz).
 pub const GALVO_HALF_LEN: usize = 128;
@@ -103,6 +106,9 @@ pub struct SimOptions {
     /// Galvo loop compute time charged per DAC sample, ns (0: the loop
     /// is instant; above the sample period it underruns).
     pub galvo_cost_ns_per_sample: u64,
+    /// The board has a galvo DAC (`false`: a board like the target's,
+    /// which has none yet, so no galvo loop runs).
+    pub galvo_dac: bool,
 }
 
 impl Default for SimOptions {
@@ -122,6 +128,7 @@ impl Default for SimOptions {
             settings_flash_cut: None,
             physical: PhysicalGimbal::default(),
             galvo_cost_ns_per_sample: 0,
+            galvo_dac: true,
         }
     }
 }
@@ -152,6 +159,8 @@ pub struct SimReport {
     pub galvo_underruns: u32,
     /// CPU-time accounting of every task's steps (polls).
     pub task_steps: Vec<executor::TaskSteps>,
+    /// What the board's LEDs, stop button and watchdog did.
+    pub panel: PanelRecord,
 }
 
 impl SimReport {
@@ -165,78 +174,6 @@ impl SimReport {
     }
 }
 
-/// The gimbal laser output: the gated pin (which records the effective
-/// laser), plus every sequencer event with its time and the servos' true
-/// state at each switch and event (for the safety checker).
-struct RecordingLaser {
-    /// The gated pin that records the effective gimbal laser.
-    pin: GatedLaserPin,
-    recording: Rc<RefCell<Recording>>,
-    bus: Rc<RefCell<SimServoBus>>,
-    gimbal: PhysicalGimbal,
-}
-
-impl RecordingLaser {
-    fn record_servos(&self, rec: &mut Recording, t_us: u64) {
-        let laser = rec.laser_at(t_us);
-        rec.servos
-            .push(servo_sample(&self.bus.borrow(), self.gimbal, t_us, laser));
-    }
-}
-
-impl LaserSwitch for RecordingLaser {
-    fn set(&mut self, on: bool) {
-        self.pin.set(on);
-        crate::executor::simulator_work(|| {
-            let t = crate::clock::now_us();
-            let mut rec = self.recording.borrow_mut();
-            self.record_servos(&mut rec, t);
-        });
-    }
-
-    fn note(&mut self, event: LaserEvent<'_>) {
-        crate::executor::simulator_work(|| self.record_event(event));
-    }
-}
-
-impl RecordingLaser {
-    fn record_event(&self, event: LaserEvent<'_>) {
-        let t_us = crate::clock::now_us();
-        let event = match event {
-            LaserEvent::Stopped { why } => SequencerEvent::Stopped {
-                why: why.to_owned(),
-            },
-            LaserEvent::RunStarted => SequencerEvent::RunStarted,
-            LaserEvent::GimbalMoveSent => SequencerEvent::GimbalMoveSent,
-            LaserEvent::GimbalArrived => SequencerEvent::GimbalArrived,
-        };
-        let mut rec = self.recording.borrow_mut();
-        let laser_switches_before = rec.laser_events.len();
-        rec.events.push(EventRecord {
-            t_us,
-            event,
-            laser_switches_before,
-        });
-        self.record_servos(&mut rec, t_us);
-    }
-}
-
-/// The gimbal servos' true angles and targets at `t_us`.
-fn servo_sample(bus: &SimServoBus, gimbal: PhysicalGimbal, t_us: u64, laser: bool) -> ServoSample {
-    let state = |id| {
-        bus.servo(id).map(|s| ServoState {
-            angle_deg: s.angle_deg(t_us),
-            target_deg: f64::from(s.target_tenths()) / 10.0,
-        })
-    };
-    ServoSample {
-        t_us,
-        yaw: state(gimbal.yaw_id),
-        pitch: state(gimbal.pitch_id),
-        laser,
-    }
-}
-
 fn is_idle(status: &StatusBoard) -> bool {
     let s = status.snapshot();
     match s.activity {
@@ -246,148 +183,145 @@ fn is_idle(status: &StatusBoard) -> bool {
     }
 }
 
-/// Runs one simulation to its end. Independent runs may execute on
-/// different threads at the same time.
-pub fn run(options: SimOptions) -> SimReport {
-    let link: &'static CommandLink = Box::leak(Box::new(CommandLink::new()));
-    let servo_link: &'static ServoLink = Box::leak(Box::new(ServoLink::new()));
-    let galvo_link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
-    let dac_recording = Rc::new(RefCell::new(DacRecording::default()));
-    let gate = recorded_gate(&dac_recording);
-    let status: &'static StatusBoard = Box::leak(Box::new(StatusBoard::new()));
-    let host = Rc::new(UsbHost::new(options.echo));
-    let recording = Rc::new(RefCell::new(Recording::default()));
-    let flash = boot_settings_flash(&options);
-    let gimbal = options.physical;
-    let bus = Rc::new(RefCell::new(SimServoBus::new(
-        &[gimbal.yaw_id, gimbal.pitch_id],
-        options.slow_factor,
-    )));
-    let port = Rc::new(SimServoPort::new(
-        bus.clone(),
-        recording.clone(),
-        options.faults.clone(),
-        0x5eed,
-    ));
+/// One run's world: the links the firmware tasks share and everything the
+/// simulated board and host record into.
+struct World {
+    links: Links,
+    host: Rc<UsbHost>,
+    recording: Rc<RefCell<Recording>>,
+    dac: Rc<RefCell<DacRecording>>,
+    panel: SharedPanel,
+    button: Rc<ButtonContacts>,
+    flash: SettingsFlash,
+    bus: Rc<RefCell<SimServoBus>>,
+    port: Rc<SimServoPort>,
+    gimbal: PhysicalGimbal,
+}
 
-    let end = {
-        let (host, recording, flash, bus, script) = (
-            host.clone(),
-            recording.clone(),
-            flash.clone(),
+impl World {
+    /// Links (leaked: one set per run), recordings, flash, servos.
+    fn new(options: &SimOptions) -> Self {
+        let dac = Rc::new(RefCell::new(DacRecording::default()));
+        let links = Links {
+            command: Box::leak(Box::new(CommandLink::new())),
+            servo: Box::leak(Box::new(ServoLink::new())),
+            galvo: Box::leak(Box::new(GalvoLink::new())),
+            status: Box::leak(Box::new(StatusBoard::new())),
+            gate: recorded_gate(&dac),
+        };
+        let recording = Rc::new(RefCell::new(Recording::default()));
+        let gimbal = options.physical;
+        let bus = Rc::new(RefCell::new(SimServoBus::new(
+            &[gimbal.yaw_id, gimbal.pitch_id],
+            options.slow_factor,
+        )));
+        let port = Rc::new(SimServoPort::new(
             bus.clone(),
+            recording.clone(),
+            options.faults.clone(),
+            0x5eed,
+        ));
+        Self {
+            links,
+            host: Rc::new(UsbHost::new(options.echo)),
+            recording,
+            dac,
+            panel: SharedPanel::default(),
+            button: Rc::new(ButtonContacts::default()),
+            flash: boot_settings_flash(options),
+            bus,
+            port,
+            gimbal,
+        }
+    }
+
+    /// The simulated board (its laser pin records into this run; call
+    /// after the gate of [`World::new`]).
+    fn board(&self, options: &SimOptions) -> SimBoard {
+        let (spot_bus, gimbal) = (self.bus.clone(), self.gimbal);
+        let laser = RecordingLaser {
+            pin: GatedLaserPin::new(
+                self.recording.clone(),
+                Box::new(move |t_us| gimbal_spot_cm(&spot_bus, gimbal, t_us)),
+            ),
+            recording: self.recording.clone(),
+            bus: self.bus.clone(),
+            gimbal,
+        };
+        let period_ns = (GalvoConfig::default().sample_period_s * 1e9) as u64;
+        SimBoard {
+            host: self.host.clone(),
+            servo_port: self.port.clone(),
+            laser,
+            settings: settings_store(self.flash.clone()),
+            galvo_dac: options.galvo_dac.then(|| {
+                SimDac::new(
+                    GALVO_HALF_LEN,
+                    period_ns,
+                    options.galvo_cost_ns_per_sample,
+                    self.dac.clone(),
+                )
+            }),
+            leds: SimLeds(self.panel.clone()),
+            stop_button: SimStopButton {
+                contacts: self.button.clone(),
+                panel: self.panel.clone(),
+            },
+            watchdog: SimWatchdog(self.panel.clone()),
+        }
+    }
+
+    /// Wires the firmware onto the simulated board (the terminal plugged
+    /// into its console), then starts the spot sampler.
+    fn start(&self, spawner: Spawner, options: &SimOptions) {
+        let host_tasks = host_tasks(
+            options.interactive,
             options.script.clone(),
+            self.host.clone(),
+            self.button.clone(),
         );
-        let interactive = options.interactive;
-        let until_idle = options.until_idle;
-        let galvo_dac = dac_recording.clone();
-        let stop_host = host.clone();
-        executor::run(
-            options.realtime,
-            options.max_time_ms * 1000,
-            move |spawner| {
-                let console_host = host.clone();
-                executor::spawn_task(&spawner, "console", TaskKind::Firmware, async move {
-                    let mut rx = &console_host.to_device;
-                    let mut tx = &console_host.from_device;
-                    laser_app::usb::run_console(&mut rx, &mut tx, link).await;
-                });
-                if interactive {
-                    let (send, lines) = std::sync::mpsc::channel();
-                    std::thread::spawn(move || {
-                        for line in std::io::stdin().lines().map_while(Result::ok) {
-                            if send.send(line).is_err() {
-                                break;
-                            }
-                        }
-                    });
-                    executor::spawn_task(
-                        &spawner,
-                        "host (interactive)",
-                        TaskKind::Simulator,
-                        interactive_task(lines, host.clone()),
-                    );
-                } else {
-                    executor::spawn_task(
-                        &spawner,
-                        "host (script)",
-                        TaskKind::Simulator,
-                        script_task(script, host.clone(), link),
-                    );
-                }
-                executor::spawn_task(
-                    &spawner,
-                    "host (terminal)",
-                    TaskKind::Simulator,
-                    terminal_task(host.clone()),
-                );
-                let servo_port = port.clone();
-                executor::spawn_task(&spawner, "servo", TaskKind::Firmware, async move {
-                    ServoBus::new(
-                        PortHandle(servo_port.clone()),
-                        PortHandle(servo_port),
-                        ServoBusConfig::default(),
-                    )
-                    .run(servo_link)
-                    .await;
-                });
-                let spot_bus = bus.clone();
-                let laser = RecordingLaser {
-                    pin: GatedLaserPin::new(
-                        recording.clone(),
-                        Box::new(move |t_us| gimbal_spot_cm(&spot_bus, gimbal, t_us)),
-                    ),
-                    recording: recording.clone(),
-                    bus: bus.clone(),
-                    gimbal,
-                };
-                let store = settings_store(flash.clone());
-                executor::spawn_task(&spawner, "sequencer", TaskKind::Firmware, async move {
-                    let mut sequencer =
-                        Sequencer::new(link, servo_link, galvo_link, status, laser, gate, store)
-                            .await;
-                    sequencer.run().await;
-                });
-                let (dac_recording, cost) = (galvo_dac, options.galvo_cost_ns_per_sample);
-                executor::spawn_task(&spawner, "galvo", TaskKind::Firmware, async move {
-                    let config = GalvoConfig::default();
-                    let mut dac = SimDac::new(
-                        GALVO_HALF_LEN,
-                        (config.sample_period_s * 1e9) as u64,
-                        cost,
-                        dac_recording,
-                    );
-                    match GalvoLoop::new(config) {
-                        Ok(mut galvo) => galvo.run(&mut dac, galvo_link, gate).await,
-                        Err(e) => log::error!("galvo loop not started: {e}"),
-                    }
-                });
-                executor::spawn_task(
-                    &spawner,
-                    "spot sampler",
-                    TaskKind::Simulator,
-                    spot_sampler(
-                        bus.clone(),
-                        recording.clone(),
-                        status,
-                        gimbal,
-                        options.sample_period_us,
-                    ),
-                );
-            },
-            move || {
-                let done = stop_host.transcript.borrow().script_done;
-                done && (!until_idle || is_idle(status))
-            },
-        )
-    };
-    let transcript = host.transcript.borrow().clone();
-    let end_time_us = crate::clock::now_us();
-    {
-        // The trace ends with the laser's final state at the end time.
-        let mut rec = recording.borrow_mut();
+        let mut sim_spawner = SimSpawner::new(spawner, host_tasks);
+        wire(self.board(options), self.links, &mut sim_spawner);
+        executor::spawn_task(
+            &spawner,
+            "spot sampler",
+            TaskKind::Simulator,
+            spot_sampler(
+                self.bus.clone(),
+                self.recording.clone(),
+                self.links.status,
+                self.gimbal,
+                options.sample_period_us,
+            ),
+        );
+    }
+
+    /// What the run produced, ended by `end`.
+    fn report(self, end: RunEnd) -> SimReport {
+        let end_time_us = crate::clock::now_us();
+        self.final_spot(end_time_us);
+        let settings_flash = self.flash.image();
+        SimReport {
+            transcript: self.host.transcript.borrow().clone(),
+            recording: self.recording.borrow().clone(),
+            end,
+            end_time_us,
+            idle_at_end: is_idle(self.links.status),
+            saved_settings: load_settings_record(settings_flash.clone()),
+            settings_flash,
+            settings_flash_stats: self.flash.stats(),
+            dac: self.dac.borrow().clone(),
+            galvo_underruns: self.links.galvo.underruns.load(Ordering::Relaxed),
+            task_steps: executor::task_steps(),
+            panel: self.panel_at_end(end_time_us),
+        }
+    }
+
+    /// The trace ends with the laser's final state at the end time.
+    fn final_spot(&self, end_time_us: u64) {
+        let mut rec = self.recording.borrow_mut();
         if rec.spot.last().is_none_or(|s| s.t_us < end_time_us)
-            && let Some((x_cm, y_cm)) = gimbal_spot_cm(&bus, gimbal, end_time_us)
+            && let Some((x_cm, y_cm)) = gimbal_spot_cm(&self.bus, self.gimbal, end_time_us)
         {
             let laser = crate::laser::gimbal_lit();
             rec.spot.push(SpotSample {
@@ -398,24 +332,27 @@ pub fn run(options: SimOptions) -> SimReport {
             });
         }
     }
-    let recording = recording.borrow().clone();
-    let settings_flash = flash.image();
-    let settings_flash_stats = flash.stats();
-    let saved_settings = load_settings_record(settings_flash.clone());
-    let dac = dac_recording.borrow().clone();
-    SimReport {
-        transcript,
-        recording,
-        end,
-        end_time_us,
-        idle_at_end: is_idle(status),
-        saved_settings,
-        settings_flash,
-        settings_flash_stats,
-        dac,
-        galvo_underruns: galvo_link.underruns.load(Ordering::Relaxed),
-        task_steps: executor::task_steps(),
+
+    fn panel_at_end(&self, end_time_us: u64) -> PanelRecord {
+        let mut panel = self.panel.borrow().clone();
+        panel.watchdog = panel.watchdog.at_end(end_time_us);
+        panel
     }
+}
+
+/// Runs one simulation to its end. Independent runs may execute on
+/// different threads at the same time.
+pub fn run(options: SimOptions) -> SimReport {
+    let world = World::new(&options);
+    let (host, status) = (world.host.clone(), world.links.status);
+    let until_idle = options.until_idle;
+    let end = executor::run(
+        options.realtime,
+        options.max_time_ms * 1000,
+        |spawner| world.start(spawner, &options),
+        move || host.transcript.borrow().script_done && (!until_idle || is_idle(status)),
+    );
+    world.report(end)
 }
 
 /// The settings flash a run boots with (see [`SimOptions::settings_flash`]).
@@ -438,89 +375,4 @@ fn boot_settings_flash(options: &SimOptions) -> SettingsFlash {
     flash
         .with_power_cut(options.settings_flash_cut)
         .with_timing(FlashTiming::Virtual)
-}
-
-/// Where the gimbal spot is at `t_us` (from the simulated servos' true
-/// angles through the exact forward kinematics), board cm.
-fn gimbal_spot_cm(
-    bus: &Rc<RefCell<SimServoBus>>,
-    gimbal: PhysicalGimbal,
-    t_us: u64,
-) -> Option<(f64, f64)> {
-    let bus = bus.borrow();
-    let yaw_deg = bus.angle_deg(gimbal.yaw_id, t_us).unwrap_or(0.0);
-    let pitch_deg = bus.angle_deg(gimbal.pitch_id, t_us).unwrap_or(0.0);
-    gimbal.spot_cm(yaw_deg, pitch_deg)
-}
-
-/// Samples the spot from the simulated servos' true angles, and records
-/// where it was at the end of each dwell.
-async fn spot_sampler(
-    bus: Rc<RefCell<SimServoBus>>,
-    recording: Rc<RefCell<Recording>>,
-    status: &'static StatusBoard,
-    gimbal: PhysicalGimbal,
-    period_us: u64,
-) {
-    let mut open_dwell: Option<(DwellKey, usize)> = None;
-    loop {
-        let t_us = crate::clock::now_us();
-        let spot = gimbal_spot_cm(&bus, gimbal, t_us);
-        {
-            let mut rec = recording.borrow_mut();
-            let laser = rec.laser_at(t_us);
-            rec.servos
-                .push(servo_sample(&bus.borrow(), gimbal, t_us, laser));
-            if let Some((x_cm, y_cm)) = spot {
-                rec.spot.push(SpotSample {
-                    t_us,
-                    x_cm,
-                    y_cm,
-                    laser,
-                });
-            }
-            let s = status.snapshot();
-            let dwelling = matches!(s.phase, Some(Phase::Dwelling | Phase::Holding));
-            let key = DwellKey {
-                index: s.point_index,
-                pass: s.pass,
-                target: s
-                    .target
-                    .map(|(t, _)| (t.point.x_cm.to_bits(), t.point.y_cm.to_bits())),
-            };
-            match (dwelling, s.target, spot) {
-                (true, Some((target, _)), Some(spot_cm)) => {
-                    // The dwell record keeps the last spot seen during the dwell
-                    // (the servos settle onto their quantised target).
-                    match open_dwell {
-                        Some((open_key, i)) if open_key == key => {
-                            if let Some(record) = rec.dwells.get_mut(i) {
-                                record.spot_cm = spot_cm;
-                                record.laser &= laser;
-                            }
-                        }
-                        _ => {
-                            rec.dwells.push(DwellRecord {
-                                t_us,
-                                target_cm: (target.point.x_cm, target.point.y_cm),
-                                grid: target.grid,
-                                spot_cm,
-                                laser,
-                            });
-                            open_dwell = Some((key, rec.dwells.len() - 1));
-                        }
-                    }
-                }
-                _ => open_dwell = None,
-            }
-        }
-        Timer::after_micros(period_us).await;
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-struct DwellKey {
-    index: Option<usize>,
-    pass: u32,
-    target: Option<(u64, u64)>,
 }

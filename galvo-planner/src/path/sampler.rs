@@ -108,6 +108,26 @@ impl<const CAP: usize> PathPlanner<CAP> {
         (p, v)
     }
 
+    /// Prepares the first block for sampling ahead of time (its speed
+    /// profile, sample indices and, for an arc, the start direction: the
+    /// f64 work [`Self::next_sample`] would otherwise do on its first
+    /// call), so the first sample costs what every other does. A no-op
+    /// when a block already runs or the head is a jump or there is none;
+    /// the samples are the same either way. For the prep stage, once the
+    /// stroke is loaded.
+    pub fn prime(&mut self) {
+        if self.exec.active {
+            return;
+        }
+        match self.block(0) {
+            Some(b) if !b.is_jump() => {
+                self.freeze_head(0.0);
+                self.replan();
+            }
+            _ => {}
+        }
+    }
+
     /// Advances one sample period (or reports a jump / idleness).
     pub fn next_sample(&mut self) -> MarkSample {
         let ts = self.limits.ts_s;

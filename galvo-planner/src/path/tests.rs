@@ -222,6 +222,45 @@ fn clockwise_arc_and_tangent_lines_join_without_slowing() {
 }
 
 #[test]
+fn priming_the_first_block_changes_no_sample() {
+    let load = || {
+        let mut p: PathPlanner<16> = PathPlanner::new(limits(), [0.0, 0.0]).expect("planner");
+        p.line_to([20.0, 0.0]).expect("line");
+        p.arc_to([20.0, -20.0], [20.0, -10.0], false).expect("arc");
+        p.line_to([0.0, -20.0]).expect("line");
+        p
+    };
+    let mut primed = load();
+    primed.prime();
+    // Priming twice, or a running block, changes nothing either.
+    primed.prime();
+    let first = primed.next_sample();
+    primed.prime();
+    let mut plain = load();
+    assert_eq!(first, plain.next_sample());
+    assert_eq!(drain(&mut primed), drain(&mut plain));
+    // An arc first: its start direction is set up by the priming.
+    let arc = || {
+        let mut p: PathPlanner<16> = PathPlanner::new(limits(), [0.0, 40.0]).expect("planner");
+        p.arc_to([0.0, 40.0], [0.0, 0.0], true).expect("arc");
+        p
+    };
+    let mut primed = arc();
+    primed.prime();
+    assert_eq!(drain(&mut primed), drain(&mut arc()));
+    // Nothing loaded: idle, not primed.
+    let mut empty: PathPlanner<16> = PathPlanner::new(limits(), [1.0, 2.0]).expect("planner");
+    empty.prime();
+    assert_eq!(
+        empty.next_sample(),
+        MarkSample::Idle {
+            x_mm: 1.0,
+            y_mm: 2.0
+        }
+    );
+}
+
+#[test]
 fn jumps_separate_paths() {
     let mut p: PathPlanner<16> = PathPlanner::new(limits(), [0.0, 0.0]).expect("planner");
     p.line_to([5.0, 0.0]).expect("line");

@@ -27,19 +27,29 @@ pub struct Row {
 /// Time-optimal jump planning in single precision (galvo-planner
 /// `fast_optimal`): met, enforced.
 const PLANNING: Enforcement = Enforcement::Enforced;
-/// The refill that starts a jump still plans it in the refill and then
-/// steps its samples at the loop's per-sample cost.
-const JUMP_REFILL: Enforcement = Enforcement::NotYetMet(
-    "issue 11 item 3: planning out of the refill (prep stage) and the per-sample loop cost",
+/// The refill steps only what the prep stage prepared (galvo/scan/prep.rs):
+/// met, enforced.
+const REFILL: Enforcement = Enforcement::Enforced;
+/// What is left per sample: the f32 galvo IK (two `atanf`, ≈ 220
+/// instructions with the DAC mapping), the path sampler (90–140), the
+/// Kahan-compensated integrator on jumps (204) and the loop's per-sample
+/// state machine around them (galvo/scan/samples.rs, ≈ 70–120).
+const LOOP: Enforcement = Enforcement::NotYetMet(
+    "issue 11 item 2: galvo IK, integrator and the loop's per-sample state machine (scan/samples.rs)",
 );
-/// What is left per sample is the loop body around the f32 math: its
-/// state machine, phase checks and sample bookkeeping (galvo/scan/samples.rs), and the
-/// Kahan-compensated integrator on jumps.
-const LOOP: Enforcement =
-    Enforcement::NotYetMet("issue 11: the loop's per-sample state machine (scan.rs)");
-/// A stroke's first half also loads it into the f64 look-ahead planner.
-const STROKE_SETUP: Enforcement =
-    Enforcement::NotYetMet("issue 11 item 3: stroke setup (f64 path planning) in the refill");
+/// Preparing a step (jump planning, f64 IK of its target, stroke setup in
+/// the f64 look-ahead planner) between halves.
+const PREP: Enforcement = Enforcement::Enforced;
+
+/// Budget of a prepared step: the half of the refill window the refill
+/// leaves (one step prepared per half keeps up), µs per step.
+const fn prep_budget(enforcement: Enforcement) -> Option<(f64, &'static str, Enforcement)> {
+    Some((
+        0.5 * REFILL_WINDOW_US,
+        "the 50 % of the 1.28 ms refill window the refill leaves",
+        enforcement,
+    ))
+}
 
 /// Budget of a refill: half the refill window, µs per half.
 const fn half_refill_budget(enforcement: Enforcement) -> Option<(f64, &'static str, Enforcement)> {
@@ -91,21 +101,39 @@ pub const ROWS: &[Row] = &[
     },
     Row {
         id: "loop.line.refill",
-        what: "refill, line job incl. stroke load (worst half)",
+        what: "refill, line job, stroke prepared (worst half)",
         unit: "half",
-        budget: half_refill_budget(STROKE_SETUP),
+        budget: half_refill_budget(REFILL),
     },
     Row {
         id: "loop.arc_r40.refill",
-        what: "refill, circle job incl. stroke load (worst half)",
+        what: "refill, circle job, stroke prepared (worst half)",
         unit: "half",
-        budget: half_refill_budget(STROKE_SETUP),
+        budget: half_refill_budget(REFILL),
     },
     Row {
         id: "loop.jump.refill",
-        what: "refill that plans a 160 mm two-axis jump",
+        what: "refill that starts a prepared 160 mm two-axis jump",
         unit: "half",
-        budget: half_refill_budget(JUMP_REFILL),
+        budget: half_refill_budget(REFILL),
+    },
+    Row {
+        id: "loop.jump.prep",
+        what: "prep: plan a 160 mm two-axis jump step (IK + time-optimal plan)",
+        unit: "step",
+        budget: prep_budget(PREP),
+    },
+    Row {
+        id: "loop.line.prep",
+        what: "prep: a line stroke step (jump + stroke setup in the f64 planner)",
+        unit: "step",
+        budget: prep_budget(PREP),
+    },
+    Row {
+        id: "loop.arc_r40.prep",
+        what: "prep: a circle stroke step (jump + stroke setup in the f64 planner)",
+        unit: "step",
+        budget: prep_budget(PREP),
     },
     Row {
         id: "loop.hold_sample",

@@ -5,7 +5,9 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench loop.holding.steady 40 128\nbench loop.line.steady 100 128\n\
     bench loop.arc_r40.steady 100 128\nbench loop.jump.steady 10 40\n\
     bench loop.holding.refill 40 1\nbench loop.line.refill 100 1\n\
-    bench loop.arc_r40.refill 100 1\nbench loop.jump.refill 400000 1\n\
+    bench loop.arc_r40.refill 100 1\nbench loop.jump.refill 1000 1\n\
+    bench loop.jump.prep 1500 1\nbench loop.line.prep 2000 1\n\
+    bench loop.arc_r40.prep 2000 1\n\
     bench plan.xy.optimal.1lsb 250 1\nbench plan.xy.optimal.160mm 300 1\n\
     bench plan.seed.1deg 100 1\ndone 0\n";
 
@@ -62,6 +64,23 @@ fn an_enforced_budget_over_fails() {
     );
     let err = check(&parse(&holding).unwrap()).unwrap_err().to_string();
     assert!(err.contains("loop.holding.steady"), "{err}");
+    // So are the refill that starts a jump and the prep of a step: 20 000
+    // ticks, 800 000 instructions (6.2 ms), over their 640 µs.
+    for id in ["loop.jump.refill", "loop.jump.prep"] {
+        let before = format!("bench {id} ");
+        let out: String = OUT
+            .lines()
+            .map(|l| {
+                if l.trim_start().starts_with(&before) {
+                    format!("{before}20000 1\n")
+                } else {
+                    format!("{l}\n")
+                }
+            })
+            .collect();
+        let err = check(&parse(&out).unwrap()).unwrap_err().to_string();
+        assert!(err.contains(id), "{err}");
+    }
     // A budget not yet met is reported, not failed: 1000 ticks for 40
     // jump samples, 1000 instructions (7.7 µs) each, over its 1 µs.
     let jumping = OUT.replace(

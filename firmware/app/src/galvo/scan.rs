@@ -4,10 +4,11 @@
 use core::fmt;
 use core::sync::atomic::Ordering;
 
-use galvo_planner::{Discrete, Method, PathPlanner, RigidParams, XyIntegrator};
+use galvo_planner::{Discrete, Method, RigidParams, XyIntegrator};
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
+use self::prep::StepRing;
 use super::path::GalvoPath;
 use super::{DacSample, DacStream, GalvoEvent, GalvoLink, Half};
 use crate::laser_gate::LaserGate;
@@ -129,7 +130,15 @@ pub struct GalvoLoop {
     planning: Galvo<f64>,
     disc: Discrete<3>,
     mirrors: XyIntegrator<3, INTEGRATOR_CAPACITY>,
-    marker: Option<PathPlanner<MARK_BLOCKS>>,
+    /// The running step (when `running`) and the steps planned ahead of
+    /// the refill by [`GalvoLoop::prep`].
+    steps: StepRing,
+    /// Whether the oldest of `steps` is the running one.
+    running: bool,
+    /// Where the running step leaves the mirrors, rad.
+    active_end_rad: [f64; 2],
+    /// Samples held dark for want of a prepared step.
+    unprepared_samples: u32,
     motion: Motion,
     queue: heapless::Deque<(u32, Job), JOB_QUEUE>,
     active: Option<Active>,
@@ -176,7 +185,10 @@ impl GalvoLoop {
             planning: config.galvo.cast(),
             disc,
             mirrors,
-            marker: None,
+            steps: StepRing::new(),
+            running: false,
+            active_end_rad: angles_rad,
+            unprepared_samples: 0,
             motion: Motion::default(),
             queue: heapless::Deque::new(),
             active: None,
@@ -195,7 +207,8 @@ impl GalvoLoop {
 
     /// What the mirrors and laser are doing now.
     pub fn phase(&self) -> ScanPhase {
-        self.active.map_or(ScanPhase::Idle, |a| a.phase)
+        // By reference: this runs several times per sample.
+        self.active.as_ref().map_or(ScanPhase::Idle, |a| a.phase)
     }
 
     /// Jobs waiting behind the current one.
@@ -263,8 +276,10 @@ impl GalvoLoop {
                 release_drawn(&mut drawing, link);
                 continue;
             }
+            // Plan ahead, outside the refill: the refill only steps plans.
+            self.prep();
             let out = &mut half[..n];
-            let computed = self.fill(out, |event| hold_done(&mut drawing, link, event));
+            let computed = self.refill(out, |event| hold_done(&mut drawing, link, event));
             link.publish(self.phase(), self.queue.len());
             if !link.laser_allowed() {
                 // `laser off`: the mirrors still move, dark.
@@ -353,6 +368,7 @@ impl Active {
 
 mod jobs;
 mod mark;
+mod prep;
 mod samples;
 #[cfg(test)]
 mod tests;

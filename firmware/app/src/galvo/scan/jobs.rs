@@ -64,18 +64,19 @@ impl GalvoLoop {
 
     /// Mirror angles (rad, f64 for planning) of a board point (mm).
     pub(super) fn angles_for(&self, target: PointMm) -> Result<[f64; 2], GalvoError> {
-        let codes = self
-            .planning
-            .board_to_codes(target)
-            .map_err(|_| GalvoError::Kinematics)?;
-        if codes.clamped() {
-            return Err(GalvoError::OutOfRange);
-        }
+        // One IK (f64: per job, in the prep stage), then its DAC codes.
         let angles = self
             .planning
             .geometry
             .ik(target)
             .map_err(|_| GalvoError::Kinematics)?;
+        let codes = self
+            .planning
+            .angles_to_codes(angles)
+            .map_err(|_| GalvoError::Kinematics)?;
+        if codes.clamped() {
+            return Err(GalvoError::OutOfRange);
+        }
         Ok([angles.x_rad, angles.y_rad])
     }
 
@@ -115,19 +116,18 @@ impl GalvoLoop {
     /// and the mirrors hold.
     pub fn stop(&mut self) {
         self.queue.clear();
+        self.steps.clear();
+        self.running = false;
         self.active = match self.active {
             Some(a) if a.phase == ScanPhase::Jumping => Some(Active {
                 cancelled: true,
                 ..a
             }),
-            Some(a) if matches!(a.phase, ScanPhase::Marking | ScanPhase::Braking) => {
-                self.marker = None;
-                Some(Active {
-                    cancelled: true,
-                    phase: ScanPhase::Braking,
-                    ..a
-                })
-            }
+            Some(a) if matches!(a.phase, ScanPhase::Marking | ScanPhase::Braking) => Some(Active {
+                cancelled: true,
+                phase: ScanPhase::Braking,
+                ..a
+            }),
             _ => None,
         };
     }

@@ -2,12 +2,12 @@
 //! galvo kinematics to DAC codes, the end of a stroke, and braking along
 //! the path when stopped mid-stroke.
 
-use galvo_planner::{MarkLimits, MarkSample, PathPlanner};
+use galvo_planner::{MarkSample, PathPlanner};
 use kinematics_core::PointMm;
 
-use super::{GalvoError, GalvoLoop, JUNCTION_DEVIATION_MM, ScanPhase};
+use super::{GalvoError, GalvoLoop, MARK_BLOCKS, ScanPhase};
 use crate::galvo::GalvoEvent;
-use crate::galvo::path::{GalvoPath, Segment};
+use crate::galvo::path::GalvoPath;
 
 /// The spot while marking or braking: position (mm) and its change over
 /// the last sample (mm per sample).
@@ -20,6 +20,14 @@ pub(super) struct Motion {
 }
 
 impl GalvoLoop {
+    /// The running step's stroke planner (where the prep stage left it).
+    fn running_stroke(&mut self) -> Option<&mut PathPlanner<MARK_BLOCKS>> {
+        if !self.running {
+            return None;
+        }
+        self.steps.get_mut(0)?.marker.as_mut()?.as_mut().ok()
+    }
+
     /// DAC codes of a board position (mm).
     fn codes_at(&self, position_mm: [f32; 2]) -> Option<(u16, u16)> {
         let [x_mm, y_mm] = position_mm;
@@ -34,7 +42,7 @@ impl GalvoLoop {
         &mut self,
         on_event: &mut impl FnMut(GalvoEvent),
     ) -> Option<(u16, u16)> {
-        let sample = self.marker.as_mut().map(|m| m.next_sample());
+        let sample = self.running_stroke().map(|m| m.next_sample());
         if let Some(MarkSample::Mark { x_mm, y_mm, .. }) = sample {
             let [px, py] = self.motion.position_mm;
             self.motion = Motion {
@@ -44,9 +52,16 @@ impl GalvoLoop {
             };
             return self.codes_at([x_mm, y_mm]);
         }
-        // Stroke done (planner idle): hold at its end, laser off.
-        self.marker = None;
-        self.hold_at_motion(on_event);
+        // Stroke done (planner idle): hold at its end, laser off. The
+        // sampler landed exactly on the stroke's end (in f32), whose angles
+        // the prep stage computed: no f64 IK here.
+        let seated = self.mirrors.hold_at(self.active_end_rad);
+        if let (Err(_), Some(a)) = (seated, self.active) {
+            on_event(GalvoEvent::Refused {
+                seq: a.seq,
+                error: GalvoError::Planner,
+            });
+        }
         if let Some(a) = self.active.as_mut() {
             a.enter(ScanPhase::LaserOffDelay, self.off_delay_samples);
         }
@@ -79,34 +94,31 @@ impl GalvoLoop {
             }
             // At rest, or the next step would leave the DAC range: hold.
             _ => {
-                self.hold_at_motion(&mut |_| {});
+                self.hold_at_motion();
                 self.active = None;
                 self.codes_at(self.motion.position_mm)
             }
         }
     }
 
-    /// Re-seats the (idle) jump integrator at rest where marking left the
+    /// Re-seats the (idle) jump integrator at rest where braking left the
     /// spot, so the next jump starts there.
-    fn hold_at_motion(&mut self, on_event: &mut impl FnMut(GalvoEvent)) {
+    /// Braking ended off the planned path: the angles come from the
+    /// galvo IK (f64, once per stop). Left as it was when they cannot be
+    /// computed (the spot stayed inside the checked range).
+    fn hold_at_motion(&mut self) {
         let [x, y] = self.motion.position_mm;
-        let seated = self
-            .angles_for(PointMm {
-                x_mm: f64::from(x),
-                y_mm: f64::from(y),
-            })
-            .and_then(|angles| {
-                self.mirrors
-                    .hold_at(angles)
-                    .map_err(|_| GalvoError::Planner)
-            });
-        if let (Err(error), Some(a)) = (seated, self.active) {
-            on_event(GalvoEvent::Refused { seq: a.seq, error });
+        if let Ok(angles) = self.angles_for(PointMm {
+            x_mm: f64::from(x),
+            y_mm: f64::from(y),
+        }) {
+            let _ = self.mirrors.hold_at(angles);
         }
     }
 
-    /// Loads stroke `stroke` of `path` into the path planner and starts
-    /// marking; `false` (with `Refused`) when the planner refuses it.
+    /// Starts marking stroke `stroke` of `path` with the path planner the
+    /// prep stage loaded for it; `false` (with `Refused`) when the planner
+    /// refused the stroke.
     pub(super) fn start_marking(
         &mut self,
         path: GalvoPath,
@@ -114,27 +126,21 @@ impl GalvoLoop {
         on_event: &mut impl FnMut(GalvoEvent),
     ) -> bool {
         let Some(a) = self.active else { return false };
-        let Some((start, segments)) = path.stroke(stroke) else {
+        let Some((start, _)) = path.stroke(stroke) else {
             return false;
         };
-        let limits = MarkLimits {
-            speed_mm_s: self.config.mark_speed_mm_s,
-            accel_mm_s2: self.config.mark_accel_mm_s2,
-            junction_deviation_mm: JUNCTION_DEVIATION_MM,
-            ts_s: self.config.sample_period_s,
+        // Every path step is prepared with its stroke; none would be a
+        // lost plan: refused, never marked without one.
+        let loaded = match self.steps.get(0).filter(|_| self.running) {
+            Some(step) => match &step.marker {
+                Some(Ok(_)) => Ok(()),
+                Some(Err(error)) => Err(*error),
+                None => Err(GalvoError::Planner),
+            },
+            None => Err(GalvoError::Planner),
         };
-        let loaded = PathPlanner::new(limits, start).and_then(|mut planner| {
-            for segment in &segments {
-                match *segment {
-                    Segment::Line(to) => planner.line_to(to)?,
-                    Segment::Arc { end, centre, ccw } => planner.arc_to(end, centre, ccw)?,
-                }
-            }
-            Ok(planner)
-        });
         match loaded {
-            Ok(planner) => {
-                self.marker = Some(planner);
+            Ok(()) => {
                 let ts = self.config.sample_period_s;
                 self.motion = Motion {
                     position_mm: [start[0] as f32, start[1] as f32],
@@ -146,11 +152,8 @@ impl GalvoLoop {
                 }
                 true
             }
-            Err(_) => {
-                on_event(GalvoEvent::Refused {
-                    seq: a.seq,
-                    error: GalvoError::Planner,
-                });
+            Err(error) => {
+                on_event(GalvoEvent::Refused { seq: a.seq, error });
                 false
             }
         }

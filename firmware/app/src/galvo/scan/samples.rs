@@ -1,8 +1,7 @@
 //! The per-sample state machine: what each sample of a half buffer is
 //! (hold, jump, dwell, mark, brake) and the jump to each job's start.
 
-use galvo_planner::{JumpSync, plan_xy_jump};
-use kinematics_core::PointMm;
+use galvo_planner::Error as PlannerError;
 
 use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase, samples_for};
 use crate::galvo::{DacSample, GalvoEvent};
@@ -34,19 +33,41 @@ impl GalvoLoop {
         })
     }
 
-    /// Fills `out` with the next samples; `on_event` gets each job's
-    /// `Done` (or `Refused`, when it cannot be planned). Returns how many
-    /// samples it computed: while holding, one, copied into the rest.
+    /// Fills `out` with the next samples, preparing (planning) each step
+    /// on demand when [`Self::prep`] has not: the host-side API (tests,
+    /// benches), one call per half. `on_event` gets each job's `Done` (or
+    /// `Refused`, when it cannot be planned). Returns how many samples it
+    /// computed: while holding, one, copied into the rest.
     pub fn fill(&mut self, out: &mut [DacSample], mut on_event: impl FnMut(GalvoEvent)) -> usize {
+        self.fill_with(out, &mut on_event, true)
+    }
+
+    /// The refill: fills `out` with the next samples from the steps
+    /// [`Self::prep`] prepared, planning nothing (bounded work per
+    /// sample). A step that is not prepared yet holds the mirrors, laser
+    /// off, until a later refill finds it prepared. `on_event` and the
+    /// result as for [`Self::fill`].
+    pub fn refill(&mut self, out: &mut [DacSample], mut on_event: impl FnMut(GalvoEvent)) -> usize {
+        self.fill_with(out, &mut on_event, false)
+    }
+
+    fn fill_with(
+        &mut self,
+        out: &mut [DacSample],
+        on_event: &mut impl FnMut(GalvoEvent),
+        on_demand: bool,
+    ) -> usize {
         if let Some(hold) = self.hold_sample() {
             out.fill(hold);
             self.last = hold;
             return out.len().min(1);
         }
         for slot in out.iter_mut() {
-            self.advance(&mut on_event);
+            if self.advance(on_event, on_demand) == Advance::Unprepared {
+                self.unprepared_samples = self.unprepared_samples.saturating_add(1);
+            }
             let codes = match self.phase() {
-                ScanPhase::Marking => self.mark_sample(&mut on_event),
+                ScanPhase::Marking => self.mark_sample(on_event),
                 ScanPhase::Braking => self.brake_sample(),
                 _ => {
                     let [x_rad, y_rad] = self.mirrors.step();
@@ -72,38 +93,47 @@ impl GalvoLoop {
     }
 
     /// Moves the state machine on until the current phase has samples to
-    /// produce.
-    fn advance(&mut self, on_event: &mut impl FnMut(GalvoEvent)) {
+    /// produce, or the next step is not prepared (`on_demand`: prepares
+    /// it).
+    fn advance(&mut self, on_event: &mut impl FnMut(GalvoEvent), on_demand: bool) -> Advance {
+        // The common case, without copying the job out and back: the
+        // current phase still has samples (the loop's first pass below
+        // returns at once in these cases too).
+        if let Some(a) = self.active.as_ref() {
+            let busy = match a.phase {
+                ScanPhase::Marking | ScanPhase::Braking => true,
+                ScanPhase::Jumping => !self.mirrors.is_idle(),
+                _ => a.samples_left > 0,
+            };
+            if busy {
+                return Advance::Ready;
+            }
+        }
         loop {
             let Some(mut a) = self.active else {
                 if let Some(event) = self.apply_pending_config(false) {
                     on_event(event);
                 }
-                let Some((seq, job)) = self.queue.pop_front() else {
-                    return;
+                let Some(&(seq, job)) = self.queue.front() else {
+                    return Advance::Ready;
                 };
-                self.active = Some(Active {
-                    seq,
-                    job,
-                    stroke: 0,
-                    phase: ScanPhase::Idle,
-                    samples_left: 0,
-                    cancelled: false,
-                });
-                if !self.jump_to_job_start(on_event) {
-                    self.active = None;
+                match self.start_step(seq, job, 0, on_demand, on_event) {
+                    StepStart::Unprepared => return Advance::Unprepared,
+                    StepStart::Started | StepStart::Refused => {
+                        self.queue.pop_front();
+                    }
                 }
                 continue;
             };
             match a.phase {
-                ScanPhase::Marking | ScanPhase::Braking => return,
-                ScanPhase::Jumping if !self.mirrors.is_idle() => return,
+                ScanPhase::Marking | ScanPhase::Braking => return Advance::Ready,
+                ScanPhase::Jumping if !self.mirrors.is_idle() => return Advance::Ready,
                 ScanPhase::Jumping if a.cancelled => {
                     self.active = None;
-                    return;
+                    return Advance::Ready;
                 }
                 ScanPhase::Jumping => a.enter(ScanPhase::Settling, self.on_delay_samples),
-                _ if a.samples_left > 0 => return,
+                _ if a.samples_left > 0 => return Advance::Ready,
                 ScanPhase::Settling => match a.job {
                     Job::Point { dwell_us: 0, .. } => {
                         on_event(GalvoEvent::Done { seq: a.seq });
@@ -133,10 +163,12 @@ impl GalvoLoop {
                         self.active = None;
                         continue;
                     };
-                    a.stroke = stroke;
                     self.active = Some(a);
-                    if !self.jump_to_job_start(on_event) {
-                        self.active = None;
+                    match self.start_step(a.seq, a.job, stroke, on_demand, on_event) {
+                        // Holds here, laser off, until the stroke is prepared.
+                        StepStart::Unprepared => return Advance::Unprepared,
+                        StepStart::Started => {}
+                        StepStart::Refused => self.active = None,
                     }
                     continue;
                 }
@@ -145,46 +177,91 @@ impl GalvoLoop {
         }
     }
 
-    /// Plans and queues the jump to the active job's point or stroke
-    /// start; `false` (with `Refused`) when it cannot be planned.
-    fn jump_to_job_start(&mut self, on_event: &mut impl FnMut(GalvoEvent)) -> bool {
-        let Some(a) = self.active else { return false };
-        let target_mm = match a.job {
-            Job::Point { target_mm, .. } => target_mm,
-            Job::Path(path) => match path.stroke(a.stroke) {
-                Some(([x_mm, y_mm], _)) => PointMm { x_mm, y_mm },
-                None => return false,
-            },
-        };
-        let capacity = self
-            .mirrors
-            .x
-            .free_samples()
-            .min(self.mirrors.y.free_samples());
-        let planned = self.angles_for(target_mm).and_then(|target_rad| {
-            plan_xy_jump(
-                &self.disc,
-                &self.disc,
-                self.mirrors.end_position_rad(),
-                target_rad,
-                self.config.method,
-                JumpSync::Independent,
-                capacity,
-            )
-            .and_then(|jump| self.mirrors.queue_jump(&jump))
-            .map_err(|_| GalvoError::Planner)
-        });
-        match planned {
-            Ok(()) => {
-                if let Some(a) = self.active.as_mut() {
-                    a.enter(ScanPhase::Jumping, 0);
+    /// Starts step `stroke` of job `(seq, job)` from its prepared plan,
+    /// where it lies: queues the jump; the stroke is marked from the
+    /// step's slot. Plans it first only when `on_demand`; otherwise an
+    /// unprepared step waits.
+    fn start_step(
+        &mut self,
+        seq: u32,
+        job: Job,
+        stroke: usize,
+        on_demand: bool,
+        on_event: &mut impl FnMut(GalvoEvent),
+    ) -> StepStart {
+        if self.running {
+            // The step before this one is over.
+            self.steps.drop_front();
+            self.running = false;
+        }
+        for _ in 0..2 {
+            if !self.next_prepared_is(seq, &job, stroke) {
+                // None prepared, or not this one: prepare again from here.
+                self.steps.clear();
+                if !on_demand {
+                    return StepStart::Unprepared;
                 }
-                true
+                self.prep();
+                if !self.next_prepared_is(seq, &job, stroke) {
+                    return StepStart::Unprepared;
+                }
             }
-            Err(error) => {
-                on_event(GalvoEvent::Refused { seq: a.seq, error });
-                false
+            let Some(step) = self.steps.get(0) else {
+                return StepStart::Unprepared;
+            };
+            let end_rad = step.end_rad;
+            // `Err(None)`: planned from somewhere the mirrors are not (stale).
+            let queued = match &step.jump {
+                Err(error) => Err(Some(*error)),
+                Ok(jump) => match self.mirrors.queue_jump(jump) {
+                    Ok(()) => Ok(()),
+                    Err(PlannerError::DiscontinuousMove) => Err(None),
+                    Err(_) => Err(Some(GalvoError::Planner)),
+                },
+            };
+            match queued {
+                Ok(()) => {
+                    self.active = Some(Active {
+                        seq,
+                        job,
+                        stroke,
+                        phase: ScanPhase::Jumping,
+                        samples_left: 0,
+                        cancelled: false,
+                    });
+                    self.running = true;
+                    self.active_end_rad = end_rad;
+                    return StepStart::Started;
+                }
+                Err(None) => self.steps.clear(),
+                Err(Some(error)) => {
+                    // Refused: the steps after it were planned from where
+                    // the mirrors stay.
+                    self.steps.drop_front();
+                    on_event(GalvoEvent::Refused { seq, error });
+                    return StepStart::Refused;
+                }
             }
         }
+        StepStart::Unprepared
     }
+}
+
+/// Whether the state machine has its next samples.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Advance {
+    /// The current phase has samples (or nothing runs).
+    Ready,
+    /// The next step is not prepared: hold, laser off.
+    Unprepared,
+}
+
+/// How starting a step went.
+enum StepStart {
+    /// Its jump is queued; the job runs it.
+    Started,
+    /// It could not be planned (`Refused` reported): the job ends.
+    Refused,
+    /// Not prepared yet: try again at a later sample.
+    Unprepared,
 }

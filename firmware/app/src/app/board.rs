@@ -1,0 +1,142 @@
+//! What a board provides to the application: the traits a board's parts
+//! implement and the [`Board`] that hands them over.
+//!
+//! The target (`firmware/src/board.rs`, STM32F4DISCOVERY) and the host
+//! simulator (`laser-sim`'s `board.rs`) are the two boards. They differ only
+//! here: every task body that runs on them is the same code
+//! ([`super::tasks`]), wired once ([`super::wire`]).
+
+use embedded_io_async::{Read, Write};
+
+use crate::galvo::{DacSample, DacStream, Half, Underrun};
+use crate::sequencer::{LaserSwitch, SettingsStore};
+
+/// The command-line port: a host that may connect and disconnect (USB
+/// CDC-ACM on the target, the simulated terminal's byte pipes on the host).
+#[allow(async_fn_in_trait)]
+pub trait Console {
+    /// Bytes from the host.
+    type Rx: Read;
+    /// Bytes to the host.
+    type Tx: Write;
+
+    /// Waits until a host is connected, then lends both directions of the
+    /// port until the console ends (the host disconnected or the input
+    /// ended); the next call waits for the next connection.
+    async fn connected(&mut self) -> (&mut Self::Rx, &mut Self::Tx);
+}
+
+/// What the status LEDs show.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Leds {
+    /// Heartbeat: a 100 ms blink once a second while the indicator task
+    /// runs.
+    pub heartbeat: bool,
+    /// The sequencer has the laser on.
+    pub laser: bool,
+    /// A servo is faulty.
+    pub fault: bool,
+}
+
+/// The status LEDs (GPIOs on the target, a recorded timeline in the
+/// simulator).
+pub trait Indicators {
+    /// Shows `leds` until the next call.
+    fn show(&mut self, leds: Leds);
+}
+
+/// The stop button: stop the run and turn the laser off.
+#[allow(async_fn_in_trait)]
+pub trait StopButton {
+    /// Waits for the next press. A board with a bouncing switch debounces
+    /// here (presses during the bounce are not presses).
+    async fn pressed(&mut self);
+}
+
+/// A watchdog that resets the MCU when it is not fed within
+/// [`WATCHDOG_TIMEOUT_US`](super::WATCHDOG_TIMEOUT_US).
+pub trait Watchdog {
+    /// Starts the countdown (it cannot be stopped again).
+    fn start(&mut self);
+    /// Restarts the countdown.
+    fn feed(&mut self);
+}
+
+/// The galvo DAC of a board that has none: no value of this type exists,
+/// so [`Parts::galvo_dac`] is always `None` and no galvo loop runs
+/// (`target galvo` is refused).
+#[derive(Debug)]
+pub enum NoGalvoDac {}
+
+impl DacStream for NoGalvoDac {
+    fn half_len(&self) -> usize {
+        match *self {}
+    }
+
+    fn set_sample_period(&mut self, _period_s: f64) {
+        match *self {}
+    }
+
+    fn holds(&self, _sample: DacSample) -> bool {
+        match *self {}
+    }
+
+    async fn write_half(&mut self, _half: Half<'_>) -> Result<(), Underrun> {
+        match *self {}
+    }
+
+    async fn repeat_half(&mut self) {
+        match *self {}
+    }
+}
+
+/// A board: the types of its parts, and the parts themselves
+/// ([`Board::into_parts`]), configured and with the laser off.
+pub trait Board {
+    /// The command-line port.
+    type Console: Console;
+    /// Bytes from the servo bus (UART receive).
+    type ServoRx: Read;
+    /// Bytes to the servo bus (UART transmit).
+    type ServoTx: Write;
+    /// The gimbal's laser-enable output (ANDed with the master laser gate).
+    type Laser: LaserSwitch;
+    /// Where settings are saved.
+    type Settings: SettingsStore;
+    /// The galvo DAC stream ([`NoGalvoDac`] on a board without one).
+    type GalvoDac: DacStream;
+    /// The status LEDs.
+    type Indicators: Indicators;
+    /// The stop button.
+    type StopButton: StopButton;
+    /// The watchdog.
+    type Watchdog: Watchdog;
+
+    /// Hands the parts over to the application.
+    fn into_parts(self) -> Parts<Self>
+    where
+        Self: Sized;
+}
+
+/// Everything a [`Board`] provides.
+pub struct Parts<B: Board + ?Sized> {
+    /// The command-line port.
+    pub console: B::Console,
+    /// Servo bus, receive half.
+    pub servo_rx: B::ServoRx,
+    /// Servo bus, transmit half.
+    pub servo_tx: B::ServoTx,
+    /// The gimbal laser output (off).
+    pub laser: B::Laser,
+    /// The settings store.
+    pub settings: B::Settings,
+    /// The galvo DAC, when the board has one (else no galvo loop runs).
+    pub galvo_dac: Option<B::GalvoDac>,
+    /// The status LEDs.
+    pub indicators: B::Indicators,
+    /// The stop button.
+    pub stop_button: B::StopButton,
+    /// The watchdog (not started yet).
+    pub watchdog: B::Watchdog,
+}

@@ -1,0 +1,116 @@
+//! The application, wired once: [`wire`] builds every task body from a
+//! [`Board`]'s parts and the shared [`Links`] and hands each to the
+//! board's [`Spawn`] hook. The target (`firmware/src/main.rs`) and the
+//! simulator (`laser-sim`'s `world`) each construct their board and call
+//! it, so the simulator runs the target's task graph.
+//!
+//! ```text
+//! console port ─▶ console ─CommandLink─▶ sequencer ─ServoLink─▶ servo bus ─▶ servo UART
+//!                      stop button ─┘     │  │  └─GalvoLink─▶ galvo loop ─▶ galvo DAC (if any)
+//!                                         │  └─▶ laser pin (every laser behind the LaserGate)
+//!                                         └─StatusBoard─▶ indicators (LEDs), watchdog
+//! ```
+//!
+//! See `ARCHITECTURE.md` for what a board provides and how to add one.
+
+mod board;
+mod tasks;
+
+pub use self::board::{Board, Console, Indicators, Leds, NoGalvoDac, Parts, StopButton, Watchdog};
+pub use self::tasks::{
+    ConsoleTask, GalvoTask, HEARTBEAT_TICKS, INDICATOR_PERIOD, IndicatorTask, SequencerTask,
+    ServoBusTask, StopButtonTask, WATCHDOG_CHECK_PERIOD, WATCHDOG_TIMEOUT_US, WatchdogTask,
+    leds_at,
+};
+
+use crate::command::CommandLink;
+use crate::galvo::GalvoLink;
+use crate::laser_gate::LaserGate;
+use crate::servo::task::ServoLink;
+use crate::status::StatusBoard;
+
+/// The channels and shared state between the tasks. The board owns them
+/// (`static`s on the target, leaked per run in the simulator) and lends
+/// them for the program's life.
+#[derive(Clone, Copy)]
+pub struct Links {
+    /// Console ↔ sequencer (commands, replies, stop requests).
+    pub command: &'static CommandLink,
+    /// Sequencer ↔ servo bus task.
+    pub servo: &'static ServoLink,
+    /// Sequencer ↔ galvo loop (no loop serves it on a board without a
+    /// galvo DAC).
+    pub galvo: &'static GalvoLink,
+    /// What the firmware is doing (for the LEDs, the watchdog, the
+    /// simulator).
+    pub status: &'static StatusBoard,
+    /// The master laser gate (its close hook is the board's).
+    pub gate: &'static LaserGate,
+}
+
+/// Runs task bodies as tasks. Embassy tasks cannot be generic, so a board
+/// implements one hook per task for its own part types: on the target a
+/// thin `#[embassy_executor::task]` wrapper around `task.run()`, in the
+/// simulator a simulated task.
+pub trait Spawn<B: Board> {
+    /// The command line.
+    fn console(&mut self, task: ConsoleTask<B::Console>);
+    /// The servo bus.
+    fn servo_bus(&mut self, task: ServoBusTask<B::ServoRx, B::ServoTx>);
+    /// The sequencer.
+    fn sequencer(&mut self, task: SequencerTask<B::Laser, B::Settings>);
+    /// The galvo loop (only called when the board has a galvo DAC; a board
+    /// with [`NoGalvoDac`] answers [`GalvoTask::unreachable`]).
+    fn galvo(&mut self, task: GalvoTask<B::GalvoDac>);
+    /// The status LEDs.
+    fn indicators(&mut self, task: IndicatorTask<B::Indicators>);
+    /// The stop button.
+    fn stop_button(&mut self, task: StopButtonTask<B::StopButton>);
+    /// The watchdog.
+    fn watchdog(&mut self, task: WatchdogTask<B::Watchdog>);
+}
+
+/// Builds the whole task set from `board` and `links` and spawns it
+/// through `spawner`, in dataflow order: console, servo bus, sequencer,
+/// galvo loop (when the board has a DAC), then the LEDs, the stop button
+/// and the watchdog.
+pub fn wire<B: Board>(board: B, links: Links, spawner: &mut impl Spawn<B>) {
+    let parts = board.into_parts();
+    spawner.console(ConsoleTask {
+        port: parts.console,
+        link: links.command,
+    });
+    spawner.servo_bus(ServoBusTask {
+        rx: parts.servo_rx,
+        tx: parts.servo_tx,
+        link: links.servo,
+    });
+    spawner.sequencer(SequencerTask {
+        laser: parts.laser,
+        store: parts.settings,
+        links,
+    });
+    if let Some(dac) = parts.galvo_dac {
+        spawner.galvo(GalvoTask {
+            dac,
+            link: links.galvo,
+            gate: links.gate,
+        });
+    }
+    spawner.indicators(IndicatorTask {
+        leds: parts.indicators,
+        status: links.status,
+    });
+    spawner.stop_button(StopButtonTask {
+        button: parts.stop_button,
+        link: links.command,
+    });
+    spawner.watchdog(WatchdogTask {
+        dog: parts.watchdog,
+        status: links.status,
+        servo: links.servo,
+    });
+}
+
+#[cfg(test)]
+mod tests;

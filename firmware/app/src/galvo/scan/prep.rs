@@ -1,0 +1,216 @@
+//! The prep stage: grbl's planner → segment prep → stepper ISR, for the
+//! galvo. Planning a job's jump (time-optimal, per jump) and loading a
+//! stroke into the look-ahead path planner (f64, per stroke) happen here,
+//! between half buffers, for the next steps of the queued work; the refill
+//! ([`GalvoLoop::refill`]) only steps the plans prepared here. A refill
+//! that needs a step nobody prepared holds the mirrors, laser off (counted
+//! in [`GalvoLoop::unprepared_samples`]): the laser is never lit without a
+//! prepared plan.
+//!
+//! A step is one jump plus what follows it: a point's dwell, or one stroke
+//! of a path. Each step is planned from where the step before it leaves
+//! the mirrors (a point's target; a stroke's end point as the path
+//! sampler lands on it, in f32), so prepared steps chain without looking
+//! at the running loop; the refill checks that chain when it queues the
+//! jump and drops the prepared steps if it broke.
+
+use galvo_planner::{JumpSync, MarkLimits, PathPlanner, XyJump, plan_xy_jump};
+use kinematics_core::PointMm;
+
+use super::{GalvoError, GalvoLoop, INTEGRATOR_CAPACITY, JUNCTION_DEVIATION_MM, Job, MARK_BLOCKS};
+use crate::galvo::path::Segment;
+
+/// Steps prepared ahead of the refill (a step takes at least the laser
+/// delays and its jump; four cover a half buffer of the shortest jobs).
+pub(super) const PREP_DEPTH: usize = 4;
+
+/// A stroke loaded into the look-ahead path planner, or why it was refused.
+pub(super) type LoadedStroke = Result<PathPlanner<MARK_BLOCKS>, GalvoError>;
+
+/// One prepared step: the jump to its start and, for a stroke, the loaded
+/// path planner.
+#[derive(Debug, Clone)]
+pub(super) struct Prepared {
+    pub(super) seq: u32,
+    pub(super) job: Job,
+    pub(super) stroke: usize,
+    /// Whether this step starts a queued job (its stroke 0).
+    starts_job: bool,
+    /// Both axes' jump plans, or why the jump was refused.
+    pub(super) jump: Result<XyJump<3>, GalvoError>,
+    /// The stroke, for a path step.
+    pub(super) marker: Option<LoadedStroke>,
+    /// Mirror angles where this step leaves the mirrors, rad.
+    pub(super) end_rad: [f64; 2],
+}
+
+impl Prepared {
+    /// Whether the job goes on after this step (the step was planned).
+    fn continues(&self) -> bool {
+        self.jump.is_ok() && !matches!(self.marker, Some(Err(_)))
+    }
+}
+
+/// What comes after a step of `job`: its next stroke, if it has one.
+fn next_stroke(job: &Job, stroke: usize) -> Option<usize> {
+    match job {
+        Job::Path(path) => path.stroke(stroke + 1).map(|_| stroke + 1),
+        Job::Point { .. } => None,
+    }
+}
+
+impl GalvoLoop {
+    /// Prepares the next steps of the queued work (up to [`PREP_DEPTH`]
+    /// ahead): plans their jumps and loads their strokes. Runs between
+    /// half buffers, never inside the refill. Returns how many steps it
+    /// prepared.
+    pub fn prep(&mut self) -> usize {
+        let mut prepared = 0;
+        while self.steps.len() - self.started() < PREP_DEPTH {
+            let Some(step) = self.next_unprepared_step() else {
+                break;
+            };
+            if !self.steps.push_back(step) {
+                break;
+            }
+            prepared += 1;
+        }
+        prepared
+    }
+
+    /// Steps at the front of [`Self::steps`] already started: the running
+    /// one (0 or 1).
+    fn started(&self) -> usize {
+        usize::from(self.running && self.steps.len() > 0)
+    }
+
+    /// Samples the refill held dark because the step it needed was not
+    /// prepared (since the loop was built).
+    pub fn unprepared_samples(&self) -> u32 {
+        self.unprepared_samples
+    }
+
+    /// Plans the step after the last prepared one (or after the running
+    /// step), if there is one.
+    fn next_unprepared_step(&self) -> Option<Prepared> {
+        let (after, start_rad) = match (self.steps.back(), self.active) {
+            (Some(last), _) => (
+                Some((last.seq, last.job, last.stroke, last.continues())),
+                last.end_rad,
+            ),
+            (None, Some(a)) if a.cancelled => return None,
+            (None, Some(a)) => (Some((a.seq, a.job, a.stroke, true)), self.active_end_rad),
+            (None, None) => (None, self.mirrors.end_position_rad()),
+        };
+        let next_in_job = after.and_then(|(seq, job, stroke, continues)| {
+            let stroke = next_stroke(&job, stroke).filter(|_| continues)?;
+            Some((seq, job, stroke, false))
+        });
+        let (seq, job, stroke, starts_job) = match next_in_job {
+            Some(step) => step,
+            None => {
+                let covered = (self.started()..self.steps.len())
+                    .filter(|&i| self.steps.get(i).is_some_and(|p| p.starts_job))
+                    .count();
+                let &(seq, job) = self.queue.iter().nth(covered)?;
+                (seq, job, 0, true)
+            }
+        };
+        Some(self.plan_step(seq, job, stroke, starts_job, start_rad))
+    }
+
+    /// Plans the jump from `start_rad` to step `stroke` of `job` and loads
+    /// the stroke.
+    fn plan_step(
+        &self,
+        seq: u32,
+        job: Job,
+        stroke: usize,
+        starts_job: bool,
+        start_rad: [f64; 2],
+    ) -> Prepared {
+        let (target_mm, marker, end_mm) = match job {
+            Job::Point { target_mm, .. } => (Ok(target_mm), None, None),
+            Job::Path(path) => match path.stroke(stroke) {
+                Some(([x_mm, y_mm], segments)) => (
+                    Ok(PointMm { x_mm, y_mm }),
+                    Some(self.load_stroke([x_mm, y_mm], &segments)),
+                    segments.last().map(|s| match *s {
+                        Segment::Line(end) | Segment::Arc { end, .. } => end,
+                    }),
+                ),
+                None => (Err(GalvoError::Planner), None, None),
+            },
+        };
+        let jump = target_mm.and_then(|target| {
+            let target_rad = self.angles_for(target)?;
+            plan_xy_jump(
+                &self.disc,
+                &self.disc,
+                start_rad,
+                target_rad,
+                self.config.method,
+                JumpSync::Independent,
+                INTEGRATOR_CAPACITY,
+            )
+            .map(|jump| (jump, target_rad))
+            .map_err(|_| GalvoError::Planner)
+        });
+        let end_rad = match (&jump, &marker, end_mm) {
+            (Err(_), _, _) => start_rad,
+            // Where the path sampler lands: the stroke's end in f32.
+            (Ok(_), Some(Ok(_)), Some([x, y])) => self
+                .angles_for(PointMm {
+                    x_mm: f64::from(x as f32),
+                    y_mm: f64::from(y as f32),
+                })
+                .unwrap_or(start_rad),
+            (Ok((_, target_rad)), _, _) => *target_rad,
+        };
+        Prepared {
+            seq,
+            job,
+            stroke,
+            starts_job,
+            jump: jump.map(|(jump, _)| jump),
+            marker,
+            end_rad,
+        }
+    }
+
+    /// Loads a stroke (its start and segments) into a fresh path planner.
+    fn load_stroke(&self, start: [f64; 2], segments: &[Segment]) -> LoadedStroke {
+        let limits = MarkLimits {
+            speed_mm_s: self.config.mark_speed_mm_s,
+            accel_mm_s2: self.config.mark_accel_mm_s2,
+            junction_deviation_mm: JUNCTION_DEVIATION_MM,
+            ts_s: self.config.sample_period_s,
+        };
+        let loaded = PathPlanner::new(limits, start).and_then(|mut planner| {
+            for segment in segments {
+                match *segment {
+                    Segment::Line(to) => planner.line_to(to)?,
+                    Segment::Arc { end, centre, ccw } => planner.arc_to(end, centre, ccw)?,
+                }
+            }
+            // The first block's f64 set-up here, not in the refill.
+            planner.prime();
+            Ok(planner)
+        });
+        loaded.map_err(|_| GalvoError::Planner)
+    }
+
+    /// Whether the first step not started is step `stroke` of job
+    /// `(seq, job)`.
+    pub(super) fn next_prepared_is(&self, seq: u32, job: &Job, stroke: usize) -> bool {
+        self.steps
+            .get(self.started())
+            .is_some_and(|p| p.seq == seq && p.job == *job && p.stroke == stroke)
+    }
+}
+
+mod ring;
+#[cfg(test)]
+mod tests;
+
+pub(super) use ring::StepRing;

@@ -1,0 +1,125 @@
+//! The STM32F4DISCOVERY's peripherals as the application's parts: each
+//! implements one of `laser-app`'s board traits
+//! ([`laser_app::app::Board`] and friends) over the HAL.
+
+use embassy_stm32::Peri;
+use embassy_stm32::exti::ExtiInput;
+use embassy_stm32::gpio::Output;
+use embassy_stm32::mode::Async;
+use embassy_stm32::peripherals::{IWDG, USB_OTG_FS};
+use embassy_stm32::usb::Driver;
+use embassy_stm32::wdg::IndependentWatchdog;
+use embassy_time::{Duration, Instant, Timer};
+use embassy_usb::class::cdc_acm::{BufferedReceiver, Sender};
+use laser_app::app::{Console, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog};
+use laser_app::laser_gate::LaserGate;
+use laser_app::sequencer::LaserSwitch;
+
+/// The USB driver type of this board.
+pub type UsbDriver = Driver<'static, USB_OTG_FS>;
+
+/// The command line on the USB CDC-ACM port.
+pub struct UsbConsole {
+    /// CDC-ACM transmit half.
+    pub tx: Sender<'static, UsbDriver>,
+    /// CDC-ACM receive half (buffered).
+    pub rx: BufferedReceiver<'static, UsbDriver>,
+}
+
+impl Console for UsbConsole {
+    type Rx = BufferedReceiver<'static, UsbDriver>;
+    type Tx = Sender<'static, UsbDriver>;
+
+    async fn connected(&mut self) -> (&mut Self::Rx, &mut Self::Tx) {
+        self.rx.wait_connection().await;
+        (&mut self.rx, &mut self.tx)
+    }
+}
+
+/// The laser-enable GPIO (active high), ANDed with the master laser gate:
+/// it goes high only while the gate is open, and the gate's close hook
+/// ([`crate::board::laser_gate_changed`]) pulls it low at once from
+/// whatever context closed it.
+pub struct LaserPin {
+    /// PB0.
+    pub pin: Output<'static>,
+    /// The master gate.
+    pub gate: &'static LaserGate,
+}
+
+impl LaserSwitch for LaserPin {
+    fn set(&mut self, on: bool) {
+        if on && self.gate.is_open() {
+            self.pin.set_high();
+            // A close between the check and the write has already run
+            // its hook: look again so the pin cannot stay high.
+            if !self.gate.is_open() {
+                self.pin.set_low();
+            }
+        } else {
+            self.pin.set_low();
+        }
+    }
+}
+
+/// Status LEDs: heartbeat (green), laser (orange), fault (red).
+pub struct StatusLeds {
+    /// PD12.
+    pub heartbeat: Output<'static>,
+    /// PD13.
+    pub laser: Output<'static>,
+    /// PD14.
+    pub fault: Output<'static>,
+}
+
+impl Indicators for StatusLeds {
+    fn show(&mut self, leds: Leds) {
+        self.laser.set_level(leds.laser.into());
+        self.fault.set_level(leds.fault.into());
+        self.heartbeat.set_level(leds.heartbeat.into());
+    }
+}
+
+/// Debounce of the user button: edges this soon after a press are bounce.
+const DEBOUNCE: Duration = Duration::from_millis(50);
+
+/// The user button (PA0, rising edge on press), debounced.
+pub struct UserButton {
+    /// PA0 with its EXTI line.
+    pub input: ExtiInput<'static, Async>,
+    /// The next press counts from this time on.
+    pub armed_from: Instant,
+}
+
+impl StopButton for UserButton {
+    async fn pressed(&mut self) {
+        Timer::at(self.armed_from).await;
+        self.input.wait_for_rising_edge().await;
+        self.armed_from = Instant::now() + DEBOUNCE;
+    }
+}
+
+/// The independent watchdog (IWDG), [`WATCHDOG_TIMEOUT_US`].
+pub struct IndependentDog {
+    /// Created with the timeout; unleashed by [`Watchdog::start`].
+    pub dog: IndependentWatchdog<'static, IWDG>,
+}
+
+impl IndependentDog {
+    /// The IWDG with the application's timeout (not running yet).
+    pub fn new(iwdg: Peri<'static, IWDG>) -> Self {
+        Self {
+            dog: IndependentWatchdog::new(iwdg, WATCHDOG_TIMEOUT_US),
+        }
+    }
+}
+
+impl Watchdog for IndependentDog {
+    fn start(&mut self) {
+        self.dog.unleash();
+    }
+
+    fn feed(&mut self) {
+        self.dog.pet();
+    }
+}
