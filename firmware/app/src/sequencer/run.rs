@@ -7,11 +7,11 @@ use super::faults;
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
 use super::targets::{self, Aim, PathCursor, Target};
-use crate::cli::format::Fixed;
 use crate::command::{GridPattern, Pattern, reply_text};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::status::Phase;
+use crate::text::Fixed;
 
 /// What a command starts.
 #[derive(Debug, Clone, Copy)]

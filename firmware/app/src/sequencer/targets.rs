@@ -7,10 +7,10 @@
 use kinematics_core as kc;
 use kinematics_core::{BoardPoint, Criterion, ErrorModel, Gimbal, Grid, GridIndex};
 
-use crate::cli::format::Fixed;
 use crate::command::{Actuator, AimModel, Pattern, PointCm};
 use crate::galvo::GalvoPath;
 use crate::settings::{AxisSettings, Settings};
+use crate::text::Fixed;
 
 /// One point the sequencer visits.
 #[derive(Debug, Clone, Copy, PartialEq)]
