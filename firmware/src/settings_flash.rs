@@ -3,7 +3,7 @@
 //! store itself (power-fail safe, shared with the simulator) is
 //! `laser_app::settings::store`; this board only supplies the flash.
 //!
-//! Erasing a sector (only when a sector fills up, about every 280 saves, or
+//! Erasing a sector (only when a sector fills up, about every 260 saves, or
 //! on the first save after an update from the earlier layout) stalls the
 //! CPU for ~1–2 s, which the watchdog timeout allows for; `save` is refused
 //! while a pattern runs.

@@ -7,8 +7,7 @@
 
 use embassy_futures::block_on;
 use embedded_storage_async::nor_flash::{NorFlash, ReadNorFlash};
-use laser_app::sequencer::SettingsStore;
-use laser_app::settings::store::FlashSettingsStore;
+use laser_app::settings::store::{FlashSettingsStore, SettingsStore};
 use laser_app::settings::{RECORD_LEN, Settings};
 use laser_sim::flash::{PowerCut, SimFlash, Tear};
 use sequential_storage::map::MapConfig;

@@ -10,8 +10,8 @@ use laser_sim::world::{
 use system_tests::{reply_to, run_with, terminal_lines};
 
 use embassy_futures::block_on;
-use laser_app::sequencer::SettingsStore;
 use laser_app::settings::Settings;
+use laser_app::settings::store::SettingsStore;
 
 /// The value line `get <param>` printed, e.g. `dwell_ms = 123 ms`.
 fn value_of(report: &SimReport, param: &str) -> String {

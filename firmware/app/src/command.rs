@@ -14,10 +14,10 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
-use crate::cli::format::Shortest;
 use crate::domain::{Actuator, AimModel, Pattern, PointCm};
 use crate::outbound::{LineKind, Outbound};
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
+use crate::text::Shortest;
 
 /// Longest reply line, bytes (longer lines are cut).
 pub const REPLY_LINE_LEN: usize = 120;
@@ -116,7 +116,7 @@ impl Command {
 }
 
 /// The command in command-line syntax (numbers in shortest form: no
-/// `core` float formatting, see [`crate::cli::format`]).
+/// `core` float formatting, see [`crate::text`]).
 impl fmt::Debug for Command {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {

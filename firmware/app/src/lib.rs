@@ -7,10 +7,11 @@
 //! [`sequencer`] (task body that runs commands and patterns) →
 //! [`servo`] (servo task body, speaking the `fashionstar` codec) and
 //! [`galvo`] (the galvo loop body feeding the DAC).
-//! The vocabulary below them all — board points, cm ↔ mm, patterns and
-//! path figures, actuators, targets, the aiming chain and the checks — is
-//! [`domain`].
-//! Text handling lives in [`cli`], parameters in [`settings`], shared
+//! The vocabulary below them all but number formatting ([`text`]) —
+//! board points, cm ↔ mm, patterns and path figures, actuators, targets,
+//! the aiming chain and the checks — is [`domain`].
+//! Text handling lives in [`cli`] (number formatting, the bottom layer, in
+//! [`text`]), parameters in [`settings`], shared
 //! state for LEDs/watchdog/simulator in [`status`], the master laser gate
 //! that no laser command or sample stream can override in [`laser_gate`].
 //! The grbl 1.1 G-code protocol (realtime bytes, G-code parser, replies),
@@ -32,4 +33,5 @@ pub mod sequencer;
 pub mod servo;
 pub mod settings;
 pub mod status;
+pub mod text;
 pub mod usb;

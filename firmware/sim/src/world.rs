@@ -63,7 +63,7 @@ pub fn settings_store(flash: SettingsFlash) -> FlashSettingsStore<SettingsFlash>
 /// The record a boot from `image` (the settings sectors) loads, if any.
 pub fn load_settings_record(image: Vec<u8>) -> Option<Vec<u8>> {
     let mut store = settings_store(SettingsFlash::from_image(SETTINGS_FLASH_OFFSET, image));
-    let mut record = vec![0u8; laser_app::settings::RECORD_LEN];
+    let mut record = vec![0u8; laser_app::settings::MAX_RECORD_LEN];
     let n = embassy_futures::block_on(store.load(&mut record));
     record.truncate(n);
     (n > 0).then_some(record)

@@ -1,11 +1,14 @@
 //! The saved settings record (`settings/record.rs`), through its public
-//! API only: `Settings::to_record`, `Settings::from_record`, `RECORD_LEN`
-//! and `crc32`.
+//! API only: `Settings::to_record`, `Settings::load_record`,
+//! `claimed_record_len`, `RECORD_LEN`, `MAX_RECORD_LEN` and `crc32`.
 //!
 //! Properties:
-//! * `from_record` never panics, whatever the bytes;
-//! * a record it accepts is valid settings that re-serialise to exactly the
-//!   same record bytes (nothing is silently changed on load);
+//! * `load_record` never panics, whatever the bytes;
+//! * a record it accepts is valid settings; an exact one (id-keyed, with
+//!   exactly this build's parameters) re-serialises to exactly the same
+//!   record bytes (nothing is silently changed on load), any other (a
+//!   positional record of the earlier layout, unknown ids skipped, missing
+//!   ones defaulted) re-serialises to an exact record of the same settings;
 //! * settings built by any sequence of accepted `set`s round-trip through
 //!   the record;
 //! * an accepted record with any error burst of up to 32 bits, or cut
@@ -15,7 +18,9 @@
 //! tried with its checksum fixed up ([`with_valid_checksum`]): that lets
 //! the fuzzer reach the value checks behind the CRC.
 
-use laser_app::settings::{PARAMS, RECORD_LEN, Settings, crc32};
+use laser_app::settings::{
+    LoadedRecord, MAX_RECORD_LEN, PARAMS, RECORD_LEN, Settings, claimed_record_len, crc32,
+};
 
 use crate::Bytes;
 
@@ -33,14 +38,14 @@ pub struct Summary {
 /// Runs the record properties on `data`; panics when one fails.
 pub fn check(data: &[u8]) -> Summary {
     let mut summary = Summary::default();
-    if let Ok(settings) = Settings::from_record(data) {
-        accepted(data, &settings);
+    if let Ok(loaded) = Settings::load_record(data) {
+        accepted(data, &loaded);
         summary.accepted = true;
         corruptions_are_refused(data, data);
     }
     let fixed = with_valid_checksum(data);
-    if let Ok(settings) = Settings::from_record(&fixed) {
-        accepted(&fixed, &settings);
+    if let Ok(loaded) = Settings::load_record(&fixed) {
+        accepted(&fixed, &loaded);
         summary.accepted_with_checksum = true;
         corruptions_are_refused(&fixed, data);
     }
@@ -52,42 +57,56 @@ pub fn check(data: &[u8]) -> Summary {
         Ok(settings),
         "settings built with accepted sets do not round-trip"
     );
-    accepted(&record, &settings);
+    let loaded = Settings::load_record(&record).expect("just checked");
+    assert!(loaded.is_exact(), "a record of this build is not exact");
+    accepted(&record, &loaded);
     corruptions_are_refused(&record, data);
     summary
 }
 
-/// The first [`RECORD_LEN`] bytes of `data` (zero-padded) with the CRC-32
-/// of the record body written into its last four bytes, little-endian (the
-/// record layout: body, then CRC-32 of the body).
+/// `data` cut or zero-padded to the length its own header claims (when
+/// it claims one up to [`MAX_RECORD_LEN`], else [`RECORD_LEN`]) with the
+/// CRC-32 of the record body written into its last four bytes,
+/// little-endian (the record layout: body, then CRC-32 of the body).
 pub fn with_valid_checksum(data: &[u8]) -> Vec<u8> {
+    let len = claimed_record_len(data)
+        .filter(|&len| len <= MAX_RECORD_LEN)
+        .unwrap_or(RECORD_LEN);
     let mut record = data.to_vec();
-    record.resize(RECORD_LEN.max(data.len()), 0);
-    let body = RECORD_LEN - 4;
+    record.resize(len, 0);
+    let body = len - 4;
     let crc = crc32(&record[..body]);
-    record[body..RECORD_LEN].copy_from_slice(&crc.to_le_bytes());
+    record[body..].copy_from_slice(&crc.to_le_bytes());
     record
 }
 
-/// Properties of a record `from_record` accepted as `settings`.
-fn accepted(bytes: &[u8], settings: &Settings) {
+/// Properties of a record `load_record` accepted as `loaded`.
+fn accepted(bytes: &[u8], loaded: &LoadedRecord) {
+    let settings = loaded.settings;
     assert!(settings.validate().is_ok(), "an accepted record is invalid");
     let again = settings.to_record();
-    assert_eq!(
-        again[..],
-        bytes[..RECORD_LEN],
-        "an accepted record re-serialises differently"
-    );
+    if loaded.is_exact() {
+        assert_eq!(
+            again[..],
+            bytes[..],
+            "an accepted record re-serialises differently"
+        );
+    } else {
+        let reloaded = Settings::load_record(&again).expect("a saved record loads");
+        assert!(
+            reloaded.is_exact() && reloaded.settings == settings,
+            "a migrated record does not save as the same settings"
+        );
+    }
 }
 
 /// Error bursts of up to 32 bits anywhere in an accepted record, and every
 /// truncation, are refused. Where and how to corrupt comes from `seed`.
 fn corruptions_are_refused(record: &[u8], seed: &[u8]) {
-    let record = &record[..RECORD_LEN];
     let mut b = Bytes::new(seed);
     let mut tries = 0;
     loop {
-        let at = usize::from(b.u16()) % RECORD_LEN;
+        let at = usize::from(b.u16()) % record.len();
         let mask: [u8; 4] = b.array();
         let mask = if mask == [0; 4] { [1, 0, 0, 0] } else { mask };
         let mut bad = record.to_vec();
@@ -105,8 +124,8 @@ fn corruptions_are_refused(record: &[u8], seed: &[u8]) {
             break;
         }
     }
-    let cut = usize::from(b.u16()) % RECORD_LEN;
-    for len in [cut, RECORD_LEN - 1, 8, 0] {
+    let cut = usize::from(b.u16()) % record.len();
+    for len in [cut, record.len() - 1, 8, 0] {
         assert!(
             Settings::from_record(&record[..len]).is_err(),
             "record cut to {len} bytes accepted"

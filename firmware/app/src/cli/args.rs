@@ -182,6 +182,18 @@ mod tests {
                 );
             }
         }
+
+        /// encode∘decode: every finite value's text parses back exactly
+        /// with the command line's own number parser.
+        #[test]
+        fn shortest_round_trips_through_the_parser(bits in proptest::prelude::any::<u64>()) {
+            extern crate std;
+            let v = f64::from_bits(bits);
+            proptest::prop_assume!(v.is_finite());
+            let text = std::format!("{}", crate::text::Shortest(v));
+            let back = parse_number(&text, "v", f64::MIN, f64::MAX);
+            proptest::prop_assert_eq!(back.map(|b| b == v), Ok(true), "{}", text);
+        }
     }
 
     impl<'a> Args<'a> {

@@ -2,7 +2,7 @@
 
 use core::fmt;
 
-use super::format::Shortest;
+use crate::text::Interval;
 
 /// A word quoted in an error message, truncated to fit.
 pub type Word = heapless::String<24>;
@@ -66,12 +66,7 @@ impl fmt::Display for CommandError {
             }
             CommandError::UnexpectedArgument(w) => write!(f, "unexpected argument '{w}'"),
             CommandError::OutOfRange { what, min, max } => {
-                write!(
-                    f,
-                    "{what} out of range [{}, {}]",
-                    Shortest(*min),
-                    Shortest(*max)
-                )
+                write!(f, "{what} out of range {}", Interval(*min, *max))
             }
             CommandError::Rejected(why) => f.write_str(why),
         }

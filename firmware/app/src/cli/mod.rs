@@ -3,6 +3,5 @@
 
 pub mod args;
 pub mod error;
-pub mod format;
 pub mod line;
 pub mod parse;

@@ -4,7 +4,7 @@
 use kinematics_core as kc;
 
 use super::point::PointCm;
-use crate::cli::format::Fixed;
+use crate::text::Fixed;
 
 /// Why a pattern (or goto) cannot run with the current settings.
 #[derive(Debug, Clone, Copy, PartialEq)]

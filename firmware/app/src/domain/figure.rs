@@ -11,7 +11,7 @@ pub use kinematics_core::{Pattern as GridPattern, Rotation};
 
 use super::point::PointCm;
 use super::units::Unit;
-use crate::cli::format::Shortest;
+use crate::text::Shortest;
 
 /// A figure drawn as a path, board cm.
 #[derive(Debug, Clone, Copy, PartialEq)]

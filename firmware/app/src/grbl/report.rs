@@ -9,7 +9,7 @@ use super::block::{PointMm, SpindleMode};
 use super::error::{Alarm, GrblError};
 use super::settings_map::GrblSetting;
 use super::state::{Distance, FeedMode, MotionMode, ParserState, Units};
-use crate::cli::format::Fixed;
+use crate::text::Fixed;
 
 /// grbl's version as senders detect it.
 pub const BANNER: &str = "Grbl 1.1h ['$' for help]";

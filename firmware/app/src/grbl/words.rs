@@ -208,7 +208,7 @@ mod tests {
         #[test]
         fn formatted_decimals_read_back(thousandths in -1_000_000_000i64..1_000_000_000) {
             let value = thousandths as f64 / 1000.0;
-            let line = std::format!("X{}", crate::cli::format::Fixed::<3>(value));
+            let line = std::format!("X{}", crate::text::Fixed::<3>(value));
             proptest::prop_assert_eq!(words(&line), Ok(std::vec![('X', value)]));
         }
     }

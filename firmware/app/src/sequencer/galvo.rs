@@ -6,12 +6,12 @@ use galvo_planner::{Method, RigidParams};
 
 use super::machine::{Action, ActionSink, Core, GalvoReadout};
 use super::run::RunKind;
-use crate::cli::format::Shortest;
 use crate::domain::{Pattern, Target};
 use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoConfig, GalvoEvent, GalvoRequest};
 use crate::log;
 use crate::settings::{GalvoSettings, JumpPlanner, LaserMode};
 use crate::status::Phase;
+use crate::text::Shortest;
 
 /// Dwell of a goto on the galvo: held until the next command, µs.
 const HOLD_US: u32 = u32::MAX;

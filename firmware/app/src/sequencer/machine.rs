@@ -28,7 +28,7 @@ use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, ScanPhase};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
-use crate::settings::{RecordError, Settings};
+use crate::settings::{LoadedRecord, RecordError, Settings};
 use crate::status::{Activity, Snapshot};
 
 /// Something that happened, for the core to act on.
@@ -59,7 +59,7 @@ pub enum Event {
     /// user.
     Saved(Result<(), &'static str>),
     /// The settings record read at boot, decoded.
-    SettingsLoaded(Result<Settings, RecordError>),
+    SettingsLoaded(Result<LoadedRecord, RecordError>),
     /// The master laser gate refused the gimbal laser: someone else (the
     /// galvo loop, on an underrun) closed it since the core last did. The
     /// gimbal laser stays dark until the core closes it again.
@@ -305,11 +305,20 @@ impl Core {
 
     /// The settings read at boot (defaults, with a warning, when the record
     /// is missing, old or corrupt); the galvo loop starts with them.
-    fn settings_loaded(&mut self, loaded: Result<Settings, RecordError>, out: &mut dyn ActionSink) {
+    fn settings_loaded(
+        &mut self,
+        loaded: Result<LoadedRecord, RecordError>,
+        out: &mut dyn ActionSink,
+    ) {
         self.settings = match loaded {
-            Ok(s) => {
-                log::info!("settings loaded from flash");
-                s
+            Ok(loaded) => {
+                log::info!(
+                    "settings loaded from flash ({:?} layout; {} unknown entries skipped, {} parameters defaulted)",
+                    loaded.layout,
+                    loaded.unknown,
+                    loaded.defaulted
+                );
+                loaded.settings
             }
             Err(RecordError::Missing) => {
                 log::info!("no saved settings, using defaults");

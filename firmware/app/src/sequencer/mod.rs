@@ -34,17 +34,9 @@ use crate::servo::task::ServoLink;
 use crate::settings::Settings;
 use crate::status::StatusBoard;
 
-/// Where settings are saved: [`crate::settings::store::FlashSettingsStore`]
-/// over the target's flash sectors 10 and 11, or over the simulator's model
-/// of them.
-#[allow(async_fn_in_trait)]
-pub trait SettingsStore {
-    /// Reads the saved record into `buf`; returns the bytes read (0 when
-    /// nothing is saved).
-    async fn load(&mut self, buf: &mut [u8]) -> usize;
-    /// Replaces the saved record; `Err` carries a message for the user.
-    async fn save(&mut self, record: &[u8]) -> Result<(), &'static str>;
-}
+/// Where settings are saved (defined with the settings; named here too,
+/// as the sequencer's store).
+pub use crate::settings::store::SettingsStore;
 
 /// Period of the housekeeping tick (liveness for the watchdog).
 const HOUSEKEEPING: Duration = Duration::from_millis(250);
@@ -108,9 +100,9 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     ) -> Self {
         laser.set(false);
         let generation = gate.close();
-        let mut record = [0u8; crate::settings::RECORD_LEN];
+        let mut record = [0u8; crate::settings::MAX_RECORD_LEN];
         let n = store.load(&mut record).await;
-        let loaded = Settings::from_record(record.get(..n).unwrap_or(&[]));
+        let loaded = Settings::load_record(record.get(..n).unwrap_or(&[]));
         let io = Io {
             link,
             servo,

@@ -3,11 +3,11 @@
 
 use super::machine::{ActionSink, Core, Readings};
 use crate::build_info;
-use crate::cli::format::Fixed;
 use crate::cli::parse::HELP_LINES;
 use crate::command::Command;
 use crate::domain::{AimModel, PointCm};
 use crate::status::{Activity, Phase, Snapshot};
+use crate::text::Fixed;
 
 impl Core {
     /// The data lines of `command` (`help`, `version`, `status`, `get`).

@@ -1,106 +1,32 @@
-//! The parameter table: name, unit, range and storage of every parameter.
+//! The parameter table: id, name, unit, range and storage of every
+//! parameter, in ascending id order (the order of `params` and of the
+//! saved record).
+//!
+//! Ids are stable (like grbl's `$N`): the saved record keys each value by
+//! its parameter's id, so adding, removing or compiling out a parameter
+//! never changes how the others are stored. An id is never changed or
+//! reused; a new parameter takes a free id in its group:
+//!
+//! | ids     | group                                         |
+//! |---------|-----------------------------------------------|
+//! | 10–19   | gimbal geometry (`oq_cm` 10, `ol_cm` 11)      |
+//! | 20–29   | grid and board (`grid.*` 20–24, `board.roll_deg` 25) |
+//! | 30–39   | motion (`dwell_ms` 30, `servo.*` 31–32, `path.step_cm` 33) |
+//! | 40–49   | yaw servo: 40 id, 41 dir, 42 scale, 43 zero_deg, 44 min_deg, 45 max_deg |
+//! | 50–59   | pitch servo: the same, 50–55                  |
+//! | 60–69   | laser (`laser.mode` 60)                        |
+//! | 70–79   | error model x: `err.dx.c0..c5` 70–75          |
+//! | 80–89   | error model y: `err.dy.c0..c5` 80–85          |
+//! | 100–109 | galvo geometry (`d_mm` 100, `e_mm` 101)       |
+//! | 110–119 | galvo DAC mapping (x scale, x offset, y scale, y offset: 110–113) |
+//! | 120–129 | galvo drive (Kt, J, L, R, Umax, Ts: 120–125)  |
+//! | 130–139 | galvo jump planner (130)                      |
+//! | 140–149 | galvo laser delays (on 140, off 141)          |
+//! | 150–159 | galvo marking (speed 150, acceleration 151)   |
 
-use core::fmt;
-
-use super::{LaserMode, Settings};
-use crate::cli::error::CommandError;
-use crate::cli::format::Shortest;
+use super::spec::COEF_HELP;
+use super::spec::{ParamSpec, Precision, Slot, choice, count, err_coef, real};
 use kinematics_core::error_model::COEF_LIMITS;
-
-/// How a parameter's value is stored.
-#[derive(Clone, Copy)]
-pub(super) enum Slot {
-    Real(fn(&mut Settings) -> &mut f64),
-    Count(fn(&mut Settings) -> &mut u8),
-    Sign(fn(&mut Settings) -> &mut i8),
-    Laser,
-    Planner,
-}
-
-/// The precision a parameter's value is used in by the code that reads
-/// it (the value is stored as f64 either way).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Precision {
-    /// Used as f64 (or as a whole number).
-    F64,
-    /// Converted to f32 where it is used (galvo geometry and DAC mapping,
-    /// marking): it must stay finite and, when non-zero, non-zero in f32.
-    F32,
-}
-
-/// Description of one parameter. Every value is checked against
-/// `min..=max` (and `min_magnitude`) before it is stored; the ranges are
-/// the physically meaningful ones for the hardware of SPEC §2, so a value
-/// that passes cannot degenerate (divide by ~0, overflow or vanish) in the
-/// precision it is used in.
-#[derive(Clone, Copy)]
-pub struct ParamSpec {
-    /// Name used by `set` / `get`.
-    pub name: &'static str,
-    /// Lowest accepted value (in the parameter's unit).
-    pub min: f64,
-    /// Highest accepted value (in the parameter's unit).
-    pub max: f64,
-    /// Smallest accepted magnitude `|value|` (0: none). For parameters
-    /// whose sign is a direction (DAC scales), so neither sign can come
-    /// close to 0.
-    pub min_magnitude: f64,
-    /// Precision the value is used in.
-    pub precision: Precision,
-    /// What it is, with unit.
-    pub help: &'static str,
-    pub(super) slot: Slot,
-}
-
-macro_rules! real {
-    ($name:literal, $min:expr, $max:expr, $help:literal, |$s:ident| $place:expr) => {
-        real!($name, $min, $max, Precision::F64, $help, |$s| $place)
-    };
-    ($name:literal, $min:expr, $max:expr, $precision:expr, $help:literal, |$s:ident| $place:expr) => {
-        ParamSpec {
-            name: $name,
-            min: $min,
-            max: $max,
-            min_magnitude: 0.0,
-            precision: $precision,
-            help: $help,
-            slot: Slot::Real(|$s| &mut $place),
-        }
-    };
-}
-
-/// A whole-number parameter (ids, counts).
-macro_rules! count {
-    ($name:literal, $min:expr, $max:expr, $help:literal, |$s:ident| $place:expr) => {
-        choice!($name, $min, $max, $help, Slot::Count(|$s| &mut $place))
-    };
-}
-
-/// A parameter that is one of a few codes (`slot` decides which).
-macro_rules! choice {
-    ($name:literal, $min:expr, $max:expr, $help:literal, $slot:expr) => {
-        ParamSpec {
-            name: $name,
-            min: $min,
-            max: $max,
-            min_magnitude: 0.0,
-            precision: Precision::F64,
-            help: $help,
-            slot: $slot,
-        }
-    };
-}
-
-/// Error-model coefficients (SPEC §5): `Δ = c0 + c1·x + c2·y + c3·x² +
-/// c4·x·y + c5·y²` with x, y, Δ in mm. Ranges from
-/// [`kinematics_core::error_model::COEF_LIMITS`] (shared with `cargo xtask
-/// calib fit`): c0 ±100 mm, c1/c2 ±1 mm/mm, c3..c5 ±0.01 1/mm.
-macro_rules! err_coef {
-    ($name:literal, $axis:ident, $i:literal, $help:literal) => {
-        real!($name, -COEF_LIMITS[$i], COEF_LIMITS[$i], $help, |s| s.$axis
-            [$i])
-    };
-}
 
 /// Smallest |galvo DAC scale|, codes/rad: 4096 codes over ±45° of mirror.
 pub const MIN_CODES_PER_RAD: f64 = 1_000.0;
@@ -110,20 +36,29 @@ pub const MAX_CODES_PER_RAD: f64 = 120_000.0;
 /// The parameter table (also the order of `params` and of the saved record).
 pub static PARAMS: &[ParamSpec] = &[
     real!(
+        10,
         "oq_cm",
         5.0,
         500.0,
         "gimbal centre to board distance OQ, cm",
         |s| s.oq_cm
     ),
-    real!("ol_cm", 0.0, 20.0, "laser axis offset OL, cm", |s| s.ol_cm),
-    real!("grid.pitch_cm", 0.1, 20.0, "grid pitch, cm", |s| s
+    real!(11, "ol_cm", 0.0, 20.0, "laser axis offset OL, cm", |s| s
+        .ol_cm),
+    real!(20, "grid.pitch_cm", 0.1, 20.0, "grid pitch, cm", |s| s
         .grid_pitch_cm),
-    count!("grid.cols", 2.0, 40.0, "grid columns (even), cells", |s| s
-        .grid_cols),
-    count!("grid.rows", 2.0, 40.0, "grid rows (even), cells", |s| s
+    count!(
+        21,
+        "grid.cols",
+        2.0,
+        40.0,
+        "grid columns (even), cells",
+        |s| s.grid_cols
+    ),
+    count!(22, "grid.rows", 2.0, 40.0, "grid rows (even), cells", |s| s
         .grid_rows),
     real!(
+        23,
         "grid.x_offset_cm",
         -100.0,
         100.0,
@@ -131,6 +66,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.x_offset_cm
     ),
     real!(
+        24,
         "grid.y_offset_cm",
         -100.0,
         100.0,
@@ -138,6 +74,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.y_offset_cm
     ),
     real!(
+        25,
         "board.roll_deg",
         -10.0,
         10.0,
@@ -145,6 +82,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.board_roll_deg
     ),
     real!(
+        30,
         "dwell_ms",
         0.0,
         60_000.0,
@@ -152,6 +90,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.dwell_ms
     ),
     real!(
+        31,
         "servo.speed_deg_s",
         1.0,
         750.0,
@@ -159,6 +98,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.servo_speed_deg_s
     ),
     real!(
+        32,
         "servo.deadband_deg",
         0.1,
         10.0,
@@ -166,24 +106,32 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.deadband_deg
     ),
     real!(
+        33,
         "path.step_cm",
         0.01,
         5.0,
         "line/circle/rect interpolation step, cm",
         |s| s.path_step_cm
     ),
-    count!("yaw.id", 0.0, 253.0, "yaw servo bus id", |s| s.yaw.id),
+    count!(40, "yaw.id", 0.0, 253.0, "yaw servo bus id", |s| s.yaw.id),
     choice!(
+        41,
         "yaw.dir",
         -1.0,
         1.0,
         "yaw direction, +1 or -1",
         Slot::Sign(|s| &mut s.yaw.direction)
     ),
-    real!("yaw.scale", 0.5, 2.0, "yaw servo deg per joint deg", |s| s
-        .yaw
-        .scale),
     real!(
+        42,
+        "yaw.scale",
+        0.5,
+        2.0,
+        "yaw servo deg per joint deg",
+        |s| s.yaw.scale
+    ),
+    real!(
+        43,
         "yaw.zero_deg",
         -90.0,
         90.0,
@@ -191,6 +139,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.yaw.zero_deg
     ),
     real!(
+        44,
         "yaw.min_deg",
         -180.0,
         180.0,
@@ -198,14 +147,18 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.yaw.min_deg
     ),
     real!(
+        45,
         "yaw.max_deg",
         -180.0,
         180.0,
         "yaw servo upper limit, deg",
         |s| s.yaw.max_deg
     ),
-    count!("pitch.id", 0.0, 253.0, "pitch servo bus id", |s| s.pitch.id),
+    count!(50, "pitch.id", 0.0, 253.0, "pitch servo bus id", |s| s
+        .pitch
+        .id),
     choice!(
+        51,
         "pitch.dir",
         -1.0,
         1.0,
@@ -213,6 +166,7 @@ pub static PARAMS: &[ParamSpec] = &[
         Slot::Sign(|s| &mut s.pitch.direction)
     ),
     real!(
+        52,
         "pitch.scale",
         0.5,
         2.0,
@@ -220,6 +174,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.pitch.scale
     ),
     real!(
+        53,
         "pitch.zero_deg",
         -90.0,
         90.0,
@@ -227,6 +182,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.pitch.zero_deg
     ),
     real!(
+        54,
         "pitch.min_deg",
         -180.0,
         180.0,
@@ -234,6 +190,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.pitch.min_deg
     ),
     real!(
+        55,
         "pitch.max_deg",
         -180.0,
         180.0,
@@ -241,75 +198,27 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.pitch.max_deg
     ),
     choice!(
+        60,
         "laser.mode",
         0.0,
         2.0,
         "0 auto, 1 dwell, 2 off",
         Slot::Laser
     ),
-    err_coef!("err.dx.c0", err_dx, 0, "error-model constant c0, mm"),
-    err_coef!(
-        "err.dx.c1",
-        err_dx,
-        1,
-        "error-model coefficient c1 of x, mm/mm"
-    ),
-    err_coef!(
-        "err.dx.c2",
-        err_dx,
-        2,
-        "error-model coefficient c2 of y, mm/mm"
-    ),
-    err_coef!(
-        "err.dx.c3",
-        err_dx,
-        3,
-        "error-model coefficient c3 of x^2, 1/mm"
-    ),
-    err_coef!(
-        "err.dx.c4",
-        err_dx,
-        4,
-        "error-model coefficient c4 of x*y, 1/mm"
-    ),
-    err_coef!(
-        "err.dx.c5",
-        err_dx,
-        5,
-        "error-model coefficient c5 of y^2, 1/mm"
-    ),
-    err_coef!("err.dy.c0", err_dy, 0, "error-model constant c0, mm"),
-    err_coef!(
-        "err.dy.c1",
-        err_dy,
-        1,
-        "error-model coefficient c1 of x, mm/mm"
-    ),
-    err_coef!(
-        "err.dy.c2",
-        err_dy,
-        2,
-        "error-model coefficient c2 of y, mm/mm"
-    ),
-    err_coef!(
-        "err.dy.c3",
-        err_dy,
-        3,
-        "error-model coefficient c3 of x^2, 1/mm"
-    ),
-    err_coef!(
-        "err.dy.c4",
-        err_dy,
-        4,
-        "error-model coefficient c4 of x*y, 1/mm"
-    ),
-    err_coef!(
-        "err.dy.c5",
-        err_dy,
-        5,
-        "error-model coefficient c5 of y^2, 1/mm"
-    ),
+    err_coef!(70, "err.dx.c0", err_dx, 0),
+    err_coef!(71, "err.dx.c1", err_dx, 1),
+    err_coef!(72, "err.dx.c2", err_dx, 2),
+    err_coef!(73, "err.dx.c3", err_dx, 3),
+    err_coef!(74, "err.dx.c4", err_dx, 4),
+    err_coef!(75, "err.dx.c5", err_dx, 5),
+    err_coef!(80, "err.dy.c0", err_dy, 0),
+    err_coef!(81, "err.dy.c1", err_dy, 1),
+    err_coef!(82, "err.dy.c2", err_dy, 2),
+    err_coef!(83, "err.dy.c3", err_dy, 3),
+    err_coef!(84, "err.dy.c4", err_dy, 4),
+    err_coef!(85, "err.dy.c5", err_dy, 5),
     real!(
+        100,
         "galvo.d_mm",
         50.0,
         5000.0,
@@ -318,6 +227,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.d_mm
     ),
     real!(
+        101,
         "galvo.e_mm",
         0.0,
         100.0,
@@ -326,6 +236,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.e_mm
     ),
     ParamSpec {
+        id: 110,
         name: "galvo.x_codes_per_rad",
         min: -MAX_CODES_PER_RAD,
         max: MAX_CODES_PER_RAD,
@@ -335,6 +246,7 @@ pub static PARAMS: &[ParamSpec] = &[
         slot: Slot::Real(|s| &mut s.galvo.x_codes_per_rad),
     },
     real!(
+        111,
         "galvo.x_offset_code",
         0.0,
         4095.0,
@@ -343,6 +255,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.x_offset_code
     ),
     ParamSpec {
+        id: 112,
         name: "galvo.y_codes_per_rad",
         min: -MAX_CODES_PER_RAD,
         max: MAX_CODES_PER_RAD,
@@ -352,6 +265,7 @@ pub static PARAMS: &[ParamSpec] = &[
         slot: Slot::Real(|s| &mut s.galvo.y_codes_per_rad),
     },
     real!(
+        113,
         "galvo.y_offset_code",
         0.0,
         4095.0,
@@ -360,6 +274,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.y_offset_code
     ),
     real!(
+        120,
         "galvo.kt_nm_per_a",
         1e-4,
         1.0,
@@ -367,16 +282,23 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.kt_nm_per_a
     ),
     real!(
+        121,
         "galvo.j_kg_m2",
         1e-10,
         1e-4,
         "galvo rotor+mirror inertia J, kg*m^2",
         |s| s.galvo.j_kg_m2
     ),
-    real!("galvo.l_h", 1e-6, 0.1, "galvo coil inductance L, H", |s| s
-        .galvo
-        .l_h),
     real!(
+        122,
+        "galvo.l_h",
+        1e-6,
+        0.1,
+        "galvo coil inductance L, H",
+        |s| s.galvo.l_h
+    ),
+    real!(
+        123,
         "galvo.r_ohm",
         0.1,
         100.0,
@@ -384,6 +306,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.r_ohm
     ),
     real!(
+        124,
         "galvo.u_max_v",
         1.0,
         100.0,
@@ -391,6 +314,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.u_max_v
     ),
     real!(
+        125,
         "galvo.ts_us",
         5.0,
         1000.0,
@@ -398,6 +322,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.sample_period_us
     ),
     choice!(
+        130,
         "galvo.planner",
         0.0,
         1.0,
@@ -405,6 +330,7 @@ pub static PARAMS: &[ParamSpec] = &[
         Slot::Planner
     ),
     real!(
+        140,
         "galvo.laser_on_delay_us",
         0.0,
         10_000.0,
@@ -412,6 +338,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.laser_on_delay_us
     ),
     real!(
+        141,
         "galvo.laser_off_delay_us",
         0.0,
         10_000.0,
@@ -419,6 +346,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.laser_off_delay_us
     ),
     real!(
+        150,
         "galvo.mark_speed_mm_s",
         1.0,
         20_000.0,
@@ -426,6 +354,7 @@ pub static PARAMS: &[ParamSpec] = &[
         |s| s.galvo.mark_speed_mm_s
     ),
     real!(
+        151,
         "galvo.mark_accel_mm_s2",
         100.0,
         1.0e8,
@@ -440,62 +369,7 @@ pub fn find_param(name: &str) -> Option<&'static ParamSpec> {
     PARAMS.iter().find(|p| p.name.eq_ignore_ascii_case(name))
 }
 
-/// Checks one value against its parameter's range and kind.
-pub(super) fn check_value(param: &ParamSpec, value: f64) -> Result<(), CommandError> {
-    if !value.is_finite() || value < param.min || value > param.max {
-        return Err(CommandError::OutOfRange {
-            what: param.name,
-            min: param.min,
-            max: param.max,
-        });
-    }
-    if value.abs() < param.min_magnitude {
-        return Err(CommandError::Rejected(
-            "value too close to 0 (see `params` for the smallest magnitude)",
-        ));
-    }
-    if param.precision == Precision::F32 && !survives_f32(value) {
-        return Err(CommandError::Rejected("value not representable in f32"));
-    }
-    // In range, so the cast is exact for every whole value.
-    let whole = (value as i64) as f64 == value;
-    match param.slot {
-        Slot::Real(_) => Ok(()),
-        Slot::Count(_) if !whole => Err(CommandError::Rejected("value must be a whole number")),
-        Slot::Sign(_) if value != 1.0 && value != -1.0 => {
-            Err(CommandError::Rejected("direction must be 1 or -1"))
-        }
-        Slot::Planner if value != 0.0 && value != 1.0 => {
-            Err(CommandError::Rejected("galvo.planner must be 0 or 1"))
-        }
-        Slot::Laser if LaserMode::from_code(value).is_none() => {
-            Err(CommandError::Rejected("laser.mode must be 0, 1 or 2"))
-        }
-        _ => Ok(()),
-    }
-}
-
-/// Whether `value` keeps its meaning as f32: finite, and non-zero unless
-/// it is 0 (the ranges keep every accepted value far from both limits;
-/// this is the check that they do).
-pub(super) fn survives_f32(value: f64) -> bool {
-    let narrow = value as f32;
-    narrow.is_finite() && (narrow != 0.0 || value == 0.0)
-}
-
-/// Format of `get`/`params` lines: `name = value  # help [min, max]`.
-pub struct ParamLine<'a>(pub &'a ParamSpec, pub f64);
-
-impl fmt::Display for ParamLine<'_> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} = {}  # {} [{}, {}]",
-            self.0.name,
-            Shortest(self.1),
-            self.0.help,
-            Shortest(self.0.min),
-            Shortest(self.0.max)
-        )
-    }
+/// Finds a parameter of `table` by id.
+pub(crate) fn param_by_id(table: &[ParamSpec], id: u16) -> Option<&ParamSpec> {
+    table.iter().find(|p| p.id == id)
 }

@@ -23,16 +23,27 @@ use embedded_storage_async::nor_flash::{MultiwriteNorFlash, NorFlash};
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapStorage};
 
-use super::record::{RECORD_LEN, intact_record_len};
+use super::record::{MAX_RECORD_LEN, intact_record_len};
 use crate::log;
-use crate::sequencer::SettingsStore;
+
+/// Where settings are saved: [`FlashSettingsStore`] over the target's flash
+/// sectors 10 and 11, or over the simulator's model of them.
+#[allow(async_fn_in_trait)]
+pub trait SettingsStore {
+    /// Reads the saved record into `buf`; returns the bytes read (0 when
+    /// nothing is saved).
+    async fn load(&mut self, buf: &mut [u8]) -> usize;
+    /// Replaces the saved record; `Err` carries a message for the user.
+    async fn save(&mut self, record: &[u8]) -> Result<(), &'static str>;
+}
 
 /// Map key of the settings record (the only item).
 const RECORD_KEY: u8 = 1;
 
-/// Scratch buffer for one map item (key byte + record), padded to the
-/// largest flash word `sequential-storage` supports (32 bytes).
-const ITEM_BUFFER_LEN: usize = (1 + RECORD_LEN).next_multiple_of(32);
+/// Scratch buffer for one map item (key byte + the longest record this
+/// build loads, of either layout), padded to the largest flash word
+/// `sequential-storage` supports (32 bytes).
+const ITEM_BUFFER_LEN: usize = (1 + MAX_RECORD_LEN).next_multiple_of(32);
 
 /// Bytes read at a time when checking that a sector is erased.
 const ERASED_CHECK_CHUNK: usize = 64;
@@ -75,6 +86,8 @@ impl<F: MultiwriteNorFlash> FlashSettingsStore<F> {
     /// `buf`, if there is one.
     async fn read_legacy(&mut self, buf: &mut [u8; ITEM_BUFFER_LEN]) -> Option<usize> {
         let at = self.legacy_offset();
+        // A record in the earlier layout lies within the last sector.
+        let buf = buf.get_mut(..F::ERASE_SIZE.min(ITEM_BUFFER_LEN))?;
         self.map.flash().read(at, buf).await.ok()?;
         intact_record_len(buf)
     }
