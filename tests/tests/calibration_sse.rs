@@ -6,7 +6,6 @@
 use kinematics_core::{PointMm, fit};
 use laser_app::cli::parse::parse_line;
 use laser_app::command::Command;
-use laser_app::sequencer::targets::error_model;
 use laser_app::settings::Settings;
 
 #[path = "../../kinematics-core/tests/support/mod.rs"]
@@ -36,7 +35,7 @@ fn reported_sse_is_that_of_the_model_the_firmware_holds() {
             settings.set(param, value).unwrap();
         }
     }
-    let model = error_model(&settings);
+    let model = settings.error_model();
     let (mut sse_x, mut sse_y) = (0.0, 0.0);
     for p in &points {
         let e = model

@@ -2,8 +2,7 @@
 //! tasks up, unreachable figures are refused or stop dark, and the laser
 //! is lit only on the figure (travel to it is dark).
 
-use laser_app::command::{Actuator, AimModel, Pattern, PointCm};
-use laser_app::sequencer::targets;
+use laser_app::domain::{self, Actuator, AimModel, Pattern, PointCm, check_pattern, pass_points};
 use laser_app::settings::Settings;
 use laser_sim::recorder::{Direction, SpotSample};
 use laser_sim::world::{SimOptions, SimReport};
@@ -165,12 +164,14 @@ fn unreachable_figures_are_refused_before_anything_moves_or_lights() {
 /// so points between the checked ones can fail.
 fn limit_between_probes(pattern: &Pattern) -> (&'static str, f64) {
     let base = Settings::default();
-    let points: Vec<PointCm> = targets::pass_points(pattern, &base)
+    let points: Vec<PointCm> = pass_points(pattern, &base.aimer(AimModel::Exact))
         .expect("a path")
         .map(|t| t.point)
         .collect();
     let pitch = |s: &Settings, p: PointCm| {
-        targets::aim(s, AimModel::Exact, p).map(|a| f64::from(a.pitch_wire) / 10.0)
+        s.aimer(AimModel::Exact)
+            .aim(p)
+            .map(|a| f64::from(a.pitch_wire) / 10.0)
     };
     let peak = points
         .iter()
@@ -186,7 +187,7 @@ fn limit_between_probes(pattern: &Pattern) -> (&'static str, f64) {
             s.pitch.min_deg = -limit;
             "pitch.min_deg"
         };
-        let checked = targets::check_pattern(pattern, &s, AimModel::Exact, Actuator::Gimbal);
+        let checked = check_pattern(pattern, &s.aimer(AimModel::Exact), Actuator::Gimbal);
         let some_fail = points.iter().any(|p| pitch(&s, *p).is_err());
         if checked.is_ok() && some_fail {
             return (name, if peak > 0.0 { limit } else { -limit });
@@ -198,10 +199,10 @@ fn limit_between_probes(pattern: &Pattern) -> (&'static str, f64) {
 #[test]
 fn a_figure_unreachable_between_checked_points_stops_dark_at_the_first_bad_point() {
     let (x0, x1, y) = (-60.0, 47.0, 20.0);
-    let pattern = Pattern::Line {
+    let pattern = Pattern::Path(domain::Figure::Line {
         from: PointCm { x_cm: x0, y_cm: y },
         to: PointCm { x_cm: x1, y_cm: y },
-    };
+    });
     let (param, limit) = limit_between_probes(&pattern);
     let script = format!("set {param} {limit:.2}\npattern line {x0} {y} {x1} {y} once\n");
     let report = run_with(&script, SimOptions::default());

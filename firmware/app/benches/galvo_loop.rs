@@ -7,7 +7,8 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
-use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoPath, GalvoRequest, ScanPhase};
+use laser_app::domain::{Figure, PointCm};
+use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoRequest, ScanPhase};
 
 const HALF: usize = 128;
 
@@ -58,9 +59,10 @@ fn galvo_loop(c: &mut Criterion) {
                 let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default config");
                 galvo.request(GalvoRequest::Path {
                     seq: 1,
-                    path: GalvoPath::Line {
-                        from_mm: [-80.0, 10.0],
-                        to_mm: [80.0, -10.0],
+                    // (-80, 10) mm to (80, -10) mm.
+                    path: Figure::Line {
+                        from: PointCm::new(-8.0, 1.0),
+                        to: PointCm::new(8.0, -1.0),
                     },
                 });
                 let mut half = [DacSample::default(); HALF];

@@ -14,6 +14,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
+use crate::domain::{Actuator, AimModel, Pattern, PointCm};
 use crate::outbound::{LineKind, Outbound};
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
 use crate::text::Shortest;
@@ -23,124 +24,6 @@ pub const REPLY_LINE_LEN: usize = 120;
 
 /// Text of one reply line.
 pub type ReplyText = heapless::String<REPLY_LINE_LEN>;
-
-/// A board point, cm (board frame: x right, y up, origin at Q).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct PointCm {
-    /// Board x, cm.
-    pub x_cm: f64,
-    /// Board y, cm.
-    pub y_cm: f64,
-}
-
-pub use kinematics_core::{Pattern as GridPattern, Rotation};
-
-/// A test pattern or path (SPEC §4.6).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Pattern {
-    /// A grid pattern: home, corner, horizontal, vertical, visit-all, full
-    /// grid raster or serpentine.
-    Grid(GridPattern),
-    /// Straight line A → B.
-    Line {
-        /// Start, cm.
-        from: PointCm,
-        /// End, cm.
-        to: PointCm,
-    },
-    /// Full circle.
-    Circle {
-        /// Centre, cm.
-        centre: PointCm,
-        /// Radius, cm.
-        radius_cm: f64,
-        /// Direction.
-        rotation: Rotation,
-    },
-    /// Rectangle border through two opposite corners.
-    Rect {
-        /// One corner, cm.
-        a: PointCm,
-        /// The opposite corner, cm.
-        b: PointCm,
-    },
-    /// Galvo tuning figure: square, inscribed circle and cross.
-    Tuning {
-        /// Centre, cm.
-        centre: PointCm,
-        /// Side of the square, cm.
-        size_cm: f64,
-    },
-}
-
-impl Pattern {
-    /// Name used on the command line.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Pattern::Grid(grid) => grid.name(),
-            Pattern::Line { .. } => "line",
-            Pattern::Circle { .. } => "circle",
-            Pattern::Rect { .. } => "rect",
-            Pattern::Tuning { .. } => "tuning",
-        }
-    }
-
-    /// Whether this is a drawn path (no dwell between its points) rather
-    /// than a set of grid points.
-    pub fn is_path(&self) -> bool {
-        matches!(
-            self,
-            Pattern::Line { .. }
-                | Pattern::Circle { .. }
-                | Pattern::Rect { .. }
-                | Pattern::Tuning { .. }
-        )
-    }
-}
-
-/// Which actuator draws.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Actuator {
-    /// The servo gimbal (default).
-    Gimbal,
-    /// The two-mirror galvo scanner.
-    Galvo,
-    /// Both, visiting the same board points together.
-    Both,
-}
-
-impl Actuator {
-    /// Name used on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Actuator::Gimbal => "gimbal",
-            Actuator::Galvo => "galvo",
-            Actuator::Both => "both",
-        }
-    }
-
-    /// Whether the gimbal takes part.
-    pub fn uses_gimbal(self) -> bool {
-        self != Actuator::Galvo
-    }
-
-    /// Whether the galvo takes part.
-    pub fn uses_galvo(self) -> bool {
-        self != Actuator::Gimbal
-    }
-}
-
-/// Which kinematic model aims the gimbal.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum AimModel {
-    /// The exact coupled model (SPEC §4.3), default.
-    Exact,
-    /// The seed's approximate model (SPEC §4.2), for comparison.
-    Seed,
-}
 
 /// A parsed, validated command for the sequencer.
 #[derive(Clone, Copy)]
@@ -232,36 +115,6 @@ impl Command {
     }
 }
 
-/// The pattern in command-line syntax (`circle 2 1 4 ccw`).
-impl fmt::Display for Pattern {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let cm = |p: PointCm| (Shortest(p.x_cm), Shortest(p.y_cm));
-        match *self {
-            Pattern::Line { from, to } | Pattern::Rect { a: from, b: to } => {
-                let ((x0, y0), (x1, y1)) = (cm(from), cm(to));
-                write!(f, "{} {x0} {y0} {x1} {y1}", self.name())
-            }
-            Pattern::Circle {
-                centre,
-                radius_cm,
-                rotation,
-            } => {
-                let (x, y) = cm(centre);
-                let turn = match rotation {
-                    Rotation::Cw => "cw",
-                    Rotation::Ccw => "ccw",
-                };
-                write!(f, "circle {x} {y} {} {turn}", Shortest(radius_cm))
-            }
-            Pattern::Tuning { centre, size_cm } => {
-                let (x, y) = cm(centre);
-                write!(f, "tuning {x} {y} {}", Shortest(size_cm))
-            }
-            _ => f.write_str(self.name()),
-        }
-    }
-}
-
 /// The command in command-line syntax (numbers in shortest form: no
 /// `core` float formatting, see [`crate::text`]).
 impl fmt::Debug for Command {
@@ -309,13 +162,6 @@ impl PartialEq for Command {
             (Command::Get(a), Command::Get(b)) => a.name == b.name,
             (a, b) => core::mem::discriminant(a) == core::mem::discriminant(b),
         }
-    }
-}
-
-#[cfg(feature = "defmt")]
-impl defmt::Format for Pattern {
-    fn format(&self, f: defmt::Formatter<'_>) {
-        defmt::write!(f, "{}", defmt::Display2Format(self))
     }
 }
 

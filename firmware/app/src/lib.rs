@@ -7,6 +7,9 @@
 //! [`sequencer`] (task body that runs commands and patterns) →
 //! [`servo`] (servo task body, speaking the `fashionstar` codec) and
 //! [`galvo`] (the galvo loop body feeding the DAC).
+//! The vocabulary below them all but number formatting ([`text`]) —
+//! board points, cm ↔ mm, patterns and path figures, actuators, targets,
+//! the aiming chain and the checks — is [`domain`].
 //! Text handling lives in [`cli`] (number formatting, the bottom layer, in
 //! [`text`]), parameters in [`settings`], shared
 //! state for LEDs/watchdog/simulator in [`status`], the master laser gate
@@ -20,6 +23,7 @@ pub mod app;
 pub mod build_info;
 pub mod cli;
 pub mod command;
+pub mod domain;
 pub mod galvo;
 pub mod grbl;
 pub mod laser_gate;

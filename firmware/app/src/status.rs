@@ -7,8 +7,7 @@ use core::cell::RefCell;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 
-use crate::command::Pattern;
-use crate::sequencer::targets::{Aim, Target};
+use crate::domain::{Aim, Pattern, Target};
 
 /// What the sequencer is doing.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -30,7 +30,8 @@ use galvo_planner::{
     plan_xy_jump,
 };
 use kinematics_core::{BoardPoint, DacAxis, ErrorModel, Galvo, Gimbal, MirrorAngles, PointMm};
-use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoPath, GalvoRequest, ScanPhase};
+use laser_app::domain::{Figure, PointCm, Rotation};
+use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoRequest, ScanPhase};
 
 mod semihosting;
 mod timer;
@@ -543,18 +544,20 @@ fn loop_halves(b: &mut Bench) {
         (
             "loop.line",
             [-80.0f32, 10.0],
-            GalvoPath::Line {
-                from_mm: [-80.0, 10.0],
-                to_mm: [80.0, -10.0],
+            // (-80, 10) mm to (80, -10) mm.
+            Figure::Line {
+                from: PointCm::new(-8.0, 1.0),
+                to: PointCm::new(8.0, -1.0),
             },
         ),
         (
             "loop.arc_r40",
             [0.0f32, 40.0],
-            GalvoPath::Circle {
-                centre_mm: [0.0, 0.0],
-                radius_mm: 40.0,
-                ccw: true,
+            // Radius 40 mm.
+            Figure::Circle {
+                centre: PointCm::new(0.0, 0.0),
+                radius_cm: 4.0,
+                rotation: Rotation::Ccw,
             },
         ),
     ];

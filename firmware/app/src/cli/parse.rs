@@ -2,7 +2,8 @@
 
 use super::args::Args;
 use super::error::{CommandError, word};
-use crate::command::{Actuator, AimModel, Command, GridPattern, Pattern, PointCm, Rotation};
+use crate::command::Command;
+use crate::domain::{Actuator, AimModel, Figure, GridPattern, Pattern, PointCm, Rotation};
 use crate::settings::{JumpPlanner, LaserMode, find_param};
 
 /// Largest board coordinate accepted anywhere, cm.
@@ -200,7 +201,7 @@ fn line(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
             "a line needs end points at least 0.1 cm apart (goto holds a single point)",
         ));
     }
-    Ok(Pattern::Line { from, to })
+    Ok(Pattern::Path(Figure::Line { from, to }))
 }
 
 /// `tuning [<cx_cm> <cy_cm> <size_cm>]`.
@@ -208,17 +209,17 @@ fn tuning(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
     // Optional centre and size; defaults: a 4 cm figure at the origin.
     let mut peek = args.clone();
     Ok(match peek.next_word() {
-        Some(w) if !w.eq_ignore_ascii_case("once") => Pattern::Tuning {
+        Some(w) if !w.eq_ignore_ascii_case("once") => Pattern::Path(Figure::Tuning {
             centre: point(args, "cx_cm", "cy_cm")?,
             size_cm: args.number("size_cm", MIN_FIGURE_CM, BOARD_LIMIT_CM)?,
-        },
-        _ => Pattern::Tuning {
+        }),
+        _ => Pattern::Path(Figure::Tuning {
             centre: PointCm {
                 x_cm: 0.0,
                 y_cm: 0.0,
             },
             size_cm: 4.0,
-        },
+        }),
     })
 }
 
@@ -233,7 +234,7 @@ fn rect(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
             "a rect needs a width and a height of at least 0.1 cm (use line for one side)",
         ));
     }
-    Ok(Pattern::Rect { a, b })
+    Ok(Pattern::Path(Figure::Rect { a, b }))
 }
 
 /// `circle <cx_cm> <cy_cm> <radius_cm> [cw|ccw]`.
@@ -252,11 +253,11 @@ fn circle(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
         }
         _ => Rotation::Ccw,
     };
-    Ok(Pattern::Circle {
+    Ok(Pattern::Path(Figure::Circle {
         centre,
         radius_cm,
         rotation,
-    })
+    }))
 }
 
 /// The next word as one of `choices` (ASCII case-insensitive); `expected`

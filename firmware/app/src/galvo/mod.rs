@@ -19,16 +19,16 @@
 //! the simulator feeds a simulated DAC. Not wired yet: the target's
 //! timer-triggered DAC DMA (see the README's status).
 
-mod path;
 mod scan;
 
-pub use path::GalvoPath;
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, ScanPhase};
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
+
+use crate::domain::Figure;
 
 /// One DAC sample: both 12-bit codes and the laser enable.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -116,8 +116,8 @@ pub enum GalvoRequest {
     Path {
         /// Request number.
         seq: u32,
-        /// What to draw.
-        path: GalvoPath,
+        /// What to draw (board cm; the loop takes its strokes in mm).
+        path: Figure,
     },
     /// Drop queued jobs, laser off at once; the mirrors finish the jump in
     /// flight (a jump is rest to rest) or brake along the stroke being

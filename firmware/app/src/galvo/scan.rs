@@ -9,8 +9,8 @@ use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
 use self::prep::StepRing;
-use super::path::GalvoPath;
 use super::{DacSample, DacStream, GalvoEvent, GalvoLink, Half};
+use crate::domain::Figure;
 use crate::laser_gate::LaserGate;
 use crate::log;
 
@@ -102,8 +102,9 @@ pub enum ScanPhase {
 enum Job {
     /// Jump to a point and dwell there (µs).
     Point { target_mm: PointMm, dwell_us: u32 },
-    /// Mark a path, stroke by stroke.
-    Path(GalvoPath),
+    /// Mark a path, stroke by stroke (in mm, see
+    /// [`Unit::GalvoMm`](crate::domain::Unit::GalvoMm)).
+    Path(Figure),
 }
 
 /// The job being run.

@@ -3,8 +3,10 @@
 
 use super::machine::{Action, ActionSink, AfterCheck, Core, Pending, Readings};
 use super::run::{RunKind, Start};
-use super::targets::{self, PatternCheck, PatternError, Target};
-use crate::command::{Actuator, Command, Pattern};
+use crate::command::Command;
+use crate::domain::{
+    Actuator, AimModel, Pattern, PatternCheck, PatternError, Target, check_target,
+};
 use crate::settings::{PARAMS, ParamLine, ParamSpec};
 
 /// Points a pattern check aims at per executor step. One gimbal IK point
@@ -48,7 +50,7 @@ impl Core {
                 out,
             ),
             Command::Goto(point) => self.goto(Target { point, grid: None }, out),
-            Command::Grid { xi, yi } => match targets::grid_point(&self.settings, xi, yi) {
+            Command::Grid { xi, yi } => match self.aimer.grid_point(xi, yi) {
                 Ok(target) => self.goto(target, out),
                 Err(reason) => self.error(out, reason),
             },
@@ -102,8 +104,9 @@ impl Core {
     /// `model`: re-aims the current point with the new model; on the
     /// galvo the new job replaces the one running (a dwell or a hold), it
     /// does not queue behind it.
-    fn set_model(&mut self, model: crate::command::AimModel, out: &mut dyn ActionSink) {
+    fn set_model(&mut self, model: AimModel, out: &mut dyn ActionSink) {
         self.model = model;
+        self.geometry_changed();
         if self.run.is_some() {
             if self.actuator.uses_galvo() {
                 self.stop_galvo(out);
@@ -121,10 +124,10 @@ impl Core {
         if let Err(e) = self.settings.set(param, value) {
             return self.error(out, e);
         }
+        self.geometry_changed();
         match self.run.map(|r| r.kind) {
             Some(RunKind::Goto(target)) => {
-                let checked =
-                    targets::check_target(&self.settings, self.model, self.actuator, &target);
+                let checked = check_target(&self.aimer, self.actuator, &target);
                 self.settings_checked(before, checked, out);
             }
             Some(kind) => match kind.pattern() {
@@ -151,6 +154,7 @@ impl Core {
             }
             Err(reason) => {
                 self.settings = before;
+                self.geometry_changed();
                 self.error(out, reason);
             }
         }
@@ -158,7 +162,7 @@ impl Core {
 
     /// Aims at one target and holds it; refuses unreachable targets.
     fn goto(&mut self, target: Target, out: &mut dyn ActionSink) {
-        match targets::check_target(&self.settings, self.model, self.actuator, &target) {
+        match check_target(&self.aimer, self.actuator, &target) {
             Ok(()) => {
                 self.start(Start::Goto(target), out);
                 self.ok(out);
@@ -168,11 +172,11 @@ impl Core {
     }
 
     /// Checks that `pattern` is reachable at its probe points (see
-    /// [`targets::PatternCheck`]; the run checks every other point before
+    /// [`PatternCheck`]; the run checks every other point before
     /// it goes there), then does `then`. A few points per step: the shell
     /// lets the other tasks run in between.
     fn check(&mut self, pattern: Pattern, then: AfterCheck, out: &mut dyn ActionSink) {
-        match PatternCheck::new(&pattern, &self.settings, self.actuator) {
+        match PatternCheck::new(&pattern, &self.aimer, self.actuator) {
             Ok(check) => {
                 self.pending = Some(Pending::Check { check, then });
                 self.check_step(CHECKS_PER_STEP, out);
@@ -190,7 +194,7 @@ impl Core {
         let Some(Pending::Check { mut check, then }) = self.pending.take() else {
             return;
         };
-        match check.step(&self.settings, self.model, self.actuator, points) {
+        match check.step(&self.aimer, self.actuator, points) {
             Ok(false) => {
                 self.pending = Some(Pending::Check { check, then });
                 out.act(Action::Yield);

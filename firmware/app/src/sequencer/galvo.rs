@@ -3,12 +3,10 @@
 //! loop knows nothing of them), and its laser permission.
 
 use galvo_planner::{Method, RigidParams};
-use kinematics_core::{DacAxis, Galvo, GalvoGeometry};
 
 use super::machine::{Action, ActionSink, Core, GalvoReadout};
 use super::run::RunKind;
-use super::targets::{self, Target};
-use crate::command::Pattern;
+use crate::domain::{Pattern, Target};
 use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoConfig, GalvoEvent, GalvoRequest};
 use crate::log;
 use crate::settings::{GalvoSettings, JumpPlanner, LaserMode};
@@ -20,20 +18,9 @@ const HOLD_US: u32 = u32::MAX;
 
 /// The loop configuration for the user's galvo parameters.
 pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
-    let dac = |codes_per_rad: f64, offset_code: f64| DacAxis {
-        codes_per_rad: codes_per_rad as f32,
-        offset_code: offset_code as f32,
-    };
     GalvoConfig {
         sample_period_s: settings.sample_period_us * 1e-6,
-        galvo: Galvo {
-            geometry: GalvoGeometry {
-                d_mm: settings.d_mm as f32,
-                e_mm: settings.e_mm as f32,
-            },
-            dac_x: dac(settings.x_codes_per_rad, settings.x_offset_code),
-            dac_y: dac(settings.y_codes_per_rad, settings.y_offset_code),
-        },
+        galvo: settings.galvo(),
         mirrors: RigidParams {
             kt_nm_per_a: settings.kt_nm_per_a,
             j_kg_m2: settings.j_kg_m2,
@@ -113,10 +100,11 @@ impl Core {
             RunKind::Goto(_) => HOLD_US,
             _ => (self.settings.dwell_ms * 1000.0) as u32,
         };
+        let [x_mm, y_mm] = target.point.galvo_mm();
         let job = |seq| GalvoRequest::Point {
             seq,
-            x_mm: (target.point.x_cm * 10.0) as f32,
-            y_mm: (target.point.y_cm * 10.0) as f32,
+            x_mm,
+            y_mm,
             dwell_us,
         };
         if !self.send_galvo_job(job, out) {
@@ -133,7 +121,7 @@ impl Core {
     /// Sends path `pattern` of the run to the galvo as one job.
     pub(super) fn begin_galvo_path(&mut self, pattern: Pattern, out: &mut dyn ActionSink) {
         self.allow_galvo_laser(out);
-        let Some(path) = targets::galvo_path(&pattern) else {
+        let Some(path) = pattern.figure() else {
             self.stop("not a path", out);
             return;
         };

@@ -23,8 +23,8 @@ use embassy_time::Instant;
 use super::faults::ServoFaults;
 use super::laser::{LaserEvent, laser_wanted};
 use super::run::Run;
-use super::targets::{Aim, PatternCheck, Target};
-use crate::command::{Actuator, AimModel, Command, ReplyText, reply_text};
+use crate::command::{Command, ReplyText, reply_text};
+use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, ScanPhase};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
@@ -188,6 +188,9 @@ pub(super) enum AfterCheck {
 pub struct Core {
     pub(super) settings: Settings,
     pub(super) model: AimModel,
+    /// The geometry of `settings` and `model`, rebuilt when either changes
+    /// ([`Core::geometry_changed`]).
+    pub(super) aimer: Aimer,
     /// Which actuator(s) draw.
     pub(super) actuator: Actuator,
     pub(super) booted_at: Instant,
@@ -219,6 +222,7 @@ impl Core {
         Self {
             settings: Settings::default(),
             model: AimModel::Exact,
+            aimer: Settings::default().aimer(AimModel::Exact),
             actuator: Actuator::Gimbal,
             booted_at: now,
             run: None,
@@ -325,7 +329,14 @@ impl Core {
                 Settings::default()
             }
         };
+        self.geometry_changed();
         self.configure_galvo(out);
+    }
+
+    /// Rebuilds the geometry the run aims with after the settings or the
+    /// model changed.
+    pub(super) fn geometry_changed(&mut self) {
+        self.aimer = self.settings.aimer(self.model);
     }
 
     /// Switches the gimbal laser to what the state calls for.

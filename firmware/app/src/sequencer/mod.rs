@@ -18,7 +18,6 @@ mod laser;
 mod machine;
 mod report;
 mod run;
-pub mod targets;
 
 use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};

@@ -4,7 +4,8 @@
 use super::machine::{ActionSink, Core, Readings};
 use crate::build_info;
 use crate::cli::parse::HELP_LINES;
-use crate::command::{AimModel, Command, PointCm};
+use crate::command::Command;
+use crate::domain::{AimModel, PointCm};
 use crate::status::{Activity, Phase, Snapshot};
 use crate::text::Fixed;
 

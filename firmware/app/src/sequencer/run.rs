@@ -6,8 +6,8 @@ use embassy_time::{Duration, Instant};
 use super::faults;
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
-use super::targets::{self, Aim, PathCursor, Target};
-use crate::command::{GridPattern, Pattern, reply_text};
+use crate::command::reply_text;
+use crate::domain::{Aim, GridPattern, PathCursor, Pattern, Target};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::status::Phase;
@@ -172,7 +172,7 @@ impl Core {
     /// The cursor at the first point of a pass of `pattern` (`None` when
     /// it cannot be interpolated).
     fn path_cursor(&self, pattern: &Pattern) -> Option<PathCursor> {
-        PathCursor::start(pattern, &self.settings)?.ok()
+        PathCursor::start(pattern, &self.aimer)?.ok()
     }
 
     /// Stops whatever runs — and, whatever the core thinks runs, the laser
@@ -193,7 +193,7 @@ impl Core {
         match run.kind {
             RunKind::Goto(target) => Some(target),
             RunKind::Grid { pattern, .. } => {
-                targets::grid_target(&Pattern::Grid(pattern), run.index, &self.settings)
+                self.aimer.grid_target(&Pattern::Grid(pattern), run.index)
             }
             RunKind::Path { cursor, .. } => Some(cursor.target()),
             RunKind::Marked { .. } => None,
@@ -241,7 +241,7 @@ impl Core {
     /// Aims the gimbal at `target` and sends the servo move; on an
     /// unreachable target stops with an error notice.
     fn begin_gimbal_move(&mut self, target: Target, out: &mut dyn ActionSink) -> bool {
-        let aim = match targets::aim(&self.settings, self.model, target.point) {
+        let aim = match self.aimer.aim(target.point) {
             Ok(aim) => aim,
             Err(e) => {
                 let why = reply_text(format_args!("{e}"));
@@ -367,9 +367,10 @@ impl Core {
                 }
                 return;
             }
-            RunKind::Grid { pattern, .. } => {
-                targets::grid_target(&Pattern::Grid(*pattern), run.index, &self.settings).is_some()
-            }
+            RunKind::Grid { pattern, .. } => self
+                .aimer
+                .grid_target(&Pattern::Grid(*pattern), run.index)
+                .is_some(),
             RunKind::Path { cursor, .. } => cursor.advance(),
             RunKind::Marked { .. } => false,
         };

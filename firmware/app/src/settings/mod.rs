@@ -16,6 +16,7 @@
 //! [`SettingsError`]s; the command line prints them as they are.
 
 mod error;
+mod geometry;
 mod legacy;
 mod params;
 mod record;

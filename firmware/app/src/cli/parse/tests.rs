@@ -99,21 +99,21 @@ fn patterns_with_options() {
     assert_eq!(
         ok("pattern circle 0 0 5 cw once"),
         Command::Pattern {
-            pattern: Pattern::Circle {
+            pattern: Pattern::Path(Figure::Circle {
                 centre: PointCm {
                     x_cm: 0.0,
                     y_cm: 0.0
                 },
                 radius_cm: 5.0,
                 rotation: Rotation::Cw
-            },
+            }),
             once: true
         }
     );
     assert_eq!(
         ok("pattern line -5 1 5 -1"),
         Command::Pattern {
-            pattern: Pattern::Line {
+            pattern: Pattern::Path(Figure::Line {
                 from: PointCm {
                     x_cm: -5.0,
                     y_cm: 1.0
@@ -122,7 +122,7 @@ fn patterns_with_options() {
                     x_cm: 5.0,
                     y_cm: -1.0
                 }
-            },
+            }),
             once: false
         }
     );

@@ -4,6 +4,7 @@
 use kinematics_core::PointMm;
 
 use super::{Active, GalvoConfig, GalvoError, GalvoLoop, Job, ScanPhase};
+use crate::domain::Unit;
 use crate::galvo::{GalvoEvent, GalvoRequest};
 use crate::log;
 
@@ -54,7 +55,7 @@ impl GalvoLoop {
         match job {
             Job::Point { target_mm, .. } => self.angles_for(*target_mm).map(|_| ()),
             Job::Path(path) => {
-                for [x_mm, y_mm] in path.bounds_mm() {
+                for [x_mm, y_mm] in path.bounds(Unit::GalvoMm) {
                     self.angles_for(PointMm { x_mm, y_mm })?;
                 }
                 Ok(())

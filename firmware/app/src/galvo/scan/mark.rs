@@ -6,8 +6,8 @@ use galvo_planner::{MarkSample, PathPlanner};
 use kinematics_core::PointMm;
 
 use super::{GalvoError, GalvoLoop, MARK_BLOCKS, ScanPhase};
+use crate::domain::{Figure, Unit};
 use crate::galvo::GalvoEvent;
-use crate::galvo::path::GalvoPath;
 
 /// The spot while marking or braking: position (mm) and its change over
 /// the last sample (mm per sample).
@@ -121,14 +121,15 @@ impl GalvoLoop {
     /// refused the stroke.
     pub(super) fn start_marking(
         &mut self,
-        path: GalvoPath,
+        path: Figure,
         stroke: usize,
         on_event: &mut impl FnMut(GalvoEvent),
     ) -> bool {
         let Some(a) = self.active else { return false };
-        let Some((start, _)) = path.stroke(stroke) else {
+        let Some(stroke) = path.stroke(stroke, Unit::GalvoMm) else {
             return false;
         };
+        let start = stroke.start;
         // Every path step is prepared with its stroke; none would be a
         // lost plan: refused, never marked without one.
         let loaded = match self.steps.get(0).filter(|_| self.running) {

@@ -18,7 +18,7 @@ use galvo_planner::{JumpSync, MarkLimits, PathPlanner, XyJump, plan_xy_jump};
 use kinematics_core::PointMm;
 
 use super::{GalvoError, GalvoLoop, INTEGRATOR_CAPACITY, JUNCTION_DEVIATION_MM, Job, MARK_BLOCKS};
-use crate::galvo::path::Segment;
+use crate::domain::{Rotation, Segment, Unit};
 
 /// Steps prepared ahead of the refill (a step takes at least the laser
 /// delays and its jump; four cover a half buffer of the shortest jobs).
@@ -54,7 +54,7 @@ impl Prepared {
 /// What comes after a step of `job`: its next stroke, if it has one.
 fn next_stroke(job: &Job, stroke: usize) -> Option<usize> {
     match job {
-        Job::Path(path) => path.stroke(stroke + 1).map(|_| stroke + 1),
+        Job::Path(path) => path.stroke(stroke + 1, Unit::GalvoMm).map(|_| stroke + 1),
         Job::Point { .. } => None,
     }
 }
@@ -131,12 +131,12 @@ impl GalvoLoop {
     ) -> Prepared {
         let (target_mm, marker, end_mm) = match job {
             Job::Point { target_mm, .. } => (Ok(target_mm), None, None),
-            Job::Path(path) => match path.stroke(stroke) {
-                Some(([x_mm, y_mm], segments)) => (
-                    Ok(PointMm { x_mm, y_mm }),
-                    Some(self.load_stroke([x_mm, y_mm], &segments)),
-                    segments.last().map(|s| match *s {
-                        Segment::Line(end) | Segment::Arc { end, .. } => end,
+            Job::Path(path) => match path.stroke(stroke, Unit::GalvoMm) {
+                Some(stroke) => (
+                    Ok(PointMm::new(stroke.start[0], stroke.start[1])),
+                    Some(self.load_stroke(stroke.start, &stroke.segments)),
+                    stroke.segments.last().map(|s| match *s {
+                        Segment::Line { to: end } | Segment::Arc { end, .. } => end,
                     }),
                 ),
                 None => (Err(GalvoError::Planner), None, None),
@@ -189,8 +189,12 @@ impl GalvoLoop {
         let loaded = PathPlanner::new(limits, start).and_then(|mut planner| {
             for segment in segments {
                 match *segment {
-                    Segment::Line(to) => planner.line_to(to)?,
-                    Segment::Arc { end, centre, ccw } => planner.arc_to(end, centre, ccw)?,
+                    Segment::Line { to } => planner.line_to(to)?,
+                    Segment::Arc {
+                        end,
+                        centre,
+                        rotation,
+                    } => planner.arc_to(end, centre, rotation == Rotation::Ccw)?,
                 }
             }
             // The first block's f64 set-up here, not in the refill.

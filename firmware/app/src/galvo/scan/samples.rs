@@ -4,6 +4,7 @@
 use galvo_planner::Error as PlannerError;
 
 use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase, samples_for};
+use crate::domain::Unit;
 use crate::galvo::{DacSample, GalvoEvent};
 
 impl GalvoLoop {
@@ -155,7 +156,9 @@ impl GalvoLoop {
                 ScanPhase::Dwelling => a.enter(ScanPhase::LaserOffDelay, self.off_delay_samples),
                 ScanPhase::LaserOffDelay | ScanPhase::Idle => {
                     let next_stroke = match a.job {
-                        Job::Path(path) => path.stroke(a.stroke + 1).map(|_| a.stroke + 1),
+                        Job::Path(path) => path
+                            .stroke(a.stroke + 1, Unit::GalvoMm)
+                            .map(|_| a.stroke + 1),
                         Job::Point { .. } => None,
                     };
                     let Some(stroke) = next_stroke else {

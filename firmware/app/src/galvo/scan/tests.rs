@@ -6,6 +6,7 @@ use galvo_planner::{JumpSync, Method, XyIntegrator, plan_xy_jump};
 use kinematics_core::{Galvo, MirrorAngles, PointMm};
 
 use super::*;
+use crate::domain::PointCm;
 use crate::galvo::GalvoRequest;
 
 /// Runs the loop in 128-sample halves until `until` says stop (at most
@@ -291,7 +292,7 @@ fn an_underrun_latches_the_laser_off_until_stop() {
     assert_eq!(galvo.request(point(3, 0.0, 0.0, 100)), None);
 }
 
-fn path(seq: u32, path: GalvoPath) -> GalvoRequest {
+fn path(seq: u32, path: Figure) -> GalvoRequest {
     GalvoRequest::Path { seq, path }
 }
 
@@ -324,9 +325,10 @@ fn largest_step(samples: &[DacSample]) -> u16 {
 #[test]
 fn a_rectangle_is_marked_on_its_border_at_the_marking_speed() {
     let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
-    let rect = GalvoPath::Rect {
-        a_mm: [-40.0, 30.0],
-        b_mm: [40.0, -30.0],
+    // (-40, 30) mm to (40, -30) mm.
+    let rect = Figure::Rect {
+        a: PointCm::new(-4.0, 3.0),
+        b: PointCm::new(4.0, -3.0),
     };
     assert_eq!(galvo.request(path(1, rect)), None);
     let (samples, events) = run(&mut galvo, done(1));
@@ -364,9 +366,10 @@ fn a_rectangle_is_marked_on_its_border_at_the_marking_speed() {
 #[test]
 fn the_tuning_figure_is_four_strokes_with_jumps_between() {
     let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
-    let figure = GalvoPath::Tuning {
-        centre_mm: [10.0, -5.0],
-        half_size_mm: 25.0,
+    // Centre (10, -5) mm, half size 25 mm.
+    let figure = Figure::Tuning {
+        centre: PointCm::new(1.0, -0.5),
+        size_cm: 5.0,
     };
     galvo.request(path(1, figure));
     let (samples, _) = run(&mut galvo, done(1));
@@ -394,9 +397,10 @@ fn stop_while_marking_brakes_dark_without_a_jump() {
     let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
     galvo.request(path(
         1,
-        GalvoPath::Line {
-            from_mm: [-60.0, 0.0],
-            to_mm: [60.0, 0.0],
+        // (-60, 0) mm to (60, 0) mm.
+        Figure::Line {
+            from: PointCm::new(-6.0, 0.0),
+            to: PointCm::new(6.0, 0.0),
         },
     ));
     let mut half = [DacSample::default(); 128];

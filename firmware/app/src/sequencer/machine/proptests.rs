@@ -23,7 +23,8 @@ use embassy_time::{Duration, Instant};
 use proptest::prelude::*;
 
 use super::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
-use crate::command::{Actuator, AimModel, Command, GridPattern, Pattern, PointCm, Rotation};
+use crate::command::Command;
+use crate::domain::{Actuator, AimModel, Figure, GridPattern, Pattern, PointCm, Rotation};
 use crate::galvo::{
     GALVO_REQUEST_DEPTH, GalvoError, GalvoEvent, GalvoRequest, ScanPhase, Underrun,
 };
@@ -83,13 +84,13 @@ fn point() -> impl Strategy<Value = PointCm> {
 fn pattern() -> impl Strategy<Value = Pattern> {
     prop_oneof![
         3 => proptest::sample::select(GridPattern::ALL.to_vec()).prop_map(Pattern::Grid),
-        1 => (point(), point()).prop_map(|(from, to)| Pattern::Line { from, to }),
+        1 => (point(), point()).prop_map(|(from, to)| Pattern::Path(Figure::Line { from, to })),
         1 => (point(), 0.0..15.0f64, any::<bool>()).prop_map(|(centre, radius_cm, cw)| {
             let rotation = if cw { Rotation::Cw } else { Rotation::Ccw };
-            Pattern::Circle { centre, radius_cm, rotation }
+            Pattern::Path(Figure::Circle { centre, radius_cm, rotation })
         }),
-        1 => (point(), point()).prop_map(|(a, b)| Pattern::Rect { a, b }),
-        1 => (point(), 0.5..20.0f64).prop_map(|(centre, size_cm)| Pattern::Tuning { centre, size_cm }),
+        1 => (point(), point()).prop_map(|(a, b)| Pattern::Path(Figure::Rect { a, b })),
+        1 => (point(), 0.5..20.0f64).prop_map(|(centre, size_cm)| Pattern::Path(Figure::Tuning { centre, size_cm })),
     ]
 }
 

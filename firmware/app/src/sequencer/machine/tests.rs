@@ -8,7 +8,8 @@ use std::vec::Vec;
 use embassy_time::Instant;
 
 use super::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
-use crate::command::{Actuator, Command, GridPattern, Pattern, PointCm, reply_text};
+use crate::command::{Command, reply_text};
+use crate::domain::{Actuator, GridPattern, Pattern, PointCm};
 use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest, ScanPhase};
 use crate::sequencer::LaserEvent;
 use crate::servo::task::{ServoOutcome, ServoRequest};
@@ -201,4 +202,63 @@ fn a_lost_gate_keeps_the_gimbal_laser_dark_until_the_next_run() {
     let again = command(&mut core, 4_000, goto, NO_GALVO);
     on(&mut core, 4_500, arrived(move_seq(&again).unwrap_or(0)));
     assert!(core.laser_on(), "a new run lights again");
+}
+
+/// The servo move in `actions`: `(yaw, pitch)`, 0.1°.
+fn move_tenths(actions: &[Action]) -> Option<(i16, i16)> {
+    actions.iter().find_map(|a| match a {
+        Action::Servo(ServoRequest::Move {
+            yaw_tenths,
+            pitch_tenths,
+            ..
+        }) => Some((*yaw_tenths, *pitch_tenths)),
+        _ => None,
+    })
+}
+
+#[test]
+fn the_geometry_follows_every_change_of_the_settings_and_the_model() {
+    use crate::domain::AimModel;
+    use crate::settings::{Settings, find_param};
+
+    let param = |name| find_param(name).expect("a parameter");
+    let point = PointCm {
+        x_cm: 8.0,
+        y_cm: 3.0,
+    };
+    let wire = |settings: &Settings, model| {
+        let aim = settings.aimer(model).aim(point).expect("reachable");
+        (aim.yaw_wire, aim.pitch_wire)
+    };
+    let mut core = Core::new(Instant::from_millis(0));
+    let set = |core: &mut Core, name, value| {
+        let param = param(name);
+        command(core, 1, Command::Set { param, value }, NO_GALVO)
+    };
+    assert_eq!(
+        set(&mut core, "yaw.zero_deg", 10.0).last(),
+        Some(&Action::Line(Line::Ok))
+    );
+    let mut turned = Settings::default();
+    turned.yaw.zero_deg = 10.0;
+    let goto = command(&mut core, 2, Command::Goto(point), NO_GALVO);
+    assert_eq!(move_tenths(&goto), Some(wire(&turned, AimModel::Exact)));
+    assert_ne!(
+        wire(&turned, AimModel::Exact),
+        wire(&Settings::default(), AimModel::Exact)
+    );
+
+    let seed = command(&mut core, 3, Command::Model(AimModel::Seed), NO_GALVO);
+    assert_eq!(move_tenths(&seed), Some(wire(&turned, AimModel::Seed)));
+
+    // A refused value changes nothing, the geometry included.
+    let refused = set(&mut core, "pitch.max_deg", 1.0);
+    assert!(
+        matches!(refused.last(), Some(Action::Line(Line::Error(_)))),
+        "{refused:?}"
+    );
+    let again = command(&mut core, 4, Command::Goto(point), NO_GALVO);
+    assert_eq!(move_tenths(&again), Some(wire(&turned, AimModel::Seed)));
+    let exact = command(&mut core, 5, Command::Model(AimModel::Exact), NO_GALVO);
+    assert_eq!(move_tenths(&exact), Some(wire(&turned, AimModel::Exact)));
 }

@@ -3,7 +3,8 @@ extern crate std;
 use std::vec::Vec;
 
 use super::super::{GalvoConfig, GalvoLoop, ScanPhase};
-use crate::galvo::{DacSample, GalvoEvent, GalvoPath, GalvoRequest};
+use crate::domain::{Figure, PointCm, Rotation};
+use crate::galvo::{DacSample, GalvoEvent, GalvoRequest};
 
 /// Every sample and event of a loop driven in 128-sample halves, the
 /// requests handed over between halves as the queue takes them.
@@ -63,25 +64,28 @@ fn prepared_refills_output_what_planning_on_demand_does() {
         point(3, -80.0, 80.0, 200),
         GalvoRequest::Path {
             seq: 4,
-            path: GalvoPath::Tuning {
-                centre_mm: [10.0, -5.0],
-                half_size_mm: 25.0,
+            // Centre (10, -5) mm, half size 25 mm.
+            path: Figure::Tuning {
+                centre: PointCm::new(1.0, -0.5),
+                size_cm: 5.0,
             },
         },
         point(5, 0.0, 0.0, 0),
         GalvoRequest::Path {
             seq: 6,
-            path: GalvoPath::Circle {
-                centre_mm: [-20.0, 10.0],
-                radius_mm: 3.0,
-                ccw: false,
+            // Centre (-20, 10) mm, radius 3 mm.
+            path: Figure::Circle {
+                centre: PointCm::new(-2.0, 1.0),
+                radius_cm: 0.3,
+                rotation: Rotation::Cw,
             },
         },
         GalvoRequest::Path {
             seq: 7,
-            path: GalvoPath::Rect {
-                a_mm: [-5.0, 5.0],
-                b_mm: [5.0, -5.0],
+            // (-5, 5) mm to (5, -5) mm.
+            path: Figure::Rect {
+                a: PointCm::new(-0.5, 0.5),
+                b: PointCm::new(0.5, -0.5),
             },
         },
         point(8, 1.0, 1.0, 0),
