@@ -8,7 +8,7 @@
 //! exactly one closing `ok` / `error:`, queued on [`CommandLink::outbound`]
 //! without ever waiting for the host (the console's writer sends them).
 
-use core::fmt::{self, Write as _};
+use core::fmt;
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
@@ -17,13 +17,33 @@ use embassy_sync::signal::Signal;
 use crate::domain::{Actuator, AimModel, Pattern, PointCm};
 use crate::outbound::{LineKind, Outbound};
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
-use crate::text::Shortest;
+use crate::text::{ReplyText, Shortest};
 
-/// Longest reply line, bytes (longer lines are cut).
-pub const REPLY_LINE_LEN: usize = 120;
-
-/// Text of one reply line.
-pub type ReplyText = heapless::String<REPLY_LINE_LEN>;
+/// One line per command for `help` (the command reference; the console
+/// parser in `cli::parse` accepts exactly these).
+pub static HELP_LINES: &[&str] = &[
+    "pattern home|corner|horizontal|vertical|visit-all [once]",
+    "pattern grid-full [raster|serpentine] [once]",
+    "pattern line <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
+    "pattern circle <cx_cm> <cy_cm> <radius_cm> [cw|ccw] [once]",
+    "pattern rect <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
+    "pattern tuning [<cx_cm> <cy_cm> <size_cm>] [once]   (galvo)",
+    "stop                         stop the pattern, laser off",
+    "goto <x_cm> <y_cm>           aim at a board point",
+    "grid <xi> <yi>               aim at a grid point",
+    "laser on|off|auto|dwell      laser mode",
+    "model exact|seed             gimbal kinematic model",
+    "target gimbal|galvo|both     which actuator draws",
+    "planner optimal|seed         galvo jump planner",
+    "galvo status                 galvo loop state, underruns",
+    "set <param> <value>          change a parameter",
+    "get <param>                  read a parameter",
+    "params                       list parameters",
+    "save                         store parameters in flash",
+    "status                       state, target, faults",
+    "version                      firmware version",
+    "help                         this list",
+];
 
 /// A parsed, validated command for the sequencer.
 #[derive(Clone, Copy)]
@@ -172,26 +192,6 @@ impl defmt::Format for Command {
     }
 }
 
-/// Formats into a reply line, cutting it at [`REPLY_LINE_LEN`] bytes.
-pub fn reply_text(args: fmt::Arguments<'_>) -> ReplyText {
-    let mut out = Truncating(ReplyText::new());
-    let _ = out.write_fmt(args);
-    out.0
-}
-
-struct Truncating(ReplyText);
-
-impl fmt::Write for Truncating {
-    fn write_str(&mut self, s: &str) -> fmt::Result {
-        for c in s.chars() {
-            if self.0.push(c).is_err() {
-                break;
-            }
-        }
-        Ok(())
-    }
-}
-
 /// Depth of the command queue. One command is in flight at a time (the
 /// console waits for its closing reply to be queued), so a small queue
 /// suffices.
@@ -254,22 +254,5 @@ impl CommandLink {
 impl Default for CommandLink {
     fn default() -> Self {
         Self::new()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn reply_text_is_cut_at_the_limit() {
-        let long = [b'x'; 300];
-        let text = core::str::from_utf8(&long).unwrap_or("");
-        let line = reply_text(format_args!("{text}"));
-        assert_eq!(line.len(), REPLY_LINE_LEN);
-        assert_eq!(
-            reply_text(format_args!("a={} b={}", 1, 2.5)).as_str(),
-            "a=1 b=2.5"
-        );
     }
 }

@@ -27,7 +27,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 use heapless::Deque;
 
-use crate::command::{REPLY_LINE_LEN, ReplyText, reply_text};
+use crate::text::{REPLY_LINE_LEN, ReplyText, reply_text};
 
 /// Size of the outbound queue, bytes (lines are stored with a 2-byte
 /// header). Holds the longest reply (`params`, about 3.2 KiB stored) with

@@ -9,8 +9,9 @@
 //! back and may paste again (`get`, `params`, ranges). [`Fixed`] prints a
 //! fixed number of decimals by integer arithmetic: for status lines.
 //! [`Interval`] prints a closed range `[min, max]` in the shortest form.
+//! [`ReplyText`] is one reply line, [`reply_text`] formats into one.
 
-use core::fmt;
+use core::fmt::{self, Write as _};
 
 /// `f64` in its shortest round-trip form (`1000`, `0.25`, `2.96e-5`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,6 +76,32 @@ impl fmt::Display for Interval {
     }
 }
 
+/// Longest reply line, bytes (longer lines are cut).
+pub const REPLY_LINE_LEN: usize = 120;
+
+/// Text of one reply line.
+pub type ReplyText = heapless::String<REPLY_LINE_LEN>;
+
+/// Formats into a reply line, cutting it at [`REPLY_LINE_LEN`] bytes.
+pub fn reply_text(args: fmt::Arguments<'_>) -> ReplyText {
+    let mut out = Truncating(ReplyText::new());
+    let _ = out.write_fmt(args);
+    out.0
+}
+
+struct Truncating(ReplyText);
+
+impl fmt::Write for Truncating {
+    fn write_str(&mut self, s: &str) -> fmt::Result {
+        for c in s.chars() {
+            if self.0.push(c).is_err() {
+                break;
+            }
+        }
+        Ok(())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
@@ -120,5 +147,17 @@ mod tests {
             let core = if core == "-0.000" { "0.000".into() } else { core };
             proptest::prop_assert_eq!(ours, core);
         }
+    }
+
+    #[test]
+    fn reply_text_is_cut_at_the_limit() {
+        let long = [b'x'; 300];
+        let text = core::str::from_utf8(&long).unwrap_or("");
+        let line = reply_text(format_args!("{text}"));
+        assert_eq!(line.len(), REPLY_LINE_LEN);
+        assert_eq!(
+            reply_text(format_args!("a={} b={}", 1, 2.5)).as_str(),
+            "a=1 b=2.5"
+        );
     }
 }

@@ -26,9 +26,10 @@ use embedded_io_async::{Read, Write};
 
 use crate::cli::line::LineAssembler;
 use crate::cli::parse::parse_line;
-use crate::command::{CommandLink, REPLY_LINE_LEN};
+use crate::command::CommandLink;
 use crate::log;
 use crate::outbound::{LineKind, OutLine, Outbound};
+use crate::text::REPLY_LINE_LEN;
 
 /// Before a command whose reply has data lines, the console waits this long
 /// at most for earlier output to reach the host, so a host that reads

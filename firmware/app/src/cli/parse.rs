@@ -278,30 +278,5 @@ fn keyword<T: Copy>(
         })
 }
 
-/// One line per command for `help`.
-pub const HELP_LINES: &[&str] = &[
-    "pattern home|corner|horizontal|vertical|visit-all [once]",
-    "pattern grid-full [raster|serpentine] [once]",
-    "pattern line <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
-    "pattern circle <cx_cm> <cy_cm> <radius_cm> [cw|ccw] [once]",
-    "pattern rect <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
-    "pattern tuning [<cx_cm> <cy_cm> <size_cm>] [once]   (galvo)",
-    "stop                         stop the pattern, laser off",
-    "goto <x_cm> <y_cm>           aim at a board point",
-    "grid <xi> <yi>               aim at a grid point",
-    "laser on|off|auto|dwell      laser mode",
-    "model exact|seed             gimbal kinematic model",
-    "target gimbal|galvo|both     which actuator draws",
-    "planner optimal|seed         galvo jump planner",
-    "galvo status                 galvo loop state, underruns",
-    "set <param> <value>          change a parameter",
-    "get <param>                  read a parameter",
-    "params                       list parameters",
-    "save                         store parameters in flash",
-    "status                       state, target, faults",
-    "version                      firmware version",
-    "help                         this list",
-];
-
 #[cfg(test)]
 mod tests;

@@ -11,10 +11,11 @@
 //! whatever the laser mode.
 
 use super::machine::{ActionSink, Core};
-use crate::command::{Command, ReplyText, reply_text};
+use crate::command::Command;
 use crate::servo::task::{ServoFault, ServoIdSet};
 use crate::settings::Settings;
 use crate::status::Phase;
+use crate::text::{ReplyText, reply_text};
 
 /// Fault bookkeeping of the sequencer.
 #[derive(Debug, Clone, Copy, Default)]

@@ -23,13 +23,14 @@ use embassy_time::Instant;
 use super::faults::ServoFaults;
 use super::laser::{LaserEvent, laser_wanted};
 use super::run::Run;
-use crate::command::{Command, ReplyText, reply_text};
+use crate::command::Command;
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, ScanPhase};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{LoadedRecord, RecordError, Settings};
 use crate::status::{Activity, Snapshot};
+use crate::text::{ReplyText, reply_text};
 
 /// Something that happened, for the core to act on.
 #[derive(Debug, Clone, Copy)]

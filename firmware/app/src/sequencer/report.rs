@@ -3,8 +3,8 @@
 
 use super::machine::{ActionSink, Core, Readings};
 use crate::build_info;
-use crate::cli::parse::HELP_LINES;
 use crate::command::Command;
+use crate::command::HELP_LINES;
 use crate::domain::{AimModel, PointCm};
 use crate::status::{Activity, Phase, Snapshot};
 use crate::text::Fixed;

@@ -6,12 +6,12 @@ use embassy_time::{Duration, Instant};
 use super::faults;
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
-use crate::command::reply_text;
 use crate::domain::{Aim, GridPattern, PathCursor, Pattern, Target};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::status::Phase;
 use crate::text::Fixed;
+use crate::text::reply_text;
 
 /// What a command starts.
 #[derive(Debug, Clone, Copy)]

@@ -1,5 +1,6 @@
 extern crate std;
 use super::*;
+use crate::command::HELP_LINES;
 use std::string::ToString;
 
 fn ok(line: &str) -> Command {

@@ -8,13 +8,14 @@ use std::vec::Vec;
 use embassy_time::Instant;
 
 use super::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
-use crate::command::{Command, reply_text};
+use crate::command::Command;
 use crate::domain::{Actuator, GridPattern, Pattern, PointCm};
 use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest, ScanPhase};
 use crate::sequencer::LaserEvent;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::LaserMode;
 use crate::status::{Activity, Phase};
+use crate::text::reply_text;
 
 /// Whether a galvo loop serves the link.
 const GALVO: bool = true;
