@@ -365,7 +365,7 @@ fn boot_settings_flash(options: &SimOptions) -> SettingsFlash {
                 SETTINGS_SECTORS,
             ));
             if let Err(e) = embassy_futures::block_on(store.save(record)) {
-                log::error!("could not seed the settings flash: {e}");
+                log::error!("could not preload the settings flash: {e}");
             }
             // A fresh handle: operation counts start at the boot.
             SettingsFlash::from_image(SETTINGS_FLASH_OFFSET, store.into_flash().image())
