@@ -111,73 +111,114 @@ impl GalvoLoop {
             }
         }
         loop {
-            let Some(mut a) = self.active else {
-                if let Some(event) = self.apply_pending_config(false) {
-                    on_event(event);
-                }
-                let Some(&(seq, job)) = self.queue.front() else {
-                    return Advance::Ready;
-                };
-                match self.start_step(seq, job, 0, on_demand, on_event) {
-                    StepStart::Unprepared => return Advance::Unprepared,
-                    StepStart::Started | StepStart::Refused => {
-                        self.queue.pop_front();
-                    }
-                }
-                continue;
+            let settled = match self.active {
+                None => self.start_queued(on_event, on_demand),
+                Some(a) => self.next_phase(a, on_event, on_demand),
             };
-            match a.phase {
-                ScanPhase::Marking | ScanPhase::Braking => return Advance::Ready,
-                ScanPhase::Jumping if !self.mirrors.is_idle() => return Advance::Ready,
-                ScanPhase::Jumping if a.cancelled => {
-                    self.active = None;
-                    return Advance::Ready;
-                }
-                ScanPhase::Jumping => a.enter(ScanPhase::Settling, self.on_delay_samples),
-                _ if a.samples_left > 0 => return Advance::Ready,
-                ScanPhase::Settling => match a.job {
-                    Job::Point { dwell_us: 0, .. } => {
-                        on_event(GalvoEvent::Done { seq: a.seq });
-                        self.active = None;
-                        continue;
-                    }
-                    Job::Point { dwell_us, .. } => a.enter(
-                        ScanPhase::Dwelling,
-                        samples_for(dwell_us, self.config.sample_period_s),
-                    ),
-                    Job::Path(path) => {
-                        self.active = Some(a);
-                        if !self.start_marking(path, a.stroke, on_event) {
-                            self.active = None;
-                        }
-                        continue;
-                    }
-                },
-                ScanPhase::Dwelling => a.enter(ScanPhase::LaserOffDelay, self.off_delay_samples),
-                ScanPhase::LaserOffDelay | ScanPhase::Idle => {
-                    let next_stroke = match a.job {
-                        Job::Path(path) => path
-                            .stroke(a.stroke + 1, Unit::GalvoMm)
-                            .map(|_| a.stroke + 1),
-                        Job::Point { .. } => None,
-                    };
-                    let Some(stroke) = next_stroke else {
-                        on_event(GalvoEvent::Done { seq: a.seq });
-                        self.active = None;
-                        continue;
-                    };
-                    self.active = Some(a);
-                    match self.start_step(a.seq, a.job, stroke, on_demand, on_event) {
-                        // Holds here, laser off, until the stroke is prepared.
-                        StepStart::Unprepared => return Advance::Unprepared,
-                        StepStart::Started => {}
-                        StepStart::Refused => self.active = None,
-                    }
-                    continue;
-                }
+            if let Some(advance) = settled {
+                return advance;
             }
-            self.active = Some(a);
         }
+    }
+
+    /// No job runs: applies waiting parameters and starts the queue's
+    /// first job. `Some` when [`Self::advance`] is done, `None` to go on.
+    #[inline(always)]
+    fn start_queued(
+        &mut self,
+        on_event: &mut impl FnMut(GalvoEvent),
+        on_demand: bool,
+    ) -> Option<Advance> {
+        if let Some(event) = self.apply_pending_config(false) {
+            on_event(event);
+        }
+        let Some(&(seq, job)) = self.queue.front() else {
+            return Some(Advance::Ready);
+        };
+        match self.start_step(seq, job, 0, on_demand, on_event) {
+            StepStart::Unprepared => return Some(Advance::Unprepared),
+            StepStart::Started | StepStart::Refused => {
+                self.queue.pop_front();
+            }
+        }
+        None
+    }
+
+    /// Job `a` (a copy of the active one) moves on from its phase when
+    /// the phase has no samples left. `Some` when [`Self::advance`] is
+    /// done, `None` to go on.
+    #[inline(always)]
+    fn next_phase(
+        &mut self,
+        mut a: Active,
+        on_event: &mut impl FnMut(GalvoEvent),
+        on_demand: bool,
+    ) -> Option<Advance> {
+        match a.phase {
+            ScanPhase::Marking | ScanPhase::Braking => return Some(Advance::Ready),
+            ScanPhase::Jumping if !self.mirrors.is_idle() => return Some(Advance::Ready),
+            ScanPhase::Jumping if a.cancelled => {
+                self.active = None;
+                return Some(Advance::Ready);
+            }
+            ScanPhase::Jumping => a.enter(ScanPhase::Settling, self.on_delay_samples),
+            _ if a.samples_left > 0 => return Some(Advance::Ready),
+            ScanPhase::Settling => match a.job {
+                Job::Point { dwell_us: 0, .. } => {
+                    on_event(GalvoEvent::Done { seq: a.seq });
+                    self.active = None;
+                    return None;
+                }
+                Job::Point { dwell_us, .. } => a.enter(
+                    ScanPhase::Dwelling,
+                    samples_for(dwell_us, self.config.sample_period_s),
+                ),
+                Job::Path(path) => {
+                    self.active = Some(a);
+                    if !self.start_marking(path, a.stroke, on_event) {
+                        self.active = None;
+                    }
+                    return None;
+                }
+            },
+            ScanPhase::Dwelling => a.enter(ScanPhase::LaserOffDelay, self.off_delay_samples),
+            ScanPhase::LaserOffDelay | ScanPhase::Idle => {
+                return self.next_stroke(a, on_event, on_demand);
+            }
+        }
+        self.active = Some(a);
+        None
+    }
+
+    /// Job `a`'s step is over (laser off): starts its next stroke, or
+    /// reports it done. `Some` when [`Self::advance`] is done, `None` to go
+    /// on.
+    #[inline(always)]
+    fn next_stroke(
+        &mut self,
+        a: Active,
+        on_event: &mut impl FnMut(GalvoEvent),
+        on_demand: bool,
+    ) -> Option<Advance> {
+        let next_stroke = match a.job {
+            Job::Path(path) => path
+                .stroke(a.stroke + 1, Unit::GalvoMm)
+                .map(|_| a.stroke + 1),
+            Job::Point { .. } => None,
+        };
+        let Some(stroke) = next_stroke else {
+            on_event(GalvoEvent::Done { seq: a.seq });
+            self.active = None;
+            return None;
+        };
+        self.active = Some(a);
+        match self.start_step(a.seq, a.job, stroke, on_demand, on_event) {
+            // Holds here, laser off, until the stroke is prepared.
+            StepStart::Unprepared => return Some(Advance::Unprepared),
+            StepStart::Started => {}
+            StepStart::Refused => self.active = None,
+        }
+        None
     }
 
     /// Starts step `stroke` of job `(seq, job)` from its prepared plan,

@@ -1,0 +1,238 @@
+//! The galvo loop's half-buffer fills: holding, marking a line, marking a
+//! circle (r = 40 mm), jumping; `GalvoLoop::new`.
+
+use core::hint::black_box;
+
+use laser_app::domain::{Figure, PointCm, Rotation};
+use laser_app::galvo::{DacSample, GalvoConfig, GalvoLoop, GalvoRequest, ScanPhase};
+
+use crate::harness::{Bench, HALF, Name, window};
+
+/// Runs the loop until it is idle (not measured).
+fn settle(galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
+    for _ in 0..10_000 {
+        if galvo.phase() == ScanPhase::Idle && galvo.queued_points() == 0 {
+            return;
+        }
+        galvo.fill(half, |_| {});
+    }
+}
+
+/// Measures every half of a job as `GalvoLoop::run` runs it: the prep
+/// stage between halves, then the refill. `<id>.steady` is the dearest
+/// refill that starts and ends in `steady` (the per-sample figure),
+/// `<id>.refill` the dearest refill of the job, `<id>.prep` the dearest
+/// prep call that prepared a step (per step).
+fn job_halves(
+    b: &mut Bench,
+    id: &str,
+    galvo: &mut GalvoLoop,
+    half: &mut [DacSample; HALF],
+    steady: ScanPhase,
+) {
+    let (mut steady_max, mut refill_max, mut steady_seen) = (0u32, 0u32, false);
+    let mut prep_max: Option<(u32, u32)> = None;
+    let unprepared = galvo.unprepared_samples();
+    for _ in 0..20_000usize {
+        let before = galvo.phase();
+        if before == ScanPhase::Idle && galvo.queued_points() == 0 {
+            break;
+        }
+        let mut steps = 0;
+        let ticks = window(|| steps = galvo.prep());
+        if steps > 0 && prep_max.is_none_or(|(t, n)| ticks / steps as u32 > t / n) {
+            prep_max = Some((ticks, steps as u32));
+        }
+        let ticks = window(|| galvo.refill(half, |_| {}));
+        refill_max = refill_max.max(ticks);
+        if before == steady && galvo.phase() == steady {
+            steady_max = steady_max.max(ticks);
+            steady_seen = true;
+        }
+    }
+    let mut name: Name = Name::new();
+    if galvo.unprepared_samples() != unprepared {
+        return b.fail(id, "the refill waited for an unprepared step");
+    }
+    if steady_seen {
+        name.set(id, ".steady");
+        b.report(name.as_str(), steady_max, HALF as u32);
+    } else {
+        b.fail(id, "no steady half");
+    }
+    name.set(id, ".refill");
+    b.report(name.as_str(), refill_max, 1);
+    name.set(id, ".prep");
+    match prep_max {
+        Some((ticks, steps)) => b.report(name.as_str(), ticks, steps),
+        None => b.fail(id, "nothing prepared"),
+    }
+}
+
+/// `DacStream::holds` as the simulated DAC answers it (firmware/sim's
+/// `dac.rs`; the target's DAC driver is not written yet): both halves hold
+/// nothing but `sample`.
+#[inline(never)]
+fn dac_holds(buffers: &[[DacSample; HALF]; 2], sample: DacSample) -> bool {
+    buffers.iter().all(|h| h.iter().all(|s| *s == sample))
+}
+
+/// The galvo loop's half-buffer fills: holding, marking a line, marking a
+/// circle (r = 40 mm), jumping; `GalvoLoop::new`.
+pub fn loop_halves(b: &mut Bench) {
+    let config = GalvoConfig::default();
+    let ticks = window(|| GalvoLoop::new(config));
+    b.report("loop.new", ticks, 1);
+    let mut galvo = match GalvoLoop::new(config) {
+        Ok(g) => g,
+        Err(e) => return b.fail("loop.new", e),
+    };
+    let mut half = [DacSample::default(); HALF];
+    holding(b, &mut galvo, &mut half);
+    marking(b, &mut galvo, &mut half);
+    jumping(b, config, &mut half);
+}
+
+/// Holding: the first halves after the loop goes idle, then the halves
+/// the DAC already holds; the hold sample alone.
+#[inline(always)]
+fn holding(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
+    // Holding, as `GalvoLoop::run` does it. The first two halves after the
+    // loop goes idle are filled: one hold sample computed and copied into
+    // the half (`loop.holding.refill`, the dearest holding half). From then
+    // on both DAC halves hold it and every wake-up only computes the hold
+    // sample and asks the DAC whether both halves hold it, then writes
+    // nothing (`loop.holding.steady`, per sample of the half).
+    let mut worst = 0u32;
+    for _ in 0..16 {
+        let mut computed = 0;
+        worst = worst.max(window(|| computed = galvo.fill(half, |_| {})));
+        if computed != 1 {
+            return b.fail("loop.holding.refill", ("computed", computed));
+        }
+    }
+    b.report("loop.holding.refill", worst, 1);
+    // The DAC's double buffer after those two halves.
+    let buffers = [*half, *half];
+    let mut worst = 0u32;
+    for _ in 0..16 {
+        let mut repeated = false;
+        worst = worst.max(window(|| {
+            repeated = galvo
+                .hold_sample()
+                .is_some_and(|hold| dac_holds(black_box(&buffers), hold));
+        }));
+        if !repeated {
+            return b.fail(
+                "loop.holding.steady",
+                "the DAC does not hold the hold sample",
+            );
+        }
+    }
+    b.report("loop.holding.steady", worst, HALF as u32);
+    let ticks = window(|| {
+        for _ in 0..64 {
+            black_box(galvo.hold_sample());
+        }
+    });
+    b.report("loop.hold_sample", ticks, 64);
+}
+
+/// Marking a line and a circle (r = 40 mm), half by half.
+#[inline(always)]
+fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
+    // Marking: first go to the stroke start (not measured), so the job's
+    // own jump is zero-length and its halves hold marking only.
+    let jobs = [
+        (
+            "loop.line",
+            [-80.0f32, 10.0],
+            // (-80, 10) mm to (80, -10) mm.
+            Figure::Line {
+                from: PointCm::new(-8.0, 1.0),
+                to: PointCm::new(8.0, -1.0),
+            },
+        ),
+        (
+            "loop.arc_r40",
+            [0.0f32, 40.0],
+            // Radius 40 mm.
+            Figure::Circle {
+                centre: PointCm::new(0.0, 0.0),
+                radius_cm: 4.0,
+                rotation: Rotation::Ccw,
+            },
+        ),
+    ];
+    for (seq, (id, [x_mm, y_mm], path)) in (1u32..).zip(jobs) {
+        galvo.request(GalvoRequest::Point {
+            seq: 100 + seq,
+            x_mm,
+            y_mm,
+            dwell_us: 0,
+        });
+        settle(galvo, half);
+        if let Some(refused) = galvo.request(GalvoRequest::Path { seq, path }) {
+            b.fail(id, refused);
+            continue;
+        }
+        job_halves(b, id, galvo, half, ScanPhase::Marking);
+    }
+}
+
+/// Jumping: the prep that plans the jump, the refill that starts it, and
+/// the jump's samples after that.
+#[inline(always)]
+fn jumping(b: &mut Bench, config: GalvoConfig, half: &mut [DacSample; HALF]) {
+    // Jumping (−80, −80) → (80, 80) mm, as `GalvoLoop::run` does it: the
+    // prep stage plans the jump (`loop.jump.prep`) before the refill that
+    // starts it (`loop.jump.refill`); `loop.jump.steady` covers the jump's
+    // samples after that refill's first, counted on one run and measured
+    // on an identical one (the loop is deterministic).
+    let jumping = |half: &mut [DacSample; HALF]| {
+        let mut galvo = GalvoLoop::new(config)?;
+        for (seq, [x_mm, y_mm]) in [(200, [-80.0, -80.0]), (201, [80.0, 80.0])] {
+            if let Some(laser_app::galvo::GalvoEvent::Refused { error, .. }) =
+                galvo.request(GalvoRequest::Point {
+                    seq,
+                    x_mm,
+                    y_mm,
+                    dwell_us: 0,
+                })
+            {
+                return Err(error);
+            }
+            if seq == 200 {
+                settle(&mut galvo, half);
+            }
+        }
+        Ok(galvo)
+    };
+    let runs = (jumping(half), jumping(half), jumping(half));
+    let (Ok(mut first), Ok(mut counted), Ok(mut measured)) = runs else {
+        return b.fail("loop.jump", "setup");
+    };
+    let mut steps = 0;
+    let ticks = window(|| steps = first.prep());
+    if steps != 1 {
+        return b.fail("loop.jump.prep", ("steps", steps));
+    }
+    b.report("loop.jump.prep", ticks, 1);
+    let ticks = window(|| first.refill(half, |_| {}));
+    if first.unprepared_samples() != 0 {
+        return b.fail("loop.jump.refill", "unprepared");
+    }
+    b.report("loop.jump.refill", ticks, 1);
+    counted.prep();
+    measured.prep();
+    counted.refill(&mut half[..1], |_| {});
+    let mut n = 0usize;
+    while counted.phase() == ScanPhase::Jumping && n < HALF {
+        counted.refill(&mut half[..1], |_| {});
+        n += 1;
+    }
+    measured.refill(&mut half[..1], |_| {});
+    let n = n.max(1);
+    let ticks = window(|| measured.refill(&mut half[..n], |_| {}));
+    b.report("loop.jump.steady", ticks, n as u32);
+}
