@@ -29,6 +29,9 @@ use crate::Bytes;
 pub struct Summary {
     /// The input as given was accepted.
     pub accepted: bool,
+    /// The input as given was accepted as a record of this build's layout
+    /// (not migrated, no unknown or defaulted parameter).
+    pub exact: bool,
     /// The input with its checksum fixed up was accepted.
     pub accepted_with_checksum: bool,
     /// `set`s accepted while building the generated settings.
@@ -41,6 +44,7 @@ pub fn check(data: &[u8]) -> Summary {
     if let Ok(loaded) = Settings::load_record(data) {
         accepted(data, &loaded);
         summary.accepted = true;
+        summary.exact = loaded.is_exact();
         corruptions_are_refused(data, data);
     }
     let fixed = with_valid_checksum(data);

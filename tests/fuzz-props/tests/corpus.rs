@@ -156,6 +156,14 @@ fn settings_record_corpus_holds_and_has_a_valid_record() {
     let all = run_all("settings_record", record::check);
     assert!(all.iter().any(|s| s.accepted), "no record loads as saved");
     assert!(
+        all.iter().any(|s| s.exact),
+        "no record of this build's layout in the corpus"
+    );
+    assert!(
+        all.iter().any(|s| s.accepted && !s.exact),
+        "no record of an earlier layout (migrated) in the corpus"
+    );
+    assert!(
         all.iter().any(|s| !s.accepted && !s.accepted_with_checksum),
         "no record refused for its values"
     );
