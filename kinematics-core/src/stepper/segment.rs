@@ -156,7 +156,11 @@ impl<const N: usize> SegmentQueue<N> {
             return None;
         }
         let seg = *self.items.get(self.head)?;
-        self.head = (self.head + 1) % N;
+        // Wrap by compare, not `%`: this runs in the step interrupt.
+        self.head += 1;
+        if self.head == N {
+            self.head = 0;
+        }
         self.len -= 1;
         Some(seg)
     }
