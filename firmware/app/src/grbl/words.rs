@@ -7,6 +7,8 @@
 //! and ignored. Numbers are `[+|-]digits[.digits]`, no exponent, read by
 //! integer arithmetic (no `core` float parsing is linked into the firmware).
 
+use core::fmt::Write as _;
+
 use super::error::GrblError;
 
 /// Largest number of integer digits a value may have; more is
@@ -100,9 +102,12 @@ impl<'a> Words<'a> {
         if !any_digit {
             return Err(GrblError::BadNumberFormat);
         }
-        // Exact for mantissa < 2^53 and fraction_digits <= 22 (correctly
-        // rounded division); at most ~1 ulp beyond.
-        let value = mantissa as f64 / libm::pow(10.0, f64::from(fraction_digits));
+        // `mantissa`e-`fraction_digits`, converted correctly rounded by the
+        // same decimal parser the command line uses (lexical-parse-float).
+        let mut text = heapless::String::<40>::new();
+        write!(text, "{mantissa}e-{fraction_digits}").map_err(|_| GrblError::BadNumberFormat)?;
+        let value: f64 = lexical_parse_float::FromLexical::from_lexical(text.as_bytes())
+            .map_err(|_| GrblError::BadNumberFormat)?;
         Ok(if negative { -value } else { value })
     }
 }
