@@ -8,7 +8,7 @@ use core::sync::atomic::{AtomicBool, Ordering};
 use embedded_io_async::Read;
 use laser_app::app::{Console, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog};
 use laser_app::laser_gate::{GateState, LaserGate};
-use laser_app::sequencer::LaserSwitch;
+use laser_app::sequencer::{LaserEvent, LaserSwitch};
 
 use crate::log_channel;
 use crate::mmio::Reg;
@@ -52,6 +52,17 @@ impl LaserSwitch for LaserPin {
             }
         } else {
             drive_laser_pin(false);
+        }
+    }
+
+    /// Reports the sequencer's laser-deciding events (`@event …`), so the
+    /// host checks the same safety rules as the simulator's recorder.
+    fn note(&mut self, event: LaserEvent<'_>) {
+        match event {
+            LaserEvent::Stopped { why } => log_channel::line(format_args!("@event stopped {why}")),
+            LaserEvent::RunStarted => log_channel::line(format_args!("@event run-started")),
+            LaserEvent::GimbalMoveSent => log_channel::line(format_args!("@event move-sent")),
+            LaserEvent::GimbalArrived => log_channel::line(format_args!("@event arrived")),
         }
     }
 }
