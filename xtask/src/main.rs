@@ -8,6 +8,7 @@ mod json_out;
 mod kin;
 mod plan;
 mod qemu;
+mod scenario;
 mod sim;
 mod toolchain;
 

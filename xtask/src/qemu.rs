@@ -27,7 +27,8 @@ use laser_sim::recorder::{Recording, SpotSample};
 
 pub use board_log::{BoardEvent, BoardLog};
 pub use machine::{Machine, MachineOptions};
-pub use script::{BoardStep, parse_board_script, run_steps, split_at_resets, wait_until_idle};
+pub use script::{BoardStep, parse_board_script, split_at_resets};
+use script::{run_steps, wait_until_idle};
 pub use terminal::Terminal;
 
 use crate::toolchain::{TARGET, ensure_flip_link, target_dir};
@@ -74,6 +75,10 @@ pub struct QemuArgs {
     /// Print the board's log channel on stderr.
     #[arg(long)]
     log: bool,
+    /// Run the scenarios of tests/scenarios on the board and check them,
+    /// as `cargo xtask test` does (no other option applies).
+    #[arg(long, conflicts_with_all = ["script", "interactive"])]
+    scenarios: bool,
 }
 
 /// Builds the board's release image; its path.
@@ -224,6 +229,9 @@ pub fn run_board(
 
 /// Runs `cargo xtask qemu`.
 pub fn run(args: QemuArgs) -> Result<ExitCode> {
+    if args.scenarios {
+        return crate::scenario::run_on_qemu().map(|()| ExitCode::SUCCESS);
+    }
     let text = script_text(&args)?;
     let steps = parse_board_script(&text)?;
     let (faults, slow_factor) = crate::sim::parse_faults(&args.faults)?;

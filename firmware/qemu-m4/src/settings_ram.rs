@@ -75,7 +75,7 @@ impl RamFlash {
 
     fn check(offset: u32, len: usize, align: usize) -> Result<usize, RamFlashError> {
         let start = offset as usize;
-        if start % align != 0 || len % align != 0 {
+        if !start.is_multiple_of(align) || !len.is_multiple_of(align) {
             return Err(RamFlashError(NorFlashErrorKind::NotAligned));
         }
         match start.checked_add(len) {
