@@ -10,6 +10,7 @@
 
 mod board_log;
 mod machine;
+mod measure;
 mod script;
 mod servo_bus;
 mod terminal;
@@ -79,6 +80,10 @@ pub struct QemuArgs {
     /// as `cargo xtask test` does (no other option applies).
     #[arg(long, conflicts_with_all = ["script", "interactive"])]
     scenarios: bool,
+    /// Measure the board (image size, instructions per command and per
+    /// second of holding, peak stack per task, the log channel's cost).
+    #[arg(long, conflicts_with_all = ["script", "interactive", "scenarios"])]
+    measure: bool,
 }
 
 /// Builds the board's release image; its path.
@@ -231,6 +236,9 @@ pub fn run_board(
 pub fn run(args: QemuArgs) -> Result<ExitCode> {
     if args.scenarios {
         return crate::scenario::run_on_qemu().map(|()| ExitCode::SUCCESS);
+    }
+    if args.measure {
+        return measure::measure().map(|()| ExitCode::SUCCESS);
     }
     let text = script_text(&args)?;
     let steps = parse_board_script(&text)?;

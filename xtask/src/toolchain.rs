@@ -252,7 +252,7 @@ pub fn parse_berkeley_size(output: &str) -> Result<ImageSize> {
     }
 }
 
-fn llvm_size_path() -> Result<PathBuf> {
+pub fn llvm_size_path() -> Result<PathBuf> {
     let out = Command::new("rustc")
         .args(["--print", "sysroot"])
         .current_dir(workspace_root())

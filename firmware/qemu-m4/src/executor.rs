@@ -30,7 +30,9 @@ pub fn run(init: impl FnOnce(Spawner)) -> ! {
         // interrupt, which runs as soon as they are on again.
         cortex_m::interrupt::disable();
         if !WOKEN.swap(false, Ordering::AcqRel) {
+            let asleep_from = crate::time_driver::timer_ticks();
             cortex_m::asm::wfi();
+            crate::stats::slept(crate::time_driver::timer_ticks() - asleep_from);
         }
         // SAFETY: enabling interrupts in thread mode outside any critical
         // section (none is held here).

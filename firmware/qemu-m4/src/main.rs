@@ -13,6 +13,7 @@ mod log_channel;
 mod mmio;
 mod parts;
 mod settings_ram;
+mod stats;
 mod tasks;
 mod time_driver;
 mod uart;
@@ -36,6 +37,7 @@ static STATUS: StatusBoard = StatusBoard::new();
 fn main() -> ! {
     // The laser pin is low from reset (a static); the log channel first so
     // everything after can report.
+    stats::paint_stack();
     uart::Uart::start(&uart::UART2);
     log_channel::init();
     time_driver::init();

@@ -109,9 +109,12 @@ impl Indicators for ReportedLeds {
 /// The byte the host sends on the log channel's input to press the stop
 /// button (`@button` in a script).
 pub const BUTTON_BYTE: u8 = b'B';
+/// The byte that asks for the CPU and stack report (`@stats` line).
+pub const STATS_BYTE: u8 = b'S';
 
 /// The stop button: [`BUTTON_BYTE`] arriving on UART2 (the host's
-/// `@button`); other bytes are ignored.
+/// `@button`). [`STATS_BYTE`] there asks for the board's measurements
+/// (`crate::stats`); other bytes are ignored.
 pub struct UartButton {
     /// UART2, receive side.
     pub rx: Uart,
@@ -121,10 +124,12 @@ impl StopButton for UartButton {
     async fn pressed(&mut self) {
         let mut byte = [0u8];
         loop {
-            if let Ok(1) = self.rx.read(&mut byte).await
-                && byte[0] == BUTTON_BYTE
-            {
-                return;
+            if let Ok(1) = self.rx.read(&mut byte).await {
+                match byte[0] {
+                    BUTTON_BYTE => return,
+                    STATS_BYTE => crate::stats::report(),
+                    _ => {}
+                }
             }
         }
     }

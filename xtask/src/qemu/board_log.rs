@@ -30,6 +30,8 @@ pub enum LogLine {
     Event(u64, BoardEvent),
     /// `@leds …` (the text after `@leds`).
     Leds(u64, String),
+    /// `@stats …` (the text after `@stats`).
+    Stats(u64, String),
     /// Anything else: a log record (level and message).
     Log(u64, String),
 }
@@ -51,6 +53,8 @@ pub fn parse_line(line: &str) -> Option<LogLine> {
         LogLine::Event(t, event)
     } else if let Some(leds) = rest.strip_prefix("@leds ") {
         LogLine::Leds(t, leds.to_owned())
+    } else if let Some(stats) = rest.strip_prefix("@stats ") {
+        LogLine::Stats(t, stats.to_owned())
     } else {
         LogLine::Log(t, rest.to_owned())
     };
@@ -70,8 +74,13 @@ pub struct BoardLog {
     pub leds: Vec<(u64, String)>,
     /// Log records: (board µs, `LEVEL message`).
     pub logs: Vec<(u64, String)>,
+    /// The board's measurement reports (the text after `@stats`).
+    pub stats: Vec<String>,
     /// Boots seen.
     pub boots: usize,
+    /// Boots after which the executor ran a task (the indicator task's
+    /// first `@leds` report).
+    pub ready_boots: usize,
     /// Time of the last line, continuous over boots, µs.
     pub last_us: u64,
     /// Offset added to this boot's stamps, µs.
@@ -88,6 +97,7 @@ impl BoardLog {
             LogLine::Laser(t, _)
             | LogLine::Event(t, _)
             | LogLine::Leds(t, _)
+            | LogLine::Stats(t, _)
             | LogLine::Log(t, _) => *t,
         };
         if let LogLine::Log(_, text) = &parsed
@@ -98,12 +108,16 @@ impl BoardLog {
             }
             self.boots += 1;
         }
+        if matches!(parsed, LogLine::Leds(..)) && self.ready_boots < self.boots {
+            self.ready_boots = self.boots;
+        }
         let t = self.boot_offset_us + raw_t;
         self.last_us = self.last_us.max(t);
         match parsed {
             LogLine::Laser(_, on) => self.laser_events.push((t, on)),
             LogLine::Event(_, e) => self.events.push((t, e)),
             LogLine::Leds(_, l) => self.leds.push((t, l)),
+            LogLine::Stats(_, text) => self.stats.push(text),
             LogLine::Log(_, text) => self.logs.push((t, text)),
         }
     }
@@ -172,6 +186,7 @@ mod tests {
             log.push(line);
         }
         assert_eq!(log.boots, 2);
+        assert_eq!(log.ready_boots, 0, "no task has run");
         assert_eq!(
             log.laser_events,
             vec![(500, true), (900, false), (1000, true)]

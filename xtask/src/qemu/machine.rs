@@ -25,6 +25,8 @@ const BOOT_TIMEOUT: Duration = Duration::from_secs(20);
 /// The byte that presses the board's stop button (`firmware/qemu-m4`'s
 /// `BUTTON_BYTE`), sent on the log channel's input.
 const BUTTON_BYTE: u8 = b'B';
+/// The byte that asks the board for its `@stats` report.
+const STATS_BYTE: u8 = b'S';
 /// Seed of the fault injection's random numbers (as the simulator's).
 const FAULT_SEED: u64 = 0x5eed;
 
@@ -190,8 +192,8 @@ impl Machine {
         self.t0.elapsed().as_micros() as u64
     }
 
-    /// Waits until the board has booted `boots` times and its console task
-    /// runs.
+    /// Waits until the board has booted `boots` times and its executor
+    /// runs the tasks (its UARTs are up: input typed from now on is read).
     fn wait_for_boot(&self, boots: usize) -> Result<()> {
         let (lock, signal) = &*self.log;
         let start = Instant::now();
@@ -199,14 +201,7 @@ impl Machine {
             .lock()
             .map_err(|_| anyhow::anyhow!("log reader died"))?;
         loop {
-            let connected = log.boots >= boots
-                && log
-                    .logs
-                    .iter()
-                    .rev()
-                    .take_while(|(_, l)| !l.contains("booting on QEMU"))
-                    .any(|(_, l)| l.contains("console: host connected"));
-            if connected {
+            if log.ready_boots >= boots {
                 return Ok(());
             }
             if start.elapsed() > BOOT_TIMEOUT {
@@ -259,6 +254,30 @@ impl Machine {
         self.log_input
             .write_all(&[BUTTON_BYTE])
             .context("writing to the log channel socket")
+    }
+
+    /// Asks the board for its measurements and waits for the `@stats`
+    /// line (the text after `@stats`).
+    pub fn stats(&mut self) -> Result<String> {
+        let before = self.log.0.lock().map(|l| l.stats.len()).unwrap_or(0);
+        self.log_input
+            .write_all(&[STATS_BYTE])
+            .context("writing to the log channel socket")?;
+        let (lock, signal) = &*self.log;
+        let start = Instant::now();
+        let mut log = lock
+            .lock()
+            .map_err(|_| anyhow::anyhow!("log reader died"))?;
+        while log.stats.len() <= before {
+            if start.elapsed() > BOOT_TIMEOUT {
+                bail!("the board did not report its measurements");
+            }
+            log = signal
+                .wait_timeout(log, Duration::from_millis(50))
+                .map_err(|_| anyhow::anyhow!("log reader died"))?
+                .0;
+        }
+        Ok(log.stats[before].clone())
     }
 
     /// Resets the board (QEMU's `system_reset`: as the reset pin) and
