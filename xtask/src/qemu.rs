@@ -80,17 +80,36 @@ pub struct QemuArgs {
     /// as `cargo xtask test` does (no other option applies).
     #[arg(long, conflicts_with_all = ["script", "interactive"])]
     scenarios: bool,
+    /// The board with its galvo DAC stream (a timer interrupt consumes the
+    /// galvo loop's double buffer at the sample rate): `target galvo`
+    /// works, and the galvo loop runs on the emulated M4.
+    #[arg(long)]
+    galvo_dac: bool,
     /// Measure the board (image size, instructions per command and per
     /// second of holding, peak stack per task, the log channel's cost).
     #[arg(long, conflicts_with_all = ["script", "interactive", "scenarios"])]
     measure: bool,
 }
 
-/// Builds the board's release image; its path.
+/// Builds the board's release image with the default features; its path.
 pub fn build_image() -> Result<PathBuf> {
+    build_image_with(&[], false)
+}
+
+/// Builds the board's release image with `features` (after
+/// `--no-default-features` when `no_default`); its path.
+pub fn build_image_with(features: &[&str], no_default: bool) -> Result<PathBuf> {
     crate::bench_m4::qemu::ensure_qemu()?;
     ensure_flip_link()?;
-    crate::bench_m4::cargo_in(MANIFEST, &["build", "--release", "--target", TARGET])?;
+    let mut args = vec!["build", "--release", "--target", TARGET];
+    if no_default {
+        args.push("--no-default-features");
+    }
+    let joined = features.join(",");
+    if !features.is_empty() {
+        args.extend(["--features", joined.as_str()]);
+    }
+    crate::bench_m4::cargo_in(MANIFEST, &args)?;
     Ok(target_dir().join(TARGET).join("release").join("qemu-m4"))
 }
 
@@ -249,7 +268,11 @@ pub fn run(args: QemuArgs) -> Result<ExitCode> {
         None if args.interactive => 3.2e7,
         None => 600.0,
     };
-    let elf = build_image()?;
+    let elf = if args.galvo_dac {
+        build_image_with(&["galvo-dac"], false)?
+    } else {
+        build_image()?
+    };
     if args.interactive {
         eprintln!("xtask qemu: type commands (help lists them); Ctrl-D ends the run");
     }

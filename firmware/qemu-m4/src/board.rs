@@ -14,7 +14,9 @@
 //! QEMU connects each UART to a chardev (`cargo xtask qemu`: Unix sockets
 //! served by the host tool).
 
-use laser_app::app::{Board, NoGalvoDac, Parts};
+#[cfg(not(feature = "galvo-dac"))]
+use laser_app::app::NoGalvoDac;
+use laser_app::app::{Board, Parts};
 
 use crate::parts::{CmsdkWatchdog, LASER_GATE, LaserPin, ReportedLeds, UartButton, UartConsole};
 use crate::settings_ram::{RamSettings, settings_store};
@@ -34,8 +36,12 @@ impl Board for QemuBoard {
     type ServoTx = Uart;
     type Laser = LaserPin;
     type Settings = RamSettings;
-    // No DAC modelled: no galvo loop runs (as on the STM32 board today).
+    // Without the `galvo-dac` feature no DAC is modelled and no galvo loop
+    // runs (as on the STM32 board today).
+    #[cfg(not(feature = "galvo-dac"))]
     type GalvoDac = NoGalvoDac;
+    #[cfg(feature = "galvo-dac")]
+    type GalvoDac = crate::galvo_dac::QemuDac;
     type Indicators = ReportedLeds;
     type StopButton = UartButton;
     type Watchdog = CmsdkWatchdog;
@@ -47,7 +53,10 @@ impl Board for QemuBoard {
             servo_tx: self.servo,
             laser: LaserPin { gate: &LASER_GATE },
             settings: self.settings,
+            #[cfg(not(feature = "galvo-dac"))]
             galvo_dac: None,
+            #[cfg(feature = "galvo-dac")]
+            galvo_dac: Some(crate::galvo_dac::QemuDac::new()),
             indicators: ReportedLeds { shown: None },
             stop_button: self.button,
             watchdog: CmsdkWatchdog,

@@ -27,6 +27,9 @@ pub enum Irq {
     Timer0 = 8,
     /// APB timer 1 reached zero (the alarm).
     Timer1 = 9,
+    /// Dual timer (the galvo DAC's sample clock, feature `galvo-dac`).
+    #[cfg(feature = "galvo-dac")]
+    DualTimer = 10,
 }
 
 // SAFETY: every value is a line number below the board's 32 external
@@ -65,5 +68,9 @@ pub static __INTERRUPTS: [Vector; 32] = {
     table[Irq::Uart2Tx as usize] = crate::uart::uart2_tx;
     table[Irq::Timer0 as usize] = crate::time_driver::timer0_wrapped;
     table[Irq::Timer1 as usize] = crate::time_driver::timer1_alarm;
+    #[cfg(feature = "galvo-dac")]
+    {
+        table[Irq::DualTimer as usize] = crate::galvo_dac::dual_timer;
+    }
     table
 };

@@ -8,6 +8,8 @@
 mod board;
 mod executor;
 mod faults;
+#[cfg(feature = "galvo-dac")]
+mod galvo_dac;
 mod interrupts;
 mod log_channel;
 mod mmio;

@@ -71,10 +71,22 @@ mod paint {
     /// Bytes painted below the stack top.
     const WINDOW_BYTES: usize = 32 * 1024;
     /// Task names in spawn order (`laser_app::app::wire`'s order).
+    #[cfg(not(feature = "galvo-dac"))]
     const NAMES: [&str; 6] = [
         "console",
         "servo-bus",
         "sequencer",
+        "indicators",
+        "stop-button",
+        "watchdog",
+    ];
+    /// Task names in spawn order (`laser_app::app::wire`'s order).
+    #[cfg(feature = "galvo-dac")]
+    const NAMES: [&str; 7] = [
+        "console",
+        "servo-bus",
+        "sequencer",
+        "galvo",
         "indicators",
         "stop-button",
         "watchdog",

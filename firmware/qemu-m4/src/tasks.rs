@@ -4,9 +4,11 @@
 //! `laser_app::app::wire`.
 
 use embassy_executor::Spawner;
+#[cfg(not(feature = "galvo-dac"))]
+use laser_app::app::NoGalvoDac;
 use laser_app::app::{
-    ConsoleTask, GalvoTask, IndicatorTask, NoGalvoDac, SequencerTask, ServoBusTask, Spawn,
-    StopButtonTask, WatchdogTask,
+    ConsoleTask, GalvoTask, IndicatorTask, SequencerTask, ServoBusTask, Spawn, StopButtonTask,
+    WatchdogTask,
 };
 
 use crate::board::QemuBoard;
@@ -26,6 +28,12 @@ async fn servo_bus(task: ServoBusTask<Uart, Uart>) -> ! {
 
 #[embassy_executor::task]
 async fn sequencer(task: SequencerTask<LaserPin, RamSettings>) -> ! {
+    task.run().await
+}
+
+#[cfg(feature = "galvo-dac")]
+#[embassy_executor::task]
+async fn galvo(task: GalvoTask<crate::galvo_dac::QemuDac>) {
     task.run().await
 }
 
@@ -72,8 +80,14 @@ impl Spawn<QemuBoard> for TaskSpawner {
         spawned("sequencer", sequencer(task), &self.0);
     }
 
+    #[cfg(not(feature = "galvo-dac"))]
     fn galvo(&mut self, task: GalvoTask<NoGalvoDac>) {
         task.unreachable()
+    }
+
+    #[cfg(feature = "galvo-dac")]
+    fn galvo(&mut self, task: GalvoTask<crate::galvo_dac::QemuDac>) {
+        spawned("galvo", galvo(task), &self.0);
     }
 
     fn indicators(&mut self, task: IndicatorTask<ReportedLeds>) {

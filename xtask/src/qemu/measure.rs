@@ -135,38 +135,71 @@ fn stack(elf: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Builds the image with `features` (`--no-default-features` first when
-/// `no_default`); its path.
-fn build(features: &[&str], no_default: bool) -> Result<std::path::PathBuf> {
-    let mut args = vec!["build", "--release", "--target", crate::toolchain::TARGET];
-    if no_default {
-        args.push("--no-default-features");
+/// The galvo loop on the board's DAC stream (feature `galvo-dac`):
+/// instructions per board second holding and marking the tuning figure,
+/// underruns, and how fast board time runs against the host clock.
+fn galvo(elf: &Path) -> Result<()> {
+    let mut m = Machine::start(elf, &MachineOptions::default())?;
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let steps = parse_board_script("target galvo\nwait 500\n")?;
+    if !run_steps(&mut m, &steps, deadline)? {
+        bail!("target galvo did not answer");
     }
-    let joined = features.join(",");
-    if !features.is_empty() {
-        args.extend(["--features", joined.as_str()]);
+    let (host_a, a) = (Instant::now(), stats(&mut m)?);
+    std::thread::sleep(HOLD);
+    let (host_b, b) = (Instant::now(), stats(&mut m)?);
+    let board_s = b.seconds_since(&a);
+    println!(
+        "  galvo holding at 100 kHz: {:.0} instructions per board second; board time ran at {:.0} % of host time",
+        b.instructions_since(&a) as f64 / board_s,
+        100.0 * board_s / (host_b - host_a).as_secs_f64()
+    );
+    let steps = parse_board_script("pattern tuning 0 0 8 once\n")?;
+    let c = stats(&mut m)?;
+    if !run_steps(&mut m, &steps, deadline)? || !super::script::wait_until_idle(&mut m, deadline)? {
+        bail!("the tuning figure did not finish");
     }
-    crate::bench_m4::cargo_in(super::MANIFEST, &args)?;
-    Ok(crate::toolchain::target_dir()
-        .join(crate::toolchain::TARGET)
-        .join("release")
-        .join("qemu-m4"))
+    let d = stats(&mut m)?;
+    println!(
+        "  galvo marking the tuning figure: {:.0} instructions per board second over {:.2} s",
+        d.instructions_since(&c) as f64 / d.seconds_since(&c),
+        d.seconds_since(&c)
+    );
+    let before = m.terminal.0.lock().map(|t| t.lines.len()).unwrap_or(0);
+    let steps = parse_board_script("galvo status\n")?;
+    run_steps(&mut m, &steps, deadline)?;
+    let lines = m
+        .terminal
+        .0
+        .lock()
+        .map(|t| t.lines.clone())
+        .unwrap_or_default();
+    for (_, line) in lines.iter().skip(before) {
+        if line.starts_with("underruns") {
+            println!("  {line}");
+            if !line.starts_with("underruns: 0,") {
+                bail!("the galvo loop underran on the emulated M4: {line}");
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Runs the measurements and prints them.
 pub fn measure() -> Result<()> {
-    crate::bench_m4::qemu::ensure_qemu()?;
-    crate::toolchain::ensure_flip_link()?;
     for (title, features, no_default) in [
         ("with laser-app's logs (default)", &[][..], false),
         ("without laser-app's logs", &[][..], true),
     ] {
-        let elf = build(features, no_default)?;
+        let elf = super::build_image_with(features, no_default)?;
         println!("qemu-m4 {title}: {}", image_size(&elf)?);
         instructions(&elf)?;
     }
+    let elf = super::build_image_with(&["galvo-dac"], false)?;
+    println!("qemu-m4 with the galvo DAC stream: {}", image_size(&elf)?);
+    galvo(&elf)?;
     for (title, no_default) in [("with logs", false), ("without logs", true)] {
-        let elf = build(&["stack-paint"], no_default)?;
+        let elf = super::build_image_with(&["stack-paint"], no_default)?;
         println!("qemu-m4 with stack painting, {title}:");
         stack(&elf)?;
     }
