@@ -36,6 +36,8 @@ pub struct Scenario {
     pub script: String,
     /// The `#! fault` specs.
     pub faults: Vec<String>,
+    /// `#! galvo-dac`: the board has a galvo DAC stream.
+    pub galvo_dac: bool,
 }
 
 impl Scenario {
@@ -48,6 +50,7 @@ impl Scenario {
             .filter_map(|l| l.trim().strip_prefix("#! fault "))
             .map(|s| s.trim().to_owned())
             .collect();
+        let galvo_dac = script.lines().any(|l| l.trim() == "#! galvo-dac");
         let name = path
             .file_stem()
             .and_then(|s| s.to_str())
@@ -57,6 +60,7 @@ impl Scenario {
             name,
             script,
             faults,
+            galvo_dac,
         })
     }
 
@@ -113,7 +117,7 @@ fn board_event(event: &SequencerEvent) -> BoardEvent {
 
 /// Runs `scenario` on the simulator: one run per part between `@reset`s,
 /// each booting from the settings flash the previous one left, until idle;
-/// a board without a galvo DAC, as the emulated one.
+/// with a galvo DAC only when the scenario asks for one.
 pub fn on_simulator(scenario: &Scenario) -> Result<Outcome> {
     let (faults, slow_factor) = scenario.faults()?;
     let mut outcome = Outcome {
@@ -130,7 +134,7 @@ pub fn on_simulator(scenario: &Scenario) -> Result<Outcome> {
             slow_factor,
             max_time_ms: 120_000,
             settings_flash: flash.take(),
-            galvo_dac: false,
+            galvo_dac: scenario.galvo_dac,
             ..SimOptions::default()
         });
         let offset = outcome.end_us;
@@ -201,14 +205,24 @@ pub fn on_qemu(elf: &Path, scenario: &Scenario) -> Result<Outcome> {
 /// runs every scenario on both boards (the simulator first: a failure
 /// there is the application's, not the board's).
 pub fn run_on_qemu() -> Result<()> {
-    let elf = crate::qemu::build_image()?;
+    let scenarios = all()?;
+    let plain = crate::qemu::build_image()?;
+    let galvo = if scenarios.iter().any(|s| s.galvo_dac) {
+        Some(crate::qemu::build_image_with(&["galvo-dac"], false)?)
+    } else {
+        None
+    };
     let mut failures = Vec::new();
-    for scenario in all()? {
+    for scenario in scenarios {
+        let elf = match &galvo {
+            Some(image) if scenario.galvo_dac => image,
+            _ => &plain,
+        };
         if let Err(e) = on_simulator(&scenario).and_then(|o| check(&scenario.name, &o)) {
             failures.push(format!("{} (simulator): {e:#}", scenario.name));
         }
         let started = std::time::Instant::now();
-        let verdict = on_qemu(&elf, &scenario).and_then(|o| check(&scenario.name, &o));
+        let verdict = on_qemu(elf, &scenario).and_then(|o| check(&scenario.name, &o));
         println!(
             "scenario {:<16} on QEMU: {} ({:.1} s)",
             scenario.name,

@@ -8,7 +8,7 @@
 //! 5000000 @stats ticks=125000000 slept=124000000 stack=console:1234,servo-bus:800,…
 //! ```
 //!
-//! Stack painting: the 32 KiB below the stack top are filled with a
+//! Stack painting: the 128 KiB below the stack top are filled with a
 //! pattern at boot; after each poll of a task (embassy-executor's trace
 //! hooks) the lowest word no longer holding the pattern is that poll's
 //! depth, and the dirtied part is painted again.
@@ -69,7 +69,7 @@ mod paint {
     /// The pattern painted words hold.
     const PAINT: u32 = 0xDEAD_BEEF;
     /// Bytes painted below the stack top.
-    const WINDOW_BYTES: usize = 32 * 1024;
+    const WINDOW_BYTES: usize = 128 * 1024;
     /// Task names in spawn order (`laser_app::app::wire`'s order).
     #[cfg(not(feature = "galvo-dac"))]
     const NAMES: [&str; 6] = [

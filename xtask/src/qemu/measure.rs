@@ -182,6 +182,9 @@ fn galvo(elf: &Path) -> Result<()> {
             }
         }
     }
+    if !d.stack.is_empty() {
+        println!("  peak stack, bytes: {}", d.stack);
+    }
     Ok(())
 }
 
@@ -197,6 +200,11 @@ pub fn measure() -> Result<()> {
     }
     let elf = super::build_image_with(&["galvo-dac"], false)?;
     println!("qemu-m4 with the galvo DAC stream: {}", image_size(&elf)?);
+    galvo(&elf)?;
+    let elf = super::build_image_with(&["galvo-dac", "stack-paint"], false)?;
+    println!(
+        "qemu-m4 with the galvo DAC stream and stack painting (instructions include the painting):"
+    );
     galvo(&elf)?;
     for (title, no_default) in [("with logs", false), ("without logs", true)] {
         let elf = super::build_image_with(&["stack-paint"], no_default)?;

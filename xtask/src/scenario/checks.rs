@@ -19,6 +19,7 @@ pub fn check(name: &str, outcome: &Outcome) -> Result<()> {
         "silent_servo" => silent_servo,
         "garbage_flood" => garbage_flood,
         "save_reset" => save_reset,
+        "galvo_tuning" => galvo_tuning,
         other => bail!("no assertions for scenario {other:?}"),
     };
     ensure!(outcome.script_done, "{board}: the script did not finish");
@@ -218,5 +219,25 @@ fn save_reset(o: &Outcome) -> Result<()> {
         "dwell_ms after the reset is not the saved 321: {:?}",
         &o.transcript[asked..]
     );
+    Ok(())
+}
+
+/// The galvo marks the whole figure on its DAC stream without an underrun.
+fn galvo_tuning(o: &Outcome) -> Result<()> {
+    ensure!(o.error_replies == 0, "{} error replies", o.error_replies);
+    ensure!(
+        stopped_because(o, "complete").is_some(),
+        "the figure never completed"
+    );
+    let asked = o
+        .transcript
+        .iter()
+        .rposition(|l| l == "> galvo status")
+        .ok_or_else(|| anyhow::anyhow!("galvo status was never typed"))?;
+    let underruns = o.transcript[asked + 1..]
+        .iter()
+        .find(|l| l.starts_with("underruns:"))
+        .ok_or_else(|| anyhow::anyhow!("galvo status without an underrun count"))?;
+    ensure!(underruns.starts_with("underruns: 0,"), "{underruns}");
     Ok(())
 }

@@ -10,7 +10,7 @@ fn scenario(name: &str) -> Scenario {
 #[test]
 fn every_scenario_passes_on_the_simulator() {
     let scenarios = all().unwrap();
-    assert!(scenarios.len() >= 5, "{} scenarios", scenarios.len());
+    assert!(scenarios.len() >= 6, "{} scenarios", scenarios.len());
     for s in scenarios {
         let outcome = on_simulator(&s).unwrap();
         if let Err(e) = check(&s.name, &outcome) {
@@ -57,4 +57,16 @@ fn a_setting_lost_over_the_reset_fails_save_reset() {
 #[test]
 fn an_unknown_scenario_name_is_refused() {
     assert!(check("no-such-scenario", &Outcome::default()).is_err());
+}
+
+#[test]
+fn an_underrun_fails_the_galvo_scenario() {
+    let mut outcome = on_simulator(&scenario("galvo_tuning")).unwrap();
+    assert!(check("galvo_tuning", &outcome).is_ok());
+    for line in &mut outcome.transcript {
+        if line.starts_with("underruns: 0,") {
+            *line = line.replacen("underruns: 0,", "underruns: 2,", 1);
+        }
+    }
+    assert!(check("galvo_tuning", &outcome).is_err());
 }
