@@ -52,7 +52,7 @@ impl Ring {
     }
 
     /// Samples in the ring (the DMA's NDTR reload value).
-    pub const fn len(&self) -> usize {
+    pub const fn samples(&self) -> usize {
         2 * self.half_len
     }
 
@@ -73,7 +73,9 @@ impl Ring {
     /// stream).
     pub fn position(&self, ndtr: u32) -> Option<usize> {
         let ndtr = usize::try_from(ndtr).ok()?;
-        (1..=self.len()).contains(&ndtr).then(|| self.len() - ndtr)
+        (1..=self.samples())
+            .contains(&ndtr)
+            .then(|| self.samples() - ndtr)
     }
 
     /// The half the DMA reads now: `counted` is the half the interrupt last
@@ -96,7 +98,7 @@ impl Ring {
         match (self.position(ndtr_a), self.position(ndtr_b)) {
             (Some(a), Some(b)) => {
                 let d = a.abs_diff(b);
-                d <= 1 || d == self.len() - 1
+                d <= 1 || d == self.samples() - 1
             }
             _ => false,
         }

@@ -4,7 +4,7 @@ use proptest::prelude::*;
 #[test]
 fn position_and_half_from_ndtr() {
     let ring = Ring::new(4);
-    assert_eq!(ring.len(), 8);
+    assert_eq!(ring.samples(), 8);
     assert_eq!(ring.position(8), Some(0));
     assert_eq!(ring.position(5), Some(3));
     assert_eq!(ring.position(4), Some(4));
@@ -80,7 +80,7 @@ proptest! {
         let advance = |t: &mut usize, to: usize, written: u32, isr_seen: &mut u32, count: &mut u32| {
             while *t < to {
                 *t += 1;
-                if *t % n == 0 {
+                if t.is_multiple_of(n) {
                     *isr_seen = isr_seen.wrapping_add(1);
                     if underrun_at_start(*isr_seen, written, false) {
                         *count += 1;
@@ -93,8 +93,8 @@ proptest! {
             advance(&mut t, to, written, &mut isr_seen, &mut isr_underruns);
             loop {
                 // The interrupt may not have run for a boundary just crossed.
-                let counted = if isr_lag[k] && t % n == 0 { isr_seen.wrapping_sub(1) } else { isr_seen };
-                let ndtr = (ring.len() - t % ring.len()) as u32;
+                let counted = if isr_lag[k] && t.is_multiple_of(n) { isr_seen.wrapping_sub(1) } else { isr_seen };
+                let ndtr = (ring.samples() - t % ring.samples()) as u32;
                 let reading = ring.reading_half(counted, ndtr).unwrap();
                 prop_assert_eq!(reading, start.wrapping_add((t / n) as u32));
                 match slot(next, reading) {

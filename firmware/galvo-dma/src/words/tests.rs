@@ -29,7 +29,7 @@ fn bsrr_words_set_low_half_reset_high_half() {
 /// from 1 on, the output (DAC word, laser pin).
 fn play(half_len: usize, halves: &[Vec<(u16, u16, bool)>], pin_start: bool) -> Vec<(u32, bool)> {
     let ring = Ring::new(half_len);
-    let (mut dac, mut laser) = (vec![0u32; ring.len()], vec![0u32; ring.len()]);
+    let (mut dac, mut laser) = (vec![0u32; ring.samples()], vec![0u32; ring.samples()]);
     let mut track = LaserTrack::new(3);
     let mut write = |h: usize, dac: &mut [u32], laser: &mut [u32]| {
         let range = ring.range(h % 2);
@@ -41,7 +41,7 @@ fn play(half_len: usize, halves: &[Vec<(u16, u16, bool)>], pin_start: bool) -> V
     let (mut holding, mut pin) = (0u32, pin_start);
     let mut out = Vec::new();
     for u in 0..halves.len() * half_len + 1 {
-        let word = laser[u % ring.len()];
+        let word = laser[u % ring.samples()];
         if word & bsrr_set(3) != 0 {
             pin = true;
         }
@@ -51,7 +51,7 @@ fn play(half_len: usize, halves: &[Vec<(u16, u16, bool)>], pin_start: bool) -> V
         if u > 0 {
             out.push((holding, pin));
         }
-        holding = dac[u % ring.len()];
+        holding = dac[u % ring.samples()];
         if u % half_len == 0 && u / half_len >= 1 {
             write(u / half_len + 1, &mut dac, &mut laser);
         }
