@@ -13,7 +13,7 @@ fn position_and_half_from_ndtr() {
     assert_eq!(ring.position(9), None);
     assert_eq!(ring.range(0), 0..4);
     assert_eq!(ring.range(1), 4..8);
-    assert_eq!(Ring::new(0).len(), 2);
+    assert_eq!(Ring::new(0).samples(), 2);
 }
 
 #[test]
