@@ -1,0 +1,362 @@
+//! The galvo DAC stream of the STM32F4DISCOVERY: [`Stm32GalvoDac`], the
+//! board's `laser_app::galvo::DacStream`.
+//!
+//! TIM8 is the sample clock (168 MHz timer clock, 100 kHz by default).
+//! Each update triggers DAC1 in dual-channel mode (X on PA4, Y on PA5,
+//! both on the same edge), whose DMA request (DMA1 stream 5 channel 7)
+//! loads the next DHR12RD word, and requests DMA2 stream 1 channel 7
+//! (TIM8_UP), which writes the next laser word to GPIOB's BSRR (PB0; DMA1
+//! cannot reach the AHB1 GPIOs). Both circular buffers hold two halves of
+//! [`HALF_LEN`] samples in main SRAM (`.bss`; the DMA cannot reach the
+//! CCM, checked at boot). The streams start together once the loop has
+//! primed both halves, so they stay in lockstep (checked at every half).
+//!
+//! The loop runs on the galvo executor (an interrupt above thread mode:
+//! USB and the sequencer cannot delay it); the DMA interrupt
+//! (`irq.rs`) counts halves, wakes it, and closes the master laser gate
+//! the moment the DMA starts a half the loop has not written. The loop
+//! learns of it from the DMA position (NDTR) when it hands over its next
+//! half ([`galvo_dma::ring::slot`]). The gate's close hook zeroes every
+//! laser word ([`darken_laser_stream`]) before pulling PB0 low, so no
+//! queued word can light the laser again.
+//!
+//! Laser words only set the pin on lit samples and reset it after the last
+//! lit one; dark samples write nothing, so an idle galvo leaves PB0 to the
+//! gimbal's laser switch. Buffer layout, word packing and the bookkeeping
+//! are the pure `galvo-dma` crate (host-tested); `regs.rs` is the register
+//! layer. Verified by building only: no board or emulator runs it here.
+
+mod irq;
+mod regs;
+
+use core::cell::UnsafeCell;
+use core::future::poll_fn;
+use core::sync::atomic::Ordering;
+use core::task::Poll;
+
+use cortex_m::peripheral::DWT;
+use embassy_stm32::gpio::Flex;
+use embassy_stm32::interrupt::typelevel::{Binding, DMA1_STREAM5};
+use embassy_stm32::peripherals::{DAC1, DMA1_CH5, DMA2_CH1, PA4, PA5, TIM8};
+use embassy_stm32::{Peri, rcc};
+use galvo_dma::ring::{Ring, Slot, slot};
+use galvo_dma::timing::{RefillMeter, TimerSetting, timer_setting};
+use galvo_dma::words::{LaserTrack, dhr12rd};
+use laser_app::galvo::{DacSample, DacStream, Half, RefillTime, Underrun};
+use laser_app::laser_gate::LaserGate;
+
+pub use irq::HalfInterrupt;
+use irq::{SHARED, pack_timer};
+
+/// Samples per half buffer (1.28 ms at the default 10 µs period).
+pub const HALF_LEN: usize = 128;
+const RING: Ring = Ring::new(HALF_LEN);
+const RING_LEN: usize = 2 * HALF_LEN;
+/// Default sample period, s (until the loop sets its own).
+const DEFAULT_PERIOD_S: f64 = 10e-6;
+/// Main SRAM (SRAM1 + SRAM2), the DMA-reachable RAM.
+const SRAM: core::ops::Range<u32> = 0x2000_0000..0x2002_0000;
+/// DAC code of mid-scale (the output before the first stream).
+const MID_CODE: u16 = 2048;
+
+/// A DMA buffer of the ring. Only whole-word volatile stores and loads go
+/// through it: by the refill, by the gate's hook (any context) and, from
+/// the other side, by a DMA stream.
+#[repr(align(4))]
+struct DmaWords(UnsafeCell<[u32; RING_LEN]>);
+
+// SAFETY: every access is a single aligned volatile word access (atomic
+// on the Cortex-M4); no reference into the array is ever created.
+unsafe impl Sync for DmaWords {}
+
+impl DmaWords {
+    const fn new() -> Self {
+        Self(UnsafeCell::new([0; RING_LEN]))
+    }
+
+    fn address(&self) -> u32 {
+        self.0.get() as u32
+    }
+
+    fn store(&self, index: usize, word: u32) {
+        if index < RING_LEN {
+            // SAFETY: in bounds, aligned, one volatile word store.
+            unsafe { self.0.get().cast::<u32>().add(index).write_volatile(word) }
+        }
+    }
+
+    fn load(&self, index: usize) -> u32 {
+        if index < RING_LEN {
+            // SAFETY: in bounds, aligned, one volatile word load.
+            unsafe { self.0.get().cast::<u32>().add(index).read_volatile() }
+        } else {
+            0
+        }
+    }
+}
+
+/// DHR12RD words, read by DMA1 stream 5.
+static DAC_WORDS: DmaWords = DmaWords::new();
+/// GPIOB BSRR words, read by DMA2 stream 1.
+static LASER_WORDS: DmaWords = DmaWords::new();
+
+/// Zeroes every laser word: from the next update on the laser stream
+/// writes nothing. The gate's close hook calls it, then pulls PB0 low.
+pub fn darken_laser_stream() {
+    for i in 0..RING_LEN {
+        LASER_WORDS.store(i, 0);
+    }
+    cortex_m::asm::dsb();
+}
+
+/// The CPU's cycle counter (enabled by `board::init`).
+fn cycles() -> u32 {
+    DWT::cycle_count()
+}
+
+/// The peripherals the stream owns (nothing else may touch them).
+pub struct GalvoDacPeripherals {
+    /// Sample clock.
+    pub timer: Peri<'static, TIM8>,
+    /// DAC1, both channels.
+    pub dac: Peri<'static, DAC1>,
+    /// DAC stream (DMA1 stream 5).
+    pub dac_dma: Peri<'static, DMA1_CH5>,
+    /// Laser stream (DMA2 stream 1).
+    pub laser_dma: Peri<'static, DMA2_CH1>,
+    /// DAC1 channel 1 output, X.
+    pub x: Peri<'static, PA4>,
+    /// DAC1 channel 2 output, Y.
+    pub y: Peri<'static, PA5>,
+}
+
+/// The timer-triggered two-channel DAC with its laser stream.
+pub struct Stm32GalvoDac {
+    gate: &'static LaserGate,
+    track: LaserTrack,
+    /// The streams run (the loop primed both halves).
+    started: bool,
+    /// The half written next (counted from the stream's start).
+    next: u32,
+    /// What each physical half replays identically, with its clock.
+    contents: [Option<(DacSample, TimerSetting)>; 2],
+    /// Sample clock for the halves written from now on.
+    timer: TimerSetting,
+    timer_hz: u32,
+    cpu_hz: u32,
+    meter: RefillMeter,
+    _outputs: [Flex<'static>; 2],
+    _owned: (
+        Peri<'static, TIM8>,
+        Peri<'static, DAC1>,
+        Peri<'static, DMA1_CH5>,
+        Peri<'static, DMA2_CH1>,
+    ),
+}
+
+impl Stm32GalvoDac {
+    /// Sets DAC1 up (both channels on TIM8's trigger, at mid-scale); the
+    /// streams start once the loop has written two halves. `cpu_hz` is
+    /// the core clock the cycle counter runs at.
+    pub fn new(
+        p: GalvoDacPeripherals,
+        gate: &'static LaserGate,
+        laser_pin: u8,
+        cpu_hz: u32,
+        _irq: impl Binding<DMA1_STREAM5, HalfInterrupt>,
+    ) -> Self {
+        // DMA cannot reach the CCM: a linker change must not move these.
+        defmt::assert!(SRAM.contains(&DAC_WORDS.address()) && SRAM.contains(&LASER_WORDS.address()));
+        rcc::enable_and_reset::<TIM8>();
+        rcc::enable_and_reset::<DAC1>();
+        let timer_hz = rcc::frequency::<TIM8>().0;
+        let mut x = Flex::new(p.x);
+        let mut y = Flex::new(p.y);
+        x.set_as_analog();
+        y.set_as_analog();
+        regs::init(dhr12rd(MID_CODE, MID_CODE));
+        let timer = timer_setting(timer_hz, DEFAULT_PERIOD_S)
+            .unwrap_or(TimerSetting { prescaler: 0, reload: u16::MAX });
+        Self {
+            gate,
+            track: LaserTrack::new(laser_pin),
+            started: false,
+            next: 0,
+            contents: [None; 2],
+            timer,
+            timer_hz,
+            cpu_hz,
+            meter: RefillMeter::new(),
+            _outputs: [x, y],
+            _owned: (p.timer, p.dac, p.dac_dma, p.laser_dma),
+        }
+    }
+
+    /// The half the DMA reads now (NDTR settles a boundary whose
+    /// interrupt has not run yet).
+    fn reading(&self) -> u32 {
+        let counted = SHARED.reading.load(Ordering::Acquire);
+        RING.reading_half(counted, regs::dac_ndtr())
+            .unwrap_or(counted)
+    }
+
+    /// Waits until the half [`Self::next`] may be written; returns the
+    /// halves the DMA started before they were written (then `next`
+    /// moves past the half it reads). Returns at once after a fault.
+    async fn wait_free(&mut self) -> u32 {
+        poll_fn(|cx| {
+            SHARED.waker.register(cx.waker());
+            if SHARED.fault.load(Ordering::Acquire) {
+                return Poll::Ready(0);
+            }
+            let reading = self.reading();
+            match slot(self.next, reading) {
+                Slot::Wait => Poll::Pending,
+                Slot::Free => Poll::Ready(0),
+                Slot::Late { halves } => {
+                    self.next = reading.wrapping_add(1);
+                    Poll::Ready(halves)
+                }
+            }
+        })
+        .await
+    }
+
+    /// Packs `half` into the physical half of [`Self::next`]: DAC words,
+    /// laser words (lit only while the gate passes the half's
+    /// generation), its clock, and whether the ring now holds one sample.
+    fn store(&mut self, half: &Half<'_>) {
+        let physical = Ring::physical(self.next);
+        // Not a hold while it is being rewritten.
+        SHARED.holding.store(false, Ordering::Release);
+        let passes = self.gate.passes(true, half.generation);
+        let (mut dac, mut laser) = ([0u32; HALF_LEN], [0u32; HALF_LEN]);
+        let samples = half.samples.iter().map(|s| (s.x_code, s.y_code, s.laser));
+        self.track.pack(half.generation, passes, samples, &mut dac, &mut laser);
+        for (i, (d, l)) in RING.range(physical).zip(dac.iter().zip(&laser)) {
+            DAC_WORDS.store(i, *d);
+            LASER_WORDS.store(i, *l);
+        }
+        if passes && !self.gate.passes(true, half.generation) {
+            // Closed meanwhile: its hook darkened what was stored before.
+            RING.range(physical).for_each(|i| LASER_WORDS.store(i, 0));
+            self.track.darken();
+        }
+        SHARED.timers[physical].store(pack_timer(self.timer), Ordering::Relaxed);
+        // Replays identically only when every word is the same.
+        let first = half.samples.first().copied();
+        let uniform = half.samples.len() == HALF_LEN
+            && half.samples.iter().all(|s| Some(*s) == first)
+            && laser.iter().all(|w| *w == laser[0]);
+        self.contents[physical] = first.filter(|_| uniform).map(|s| (s, self.timer));
+        let holding = self.contents[physical].is_some() && self.contents[0] == self.contents[1];
+        SHARED.holding.store(holding, Ordering::Release);
+    }
+
+    /// Both halves are primed: start the streams.
+    fn start(&mut self) {
+        SHARED.reading.store(0, Ordering::Release);
+        SHARED.written.store(2, Ordering::Release);
+        SHARED.running.store(true, Ordering::Release);
+        self.started = true;
+        let timer = self.contents[0].map_or(self.timer, |(_, t)| t);
+        regs::start(
+            DAC_WORDS.address(),
+            LASER_WORDS.address(),
+            RING_LEN as u16,
+            DAC_WORDS.load(0),
+            timer,
+        );
+    }
+
+    /// After a fault (the interrupt stopped the streams): prime again.
+    fn reset(&mut self) {
+        regs::stop();
+        SHARED.running.store(false, Ordering::Release);
+        SHARED.holding.store(false, Ordering::Release);
+        self.started = false;
+        self.next = 0;
+        self.contents = [None; 2];
+        self.track.darken();
+    }
+}
+
+impl DacStream for Stm32GalvoDac {
+    fn half_len(&self) -> usize {
+        HALF_LEN
+    }
+
+    fn set_sample_period(&mut self, period_s: f64) {
+        match timer_setting(self.timer_hz, period_s) {
+            Some(timer) => self.timer = timer,
+            None => defmt::warn!("galvo: sample period refused by TIM8"),
+        }
+    }
+
+    fn holds(&self, sample: DacSample) -> bool {
+        self.started
+            && !SHARED.fault.load(Ordering::Acquire)
+            && self.contents.iter().all(|c| *c == Some((sample, self.timer)))
+    }
+
+    async fn write_half(&mut self, half: Half<'_>) -> Result<(), Underrun> {
+        let entered = cycles();
+        let mut late = 0;
+        if self.started {
+            late = self.wait_free().await;
+        }
+        if SHARED.fault.swap(false, Ordering::AcqRel) {
+            // The interrupt stopped the streams: what played was dark.
+            self.reset();
+            late += 1;
+        }
+        let copy_from = cycles();
+        self.store(&half);
+        if self.started {
+            SHARED.written.store(self.next.wrapping_add(1), Ordering::Release);
+            // The DMA reached it during the copy: it began partly stale.
+            if matches!(slot(self.next, self.reading()), Slot::Late { .. }) {
+                late += 1;
+            }
+            self.next = self.next.wrapping_add(1);
+        } else {
+            self.next += 1;
+            if self.next == 2 {
+                self.start();
+            }
+        }
+        self.meter.record(entered, copy_from, cycles());
+        if late > 0 {
+            Err(Underrun { halves: late })
+        } else {
+            Ok(())
+        }
+    }
+
+    async fn repeat_half(&mut self) {
+        if !self.started {
+            return;
+        }
+        let entered = cycles();
+        // However late: both halves hold the sample the loop wants.
+        self.wait_free().await;
+        if SHARED.fault.load(Ordering::Acquire) {
+            // The next write_half restarts the streams and reports it.
+            return;
+        }
+        SHARED.written.store(self.next.wrapping_add(1), Ordering::Release);
+        self.next = self.next.wrapping_add(1);
+        let now = cycles();
+        self.meter.record(entered, now, now);
+    }
+
+    fn worst_refill(&self) -> Option<RefillTime> {
+        let window = HALF_LEN as u64 * u64::from(self.timer.period_ticks()) * u64::from(self.cpu_hz)
+            / u64::from(self.timer_hz.max(1));
+        self.meter.worst().map(|cycles| RefillTime {
+            cycles,
+            cpu_hz: self.cpu_hz,
+            window_cycles: u32::try_from(window).unwrap_or(u32::MAX),
+        })
+    }
+}
