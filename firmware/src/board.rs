@@ -177,6 +177,12 @@ pub fn init(spawner: Spawner) -> Stm32Board {
     spawner.spawn(defmt::unwrap!(crate::tasks::usb_device(usb_device)));
     let (servo_tx, servo_rx) = servo_uart(p.USART2, p.PA3, p.PA2);
     enable_cycle_counter();
+    // The HardFault handler's hand-written register addresses.
+    defmt::assert!(
+        pac::TIM8.cr1().as_ptr() as u32 == crate::panic::TIM8_CR1
+            && pac::DMA2.st(1).cr().as_ptr() as u32 == crate::panic::DMA2_S1CR
+            && pac::GPIOB.bsrr().as_ptr() as u32 == crate::panic::GPIOB_BSRR
+    );
     let galvo_parts = GalvoDacPeripherals {
         timer: p.TIM8,
         dac: p.DAC1,
@@ -185,7 +191,13 @@ pub fn init(spawner: Spawner) -> Stm32Board {
         x: p.PA4,
         y: p.PA5,
     };
-    let galvo = Stm32GalvoDac::new(galvo_parts, &LASER_GATE, LASER_PIN_BIT as u8, SYSCLK_HZ, Irqs);
+    let galvo = Stm32GalvoDac::new(
+        galvo_parts,
+        &LASER_GATE,
+        LASER_PIN_BIT as u8,
+        SYSCLK_HZ,
+        Irqs,
+    );
     Stm32Board {
         laser,
         console,
@@ -260,7 +272,15 @@ fn servo_uart(
     static SERVO_RX_BUFFER: StaticCell<[u8; SERVO_BUFFER_BYTES]> = StaticCell::new();
     let tx_buffer = SERVO_TX_BUFFER.init([0; SERVO_BUFFER_BYTES]);
     let rx_buffer = SERVO_RX_BUFFER.init([0; SERVO_BUFFER_BYTES]);
-    match BufferedUart::new(usart, rx_pin, tx_pin, tx_buffer, rx_buffer, Irqs, uart_config) {
+    match BufferedUart::new(
+        usart,
+        rx_pin,
+        tx_pin,
+        tx_buffer,
+        rx_buffer,
+        Irqs,
+        uart_config,
+    ) {
         Ok(uart) => uart.split(),
         Err(_) => defmt::panic!("USART2 configuration rejected"),
     }

@@ -46,7 +46,7 @@ use laser_app::galvo::{DacSample, DacStream, Half, RefillTime, Underrun};
 use laser_app::laser_gate::LaserGate;
 
 pub use irq::HalfInterrupt;
-use irq::{SHARED, pack_timer};
+use irq::{SHARED, pack_timer, unpack_timer};
 
 /// Samples per half buffer (1.28 ms at the default 10 µs period).
 pub const HALF_LEN: usize = 128;
@@ -166,7 +166,9 @@ impl Stm32GalvoDac {
         _irq: impl Binding<DMA1_STREAM5, HalfInterrupt>,
     ) -> Self {
         // DMA cannot reach the CCM: a linker change must not move these.
-        defmt::assert!(SRAM.contains(&DAC_WORDS.address()) && SRAM.contains(&LASER_WORDS.address()));
+        defmt::assert!(
+            SRAM.contains(&DAC_WORDS.address()) && SRAM.contains(&LASER_WORDS.address())
+        );
         rcc::enable_and_reset::<TIM8>();
         rcc::enable_and_reset::<DAC1>();
         let timer_hz = rcc::frequency::<TIM8>().0;
@@ -175,8 +177,10 @@ impl Stm32GalvoDac {
         x.set_as_analog();
         y.set_as_analog();
         regs::init(dhr12rd(MID_CODE, MID_CODE));
-        let timer = timer_setting(timer_hz, DEFAULT_PERIOD_S)
-            .unwrap_or(TimerSetting { prescaler: 0, reload: u16::MAX });
+        let timer = timer_setting(timer_hz, DEFAULT_PERIOD_S).unwrap_or(TimerSetting {
+            prescaler: 0,
+            reload: u16::MAX,
+        });
         Self {
             gate,
             track: LaserTrack::new(laser_pin),
@@ -232,7 +236,8 @@ impl Stm32GalvoDac {
         let passes = self.gate.passes(true, half.generation);
         let (mut dac, mut laser) = ([0u32; HALF_LEN], [0u32; HALF_LEN]);
         let samples = half.samples.iter().map(|s| (s.x_code, s.y_code, s.laser));
-        self.track.pack(half.generation, passes, samples, &mut dac, &mut laser);
+        self.track
+            .pack(half.generation, passes, samples, &mut dac, &mut laser);
         for (i, (d, l)) in RING.range(physical).zip(dac.iter().zip(&laser)) {
             DAC_WORDS.store(i, *d);
             LASER_WORDS.store(i, *l);
@@ -259,7 +264,7 @@ impl Stm32GalvoDac {
         SHARED.written.store(2, Ordering::Release);
         SHARED.running.store(true, Ordering::Release);
         self.started = true;
-        let timer = self.contents[0].map_or(self.timer, |(_, t)| t);
+        let timer = unpack_timer(SHARED.timers[0].load(Ordering::Relaxed));
         regs::start(
             DAC_WORDS.address(),
             LASER_WORDS.address(),
@@ -296,7 +301,10 @@ impl DacStream for Stm32GalvoDac {
     fn holds(&self, sample: DacSample) -> bool {
         self.started
             && !SHARED.fault.load(Ordering::Acquire)
-            && self.contents.iter().all(|c| *c == Some((sample, self.timer)))
+            && self
+                .contents
+                .iter()
+                .all(|c| *c == Some((sample, self.timer)))
     }
 
     async fn write_half(&mut self, half: Half<'_>) -> Result<(), Underrun> {
@@ -313,7 +321,9 @@ impl DacStream for Stm32GalvoDac {
         let copy_from = cycles();
         self.store(&half);
         if self.started {
-            SHARED.written.store(self.next.wrapping_add(1), Ordering::Release);
+            SHARED
+                .written
+                .store(self.next.wrapping_add(1), Ordering::Release);
             // The DMA reached it during the copy: it began partly stale.
             if matches!(slot(self.next, self.reading()), Slot::Late { .. }) {
                 late += 1;
@@ -344,15 +354,18 @@ impl DacStream for Stm32GalvoDac {
             // The next write_half restarts the streams and reports it.
             return;
         }
-        SHARED.written.store(self.next.wrapping_add(1), Ordering::Release);
+        SHARED
+            .written
+            .store(self.next.wrapping_add(1), Ordering::Release);
         self.next = self.next.wrapping_add(1);
         let now = cycles();
         self.meter.record(entered, now, now);
     }
 
     fn worst_refill(&self) -> Option<RefillTime> {
-        let window = HALF_LEN as u64 * u64::from(self.timer.period_ticks()) * u64::from(self.cpu_hz)
-            / u64::from(self.timer_hz.max(1));
+        let window =
+            HALF_LEN as u64 * u64::from(self.timer.period_ticks()) * u64::from(self.cpu_hz)
+                / u64::from(self.timer_hz.max(1));
         self.meter.worst().map(|cycles| RefillTime {
             cycles,
             cpu_hz: self.cpu_hz,

@@ -48,7 +48,7 @@ pub(super) fn pack_timer(timer: TimerSetting) -> u32 {
     u32::from(timer.prescaler) << 16 | u32::from(timer.reload)
 }
 
-fn unpack_timer(word: u32) -> TimerSetting {
+pub(super) fn unpack_timer(word: u32) -> TimerSetting {
     TimerSetting {
         prescaler: (word >> 16) as u16,
         reload: word as u16,

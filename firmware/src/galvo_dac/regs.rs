@@ -64,7 +64,14 @@ fn output_now(word: u32) {
 /// One stream: memory (`len` words from `memory`) to the peripheral
 /// register at `peripheral`, circular, 32-bit, direct mode, very high
 /// priority; half and complete interrupts when `interrupts`.
-fn configure(dma: pac::dma::Dma, stream: usize, peripheral: u32, memory: u32, len: u16, interrupts: bool) {
+fn configure(
+    dma: pac::dma::Dma,
+    stream: usize,
+    peripheral: u32,
+    memory: u32,
+    len: u16,
+    interrupts: bool,
+) {
     let st = dma.st(stream);
     st.cr().modify(|w| w.set_en(false));
     while st.cr().read().en() {}
@@ -109,8 +116,22 @@ pub fn start(dac_words: u32, laser_words: u32, len: u16, first: u32, timer: Time
     tim.cnt().write(|w| w.set_cnt(0));
     // Loads PSC/ARR and latches `first` into the DAC (no request enabled).
     output_now(first);
-    configure(pac::DMA1, DAC_STREAM, dhr12rd_address(), dac_words, len, true);
-    configure(pac::DMA2, LASER_STREAM, gpiob_bsrr_address(), laser_words, len, false);
+    configure(
+        pac::DMA1,
+        DAC_STREAM,
+        dhr12rd_address(),
+        dac_words,
+        len,
+        true,
+    );
+    configure(
+        pac::DMA2,
+        LASER_STREAM,
+        gpiob_bsrr_address(),
+        laser_words,
+        len,
+        false,
+    );
     pac::DAC1.cr().modify(|w| w.set_dmaen(0, true));
     tim.dier().write(|w| w.set_ude(true));
     tim.cr1().write(|w| {
