@@ -41,7 +41,7 @@ use embassy_stm32::peripherals::{DAC1, DMA1_CH5, DMA2_CH1, PA4, PA5, TIM8};
 use embassy_stm32::{Peri, rcc};
 use galvo_dma::ring::{Ring, Slot, slot};
 use galvo_dma::timing::{RefillMeter, TimerSetting, timer_setting};
-use galvo_dma::words::{LaserTrack, dhr12rd};
+use galvo_dma::words::{LaserTrack, dhr12rd, replays_identically};
 use laser_app::galvo::{DacSample, DacStream, Half, RefillTime, Underrun};
 use laser_app::laser_gate::LaserGate;
 
@@ -252,7 +252,7 @@ impl Stm32GalvoDac {
         let first = half.samples.first().copied();
         let uniform = half.samples.len() == HALF_LEN
             && half.samples.iter().all(|s| Some(*s) == first)
-            && laser.iter().all(|w| *w == laser[0]);
+            && replays_identically(&dac, &laser);
         self.contents[physical] = first.filter(|_| uniform).map(|s| (s, self.timer));
         let holding = self.contents[physical].is_some() && self.contents[0] == self.contents[1];
         SHARED.holding.store(holding, Ordering::Release);

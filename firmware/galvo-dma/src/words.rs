@@ -117,5 +117,13 @@ impl LaserTrack {
     }
 }
 
+/// Whether a packed half replays exactly as written when the DMA plays it
+/// again: every DAC word and every laser word the same. A hold right after
+/// a lit stretch does not (its first laser slot carries the reset of the
+/// last lit sample, or a set), the next one does.
+pub fn replays_identically(dac: &[u32], laser: &[u32]) -> bool {
+    dac.iter().all(|w| Some(w) == dac.first()) && laser.iter().all(|w| Some(w) == laser.first())
+}
+
 #[cfg(test)]
 mod tests;

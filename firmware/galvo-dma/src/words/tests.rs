@@ -124,3 +124,27 @@ fn a_short_half_repeats_the_last_position_dark() {
     assert_eq!(dac, [dhr12rd(5, 6); 3]);
     assert_eq!(laser, [0, bsrr_set(0), bsrr_reset(0)]);
 }
+
+#[test]
+fn a_hold_replays_identically_only_once_its_carry_is_its_own() {
+    let mut track = LaserTrack::new(0);
+    let (mut dac, mut laser) = ([0u32; 4], [0u32; 4]);
+    track.pack(0, true, [(7, 7, true); 4], &mut dac, &mut laser);
+    // Lit hold after nothing: slot 0 is still the dark carry.
+    assert!(!replays_identically(&dac, &laser));
+    track.pack(0, true, [(7, 7, true); 4], &mut dac, &mut laser);
+    assert!(
+        replays_identically(&dac, &laser),
+        "lit hold, set everywhere"
+    );
+    track.pack(0, true, [(7, 7, false); 4], &mut dac, &mut laser);
+    assert!(
+        !replays_identically(&dac, &laser),
+        "slot 0 sets, slot 1 resets"
+    );
+    track.pack(0, true, [(7, 7, false); 4], &mut dac, &mut laser);
+    assert!(replays_identically(&dac, &laser), "dark hold, hands off");
+    assert_eq!(laser, [0; 4]);
+    track.pack(0, true, [(7, 8, false); 4], &mut dac, &mut laser);
+    assert!(!replays_identically(&dac, &laser), "the mirrors still move");
+}
