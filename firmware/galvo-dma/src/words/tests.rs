@@ -145,6 +145,7 @@ fn a_hold_replays_identically_only_once_its_carry_is_its_own() {
     track.pack(0, true, [(7, 7, false); 4], &mut dac, &mut laser);
     assert!(replays_identically(&dac, &laser), "dark hold, hands off");
     assert_eq!(laser, [0; 4]);
-    track.pack(0, true, [(7, 8, false); 4], &mut dac, &mut laser);
-    assert!(!replays_identically(&dac, &laser), "the mirrors still move");
+    let moving = [(7, 7, false), (7, 8, false), (7, 9, false), (7, 9, false)];
+    track.pack(0, true, moving, &mut dac, &mut laser);
+    assert!(!replays_identically(&dac, &laser), "the mirrors move");
 }
