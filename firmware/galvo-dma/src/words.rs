@@ -118,9 +118,10 @@ impl LaserTrack {
 }
 
 /// Whether a packed half replays exactly as written when the DMA plays it
-/// again: every DAC word and every laser word the same. A hold right after
-/// a lit stretch does not (its first laser slot carries the reset of the
-/// last lit sample, or a set), the next one does.
+/// again: every DAC word and every laser word the same. The first half of
+/// a hold whose laser state differs from the samples before it does not
+/// (its first slots carry that change: the previous sample's word, and a
+/// reset after a lit one); the next half of the same hold does.
 pub fn replays_identically(dac: &[u32], laser: &[u32]) -> bool {
     dac.iter().all(|w| Some(w) == dac.first()) && laser.iter().all(|w| Some(w) == laser.first())
 }
