@@ -38,7 +38,7 @@ use cortex_m::peripheral::DWT;
 use embassy_stm32::gpio::Flex;
 use embassy_stm32::interrupt::typelevel::{Binding, DMA1_STREAM5};
 use embassy_stm32::peripherals::{DAC1, DMA1_CH5, DMA2_CH1, PA4, PA5, TIM8};
-use embassy_stm32::{Peri, rcc};
+use embassy_stm32::{Peri, dac, rcc, timer};
 use galvo_dma::ring::{Ring, Slot, slot};
 use galvo_dma::timing::{RefillMeter, TimerSetting, timer_setting};
 use galvo_dma::words::{LaserTrack, dhr12rd, replays_identically};
@@ -114,6 +114,20 @@ fn cycles() -> u32 {
     DWT::cycle_count()
 }
 
+/// The request map and pins `regs.rs` hard-codes, checked against
+/// embassy-stm32's chip metadata at compile time: DMA1 stream 5 serves
+/// DAC1 channel 1 and DMA2 stream 1 TIM8's update (both request channel 7,
+/// checked at boot), PA4/PA5 are DAC1's outputs.
+const fn request_map<D, U, X, Y>()
+where
+    D: dac::Dma<DAC1, dac::Ch1>,
+    U: timer::UpDma<TIM8>,
+    X: dac::DacPin<DAC1, dac::Ch1>,
+    Y: dac::DacPin<DAC1, dac::Ch2>,
+{
+}
+const _: () = request_map::<DMA1_CH5, DMA2_CH1, PA4, PA5>();
+
 /// The peripherals the stream owns (nothing else may touch them).
 pub struct GalvoDacPeripherals {
     /// Sample clock.
@@ -168,6 +182,10 @@ impl Stm32GalvoDac {
         // DMA cannot reach the CCM: a linker change must not move these.
         defmt::assert!(
             SRAM.contains(&DAC_WORDS.address()) && SRAM.contains(&LASER_WORDS.address())
+        );
+        defmt::assert!(
+            dac::Dma::<DAC1, dac::Ch1>::request(&*p.dac_dma) == regs::REQUEST_CHANNEL
+                && timer::UpDma::<TIM8>::request(&*p.laser_dma) == regs::REQUEST_CHANNEL
         );
         rcc::enable_and_reset::<TIM8>();
         rcc::enable_and_reset::<DAC1>();

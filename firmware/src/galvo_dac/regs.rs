@@ -18,7 +18,7 @@ const DAC_STREAM: usize = 5;
 /// DMA2 stream of TIM8_UP's request (channel 7).
 const LASER_STREAM: usize = 1;
 /// Request channel of both streams.
-const REQUEST_CHANNEL: u8 = 7;
+pub const REQUEST_CHANNEL: u8 = 7;
 /// DAC trigger selection: TIM8 TRGO.
 const TSEL_TIM8_TRGO: u8 = 0b001;
 
