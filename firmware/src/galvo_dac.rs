@@ -26,10 +26,10 @@
 //! are the pure `galvo-dma` crate (host-tested); `regs.rs` is the register
 //! layer. Verified by building only: no board or emulator runs it here.
 
+mod buffers;
 mod irq;
 mod regs;
 
-use core::cell::UnsafeCell;
 use core::future::poll_fn;
 use core::sync::atomic::Ordering;
 use core::task::Poll;
@@ -45,6 +45,8 @@ use galvo_dma::words::{LaserTrack, dhr12rd, replays_identically};
 use laser_app::galvo::{DacSample, DacStream, Half, RefillTime, Underrun};
 use laser_app::laser_gate::LaserGate;
 
+pub use buffers::darken_laser_stream;
+use buffers::{DAC_WORDS, LASER_WORDS};
 pub use irq::HalfInterrupt;
 use irq::{SHARED, pack_timer, unpack_timer};
 
@@ -54,60 +56,8 @@ const RING: Ring = Ring::new(HALF_LEN);
 const RING_LEN: usize = 2 * HALF_LEN;
 /// Default sample period, s (until the loop sets its own).
 const DEFAULT_PERIOD_S: f64 = 10e-6;
-/// Main SRAM (SRAM1 + SRAM2), the DMA-reachable RAM.
-const SRAM: core::ops::Range<u32> = 0x2000_0000..0x2002_0000;
 /// DAC code of mid-scale (the output before the first stream).
 const MID_CODE: u16 = 2048;
-
-/// A DMA buffer of the ring. Only whole-word volatile stores and loads go
-/// through it: by the refill, by the gate's hook (any context) and, from
-/// the other side, by a DMA stream.
-#[repr(align(4))]
-struct DmaWords(UnsafeCell<[u32; RING_LEN]>);
-
-// SAFETY: every access is a single aligned volatile word access (atomic
-// on the Cortex-M4); no reference into the array is ever created.
-unsafe impl Sync for DmaWords {}
-
-impl DmaWords {
-    const fn new() -> Self {
-        Self(UnsafeCell::new([0; RING_LEN]))
-    }
-
-    fn address(&self) -> u32 {
-        self.0.get() as u32
-    }
-
-    fn store(&self, index: usize, word: u32) {
-        if index < RING_LEN {
-            // SAFETY: in bounds, aligned, one volatile word store.
-            unsafe { self.0.get().cast::<u32>().add(index).write_volatile(word) }
-        }
-    }
-
-    fn load(&self, index: usize) -> u32 {
-        if index < RING_LEN {
-            // SAFETY: in bounds, aligned, one volatile word load.
-            unsafe { self.0.get().cast::<u32>().add(index).read_volatile() }
-        } else {
-            0
-        }
-    }
-}
-
-/// DHR12RD words, read by DMA1 stream 5.
-static DAC_WORDS: DmaWords = DmaWords::new();
-/// GPIOB BSRR words, read by DMA2 stream 1.
-static LASER_WORDS: DmaWords = DmaWords::new();
-
-/// Zeroes every laser word: from the next update on the laser stream
-/// writes nothing. The gate's close hook calls it, then pulls PB0 low.
-pub fn darken_laser_stream() {
-    for i in 0..RING_LEN {
-        LASER_WORDS.store(i, 0);
-    }
-    cortex_m::asm::dsb();
-}
 
 /// The CPU's cycle counter (enabled by `board::init`).
 fn cycles() -> u32 {
@@ -180,9 +130,7 @@ impl Stm32GalvoDac {
         _irq: impl Binding<DMA1_STREAM5, HalfInterrupt>,
     ) -> Self {
         // DMA cannot reach the CCM: a linker change must not move these.
-        defmt::assert!(
-            SRAM.contains(&DAC_WORDS.address()) && SRAM.contains(&LASER_WORDS.address())
-        );
+        defmt::assert!(buffers::in_main_sram());
         defmt::assert!(
             dac::Dma::<DAC1, dac::Ch1>::request(&*p.dac_dma) == regs::REQUEST_CHANNEL
                 && timer::UpDma::<TIM8>::request(&*p.laser_dma) == regs::REQUEST_CHANNEL
