@@ -39,7 +39,7 @@ use embassy_stm32::gpio::Flex;
 use embassy_stm32::interrupt::typelevel::{Binding, DMA1_STREAM5};
 use embassy_stm32::peripherals::{DAC1, DMA1_CH5, DMA2_CH1, PA4, PA5, TIM8};
 use embassy_stm32::{Peri, dac, rcc, timer};
-use galvo_dma::ring::{Ring, Slot, slot};
+use galvo_dma::ring::{Claim, Cursor, Ring};
 use galvo_dma::timing::{RefillMeter, TimerSetting, timer_setting};
 use galvo_dma::words::{LaserTrack, dhr12rd, replays_identically};
 use laser_app::galvo::{DacSample, DacStream, Half, RefillTime, Underrun};
@@ -98,10 +98,8 @@ pub struct GalvoDacPeripherals {
 pub struct Stm32GalvoDac {
     gate: &'static LaserGate,
     track: LaserTrack,
-    /// The streams run (the loop primed both halves).
-    started: bool,
-    /// The half written next (counted from the stream's start).
-    next: u32,
+    /// Which half is written next; whether the streams run.
+    cursor: Cursor,
     /// What each physical half replays identically, with its clock.
     contents: [Option<(DacSample, TimerSetting)>; 2],
     /// Sample clock for the halves written from now on.
@@ -150,8 +148,7 @@ impl Stm32GalvoDac {
         Self {
             gate,
             track: LaserTrack::new(laser_pin),
-            started: false,
-            next: 0,
+            cursor: Cursor::new(),
             contents: [None; 2],
             timer,
             timer_hz,
@@ -170,33 +167,37 @@ impl Stm32GalvoDac {
             .unwrap_or(counted)
     }
 
-    /// Waits until the half [`Self::next`] may be written; returns the
-    /// halves the DMA started before they were written (then `next`
-    /// moves past the half it reads). Returns at once after a fault.
+    /// Waits until the cursor's next half may be written; returns the
+    /// halves the DMA started before they were written (then the cursor
+    /// moved past the half it reads). Returns at once after a fault.
     async fn wait_free(&mut self) -> u32 {
         poll_fn(|cx| {
             SHARED.waker.register(cx.waker());
             if SHARED.fault.load(Ordering::Acquire) {
                 return Poll::Ready(0);
             }
-            let reading = self.reading();
-            match slot(self.next, reading) {
-                Slot::Wait => Poll::Pending,
-                Slot::Free => Poll::Ready(0),
-                Slot::Late { halves } => {
-                    self.next = reading.wrapping_add(1);
-                    Poll::Ready(halves)
-                }
+            match self.cursor.claim(self.reading()) {
+                Claim::Wait => Poll::Pending,
+                Claim::Write { late, .. } => Poll::Ready(late),
             }
         })
         .await
     }
 
-    /// Packs `half` into the physical half of [`Self::next`]: DAC words,
+    /// Publishes the claimed half as written; `true` when the DMA had
+    /// already begun it (the copy ended too late: it began partly stale).
+    fn commit(&mut self) -> bool {
+        SHARED
+            .written
+            .store(self.cursor.commit(), Ordering::Release);
+        self.cursor.check(self.reading())
+    }
+
+    /// Packs `half` into the cursor's next physical half: DAC words,
     /// laser words (lit only while the gate passes the half's
     /// generation), its clock, and whether the ring now holds one sample.
     fn store(&mut self, half: &Half<'_>) {
-        let physical = Ring::physical(self.next);
+        let physical = self.cursor.physical();
         // Not a hold while it is being rewritten.
         SHARED.holding.store(false, Ordering::Release);
         let passes = self.gate.passes(true, half.generation);
@@ -229,7 +230,6 @@ impl Stm32GalvoDac {
         SHARED.reading.store(0, Ordering::Release);
         SHARED.written.store(2, Ordering::Release);
         SHARED.running.store(true, Ordering::Release);
-        self.started = true;
         let timer = unpack_timer(SHARED.timers[0].load(Ordering::Relaxed));
         regs::start(
             DAC_WORDS.address(),
@@ -245,8 +245,7 @@ impl Stm32GalvoDac {
         regs::stop();
         SHARED.running.store(false, Ordering::Release);
         SHARED.holding.store(false, Ordering::Release);
-        self.started = false;
-        self.next = 0;
+        self.cursor.reset();
         self.contents = [None; 2];
         self.track.darken();
     }
@@ -265,7 +264,7 @@ impl DacStream for Stm32GalvoDac {
     }
 
     fn holds(&self, sample: DacSample) -> bool {
-        self.started
+        self.cursor.started()
             && !SHARED.fault.load(Ordering::Acquire)
             && self
                 .contents
@@ -276,7 +275,7 @@ impl DacStream for Stm32GalvoDac {
     async fn write_half(&mut self, half: Half<'_>) -> Result<(), Underrun> {
         let entered = cycles();
         let mut late = 0;
-        if self.started {
+        if self.cursor.started() {
             late = self.wait_free().await;
         }
         if SHARED.fault.swap(false, Ordering::AcqRel) {
@@ -286,20 +285,10 @@ impl DacStream for Stm32GalvoDac {
         }
         let copy_from = cycles();
         self.store(&half);
-        if self.started {
-            SHARED
-                .written
-                .store(self.next.wrapping_add(1), Ordering::Release);
-            // The DMA reached it during the copy: it began partly stale.
-            if matches!(slot(self.next, self.reading()), Slot::Late { .. }) {
-                late += 1;
-            }
-            self.next = self.next.wrapping_add(1);
-        } else {
-            self.next += 1;
-            if self.next == 2 {
-                self.start();
-            }
+        if self.cursor.started() {
+            late += u32::from(self.commit());
+        } else if self.cursor.primed() {
+            self.start();
         }
         self.meter.record(entered, copy_from, cycles());
         if late > 0 {
@@ -310,7 +299,7 @@ impl DacStream for Stm32GalvoDac {
     }
 
     async fn repeat_half(&mut self) {
-        if !self.started {
+        if !self.cursor.started() {
             return;
         }
         let entered = cycles();
@@ -320,10 +309,8 @@ impl DacStream for Stm32GalvoDac {
             // The next write_half restarts the streams and reports it.
             return;
         }
-        SHARED
-            .written
-            .store(self.next.wrapping_add(1), Ordering::Release);
-        self.next = self.next.wrapping_add(1);
+        // A hold replays identically: late or not, nothing to report.
+        self.commit();
         let now = cycles();
         self.meter.record(entered, now, now);
     }

@@ -127,5 +127,98 @@ pub const fn underrun_at_start(started: u32, written: u32, holding: bool) -> boo
     !holding && ahead(started, written) >= 0
 }
 
+/// The refill's side of the bookkeeping: primes both halves, then claims
+/// each next half as the DMA frees it and commits it.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Cursor {
+    /// The half written next.
+    next: u32,
+    /// Both halves were primed: the streams run.
+    started: bool,
+}
+
+/// What [`Cursor::claim`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Claim {
+    /// The half's buffer still plays: wait for the next boundary.
+    Wait,
+    /// Write physical half `physical` now; `late` halves were started by
+    /// the DMA before they were written (0: in time).
+    Write {
+        /// The physical half (0 or 1).
+        physical: usize,
+        /// Halves the DMA replayed stale.
+        late: u32,
+    },
+}
+
+impl Cursor {
+    /// Nothing written, streams stopped.
+    pub const fn new() -> Self {
+        Self {
+            next: 0,
+            started: false,
+        }
+    }
+
+    /// Whether the streams run.
+    pub const fn started(&self) -> bool {
+        self.started
+    }
+
+    /// The physical half the next write goes to.
+    pub const fn physical(&self) -> usize {
+        Ring::physical(self.next)
+    }
+
+    /// Before the start: counts one primed half; `true` when both are and
+    /// the streams start now (the DMA reads half 0, halves 0 and 1 are
+    /// written: the interrupt's counts start at 0 and 2).
+    pub fn primed(&mut self) -> bool {
+        self.next += 1;
+        self.started = self.next >= 2;
+        self.started
+    }
+
+    /// While started, with the DMA reading `reading`: whether the next half
+    /// may be written and where. When late, the next half becomes the one
+    /// after the half the DMA reads.
+    pub fn claim(&mut self, reading: u32) -> Claim {
+        match slot(self.next, reading) {
+            Slot::Wait => Claim::Wait,
+            Slot::Free => Claim::Write {
+                physical: self.physical(),
+                late: 0,
+            },
+            Slot::Late { halves } => {
+                self.next = reading.wrapping_add(1);
+                Claim::Write {
+                    physical: self.physical(),
+                    late: halves,
+                }
+            }
+        }
+    }
+
+    /// The claimed half is written (or a hold left as it is): the value of
+    /// `written` for the interrupt, to store before [`Self::check`].
+    pub fn commit(&mut self) -> u32 {
+        self.next = self.next.wrapping_add(1);
+        self.next
+    }
+
+    /// After [`Self::commit`] was published, with the DMA now reading
+    /// `reading`: whether it had already begun the committed half (the
+    /// copy finished too late; it started partly stale).
+    pub const fn check(&self, reading: u32) -> bool {
+        ahead(reading, self.next.wrapping_sub(1)) >= 0
+    }
+
+    /// The streams stopped (a fault): prime again.
+    pub fn reset(&mut self) {
+        *self = Self::new();
+    }
+}
+
 #[cfg(test)]
 mod tests;

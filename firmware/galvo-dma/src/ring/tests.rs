@@ -58,25 +58,56 @@ fn lockstep_allows_one_item_either_way_round_the_wrap() {
     assert!(!ring.in_lockstep(0, 4), "a stopped stream");
 }
 
+#[test]
+fn the_cursor_primes_two_halves_then_follows_the_dma() {
+    let mut c = Cursor::new();
+    assert!(!c.started());
+    assert_eq!(c.physical(), 0);
+    assert!(!c.primed());
+    assert_eq!(c.physical(), 1);
+    assert!(c.primed(), "starts with both halves written");
+    // The DMA reads half 0: half 2 (physical 0) waits for it.
+    assert_eq!(c.claim(0), Claim::Wait);
+    assert_eq!(
+        c.claim(1),
+        Claim::Write {
+            physical: 0,
+            late: 0
+        }
+    );
+    assert_eq!(c.commit(), 3, "halves 0..3 written");
+    assert!(!c.check(1), "the DMA is still before it");
+    assert!(c.check(2), "the DMA began it during the copy");
+    // Three halves late: written after the one the DMA reads.
+    assert_eq!(
+        c.claim(5),
+        Claim::Write {
+            physical: 0,
+            late: 3
+        }
+    );
+    assert_eq!(c.commit(), 7);
+    c.reset();
+    assert_eq!(c, Cursor::new());
+}
+
 proptest! {
-    /// The refill (slot at each hand-over) and the interrupt (a check at
-    /// each half start) count the same underruns, whatever the refill's
-    /// timing and however late the interrupt sees a boundary.
+    /// The refill (the cursor at each hand-over) and the interrupt (a
+    /// check at each half start) count the same underruns, whatever the
+    /// refill's timing and however late the interrupt sees a boundary.
     #[test]
     fn refill_and_interrupt_agree_on_underruns(
         half_len in 1usize..8,
         computes in prop::collection::vec(0usize..40, 1..60),
         isr_lag in prop::collection::vec(any::<bool>(), 60),
-        start in any::<u32>(),
     ) {
-        // Half 0 is physical half 0: the count starts even.
-        let start = start & !1;
         let ring = Ring::new(half_len);
         let n = half_len;
-        // Time in samples; the DMA reads sample t mod len of half `start + t / n`.
-        let mut t = 0usize;
-        let (mut next, mut written) = (start.wrapping_add(2), start.wrapping_add(2));
-        let (mut isr_seen, mut isr_underruns, mut refill_underruns) = (start, 0u32, 0u32);
+        let mut cursor = Cursor::new();
+        prop_assert!(!cursor.primed() && cursor.primed());
+        // Time in samples; the DMA reads sample t mod len of half t / n.
+        let (mut t, mut written) = (0usize, 2u32);
+        let (mut isr_seen, mut isr_underruns, mut refill_underruns) = (0u32, 0u32, 0u32);
         let advance = |t: &mut usize, to: usize, written: u32, isr_seen: &mut u32, count: &mut u32| {
             while *t < to {
                 *t += 1;
@@ -91,27 +122,26 @@ proptest! {
         for (k, &compute) in computes.iter().enumerate() {
             let to = t + compute;
             advance(&mut t, to, written, &mut isr_seen, &mut isr_underruns);
-            loop {
+            let late = loop {
                 // The interrupt may not have run for a boundary just crossed.
                 let counted = if isr_lag[k] && t.is_multiple_of(n) { isr_seen.wrapping_sub(1) } else { isr_seen };
                 let ndtr = (ring.samples() - t % ring.samples()) as u32;
                 let reading = ring.reading_half(counted, ndtr).unwrap();
-                prop_assert_eq!(reading, start.wrapping_add((t / n) as u32));
-                match slot(next, reading) {
-                    Slot::Wait => {
+                prop_assert_eq!(reading, (t / n) as u32);
+                match cursor.claim(reading) {
+                    Claim::Wait => {
                         let boundary = (t / n + 1) * n;
                         advance(&mut t, boundary, written, &mut isr_seen, &mut isr_underruns);
                     }
-                    Slot::Free => break,
-                    Slot::Late { halves } => {
-                        refill_underruns += halves;
-                        next = reading.wrapping_add(1);
-                        break;
+                    Claim::Write { physical, late } => {
+                        prop_assert_ne!(physical, (t / n) % 2, "never the half the DMA reads");
+                        break late;
                     }
                 }
-            }
-            next = next.wrapping_add(1);
-            written = next;
+            };
+            refill_underruns += late;
+            written = cursor.commit();
+            prop_assert!(!cursor.check((t / n) as u32), "an instant copy is in time");
         }
         prop_assert_eq!(refill_underruns, isr_underruns);
     }
