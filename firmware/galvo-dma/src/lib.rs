@@ -17,7 +17,8 @@
 //!   it; a BSRR write acts at once).
 //! * [`ring`]: the ring layout, the half the DMA reads from its NDTR
 //!   counter, whether the next half is free or already late (underrun),
-//!   the interrupt's underrun check, lockstep of the two streams.
+//!   the interrupt's underrun check, lockstep of the two streams, and the
+//!   refill's cursor (prime both halves, claim, commit, check).
 //! * [`timing`]: TIM8 prescaler/reload for a sample period, and the worst
 //!   refill time from cycle-counter readings.
 #![no_std]
