@@ -84,6 +84,9 @@ fn on_half_boundary() {
         }
     }
     SHARED.reading.store(started, Ordering::Release);
+    // The half's own sample clock, preloaded: it takes effect at the next
+    // update, which outputs the previous half's last sample (the DAC's
+    // one-update delay), so a period change starts one sample early.
     let timer = SHARED.timers[Ring::physical(started)].load(Ordering::Relaxed);
     regs::set_timer(unpack_timer(timer));
     if !RING.in_lockstep(regs::dac_ndtr(), regs::laser_ndtr()) {
