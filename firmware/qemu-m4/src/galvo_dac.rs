@@ -4,7 +4,10 @@
 //! executor and interrupts at the M4's instruction timing, with the other
 //! tasks running. The "DAC output" is the sample register the interrupt
 //! sets; the galvo laser's switches are reported on the log channel
-//! (`@galvo-laser 0|1`), underruns counted for `galvo status`.
+//! (`@galvo-laser 0|1`), underruns counted for `galvo status`, and the
+//! worst refill measured with the STM32 stream's meter (`galvo-dma`) in
+//! instructions (board time under `-icount shift=0`: 1 ns each), shown by
+//! `galvo status` as cycles of a 1 GHz clock.
 //!
 //! Timing: CMSDK dual timer 1 (0x4000_2000, IRQ 10), periodic, at the
 //! sample period in 25 MHz ticks.
@@ -15,7 +18,8 @@ use core::task::Poll;
 
 use critical_section::Mutex;
 use embassy_sync::waitqueue::WakerRegistration;
-use laser_app::galvo::{DacSample, DacStream, Half, Underrun};
+use galvo_dma::timing::RefillMeter;
+use laser_app::galvo::{DacSample, DacStream, Half, RefillTime, Underrun};
 
 use crate::log_channel;
 use crate::mmio::Reg;
@@ -27,6 +31,15 @@ pub const HALF_LEN: usize = 128;
 const TIMER_HZ: f64 = 25_000_000.0;
 /// Fewest timer ticks per sample (1 MHz).
 const MIN_PERIOD_TICKS: u32 = 25;
+/// Instructions per timer tick under `-icount shift=0` (1 ns each).
+const INSTRUCTIONS_PER_TICK: u64 = 40;
+/// The "CPU clock" refill times are given in: one instruction per ns.
+const INSTRUCTIONS_HZ: u32 = 1_000_000_000;
+
+/// Instructions since boot (wrapping), for the refill meter.
+fn instructions() -> u32 {
+    (crate::time_driver::timer_ticks() * INSTRUCTIONS_PER_TICK) as u32
+}
 
 const BASE: usize = 0x4000_2000;
 const LOAD: Reg = Reg(BASE);
@@ -79,6 +92,7 @@ static SHARED: Mutex<RefCell<Shared>> = Mutex::new(RefCell::new(Shared {
 pub struct QemuDac {
     period_ticks: u32,
     primed: usize,
+    meter: RefillMeter,
 }
 
 impl QemuDac {
@@ -88,6 +102,7 @@ impl QemuDac {
         Self {
             period_ticks: 250,
             primed: 0,
+            meter: RefillMeter::new(),
         }
     }
 
@@ -131,6 +146,37 @@ impl DacStream for QemuDac {
     }
 
     async fn write_half(&mut self, half: Half<'_>) -> Result<(), Underrun> {
+        let entered = instructions();
+        let written = self.store_half(half).await;
+        let now = instructions();
+        // The copy is part of the wait here (done in the same critical
+        // section that finds the half free): the refill is the loop's own
+        // time between hand-overs.
+        self.meter.record(entered, now, now);
+        written
+    }
+
+    async fn repeat_half(&mut self) {
+        let entered = instructions();
+        self.repeat().await;
+        let now = instructions();
+        self.meter.record(entered, now, now);
+    }
+
+    fn worst_refill(&self) -> Option<RefillTime> {
+        let window = HALF_LEN as u64 * u64::from(self.period_ticks) * INSTRUCTIONS_PER_TICK;
+        self.meter.worst().map(|cycles| RefillTime {
+            cycles,
+            cpu_hz: INSTRUCTIONS_HZ,
+            window_cycles: u32::try_from(window).unwrap_or(u32::MAX),
+        })
+    }
+}
+
+impl QemuDac {
+    /// Stores `half` in the free half (priming first), as
+    /// [`DacStream::write_half`].
+    async fn store_half(&mut self, half: Half<'_>) -> Result<(), Underrun> {
         if self.primed < 2 {
             let index = self.primed;
             self.primed += 1;
@@ -176,7 +222,9 @@ impl DacStream for QemuDac {
         .await
     }
 
-    async fn repeat_half(&mut self) {
+    /// Waits for the free half and keeps it as it is, as
+    /// [`DacStream::repeat_half`].
+    async fn repeat(&mut self) {
         poll_fn(|cx| {
             critical_section::with(|cs| {
                 let mut s = SHARED.borrow(cs).borrow_mut();

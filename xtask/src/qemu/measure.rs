@@ -175,6 +175,9 @@ fn galvo(elf: &Path) -> Result<()> {
         .map(|t| t.lines.clone())
         .unwrap_or_default();
     for (_, line) in lines.iter().skip(before) {
+        if line.starts_with("worst refill") {
+            println!("  {line} (cycles: instructions)");
+        }
         if line.starts_with("underruns") {
             println!("  {line}");
             if !line.starts_with("underruns: 0,") {
