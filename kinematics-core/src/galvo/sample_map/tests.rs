@@ -1,0 +1,120 @@
+use super::*;
+use crate::frames::PointMm;
+use crate::galvo::{GalvoGeometry, MirrorAngles};
+
+/// The polynomial arc tangent against the `f64` one: over a dense
+/// logarithmic sweep of both signs (every reduction range and its edges),
+/// and the special values.
+#[test]
+fn atan_f32_is_within_2e7_rad_everywhere() {
+    let mut worst = 0.0f64;
+    let mut t = 1e-6f32;
+    while t < 1e7 {
+        for v in [t, -t, t.next_up(), t.next_down()] {
+            let err = (f64::from(atan_f32(v)) - libm::atan(f64::from(v))).abs();
+            assert!(err < 2e-7, "{v}: {err}");
+            worst = worst.max(err);
+        }
+        t *= 1.0001;
+    }
+    for edge in [TAN_PI_8, TAN_3PI_8, 1.0] {
+        for v in [edge, edge.next_up(), edge.next_down()] {
+            let err = (f64::from(atan_f32(v)) - libm::atan(f64::from(v))).abs();
+            assert!(err < 2e-7, "{v}: {err}");
+        }
+    }
+    assert!(worst > 0.0);
+    assert_eq!(atan_f32(0.0), 0.0);
+    assert_eq!(atan_f32(f32::INFINITY), core::f32::consts::FRAC_PI_2);
+    assert_eq!(atan_f32(f32::NEG_INFINITY), -core::f32::consts::FRAC_PI_2);
+    assert!(atan_f32(f32::NAN).is_nan());
+    // Odd.
+    for v in [0.1f32, 0.5, 2.0, 30.0] {
+        assert_eq!(atan_f32(-v), -atan_f32(v));
+    }
+}
+
+/// A galvo with asymmetric, non-default mappings.
+fn odd_galvo() -> Galvo<f32> {
+    Galvo::<f32> {
+        geometry: GalvoGeometry {
+            d_mm: 350.0,
+            e_mm: 12.0,
+        },
+        dac_x: DacAxis {
+            codes_per_rad: -9000.0,
+            offset_code: 2040.0,
+        },
+        dac_y: DacAxis {
+            codes_per_rad: 9500.0,
+            offset_code: 2050.5,
+        },
+    }
+}
+
+/// The exact (f64) code value of an axis for a board point.
+fn exact_values(g: &Galvo<f32>, x: f32, y: f32) -> [f64; 2] {
+    let g64: Galvo<f64> = g.cast();
+    let a = g64
+        .geometry
+        .ik(PointMm::new(f64::from(x), f64::from(y)))
+        .unwrap();
+    [
+        g64.dac_x.offset_code + g64.dac_x.codes_per_rad * a.x_rad,
+        g64.dac_y.offset_code + g64.dac_y.codes_per_rad * a.y_rad,
+    ]
+}
+
+/// Board → codes agrees with the checked `f32` path (libm's `atanf`)
+/// except where the exact code value lies within 1/256 LSB of a rounding
+/// tie; angles → codes agrees bit for bit; bad input is refused.
+#[test]
+fn sample_map_agrees_with_the_checked_path_and_refuses_bad_input() {
+    let g = odd_galvo();
+    let map = SampleMap::new(&g).unwrap();
+    let mut differ = 0;
+    for i in -60..=60 {
+        for j in -60..=60 {
+            let (x, y) = (i as f32 * 3.7, j as f32 * 3.3);
+            let fast = map.board_to_codes(x, y).unwrap();
+            let checked = g.board_to_codes(PointMm::new(x, y)).unwrap();
+            let exact = exact_values(&g, x, y);
+            for (a, b, v) in [(fast.x, checked.x, exact[0]), (fast.y, checked.y, exact[1])] {
+                assert_eq!(a.clamped, b.clamped);
+                if a.code != b.code {
+                    let tie = (v - v.floor() - 0.5).abs();
+                    assert!(tie < 1.0 / 256.0, "({x}, {y}): {v}");
+                    differ += 1;
+                }
+            }
+            let (tx, ty) = (i as f32 * 0.004, j as f32 * -0.0041);
+            assert_eq!(
+                map.angles_to_codes(tx, ty),
+                g.angles_to_codes(MirrorAngles {
+                    x_rad: tx,
+                    y_rad: ty
+                })
+                .ok()
+            );
+        }
+    }
+    assert!(differ < 10, "{differ}");
+    // Far outside: clamped and flagged, as the checked path.
+    let far = map.board_to_codes(1e6, -1e6).unwrap();
+    assert!(far.x.clamped && far.y.clamped);
+    assert_eq!(map.board_to_codes(f32::NAN, 0.0), None);
+    assert_eq!(map.board_to_codes(0.0, f32::INFINITY), None);
+    assert_eq!(map.angles_to_codes(f32::NAN, 0.0), None);
+    let mut bad = g;
+    bad.dac_y.codes_per_rad = 0.0;
+    assert!(matches!(
+        SampleMap::new(&bad),
+        Err(Error::InvalidConfig { .. })
+    ));
+    bad = g;
+    bad.geometry.d_mm = -1.0;
+    assert!(matches!(
+        SampleMap::new(&bad),
+        Err(Error::InvalidConfig { .. })
+    ));
+}
