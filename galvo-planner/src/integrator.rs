@@ -42,6 +42,7 @@ use crate::model::{Discrete, THETA};
 use crate::plan::JumpPlan;
 use kinematics_core::numeric::finite;
 
+mod run;
 mod xy;
 pub use xy::XyIntegrator;
 
@@ -261,13 +262,6 @@ impl<const S: usize, const CAP: usize, const Q: usize> Integrator<S, CAP, Q> {
             self.move_count -= 1;
         }
         self.position_rad()
-    }
-
-    /// Fills `out` with the commanded angle of the next `out.len()` samples.
-    pub fn fill(&mut self, out: &mut [f32]) {
-        for o in out.iter_mut() {
-            *o = self.step();
-        }
     }
 
     /// Commanded motor angle now, rad.

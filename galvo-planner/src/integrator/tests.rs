@@ -101,6 +101,52 @@ fn fill_equals_stepping() {
     assert_eq!(filled, stepped);
 }
 
+/// Runs of any length, across move ends (two moves queued back to back)
+/// and into the idle hold, give the stepped angles bit for bit, for both
+/// axes of an [`XyIntegrator`].
+#[test]
+fn fill_runs_equal_stepping_across_moves() {
+    let d = rigid(10e-6);
+    let first = plan_xy_jump(
+        &d,
+        &d,
+        [0.0, 0.0],
+        [3.0 * DEG, -DEG],
+        Method::TimeOptimal,
+        JumpSync::Independent,
+        512,
+    )
+    .expect("plan");
+    let second = plan_xy_jump(
+        &d,
+        &d,
+        [3.0 * DEG, -DEG],
+        [-4.0 * DEG, 2.5 * DEG],
+        Method::TimeOptimal,
+        JumpSync::Independent,
+        512,
+    )
+    .expect("plan");
+    for block in [1usize, 3, 7, 32, 100] {
+        let mut a: XyIntegrator<3, 1024> =
+            XyIntegrator::new(&d, &d, [0.0, 0.0]).expect("integrator");
+        a.queue_jump(&first).expect("queue");
+        a.queue_jump(&second).expect("queue");
+        let mut b = a.clone();
+        let total = first.samples() + second.samples() + 20;
+        let mut filled = Vec::new();
+        let mut buf = [[0.0f32; 2]; 100];
+        while filled.len() < total {
+            a.fill(&mut buf[..block]);
+            filled.extend_from_slice(&buf[..block]);
+        }
+        let stepped: Vec<[f32; 2]> = (0..filled.len()).map(|_| b.step()).collect();
+        assert_eq!(filled, stepped, "block {block}");
+        assert!(a.is_idle());
+        assert_eq!(a.x.state(), b.x.state());
+    }
+}
+
 #[test]
 fn queue_errors() {
     let d = rigid(10e-6);

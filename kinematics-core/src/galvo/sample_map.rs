@@ -52,6 +52,19 @@ pub fn atan_f32(t: f32) -> f32 {
     f32::from_bits(r.to_bits() | (t.to_bits() & 0x8000_0000))
 }
 
+/// A finite code value rounded half away from zero to a DAC code,
+/// saturated to 0..=4095: the code of [`round_to_code`] (tests), in five
+/// FPU/ALU instructions instead of its compare chain. For `v ≥ ½`,
+/// `v + ½` in `f32` is exact or rounds within its binade's first half
+/// unit above a power of two, so its truncation is `⌊v + ½⌋`; below ½
+/// the code is 0 (or, under −½, saturated to 0).
+#[inline(always)]
+fn block_code(v: f32) -> u16 {
+    let up = (v + 0.5) as u32;
+    let code = if v < 0.5 { 0 } else { up };
+    code.min(u32::from(super::DAC_MAX_CODE)) as u16
+}
+
 /// The per-sample form of a [`Galvo<f32>`]: checked once when built, then
 /// board point or mirror angles → DAC codes with no per-call validation
 /// and no error plumbing, all in `f32` on the FPU. Its angle → code
@@ -135,6 +148,54 @@ impl SampleMap {
             x: round_to_code(x),
             y: round_to_code(y),
         })
+    }
+
+    /// The codes `[x, y]` of a block of mirror angles `[θx, θy]` (rad)
+    /// into `codes` (up to the shorter of the two); a non-finite angle
+    /// repeats the codes before it (`hold` for the first). Returns the
+    /// last codes. A concrete loop compiled here, for speed (see
+    /// `galvo_planner::blocks`).
+    #[inline(never)]
+    pub fn angles_block(
+        &self,
+        angles: &[[f32; 2]],
+        codes: &mut [[u16; 2]],
+        hold: [u16; 2],
+    ) -> [u16; 2] {
+        let mut last = hold;
+        for (out, [x_rad, y_rad]) in codes.iter_mut().zip(angles) {
+            let x = self.dac_x.offset_code + self.dac_x.codes_per_rad * x_rad;
+            let y = self.dac_y.offset_code + self.dac_y.codes_per_rad * y_rad;
+            if x.is_finite() && y.is_finite() {
+                last = [block_code(x), block_code(y)];
+            }
+            *out = last;
+        }
+        last
+    }
+
+    /// The codes `[x, y]` of a block of board points `[x, y]` (mm), as
+    /// [`Self::angles_block`] does for angles.
+    #[inline(never)]
+    pub fn board_block(
+        &self,
+        points_mm: &[[f32; 2]],
+        codes: &mut [[u16; 2]],
+        hold: [u16; 2],
+    ) -> [u16; 2] {
+        let mut last = hold;
+        let [sx, sy] = self.half_slope;
+        for (out, &[x_mm, y_mm]) in codes.iter_mut().zip(points_mm) {
+            if x_mm.is_finite() && y_mm.is_finite() {
+                // As Self::board_to_codes, operation for operation.
+                let path_mm = crate::real::sqrt_f32(self.d2_mm2 + y_mm * y_mm) + self.e_mm;
+                let x = self.dac_x.offset_code + sx * atan_f32(x_mm / path_mm);
+                let y = self.dac_y.offset_code + sy * atan_f32(y_mm * self.inv_d);
+                last = [block_code(x), block_code(y)];
+            }
+            *out = last;
+        }
+        last
     }
 }
 

@@ -4,6 +4,7 @@
 use core::fmt;
 use core::sync::atomic::Ordering;
 
+use galvo_planner::blocks::LoopIntegrator;
 use galvo_planner::{Discrete, Method, RigidParams, XyIntegrator};
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
@@ -16,13 +17,13 @@ use crate::log;
 
 /// Jump input samples the integrator holds per axis (10.24 ms at 100 kHz,
 /// longer than any full-range time-optimal jump of the reference galvo).
-pub const INTEGRATOR_CAPACITY: usize = 1024;
+pub const INTEGRATOR_CAPACITY: usize = galvo_planner::blocks::JUMP_CAPACITY;
 /// Longest half buffer the loop fills, samples.
 pub const MAX_HALF_LEN: usize = 512;
 /// Jobs queued inside the loop (beyond the request channel).
 const JOB_QUEUE: usize = 4;
 /// Look-ahead blocks of the path planner (a stroke has at most 4).
-const MARK_BLOCKS: usize = 16;
+const MARK_BLOCKS: usize = galvo_planner::blocks::MARK_BLOCKS;
 /// GRBL's default junction deviation, mm.
 const JUNCTION_DEVIATION_MM: f64 = 0.01;
 
@@ -130,7 +131,7 @@ pub struct GalvoLoop {
     sample_map: SampleMap,
     planning: Galvo<f64>,
     disc: Discrete<3>,
-    mirrors: XyIntegrator<3, INTEGRATOR_CAPACITY>,
+    mirrors: LoopIntegrator,
     /// The running step (when `running`) and the steps planned ahead of
     /// the refill by [`GalvoLoop::prep`].
     steps: StepRing,
@@ -370,6 +371,7 @@ impl Active {
 mod jobs;
 mod mark;
 mod prep;
+mod runs;
 mod samples;
 #[cfg(test)]
 mod tests;

@@ -1,6 +1,7 @@
 use super::*;
 use crate::frames::PointMm;
-use crate::galvo::{GalvoGeometry, MirrorAngles};
+use crate::galvo::{GalvoGeometry, MirrorAngles, round_to_code};
+extern crate std;
 
 /// The polynomial arc tangent against the `f64` one: over a dense
 /// logarithmic sweep of both signs (every reduction range and its edges),
@@ -117,4 +118,47 @@ fn sample_map_agrees_with_the_checked_path_and_refuses_bad_input() {
         SampleMap::new(&bad),
         Err(Error::InvalidConfig { .. })
     ));
+}
+
+/// The block functions' codes are the per-point functions' bit for bit:
+/// the fast rounding against `round_to_code` over every rounding tie
+/// and its neighbours in 0..=4095, the clamps, and both blocks over a
+/// grid (non-finite input holds the codes before it).
+#[test]
+fn blocks_equal_the_per_point_maps() {
+    for k in 0..=8192u32 {
+        let tie = k as f32 * 0.5 - 0.5;
+        for v in [tie, tie.next_up(), tie.next_down()] {
+            assert_eq!(block_code(v), round_to_code(v).code, "{v}");
+        }
+    }
+    for v in [-1e9f32, -3.0, 0.0, 0.49999997, 1e9] {
+        assert_eq!(block_code(v), round_to_code(v).code, "{v}");
+    }
+    let map = SampleMap::new(&odd_galvo()).unwrap();
+    let points: std::vec::Vec<[f32; 2]> = (-40..=40)
+        .flat_map(|i| (-40..=40).map(move |j| [i as f32 * 5.7, j as f32 * 4.9]))
+        .chain([[f32::NAN, 1.0]])
+        .collect();
+    let mut codes = std::vec![[0u16; 2]; points.len()];
+    let last = map.board_block(&points, &mut codes, [7, 9]);
+    let mut hold = [7, 9];
+    for (p, c) in points.iter().zip(&codes) {
+        if let Some(d) = map.board_to_codes(p[0], p[1]) {
+            hold = [d.x.code, d.y.code];
+        }
+        assert_eq!(*c, hold, "{p:?}");
+    }
+    assert_eq!(last, hold);
+    let angles: std::vec::Vec<[f32; 2]> =
+        points.iter().map(|p| [p[0] * 1e-3, p[1] * -1e-3]).collect();
+    let last = map.angles_block(&angles, &mut codes, [1, 2]);
+    let mut hold = [1, 2];
+    for (a, c) in angles.iter().zip(&codes) {
+        if let Some(d) = map.angles_to_codes(a[0], a[1]) {
+            hold = [d.x.code, d.y.code];
+        }
+        assert_eq!(*c, hold, "{a:?}");
+    }
+    assert_eq!(last, hold);
 }

@@ -63,32 +63,18 @@ impl GalvoLoop {
             self.last = hold;
             return out.len().min(1);
         }
-        for slot in out.iter_mut() {
-            if self.advance(on_event, on_demand) == Advance::Unprepared {
+        // Run by run: each phase produces as many samples as it has (or
+        // the half takes) in a tight loop of its own (scan/runs.rs).
+        let mut done = 0;
+        while let Some(rest) = out.get_mut(done..).filter(|rest| !rest.is_empty()) {
+            let n = if self.advance(on_event, on_demand) == Advance::Unprepared {
                 self.unprepared_samples = self.unprepared_samples.saturating_add(1);
-            }
-            let codes = match self.phase() {
-                ScanPhase::Marking => self.mark_sample(on_event),
-                ScanPhase::Braking => self.brake_sample(),
-                _ => {
-                    let [x_rad, y_rad] = self.mirrors.step();
-                    self.sample_map
-                        .angles_to_codes(x_rad, y_rad)
-                        .map(|c| (c.x.code, c.y.code))
-                }
+                let one = rest.len().min(1);
+                self.held_run(&mut rest[..one])
+            } else {
+                self.phase_run(rest, on_event)
             };
-            // Angles and marked positions stay inside the checked range;
-            // on a conversion error hold the last codes rather than output
-            // garbage.
-            if let Some((x_code, y_code)) = codes {
-                self.last.x_code = x_code;
-                self.last.y_code = y_code;
-            }
-            self.last.laser = matches!(self.phase(), ScanPhase::Dwelling | ScanPhase::Marking);
-            *slot = self.last;
-            if let Some(a) = self.active.as_mut() {
-                a.samples_left = a.samples_left.saturating_sub(1);
-            }
+            done += n.max(1);
         }
         out.len()
     }

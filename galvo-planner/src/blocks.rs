@@ -1,0 +1,50 @@
+//! The galvo loop's per-sample blocks as concrete functions of this
+//! crate.
+//!
+//! The firmware builds this crate for speed but the application for
+//! size, and generic code (the integrator's and the path planner's
+//! loops) is compiled in the crate that names the types, with that
+//! crate's size settings (calls outlined, nothing inlined: 2–3× the
+//! instructions on the M4F). These functions fix the types the loop uses,
+//! so their loops are compiled here, once, for speed; `#[inline(never)]`
+//! keeps them out of the size-built callers.
+
+use crate::integrator::XyIntegrator;
+use crate::path::{MIN_CAPACITY, MarkSample, PathPlanner};
+
+/// Jump input samples the loop's integrator holds per axis (10.24 ms at
+/// 100 kHz, longer than any full-range time-optimal jump of the reference
+/// galvo).
+pub const JUMP_CAPACITY: usize = 1024;
+
+/// Look-ahead blocks of the loop's path planner.
+pub const MARK_BLOCKS: usize = MIN_CAPACITY;
+
+/// The rigid two-axis integrator the galvo loop runs.
+pub type LoopIntegrator = XyIntegrator<3, JUMP_CAPACITY>;
+
+/// The path planner the galvo loop marks strokes with.
+pub type LoopPathPlanner = PathPlanner<MARK_BLOCKS>;
+
+/// [`XyIntegrator::fill`] for the loop's integrator: the next
+/// `out.len()` samples' `[θx, θy]`, rad.
+#[inline(never)]
+pub fn fill_jump(mirrors: &mut LoopIntegrator, out: &mut [[f32; 2]]) {
+    mirrors.fill(out);
+}
+
+/// The next marking samples of `planner` (`[x, y]`, mm) until `out` is
+/// full or the stroke ends (or a jump is due); returns how many it wrote.
+/// The samples [`PathPlanner::next_sample`] gives, bit for bit.
+#[inline(never)]
+pub fn fill_marks(planner: &mut LoopPathPlanner, out: &mut [[f32; 2]]) -> usize {
+    let mut n = 0;
+    for slot in out.iter_mut() {
+        let MarkSample::Mark { x_mm, y_mm, .. } = planner.next_sample() else {
+            break;
+        };
+        *slot = [x_mm, y_mm];
+        n += 1;
+    }
+    n
+}
