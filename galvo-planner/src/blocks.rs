@@ -9,8 +9,10 @@
 //! so their loops are compiled here, once, for speed; `#[inline(never)]`
 //! keeps them out of the size-built callers.
 
+use crate::error::Error;
 use crate::integrator::XyIntegrator;
 use crate::path::{MIN_CAPACITY, MarkSample, PathPlanner};
+use crate::plan::XyJump;
 
 /// Jump input samples the loop's integrator holds per axis (10.24 ms at
 /// 100 kHz, longer than any full-range time-optimal jump of the reference
@@ -19,6 +21,10 @@ pub const JUMP_CAPACITY: usize = 1024;
 
 /// Look-ahead blocks of the loop's path planner.
 pub const MARK_BLOCKS: usize = MIN_CAPACITY;
+
+/// Longest jump (samples) whose angles [`jump_angles`] computes ahead of
+/// time (the reference galvo's full-field jump takes about 75).
+pub const PRECOMPUTED_JUMP: usize = 128;
 
 /// The rigid two-axis integrator the galvo loop runs.
 pub type LoopIntegrator = XyIntegrator<3, JUMP_CAPACITY>;
@@ -47,4 +53,39 @@ pub fn fill_marks(planner: &mut LoopPathPlanner, out: &mut [[f32; 2]]) -> usize 
         n += 1;
     }
     n
+}
+
+/// The `[θx, θy]` (rad) of every sample of `jump` stepped with the
+/// loop's `mirrors` model from rest at the jump's start, into `out`:
+/// what `mirrors`, holding there, steps for it, bit for bit
+/// ([`Integrator::plan_angles`](crate::integrator::Integrator::plan_angles);
+/// an axis that lands first holds its target). Returns how many samples
+/// (`jump.samples()`).
+///
+/// Errors: [`Error::QueueFull`] for a jump longer than `out`,
+/// [`Error::ModelMismatch`] for a jump planned on another model.
+#[inline(never)]
+pub fn jump_angles(
+    mirrors: &LoopIntegrator,
+    jump: &XyJump<3>,
+    out: &mut [[f32; 2]; PRECOMPUTED_JUMP],
+) -> Result<usize, Error> {
+    let mut x = [0.0f32; PRECOMPUTED_JUMP];
+    let mut y = [0.0f32; PRECOMPUTED_JUMP];
+    let nx = mirrors.x.plan_angles(&jump.x, &mut x)?;
+    let ny = mirrors.y.plan_angles(&jump.y, &mut y)?;
+    // Before a move, an axis holds its start.
+    let start =
+        |plan: &crate::plan::JumpPlan<3>| plan.start_state().first().copied().unwrap_or(0.0) as f32;
+    let mut held = [start(&jump.x), start(&jump.y)];
+    for (i, slot) in out.iter_mut().take(nx.max(ny)).enumerate() {
+        if let Some(&theta) = x.get(i).filter(|_| i < nx) {
+            held[0] = theta;
+        }
+        if let Some(&theta) = y.get(i).filter(|_| i < ny) {
+            held[1] = theta;
+        }
+        *slot = held;
+    }
+    Ok(nx.max(ny))
 }

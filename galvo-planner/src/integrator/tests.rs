@@ -280,3 +280,66 @@ proptest! {
         }
     }
 }
+
+/// The `f32` inputs the integrator queues are the plan's `f64` inputs
+/// rounded, for bang-bang plans of many lengths (switches anywhere) and
+/// the other laws.
+#[test]
+fn f32_inputs_are_the_rounded_f64_inputs() {
+    let d = rigid(10e-6);
+    let mut plans = Vec::new();
+    for k in 1..40 {
+        let to = f64::from(k) * 0.37 * DEG - 6.0 * DEG;
+        plans.push(plan_jump(&d, 0.0, to, Method::TimeOptimal, 1024).expect("plan"));
+    }
+    plans.push(plan_jump(&d, 0.0, 2.0 * DEG, Method::BISECTION, 1024).expect("plan"));
+    for plan in &plans {
+        let mut wide = Vec::new();
+        plan.for_each_input_rev(|k, u| wide.push((k, u as f32)));
+        let mut narrow = Vec::new();
+        plan.for_each_input_rev_f32(|k, u| narrow.push((k, u)));
+        assert_eq!(wide, narrow);
+    }
+}
+
+/// A jump's angles computed ahead (`plan_angles`, `blocks::jump_angles`)
+/// are what the integrator steps for it, bit for bit; an integrator that
+/// skips the jump's samples lands where stepping lands.
+#[test]
+fn angles_ahead_equal_stepping_and_skipping_lands() {
+    let d = rigid(10e-6);
+    let from = [2.0 * DEG, -3.0 * DEG];
+    for to in [
+        [-6.0 * DEG, 5.0 * DEG],
+        [2.0 * DEG, 4.0 * DEG],
+        [9.0 * DEG, -3.5 * DEG],
+    ] {
+        let jump = plan_xy_jump(
+            &d,
+            &d,
+            from,
+            to,
+            Method::TimeOptimal,
+            JumpSync::Independent,
+            1024,
+        )
+        .expect("plan");
+        let mut stepped: crate::blocks::LoopIntegrator =
+            XyIntegrator::new(&d, &d, from).expect("integrator");
+        let mut ahead = [[0.0f32; 2]; crate::blocks::PRECOMPUTED_JUMP];
+        let n = crate::blocks::jump_angles(&stepped, &jump, &mut ahead).expect("angles");
+        assert_eq!(n, jump.samples());
+        let mut skipped = stepped.clone();
+        stepped.queue_jump(&jump).expect("queue");
+        skipped.queue_jump_skipped(&jump).expect("queue");
+        let steps: Vec<[f32; 2]> = (0..n).map(|_| stepped.step()).collect();
+        assert_eq!(&ahead[..n], &steps[..]);
+        skipped.skip(n / 2);
+        assert!(!skipped.is_idle());
+        skipped.skip(n - n / 2);
+        assert!(skipped.is_idle());
+        assert_eq!(skipped.x.state(), stepped.x.state());
+        assert_eq!(skipped.y.state(), stepped.y.state());
+        assert_eq!(skipped.step(), stepped.step());
+    }
+}

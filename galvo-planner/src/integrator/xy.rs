@@ -37,6 +37,21 @@ impl<const S: usize, const CAP: usize, const Q: usize> XyIntegrator<S, CAP, Q> {
         self.y.queue(&jump.y)
     }
 
+    /// Queues both axes of a jump whose samples someone else computes
+    /// (see [`Integrator::queue_skipped`]), or neither.
+    pub fn queue_jump_skipped(&mut self, jump: &XyJump<S>) -> Result<(), Error> {
+        self.x.check_queue(&jump.x)?;
+        self.y.check_queue(&jump.y)?;
+        self.x.queue_skipped(&jump.x)?;
+        self.y.queue_skipped(&jump.y)
+    }
+
+    /// Passes over `n` samples of both axes ([`Integrator::skip`]).
+    pub fn skip(&mut self, n: usize) {
+        self.x.skip(n);
+        self.y.skip(n);
+    }
+
     /// One sample of both axes: `[θx, θy]`, rad.
     #[inline]
     pub fn step(&mut self) -> [f32; 2] {

@@ -81,7 +81,7 @@ fn an_enforced_budget_over_fails() {
         let err = check(&parse(&out).unwrap()).unwrap_err().to_string();
         assert!(err.contains(id), "{err}");
     }
-    // A budget not yet met is reported, not failed: 1000 ticks for 40
+    // So are the per-sample jump and marking budgets: 1000 ticks for 40
     // jump samples, 1000 instructions (7.7 µs) each, over its 1 µs.
     let jumping = OUT.replace(
         "bench loop.jump.steady 10 40",
@@ -89,14 +89,10 @@ fn an_enforced_budget_over_fails() {
     );
     let r = parse(&jumping).unwrap();
     let m = r.rows.iter().find(|m| m.id == "loop.jump.steady").unwrap();
-    assert!(m.share.unwrap() > 1.0 && !m.over_budget);
-    assert!(
-        m.status
-            .as_deref()
-            .unwrap()
-            .starts_with("reported, not yet met")
-    );
-    assert!(check(&r).is_ok());
+    assert!(m.share.unwrap() > 1.0 && m.over_budget);
+    assert_eq!(m.status.as_deref(), Some("enforced"));
+    let err = check(&r).unwrap_err().to_string();
+    assert!(err.contains("loop.jump.steady"), "{err}");
 }
 
 fn manifest(path: &str) -> toml::Table {

@@ -137,6 +137,10 @@ pub struct GalvoLoop {
     steps: StepRing,
     /// Whether the oldest of `steps` is the running one.
     running: bool,
+    /// The running jump's codes (prepared), and the next one to output
+    /// (`None`: the jump is stepped on the integrator).
+    jump_codes: prep::JumpCodes,
+    jump_cursor: Option<usize>,
     /// Where the running step leaves the mirrors, rad.
     active_end_rad: [f64; 2],
     /// Samples held dark for want of a prepared step.
@@ -189,6 +193,8 @@ impl GalvoLoop {
             mirrors,
             steps: StepRing::new(),
             running: false,
+            jump_codes: prep::JumpCodes::EMPTY,
+            jump_cursor: None,
             active_end_rad: angles_rad,
             unprepared_samples: 0,
             motion: Motion::default(),

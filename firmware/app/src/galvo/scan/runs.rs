@@ -4,6 +4,10 @@
 //! DAC mapping while marking; a copy while holding) and the state
 //! machine runs once per phase change, not once per sample.
 
+use galvo_planner::blocks::LoopIntegrator;
+use galvo_planner::{Error as PlannerError, XyJump};
+
+use super::prep::JumpCodes;
 use super::{GalvoLoop, ScanPhase};
 use crate::galvo::{DacSample, GalvoEvent};
 
@@ -84,10 +88,32 @@ impl GalvoLoop {
         n.min(out.len())
     }
 
-    /// Jumping, laser off: the integrator's angles block by block, each
-    /// mapped to DAC codes, until the jump lands or `out` is full.
+    /// Jumping, laser off: the prepared codes copied, or the integrator's
+    /// angles block by block, each mapped to DAC codes, until the jump
+    /// lands or `out` is full.
     fn jump_run(&mut self, out: &mut [DacSample]) -> usize {
         let n = out.len().min(self.mirrors.remaining_samples()).max(1);
+        if let Some(cursor) = self.jump_cursor {
+            let codes = self.jump_codes.codes.get(cursor..).unwrap_or_default();
+            let n = n.min(codes.len()).min(out.len());
+            let (codes, out) = (codes.get(..n).unwrap_or_default(), &mut out[..n]);
+            write_codes(out, codes, false);
+            if let Some(&[x_code, y_code]) = codes.last() {
+                self.last = DacSample {
+                    x_code,
+                    y_code,
+                    laser: false,
+                };
+            }
+            self.mirrors.skip(n);
+            self.jump_cursor = Some(cursor + n);
+            if n > 0 {
+                return n;
+            }
+            // Out of codes before the integrator landed (cannot happen:
+            // both count the plan's samples): step it from here.
+            self.jump_cursor = None;
+        }
         let mut angles = [[0.0f32; 2]; BLOCK];
         let mut codes = [[0u16; 2]; BLOCK];
         let mut last = [self.last.x_code, self.last.y_code];
@@ -118,4 +144,29 @@ pub(super) fn write_codes(out: &mut [DacSample], codes: &[[u16; 2]], laser: bool
             laser,
         };
     }
+}
+
+/// Queues `jump` on the loop's `mirrors`; with its `codes` computed by
+/// the prep stage the refill copies them (into `running`, from
+/// `cursor`) and the integrator only counts the samples, else the
+/// refill steps the integrator.
+pub(super) fn queue_jump(
+    mirrors: &mut LoopIntegrator,
+    running: &mut JumpCodes,
+    cursor: &mut Option<usize>,
+    jump: &XyJump<3>,
+    codes: Option<&JumpCodes>,
+) -> Result<(), PlannerError> {
+    match codes {
+        Some(codes) if codes.len == jump.samples() => {
+            mirrors.queue_jump_skipped(jump)?;
+            running.clone_from(codes);
+            *cursor = Some(0);
+        }
+        _ => {
+            mirrors.queue_jump(jump)?;
+            *cursor = None;
+        }
+    }
+    Ok(())
 }

@@ -3,6 +3,7 @@
 
 use galvo_planner::Error as PlannerError;
 
+use super::runs::queue_jump;
 use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase, samples_for};
 use crate::domain::Unit;
 use crate::galvo::{DacSample, GalvoEvent};
@@ -243,7 +244,13 @@ impl GalvoLoop {
             // `Err(None)`: planned from somewhere the mirrors are not (stale).
             let queued = match &step.jump {
                 Err(error) => Err(Some(*error)),
-                Ok(jump) => match self.mirrors.queue_jump(jump) {
+                Ok(jump) => match queue_jump(
+                    &mut self.mirrors,
+                    &mut self.jump_codes,
+                    &mut self.jump_cursor,
+                    jump,
+                    step.jump_codes.as_ref(),
+                ) {
                     Ok(()) => Ok(()),
                     Err(PlannerError::DiscontinuousMove) => Err(None),
                     Err(_) => Err(Some(GalvoError::Planner)),
