@@ -23,8 +23,9 @@ pub const JUMP_CAPACITY: usize = 1024;
 pub const MARK_BLOCKS: usize = MIN_CAPACITY;
 
 /// Longest jump (samples) whose angles [`jump_angles`] computes ahead of
-/// time (the reference galvo's full-field jump takes about 75).
-pub const PRECOMPUTED_JUMP: usize = 128;
+/// time (the reference galvo's 160 mm diagonal jump takes 49 samples, its
+/// full field about 75).
+pub const PRECOMPUTED_JUMP: usize = 96;
 
 /// The rigid two-axis integrator the galvo loop runs.
 pub type LoopIntegrator = XyIntegrator<3, JUMP_CAPACITY>;
@@ -55,37 +56,35 @@ pub fn fill_marks(planner: &mut LoopPathPlanner, out: &mut [[f32; 2]]) -> usize 
     n
 }
 
-/// The `[θx, θy]` (rad) of every sample of `jump` stepped with the
-/// loop's `mirrors` model from rest at the jump's start, into `out`:
-/// what `mirrors`, holding there, steps for it, bit for bit
-/// ([`Integrator::plan_angles`](crate::integrator::Integrator::plan_angles);
-/// an axis that lands first holds its target). Returns how many samples
-/// (`jump.samples()`).
+/// The angles (rad) of every sample of `jump` stepped with the loop's
+/// `mirrors` model from rest at the jump's start, `θx` into `x` and `θy`
+/// into `y`: what `mirrors`, holding there, steps for it, bit for bit
+/// ([`Integrator::plan_angles`](crate::integrator::Integrator::plan_angles)).
+/// An axis that lands first holds its target for the other's samples.
+/// Returns how many samples (`jump.samples()`).
 ///
-/// Errors: [`Error::QueueFull`] for a jump longer than `out`,
+/// Errors: [`Error::QueueFull`] for a jump longer than the buffers,
 /// [`Error::ModelMismatch`] for a jump planned on another model.
 #[inline(never)]
 pub fn jump_angles(
     mirrors: &LoopIntegrator,
     jump: &XyJump<3>,
-    out: &mut [[f32; 2]; PRECOMPUTED_JUMP],
+    x: &mut [f32; PRECOMPUTED_JUMP],
+    y: &mut [f32; PRECOMPUTED_JUMP],
 ) -> Result<usize, Error> {
-    let mut x = [0.0f32; PRECOMPUTED_JUMP];
-    let mut y = [0.0f32; PRECOMPUTED_JUMP];
-    let nx = mirrors.x.plan_angles(&jump.x, &mut x)?;
-    let ny = mirrors.y.plan_angles(&jump.y, &mut y)?;
-    // Before a move, an axis holds its start.
-    let start =
-        |plan: &crate::plan::JumpPlan<3>| plan.start_state().first().copied().unwrap_or(0.0) as f32;
-    let mut held = [start(&jump.x), start(&jump.y)];
-    for (i, slot) in out.iter_mut().take(nx.max(ny)).enumerate() {
-        if let Some(&theta) = x.get(i).filter(|_| i < nx) {
-            held[0] = theta;
-        }
-        if let Some(&theta) = y.get(i).filter(|_| i < ny) {
-            held[1] = theta;
-        }
-        *slot = held;
+    let nx = mirrors.x.plan_angles(&jump.x, x)?;
+    let ny = mirrors.y.plan_angles(&jump.y, y)?;
+    let n = nx.max(ny);
+    for (axis, plan, len) in [(x, &jump.x, nx), (y, &jump.y, ny)] {
+        // Before a move an axis holds its start, after it its target.
+        let held = match len.checked_sub(1).and_then(|last| axis.get(last)) {
+            Some(&theta) => theta,
+            None => plan.start_state().first().copied().unwrap_or(0.0) as f32,
+        };
+        axis.iter_mut()
+            .take(n)
+            .skip(len)
+            .for_each(|theta| *theta = held);
     }
-    Ok(nx.max(ny))
+    Ok(n)
 }

@@ -326,9 +326,11 @@ fn angles_ahead_equal_stepping_and_skipping_lands() {
         .expect("plan");
         let mut stepped: crate::blocks::LoopIntegrator =
             XyIntegrator::new(&d, &d, from).expect("integrator");
-        let mut ahead = [[0.0f32; 2]; crate::blocks::PRECOMPUTED_JUMP];
-        let n = crate::blocks::jump_angles(&stepped, &jump, &mut ahead).expect("angles");
+        let mut x = [0.0f32; crate::blocks::PRECOMPUTED_JUMP];
+        let mut y = [0.0f32; crate::blocks::PRECOMPUTED_JUMP];
+        let n = crate::blocks::jump_angles(&stepped, &jump, &mut x, &mut y).expect("angles");
         assert_eq!(n, jump.samples());
+        let ahead: Vec<[f32; 2]> = x.iter().zip(&y).map(|(x, y)| [*x, *y]).collect();
         let mut skipped = stepped.clone();
         stepped.queue_jump(&jump).expect("queue");
         skipped.queue_jump_skipped(&jump).expect("queue");

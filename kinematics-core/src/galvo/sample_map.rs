@@ -174,6 +174,28 @@ impl SampleMap {
         last
     }
 
+    /// The codes `[x, y]` of mirror angles given per axis, `θx` from `x`
+    /// and `θy` from `y` (rad), as [`Self::angles_block`] does for pairs.
+    #[inline(never)]
+    pub fn axes_block(
+        &self,
+        x: &[f32],
+        y: &[f32],
+        codes: &mut [[u16; 2]],
+        hold: [u16; 2],
+    ) -> [u16; 2] {
+        let mut last = hold;
+        for ((out, x_rad), y_rad) in codes.iter_mut().zip(x).zip(y) {
+            let x = self.dac_x.offset_code + self.dac_x.codes_per_rad * x_rad;
+            let y = self.dac_y.offset_code + self.dac_y.codes_per_rad * y_rad;
+            if x.is_finite() && y.is_finite() {
+                last = [block_code(x), block_code(y)];
+            }
+            *out = last;
+        }
+        last
+    }
+
     /// The codes `[x, y]` of a block of board points `[x, y]` (mm), as
     /// [`Self::angles_block`] does for angles.
     #[inline(never)]

@@ -117,6 +117,24 @@ pub const ROWS: &[Row] = &[
         budget: half_refill_budget(REFILL),
     },
     Row {
+        id: "loop.tuning.steady",
+        what: "loop, marking the 80 mm tuning figure (square, circle, cross)",
+        unit: "sample",
+        budget: Some((0.20 * SAMPLE_US, "20 % of the 10 µs sample", LOOP)),
+    },
+    Row {
+        id: "loop.tuning.refill",
+        what: "refill, tuning figure, steps prepared (worst half)",
+        unit: "half",
+        budget: half_refill_budget(REFILL),
+    },
+    Row {
+        id: "loop.tuning.prep",
+        what: "prep: a tuning-figure step (jump plan and codes + stroke setup)",
+        unit: "step",
+        budget: prep_budget(PREP),
+    },
+    Row {
         id: "loop.jump.prep",
         what: "prep: plan a 160 mm two-axis jump step (IK + time-optimal plan)",
         unit: "step",
@@ -132,6 +150,12 @@ pub const ROWS: &[Row] = &[
         id: "loop.arc_r40.prep",
         what: "prep: a circle stroke step (jump + stroke setup in the f64 planner)",
         unit: "step",
+        budget: prep_budget(PREP),
+    },
+    Row {
+        id: "loop.reconfigure",
+        what: "new parameters, mirror model kept: the loop rebuilt at a half boundary",
+        unit: "call",
         budget: prep_budget(PREP),
     },
     Row {

@@ -20,6 +20,10 @@ use crate::log;
 pub const INTEGRATOR_CAPACITY: usize = galvo_planner::blocks::JUMP_CAPACITY;
 /// Longest half buffer the loop fills, samples.
 pub const MAX_HALF_LEN: usize = 512;
+/// Steps the prep stage prepares per half buffer in [`GalvoLoop::run`]:
+/// one stroke step and the refill fit the 1.28 ms window (bench-m4's
+/// `loop.*.prep` and `loop.*.refill`); more could overrun it.
+const PREP_PER_HALF: usize = 1;
 /// Jobs queued inside the loop (beyond the request channel).
 const JOB_QUEUE: usize = 4;
 /// Look-ahead blocks of the path planner (a stroke has at most 4).
@@ -143,6 +147,8 @@ pub struct GalvoLoop {
     jump_cursor: Option<usize>,
     /// Where the running step leaves the mirrors, rad.
     active_end_rad: [f64; 2],
+    /// Work since the last half buffer (the cost model's input).
+    work: super::LoopWork,
     /// Samples held dark for want of a prepared step.
     unprepared_samples: u32,
     motion: Motion,
@@ -168,11 +174,7 @@ impl GalvoLoop {
     /// Errors: [`GalvoError::Planner`] for an invalid mirror model or
     /// sample period, [`GalvoError::Kinematics`] for invalid geometry.
     pub fn new(config: GalvoConfig) -> Result<Self, GalvoError> {
-        Self::holding_at(config, [0.0, 0.0])
-    }
-
-    /// A loop holding the mirrors at `angles_rad`, laser off.
-    fn holding_at(config: GalvoConfig, angles_rad: [f64; 2]) -> Result<Self, GalvoError> {
+        let angles_rad = [0.0, 0.0];
         let disc = config
             .mirrors
             .model()
@@ -197,6 +199,7 @@ impl GalvoLoop {
             jump_cursor: None,
             active_end_rad: angles_rad,
             unprepared_samples: 0,
+            work: super::LoopWork::default(),
             motion: Motion::default(),
             queue: heapless::Deque::new(),
             active: None,
@@ -257,6 +260,7 @@ impl GalvoLoop {
         let mut drawing: heapless::Deque<(GalvoEvent, u8), DONE_QUEUE> = heapless::Deque::new();
         dac.set_sample_period(period_s);
         loop {
+            self.work = super::LoopWork::default();
             let now = gate.generation();
             if now != generation {
                 self.stop();
@@ -285,7 +289,7 @@ impl GalvoLoop {
                 continue;
             }
             // Plan ahead, outside the refill: the refill only steps plans.
-            self.prep();
+            self.prep_up_to(PREP_PER_HALF);
             let out = &mut half[..n];
             let computed = self.refill(out, |event| hold_done(&mut drawing, link, event));
             link.publish(self.phase(), self.queue.len());
@@ -302,6 +306,7 @@ impl GalvoLoop {
                     samples: out,
                     generation,
                     computed,
+                    work: self.work,
                 })
                 .await;
             release_drawn(&mut drawing, link);

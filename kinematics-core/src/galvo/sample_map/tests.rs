@@ -161,4 +161,9 @@ fn blocks_equal_the_per_point_maps() {
         assert_eq!(*c, hold, "{a:?}");
     }
     assert_eq!(last, hold);
+    let (x, y): (std::vec::Vec<f32>, std::vec::Vec<f32>) =
+        angles.iter().map(|a| (a[0], a[1])).unzip();
+    let mut by_axes = std::vec![[0u16; 2]; points.len()];
+    assert_eq!(map.axes_block(&x, &y, &mut by_axes, [1, 2]), last);
+    assert_eq!(by_axes, codes);
 }

@@ -77,10 +77,12 @@ impl GalvoLoop {
         if n > 0 {
             self.motion.step_mm = [position[0] - prev[0], position[1] - prev[1]];
         }
-        match out.get_mut(n..) {
+        let n = match out.get_mut(n..) {
             Some(rest) if !rest.is_empty() => n + self.end_stroke(rest, on_event),
             _ => n,
-        }
+        };
+        self.work.marked += n as u32;
+        n
     }
 
     /// The stroke is done (planner idle): the mirrors hold at its end,

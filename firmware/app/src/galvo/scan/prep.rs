@@ -86,13 +86,25 @@ impl GalvoLoop {
     /// half buffers, never inside the refill. Returns how many steps it
     /// prepared.
     pub fn prep(&mut self) -> usize {
+        self.prep_up_to(PREP_DEPTH)
+    }
+
+    /// [`Self::prep`], preparing at most `max_steps` steps (the run loop
+    /// prepares one per half buffer, to stay within its window).
+    pub fn prep_up_to(&mut self, max_steps: usize) -> usize {
         let mut prepared = 0;
-        while self.steps.len() - self.started() < PREP_DEPTH {
+        while prepared < max_steps && self.steps.len() - self.started() < PREP_DEPTH {
             let Some(step) = self.next_unprepared_step() else {
                 break;
             };
+            let stroke = step.marker.is_some();
             if !self.steps.push_back(step) {
                 break;
+            }
+            if stroke {
+                self.work.strokes_prepared += 1;
+            } else {
+                self.work.points_prepared += 1;
             }
             prepared += 1;
         }
@@ -179,13 +191,20 @@ impl GalvoLoop {
         });
         let end_rad = match (&jump, &marker, end_mm) {
             (Err(_), _, _) => start_rad,
-            // Where the path sampler lands: the stroke's end in f32.
-            (Ok(_), Some(Ok(_)), Some([x, y])) => self
-                .angles_for(PointMm {
+            // Where the path sampler lands: the stroke's end in f32 (a
+            // closed stroke whose start is exact in f32 ends at its start:
+            // the same IK, not computed twice).
+            (Ok((_, target_rad)), Some(Ok(_)), Some([x, y])) => {
+                let end = PointMm {
                     x_mm: f64::from(x as f32),
                     y_mm: f64::from(y as f32),
-                })
-                .unwrap_or(start_rad),
+                };
+                if Ok(end) == target_mm {
+                    *target_rad
+                } else {
+                    self.angles_for(end).unwrap_or(start_rad)
+                }
+            }
             (Ok((_, target_rad)), _, _) => *target_rad,
         };
         let jump_codes = match &jump {
@@ -212,15 +231,15 @@ impl GalvoLoop {
             // Already there: nothing to output.
             return None;
         }
-        let mut angles = [[0.0f32; 2]; PRECOMPUTED_JUMP];
-        let len = jump_angles(&self.mirrors, jump, &mut angles).ok()?;
+        let (mut x, mut y) = ([0.0f32; PRECOMPUTED_JUMP], [0.0f32; PRECOMPUTED_JUMP]);
+        let len = jump_angles(&self.mirrors, jump, &mut x, &mut y).ok()?;
         let mut codes = JumpCodes {
             len,
             codes: [[0; 2]; PRECOMPUTED_JUMP],
         };
         let hold = [self.last.x_code, self.last.y_code];
         self.sample_map
-            .angles_block(angles.get(..len)?, &mut codes.codes, hold);
+            .axes_block(x.get(..len)?, y.get(..len)?, &mut codes.codes, hold);
         Some(codes)
     }
 

@@ -26,6 +26,7 @@ impl GalvoLoop {
         match self.phase() {
             ScanPhase::Marking => self.mark_run(out, on_event),
             ScanPhase::Braking => {
+                self.work.marked += 1;
                 let codes = self.brake_sample();
                 self.emit(out, codes, false)
             }
@@ -83,6 +84,7 @@ impl GalvoLoop {
             .angles_to_codes(x_rad, y_rad)
             .map(|c| (c.x.code, c.y.code));
         self.emit(out, codes, phase == ScanPhase::Dwelling);
+        self.work.held += n as u32;
         let sample = self.last;
         out.iter_mut().take(n).for_each(|s| *s = sample);
         n.min(out.len())
@@ -107,6 +109,7 @@ impl GalvoLoop {
             }
             self.mirrors.skip(n);
             self.jump_cursor = Some(cursor + n);
+            self.work.jump_copied += n as u32;
             if n > 0 {
                 return n;
             }
@@ -117,6 +120,7 @@ impl GalvoLoop {
         let mut angles = [[0.0f32; 2]; BLOCK];
         let mut codes = [[0u16; 2]; BLOCK];
         let mut last = [self.last.x_code, self.last.y_code];
+        self.work.jump_stepped += n as u32;
         for chunk in out.get_mut(..n).unwrap_or_default().chunks_mut(BLOCK) {
             let angles = angles.get_mut(..chunk.len()).unwrap_or_default();
             galvo_planner::blocks::fill_jump(&mut self.mirrors, angles);

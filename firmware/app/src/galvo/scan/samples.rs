@@ -59,7 +59,9 @@ impl GalvoLoop {
         on_event: &mut impl FnMut(GalvoEvent),
         on_demand: bool,
     ) -> usize {
+        self.work.refills += 1;
         if let Some(hold) = self.hold_sample() {
+            self.work.held += out.len() as u32;
             out.fill(hold);
             self.last = hold;
             return out.len().min(1);
@@ -116,6 +118,12 @@ impl GalvoLoop {
         on_event: &mut impl FnMut(GalvoEvent),
         on_demand: bool,
     ) -> Option<Advance> {
+        if self.pending_config.is_some() && !on_demand {
+            // New parameters wait for the next half boundary
+            // (`GalvoLoop::run` applies them there): no rebuild inside
+            // the refill. The mirrors hold, laser off, until then.
+            return Some(Advance::Ready);
+        }
         if let Some(event) = self.apply_pending_config(false) {
             on_event(event);
         }
@@ -268,6 +276,7 @@ impl GalvoLoop {
                     });
                     self.running = true;
                     self.active_end_rad = end_rad;
+                    self.work.steps_started += 1;
                     return StepStart::Started;
                 }
                 Err(None) => self.steps.clear(),
