@@ -8,6 +8,8 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench loop.arc_r40.refill 100 1\nbench loop.jump.refill 1000 1\n\
     bench loop.jump.prep 1500 1\nbench loop.line.prep 2000 1\n\
     bench loop.arc_r40.prep 2000 1\n\
+    bench loop.tuning.steady 100 128\nbench loop.tuning.refill 100 1\n\
+    bench loop.tuning.prep 2000 1\nbench loop.reconfigure 150 1\n\
     bench plan.xy.optimal.1lsb 250 1\nbench plan.xy.optimal.160mm 300 1\n\
     bench plan.seed.1deg 100 1\ndone 0\n";
 
