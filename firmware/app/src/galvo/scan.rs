@@ -309,6 +309,7 @@ impl GalvoLoop {
                     work: self.work,
                 })
                 .await;
+            link.publish_refill(dac.worst_refill());
             release_drawn(&mut drawing, link);
             if let Err(underrun) = written {
                 generation = gate.close();
