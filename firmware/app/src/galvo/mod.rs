@@ -19,8 +19,10 @@
 //! the simulator feeds a simulated DAC. Not wired yet: the target's
 //! timer-triggered DAC DMA (see the README's status).
 
+mod cost;
 mod scan;
 
+pub use cost::{CostModel, LoopWork, M4_COST};
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, ScanPhase};
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
@@ -63,6 +65,9 @@ pub struct Half<'a> {
     /// Samples the loop actually computed; the rest repeat a hold sample
     /// (the simulated DAC charges loop time per computed sample).
     pub computed: usize,
+    /// What computing the half (and preparing steps before it) took, for
+    /// the simulated DAC's M4 cost model ([`M4_COST`]).
+    pub work: LoopWork,
 }
 
 /// A hardware-timed DAC fed from a double buffer: a timer-triggered DMA
