@@ -14,12 +14,15 @@
 mod commands;
 mod faults;
 mod galvo;
+mod gcode;
+mod gcode_motion;
+mod gcode_settings;
 mod laser;
 mod machine;
 mod report;
 mod run;
 
-use embassy_futures::select::{Either, Either4, select, select4};
+use embassy_futures::select::{Either, Either3, Either4, select, select3, select4};
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::galvo::config_from;
@@ -163,7 +166,11 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             command,
             io.servo.outcomes.receive(),
             timer,
-            select(Timer::at(housekeeping), io.galvo.events.receive()),
+            select3(
+                Timer::at(housekeeping),
+                io.galvo.events.receive(),
+                io.link.realtime.receive(),
+            ),
         )
         .await;
         match event {
@@ -177,8 +184,9 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             Either4::First(Either::Second(())) => Event::StopRequest,
             Either4::Second(outcome) => Event::Servo(outcome),
             Either4::Third(()) => Event::DwellEnded,
-            Either4::Fourth(Either::First(())) => Event::Tick,
-            Either4::Fourth(Either::Second(event)) => Event::Galvo(event),
+            Either4::Fourth(Either3::First(())) => Event::Tick,
+            Either4::Fourth(Either3::Second(event)) => Event::Galvo(event),
+            Either4::Fourth(Either3::Third(command)) => Event::Realtime(command),
         }
     }
 
@@ -292,6 +300,9 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
                     Line::Notice(text) => outbound.push(LineKind::Notice, text),
                     Line::Ok => outbound.push(LineKind::Ok, ""),
                     Line::Error(text) => outbound.push(LineKind::Error, text),
+                    Line::GrblError(error) => {
+                        outbound.push_fmt(LineKind::GrblError, format_args!("{}", error.code()))
+                    }
                 };
             }
             Action::Save => self.follow_up = FollowUp::Save,
