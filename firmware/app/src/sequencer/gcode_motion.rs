@@ -27,6 +27,14 @@ use crate::settings::LaserMode;
 /// Blocks the motion queue holds (`$I` advertises it).
 pub const PLANNER_BLOCKS: usize = 16;
 
+/// Arrival deadband at the end of a G-code block on the gimbal: the
+/// servo resolution, 0.1°.
+const CORNER_DEADBAND_TENTHS: u16 = 1;
+/// After arriving at the end of a block the gimbal settles this long, ms,
+/// before the next block starts (the servos close in on their target
+/// beyond the deadband), so corners are not cut.
+const CORNER_SETTLE_MS: u64 = 40;
+
 /// Most steps one block is split into.
 const MAX_STEPS: u32 = 100_000;
 
@@ -165,15 +173,22 @@ fn cm(p: PointMm) -> PointCm {
 }
 
 impl Core {
-    /// Whether every point of `block` is within the reach of the
-    /// actuator(s) (end points, and arcs along their sweep).
+    /// Whether every point of `block` is within grbl's soft limits: on
+    /// the board (`$130` × `$131` about its centre) and within the reach
+    /// of the actuator(s) (end points, and arcs along their sweep).
     pub(super) fn block_reachable(&self, block: &Block) -> bool {
         let Some(end) = block_end(block) else {
             return true;
         };
+        let s = &self.settings;
+        let half_width_mm = s.grid_pitch_cm * f64::from(s.grid_cols) * 5.0;
+        let half_height_mm = s.grid_pitch_cm * f64::from(s.grid_rows) * 5.0;
         let reachable = |p: PointMm| {
+            let on_board = libm::fabs(p.x_mm) <= half_width_mm + 1e-9
+                && libm::fabs(p.y_mm) <= half_height_mm + 1e-9;
             let p = cm(p);
-            (!self.actuator.uses_gimbal() || self.aimer.aim(p).is_ok())
+            on_board
+                && (!self.actuator.uses_gimbal() || self.aimer.aim(p).is_ok())
                 && (!self.actuator.uses_galvo() || self.aimer.galvo_in_range(p))
         };
         match block {
@@ -292,7 +307,11 @@ impl Core {
         let mut servo_seq = None;
         let mut galvo_seq = None;
         if self.actuator.uses_gimbal() {
-            servo_seq = self.gcode_servo_move(from, to, feed, out);
+            // The last step of a block ends at a corner: it must arrive
+            // within the servo resolution, or the next block's first step
+            // would cut the corner by up to the arrival deadband.
+            let corner = current.index >= current.count;
+            servo_seq = self.gcode_servo_move(from, to, feed, corner, out);
             if servo_seq.is_none() {
                 return;
             }
@@ -339,6 +358,7 @@ impl Core {
         from: PointMm,
         to: PointMm,
         feed: Option<f64>,
+        corner: bool,
         out: &mut dyn ActionSink,
     ) -> Option<u32> {
         let point = cm(to);
@@ -360,7 +380,11 @@ impl Core {
             pitch_tenths: aim.pitch_wire,
             interval_ms,
             ids: (self.settings.yaw.id, self.settings.pitch.id),
-            deadband_tenths: (self.settings.deadband_deg * 10.0) as u16,
+            deadband_tenths: if corner {
+                CORNER_DEADBAND_TENTHS
+            } else {
+                (self.settings.deadband_deg * 10.0) as u16
+            },
             ranges_tenths: super::faults::servo_ranges_tenths(&self.settings),
         }));
         out.act(Action::Note(LaserEvent::GimbalMoveSent));
@@ -378,6 +402,13 @@ impl Core {
             return false;
         }
         c.servo_seq = None;
+        if c.index >= c.count && c.count > 0 {
+            c.until = Some(
+                self.inputs
+                    .now
+                    .saturating_add(Duration::from_millis(CORNER_SETTLE_MS)),
+            );
+        }
         self.gcode.motion.arrived = true;
         out.act(Action::Note(LaserEvent::GimbalArrived));
         self.gcode_step_done(out);
