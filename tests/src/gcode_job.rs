@@ -270,6 +270,8 @@ pub struct PathFit {
     pub worst_missed_mm: f64,
     /// Lit positions checked.
     pub lit: usize,
+    /// The toolpath piece with the worst gap (index into the pieces).
+    pub worst_piece: usize,
 }
 
 /// Compares lit spot positions with `pieces`.
@@ -302,14 +304,24 @@ pub fn fit(lit: &[[f64; 2]], pieces: &[Piece]) -> PathFit {
         }
         best
     };
-    let worst_missed_mm = pieces
+    let (worst_piece, worst_missed_mm) = pieces
         .iter()
-        .flat_map(|piece| piece.points(0.5))
-        .map(nearest)
-        .fold(0.0, f64::max);
+        .map(|piece| {
+            piece
+                .points(0.5)
+                .into_iter()
+                .map(nearest)
+                .fold(0.0, f64::max)
+        })
+        .enumerate()
+        .fold(
+            (0, 0.0),
+            |best, (k, d)| if d > best.1 { (k, d) } else { best },
+        );
     PathFit {
         worst_lit_mm,
         worst_missed_mm,
         lit: lit.len(),
+        worst_piece,
     }
 }

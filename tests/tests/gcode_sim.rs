@@ -64,6 +64,7 @@ fn a_laser_job_draws_its_toolpath_on_the_gimbal() {
         worst_lit_mm,
         worst_missed_mm,
         lit,
+        ..
     } = fit(&gimbal_lit_mm(&report), &job.pieces);
     eprintln!(
         "gimbal: {lit} lit samples, worst off path {worst_lit_mm:.3} mm, worst gap {worst_missed_mm:.3} mm, {:.1} s",
@@ -89,6 +90,7 @@ fn a_laser_job_draws_its_toolpath_on_the_galvo() {
         worst_lit_mm,
         worst_missed_mm,
         lit,
+        ..
     } = fit(&galvo_lit_mm(&report), &job.pieces);
     eprintln!(
         "galvo: {lit} lit samples, worst off path {worst_lit_mm:.3} mm, worst gap {worst_missed_mm:.3} mm, {:.1} s",
