@@ -27,6 +27,21 @@ def on_event(event, *data):
 
 
 g = GrblStreamer(on_event)
+# grbl-streamer 2.0.2 streams from two threads (job_run() in the caller's,
+# every `ok` in its reader's) without a lock: when an `ok` arrives while
+# the caller's thread still fills the RX buffer, both advance the line
+# pointer and a line is skipped (seen: 103 of 104 lines written). Its
+# character counting is kept; only its streaming step is serialised.
+stream_lock = threading.Lock()
+original_stream = g._stream
+
+
+def locked_stream():
+    with stream_lock:
+        original_stream()
+
+
+g._stream = locked_stream
 g.cnect(port, 115200)
 if not booted.wait(10):
     print(json.dumps({**summary, "completed": False, "why": "no banner"}))

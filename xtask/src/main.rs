@@ -8,6 +8,7 @@ mod json_out;
 mod kin;
 mod plan;
 mod sim;
+mod size_gcode;
 mod toolchain;
 
 use std::process::ExitCode;

@@ -41,6 +41,19 @@ use crate::status::StatusBoard;
 /// as the sequencer's store).
 pub use crate::settings::store::SettingsStore;
 
+/// RAM the G-code path adds, bytes (host layout): the sequencer's grbl
+/// session with its motion queue, the realtime command queue and the
+/// console's RX buffer.
+pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::Gcode>()
+    + core::mem::size_of::<
+        embassy_sync::channel::Channel<
+            embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex,
+            crate::grbl::realtime::Realtime,
+            { crate::command::REALTIME_QUEUE_DEPTH },
+        >,
+    >()
+    + crate::usb::RX_BUFFER_BYTES;
+
 /// Period of the housekeeping tick (liveness for the watchdog).
 const HOUSEKEEPING: Duration = Duration::from_millis(250);
 
