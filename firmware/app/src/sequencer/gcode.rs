@@ -399,3 +399,6 @@ impl core::fmt::Display for SettingLine<'_> {
         report::write_setting(f, self.0, self.1)
     }
 }
+
+#[cfg(test)]
+mod tests;
