@@ -234,3 +234,35 @@ fn soft_reset_during_motion_raises_alarm_3_and_keeps_settings() {
     let last_status = lines.iter().rev().find(|l| l.starts_with('<')).unwrap();
     assert!(last_status.starts_with("<Idle|MPos:"), "{last_status}");
 }
+
+#[test]
+fn feed_hold_on_the_galvo_is_dark_and_the_job_still_draws_its_toolpath() {
+    let job = laser_job(25.0);
+    // Hold after 40 lines (16 blocks queued ahead), resume 500 ms later.
+    let mut lines = job.lines.clone();
+    lines.insert(40, "!".into());
+    lines.insert(41, "wait 500".into());
+    lines.insert(42, "?".into());
+    lines.insert(43, "~".into());
+    let report = run_with(&script("target galvo\n", &lines), SimOptions::default());
+    assert_all_ok(&report, "galvo hold");
+    let hold_us = system_tests::sent_at(&report, "!");
+    let resume_us = system_tests::sent_at(&report, "~");
+    let lit_in_hold: Vec<u64> = system_tests::lit_sample_times_ns(&report)
+        .into_iter()
+        .filter(|&t| t > (hold_us + 1_000) * 1_000 && t < resume_us * 1_000)
+        .collect();
+    assert!(
+        lit_in_hold.is_empty(),
+        "{} lit samples in the hold",
+        lit_in_hold.len()
+    );
+    let status = terminal_lines(&report)
+        .into_iter()
+        .find(|l| l.starts_with('<'))
+        .expect("a status report");
+    assert!(status.starts_with("<Hold:0|"), "{status}");
+    let fit = fit(&galvo_lit_mm(&report), &job.pieces);
+    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+}

@@ -14,7 +14,6 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
-use crate::cli::line::MAX_LINE_LEN;
 use crate::domain::{Actuator, AimModel, Pattern, PointCm};
 use crate::grbl::realtime::Realtime;
 use crate::outbound::{LineKind, Outbound};
@@ -101,6 +100,9 @@ pub enum Command {
     /// motion is queued, `error:N` when refused).
     Grbl(GrblLine),
 }
+
+/// Longest accepted command line, bytes (excluding the terminator).
+pub const MAX_LINE_LEN: usize = 128;
 
 /// A G-code or `$` line as the console assembled it: printable ASCII, at
 /// most [`MAX_LINE_LEN`] bytes (a plain array, so [`Command`] stays `Copy`).
@@ -246,7 +248,18 @@ pub struct CommandLink {
     /// console's byte stream, in arrival order; acted on at once, also
     /// while a line waits for room in the motion queue. When full (a host
     /// flooding `?`), further ones are dropped.
-    pub realtime: Channel<CriticalSectionRawMutex, Realtime, REALTIME_QUEUE_DEPTH>,
+    pub realtime: Channel<CriticalSectionRawMutex, RealtimeRequest, REALTIME_QUEUE_DEPTH>,
+}
+
+/// A realtime command as the console took it out of the byte stream.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RealtimeRequest {
+    /// The command.
+    pub command: Realtime,
+    /// Free bytes in the console's RX buffer when it arrived (grbl's
+    /// `Bf:` second field).
+    pub rx_free_bytes: u16,
 }
 
 /// Depth of the realtime command queue.

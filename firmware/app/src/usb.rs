@@ -28,11 +28,11 @@ use heapless::Deque;
 
 use crate::cli::line::LineAssembler;
 use crate::cli::parse::parse_line;
-use crate::command::{Command, CommandLink, GrblLine};
-use crate::grbl::GrblError;
+use crate::command::{Command, CommandLink, GrblLine, RealtimeRequest};
 use crate::grbl::classify::{LineKind, classify};
 use crate::grbl::realtime::{self, Filtered, Realtime};
 use crate::grbl::report::BANNER;
+use crate::grbl::{GrblError, RX_BUFFER_BYTES};
 use crate::log;
 use crate::outbound::{LineKind as OutKind, OutLine, Outbound};
 use crate::text::REPLY_LINE_LEN;
@@ -152,12 +152,6 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
     }
 }
 
-/// grbl's RX buffer: bytes read from the host and not yet assembled into
-/// lines, bytes. A character-counting sender keeps at most this many
-/// bytes unanswered (`$I` advertises it); a host sending more just waits
-/// (USB or PTY back-pressure: nothing is lost).
-pub const RX_BUFFER_BYTES: usize = 128;
-
 /// What [`RxBuffer::fill`] read.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Filled {
@@ -168,8 +162,10 @@ enum Filled {
     SoftReset,
 }
 
-/// The console's input between the host and the line assembler, with
-/// grbl's realtime bytes taken out as they arrive.
+/// The console's input between the host and the line assembler (grbl's
+/// RX buffer, [`RX_BUFFER_BYTES`]), with grbl's realtime bytes taken out as
+/// they arrive. A host sending more than fits just waits (USB or PTY
+/// back-pressure: nothing is lost).
 struct RxBuffer {
     bytes: Deque<u8, RX_BUFFER_BYTES>,
     /// grbl's banner was sent on this connection (before the first grbl
@@ -226,7 +222,12 @@ impl RxBuffer {
                     } else {
                         self.greet(link);
                     }
-                    if link.realtime.try_send(command).is_err() {
+                    let rx_free_bytes = (RX_BUFFER_BYTES - self.bytes.len()) as u16;
+                    let request = RealtimeRequest {
+                        command,
+                        rx_free_bytes,
+                    };
+                    if link.realtime.try_send(request).is_err() {
                         log::warning!("usb: realtime queue full, {:?} dropped", command);
                     }
                 }

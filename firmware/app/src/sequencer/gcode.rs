@@ -7,6 +7,7 @@
 use super::gcode_motion::{Hold, Motion, PLANNER_BLOCKS};
 use super::gcode_settings::GrblValues;
 use super::machine::{Action, ActionSink, Core, Line};
+use crate::command::RealtimeRequest;
 use crate::grbl::classify::{LineKind, classify};
 use crate::grbl::realtime::Realtime;
 use crate::grbl::report::{self, MachineState, Overrides, Status};
@@ -14,9 +15,8 @@ use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError, ParserState};
 use crate::text::{ReplyText, reply_text};
 
-/// grbl's RX buffer as `$I` advertises it: the console's input buffer
-/// (see `usb::RX_BUFFER_BYTES`), bytes.
-pub const RX_BUFFER_BYTES: u16 = 128;
+/// grbl's RX buffer as `$I` advertises it, bytes.
+const RX_BUFFER_BYTES: u16 = crate::grbl::RX_BUFFER_BYTES as u16;
 
 /// Whether G-code runs, is only checked, or is locked by an alarm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -281,10 +281,10 @@ impl Core {
     }
 
     /// A realtime command from the console.
-    pub(super) fn grbl_realtime(&mut self, command: Realtime, out: &mut dyn ActionSink) {
+    pub(super) fn grbl_realtime(&mut self, request: RealtimeRequest, out: &mut dyn ActionSink) {
         let ov = &mut self.gcode.overrides;
-        match command {
-            Realtime::StatusReport => self.grbl_status(out),
+        match request.command {
+            Realtime::StatusReport => self.grbl_status(request.rx_free_bytes, out),
             Realtime::FeedHold => self.grbl_hold(out),
             Realtime::CycleStart => self.grbl_resume(out),
             Realtime::SoftReset => self.grbl_reset(out),
@@ -322,7 +322,7 @@ impl Core {
     }
 
     /// `?`: one status report, whatever the state.
-    fn grbl_status(&mut self, out: &mut dyn ActionSink) {
+    fn grbl_status(&mut self, rx_free_bytes: u16, out: &mut dyn ActionSink) {
         let g = &self.gcode;
         let motion = &g.motion;
         let state = match (g.mode, motion.hold) {
@@ -344,7 +344,7 @@ impl Core {
             machine_mm: motion.position,
             work_offset_mm: g.parser.work_offset(),
             report_machine: mask & 1 != 0,
-            buffer: (mask & 2 != 0).then_some((free_blocks, RX_BUFFER_BYTES)),
+            buffer: (mask & 2 != 0).then_some((free_blocks, rx_free_bytes)),
             line_number: None,
             feed_mm_min: feed,
             power,

@@ -28,7 +28,6 @@ use crate::command::Command;
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, ScanPhase};
 use crate::grbl::GrblError;
-use crate::grbl::realtime::Realtime;
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{LoadedRecord, RecordError, Settings};
@@ -69,7 +68,7 @@ pub enum Event {
     /// gimbal laser stays dark until the core closes it again.
     GateLost,
     /// A grbl realtime command from the console (`?`, `!`, `~`, 0x18, …).
-    Realtime(Realtime),
+    Realtime(crate::command::RealtimeRequest),
 }
 
 /// What the shell reads from the links when a command arrives.
@@ -274,7 +273,7 @@ impl Core {
             Event::Saved(result) => self.saved(result, out),
             Event::SettingsLoaded(loaded) => self.settings_loaded(loaded, out),
             Event::GateLost => self.gate_lost = true,
-            Event::Realtime(command) => self.grbl_realtime(command, out),
+            Event::Realtime(request) => self.grbl_realtime(request, out),
         }
         // A command in check has not changed anything yet.
         if !matches!(self.pending, Some(Pending::Check { .. })) {

@@ -48,11 +48,11 @@ pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::Gcode>()
     + core::mem::size_of::<
         embassy_sync::channel::Channel<
             embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex,
-            crate::grbl::realtime::Realtime,
+            crate::command::RealtimeRequest,
             { crate::command::REALTIME_QUEUE_DEPTH },
         >,
     >()
-    + crate::usb::RX_BUFFER_BYTES;
+    + crate::grbl::RX_BUFFER_BYTES;
 
 /// Period of the housekeeping tick (liveness for the watchdog).
 const HOUSEKEEPING: Duration = Duration::from_millis(250);
@@ -199,7 +199,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             Either4::Third(()) => Event::DwellEnded,
             Either4::Fourth(Either3::First(())) => Event::Tick,
             Either4::Fourth(Either3::Second(event)) => Event::Galvo(event),
-            Either4::Fourth(Either3::Third(command)) => Event::Realtime(command),
+            Either4::Fourth(Either3::Third(request)) => Event::Realtime(request),
         }
     }
 

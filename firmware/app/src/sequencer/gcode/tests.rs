@@ -10,7 +10,7 @@ use embassy_time::Instant;
 
 use super::super::gcode_motion::PLANNER_BLOCKS;
 use super::super::machine::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
-use crate::command::{Command, GrblLine};
+use crate::command::{Command, GrblLine, RealtimeRequest};
 use crate::galvo::ScanPhase;
 use crate::grbl::realtime::Realtime;
 use crate::servo::task::{ServoOutcome, ServoRequest};
@@ -83,8 +83,16 @@ fn arrive(core: &mut Core, ms: u64, seq: u32) -> Vec<Action> {
     )
 }
 
+fn realtime(core: &mut Core, ms: u64, command: Realtime) -> Vec<Action> {
+    let request = RealtimeRequest {
+        command,
+        rx_free_bytes: 100,
+    };
+    on(core, ms, Event::Realtime(request))
+}
+
 fn status(core: &mut Core, ms: u64) -> String {
-    let out = on(core, ms, Event::Realtime(Realtime::StatusReport));
+    let out = realtime(core, ms, Realtime::StatusReport);
     texts(&out).pop().expect("a status report")
 }
 
@@ -122,7 +130,7 @@ fn jog_cancel_stops_after_the_step_in_flight_and_the_parser_follows() {
         1,
         "G-code refused while jogging"
     );
-    on(&mut core, 4, Event::Realtime(Realtime::JogCancel));
+    realtime(&mut core, 4, Realtime::JogCancel);
     let after = arrive(&mut core, 20, seq);
     assert_eq!(move_seq(&after), None, "no further step");
     let report = status(&mut core, 21);
@@ -166,4 +174,16 @@ fn settings_map_to_product_parameters() {
     assert!(settings.contains(&String::from("$110=30000.000")));
     assert!(settings.contains(&String::from("$32=1")));
     assert!(settings.iter().any(|s| s.starts_with("$130=229.9")));
+}
+
+#[test]
+fn buffer_state_shows_with_report_mask_2() {
+    let mut core = Core::new(Instant::from_millis(0));
+    assert!(!status(&mut core, 1).contains("|Bf:"));
+    assert_eq!(closers(&line(&mut core, 2, "$10=3")), 1);
+    assert_eq!(closers(&line(&mut core, 3, "G0 X1")), 1);
+    assert_eq!(closers(&line(&mut core, 4, "G0 X2")), 1);
+    let report = status(&mut core, 5);
+    // One block runs, one waits: 15 of 16 free; the console had 100 bytes.
+    assert!(report.contains("|Bf:15,100|"), "{report}");
 }
