@@ -10,13 +10,13 @@ use super::machine::{Action, ActionSink, Core, Line};
 use crate::command::RealtimeRequest;
 use crate::grbl::classify::{LineKind, classify};
 use crate::grbl::realtime::Realtime;
-use crate::grbl::report::{self, MachineState, Overrides, Status};
+use crate::grbl::report::{self, Overrides};
 use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError, ParserState};
 use crate::text::{ReplyText, reply_text};
 
 /// grbl's RX buffer as `$I` advertises it, bytes.
-const RX_BUFFER_BYTES: u16 = crate::grbl::RX_BUFFER_BYTES as u16;
+pub(super) const RX_BUFFER_BYTES: u16 = crate::grbl::RX_BUFFER_BYTES as u16;
 
 /// Whether G-code runs, is only checked, or is locked by an alarm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,7 +42,7 @@ pub(super) struct Gcode {
     /// The motion queue and what runs.
     pub(super) motion: Motion,
     /// Status reports sent (grbl adds `WCO:` / `Ov:` every few).
-    reports: u32,
+    pub(super) reports: u32,
 }
 
 impl Gcode {
@@ -79,7 +79,7 @@ impl Core {
     }
 
     /// A data line in grbl's form (no decoration).
-    fn grbl_data(&self, out: &mut dyn ActionSink, text: ReplyText) {
+    pub(super) fn grbl_data(&self, out: &mut dyn ActionSink, text: ReplyText) {
         out.act(Action::Line(Line::Data(text)));
     }
 
@@ -143,36 +143,12 @@ impl Core {
         };
         let idle = self.gcode.motion.is_idle();
         match command {
-            SystemCommand::Help => {
-                self.grbl_data(out, reply_text(format_args!("{}", report::HELP)))
-            }
-            SystemCommand::Settings => self.grbl_report_settings(out),
-            SystemCommand::Parameters => {
-                for index in 0..report::PARAMETER_LINES {
-                    let p = &self.gcode.parser;
-                    let text = reply_text(format_args!("{}", ParameterLine(index, p)));
-                    self.grbl_data(out, text);
-                }
-            }
-            SystemCommand::ParserState => {
-                let text = reply_text(format_args!("{}", ParserLine(&self.gcode.parser)));
-                self.grbl_data(out, text);
-            }
-            SystemCommand::BuildInfo => {
-                let version = reply_text(format_args!(
-                    "[VER:1.1h.{}:{}]",
-                    crate::build_info::VERSION,
-                    crate::build_info::PRODUCT
-                ));
-                self.grbl_data(out, version);
-                let options =
-                    reply_text(format_args!("[OPT:VN,{PLANNER_BLOCKS},{RX_BUFFER_BYTES}]"));
-                self.grbl_data(out, options);
-            }
-            SystemCommand::StartupLines => {
-                self.grbl_data(out, reply_text(format_args!("$N0=")));
-                self.grbl_data(out, reply_text(format_args!("$N1=")));
-            }
+            SystemCommand::Help
+            | SystemCommand::Settings
+            | SystemCommand::Parameters
+            | SystemCommand::ParserState
+            | SystemCommand::BuildInfo
+            | SystemCommand::StartupLines => self.grbl_info(command, out),
             SystemCommand::CheckMode => return self.grbl_check_mode(idle, out),
             SystemCommand::Unlock => {
                 if self.gcode.mode == GrblMode::Alarm {
@@ -319,84 +295,6 @@ impl Core {
         if self.gcode.mode == GrblMode::Alarm {
             self.notify(out, format_args!("MSG:'$H'|'$X' to unlock"));
         }
-    }
-
-    /// `?`: one status report, whatever the state.
-    fn grbl_status(&mut self, rx_free_bytes: u16, out: &mut dyn ActionSink) {
-        let g = &self.gcode;
-        let motion = &g.motion;
-        let state = match (g.mode, motion.hold) {
-            (GrblMode::Alarm, _) => MachineState::Alarm,
-            (GrblMode::Check, _) => MachineState::Check,
-            (_, Hold::Held) => MachineState::Hold {
-                decelerating: false,
-            },
-            (_, Hold::Stopping) => MachineState::Hold { decelerating: true },
-            _ if motion.jogging() => MachineState::Jog,
-            _ if motion.is_idle() => MachineState::Idle,
-            _ => MachineState::Run,
-        };
-        let (feed, power) = motion.feed_and_power(&g.overrides);
-        let mask = g.values.report_mask;
-        let free_blocks = (PLANNER_BLOCKS - motion.queue.len()) as u16;
-        let status = Status {
-            state,
-            machine_mm: motion.position,
-            work_offset_mm: g.parser.work_offset(),
-            report_machine: mask & 1 != 0,
-            buffer: (mask & 2 != 0).then_some((free_blocks, rx_free_bytes)),
-            line_number: None,
-            feed_mm_min: feed,
-            power,
-            show_work_offset: self.gcode.reports.is_multiple_of(10),
-            overrides: (self.gcode.reports % 10 == 1).then_some((
-                g.overrides,
-                g.parser.spindle,
-                g.parser.coolant,
-            )),
-        };
-        let text = reply_text(format_args!("{}", StatusLine(&status)));
-        self.gcode.reports = self.gcode.reports.wrapping_add(1);
-        self.grbl_data(out, text);
-    }
-
-    /// `$$`.
-    fn grbl_report_settings(&mut self, out: &mut dyn ActionSink) {
-        for setting in crate::grbl::settings_map::SETTINGS {
-            let value = self.grbl_setting_value(setting);
-            let text = reply_text(format_args!("{}", SettingLine(setting, value)));
-            self.grbl_data(out, text);
-        }
-    }
-}
-
-/// Adapters from the report writers to `Display`.
-struct StatusLine<'a>(&'a Status);
-struct ParserLine<'a>(&'a ParserState);
-struct ParameterLine<'a>(usize, &'a ParserState);
-struct SettingLine<'a>(&'a crate::grbl::settings_map::GrblSetting, f64);
-
-impl core::fmt::Display for StatusLine<'_> {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        report::write_status(f, self.0)
-    }
-}
-
-impl core::fmt::Display for ParserLine<'_> {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        report::write_parser_state(f, self.0)
-    }
-}
-
-impl core::fmt::Display for ParameterLine<'_> {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        report::write_parameter_line(f, self.0, self.1)
-    }
-}
-
-impl core::fmt::Display for SettingLine<'_> {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        report::write_setting(f, self.0, self.1)
     }
 }
 

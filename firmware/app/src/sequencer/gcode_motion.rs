@@ -17,11 +17,9 @@ use heapless::Deque;
 
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
-use crate::domain::{Figure, PointCm, Target};
-use crate::galvo::GalvoRequest;
+use crate::domain::PointCm;
 use crate::grbl::report::Overrides;
 use crate::grbl::{Block, Blocks, PointMm, SpindleMode};
-use crate::servo::task::ServoRequest;
 use crate::settings::LaserMode;
 
 /// Blocks the motion queue holds (`$I` advertises it).
@@ -29,11 +27,11 @@ pub const PLANNER_BLOCKS: usize = 16;
 
 /// Arrival deadband at the end of a G-code block on the gimbal: the
 /// servo resolution, 0.1°.
-const CORNER_DEADBAND_TENTHS: u16 = 1;
+pub(super) const CORNER_DEADBAND_TENTHS: u16 = 1;
 /// After arriving at the end of a block the gimbal settles this long, ms,
 /// before the next block starts (the servos close in on their target
 /// beyond the deadband), so corners are not cut.
-const CORNER_SETTLE_MS: u64 = 40;
+pub(super) const CORNER_SETTLE_MS: u64 = 40;
 
 /// Most steps one block is split into.
 const MAX_STEPS: u32 = 100_000;
@@ -53,18 +51,18 @@ pub(super) enum Hold {
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Current {
     pub(super) block: Block,
-    index: u32,
-    count: u32,
+    pub(super) index: u32,
+    pub(super) count: u32,
     /// Where the step in flight started, mm.
-    from: PointMm,
+    pub(super) from: PointMm,
     /// Servo move in flight.
-    servo_seq: Option<u32>,
+    pub(super) servo_seq: Option<u32>,
     /// Galvo job in flight.
-    galvo_seq: Option<u32>,
+    pub(super) galvo_seq: Option<u32>,
     /// End of a dwell.
-    until: Option<Instant>,
+    pub(super) until: Option<Instant>,
     /// A jog cancel ends the block after the step in flight.
-    cancelled: bool,
+    pub(super) cancelled: bool,
 }
 
 /// The queue and the motion in progress.
@@ -81,7 +79,7 @@ pub(super) struct Motion {
     started: bool,
     /// The gimbal arrived somewhere since the start (before that its
     /// laser stays dark: it may be travelling from afar).
-    arrived: bool,
+    pub(super) arrived: bool,
     /// The gimbal laser should be lit.
     pub(super) gimbal_lit: bool,
 }
@@ -151,7 +149,7 @@ fn block_end(block: &Block) -> Option<PointMm> {
 }
 
 /// Point `k` of `n` along a motion block.
-fn point_at(block: &Block, k: u32, n: u32) -> PointMm {
+pub(super) fn point_at(block: &Block, k: u32, n: u32) -> PointMm {
     let t = f64::from(k) / f64::from(n.max(1));
     match *block {
         Block::Rapid { from, to } | Block::Line { from, to, .. } | Block::Jog { from, to, .. } => {
@@ -168,7 +166,7 @@ fn point_at(block: &Block, k: u32, n: u32) -> PointMm {
     }
 }
 
-fn cm(p: PointMm) -> PointCm {
+pub(super) fn cm(p: PointMm) -> PointCm {
     PointCm::new(p.x_mm / 10.0, p.y_mm / 10.0)
 }
 
@@ -279,201 +277,10 @@ impl Core {
     }
 
     /// Whether laser setting (`mode`, `power`) lights a feed move.
-    fn gcode_lit(&self, mode: SpindleMode, power: f64) -> bool {
+    pub(super) fn gcode_lit(&self, mode: SpindleMode, power: f64) -> bool {
         let v = &self.gcode.values;
         let fraction = crate::grbl::Laser { mode, power }.fraction(v.s_min, v.s_max);
         fraction > 0.0 && self.settings.laser_mode == LaserMode::Auto
-    }
-
-    /// Sends the current step to every actuator that draws.
-    fn gcode_send_step(&mut self, out: &mut dyn ActionSink) {
-        let motion = &self.gcode.motion;
-        let Some(current) = motion.current else {
-            return;
-        };
-        let to = point_at(&current.block, current.index, current.count);
-        let (feed, lit) = match current.block {
-            Block::Line {
-                feed_mm_min, laser, ..
-            }
-            | Block::Arc {
-                feed_mm_min, laser, ..
-            } => (Some(feed_mm_min), self.gcode_lit(laser.mode, laser.power)),
-            Block::Jog { feed_mm_min, .. } => (Some(feed_mm_min), false),
-            _ => (None, false),
-        };
-        let lit = lit && motion.hold == Hold::None;
-        let from = motion.position;
-        let mut servo_seq = None;
-        let mut galvo_seq = None;
-        if self.actuator.uses_gimbal() {
-            // The last step of a block ends at a corner: it must arrive
-            // within the servo resolution, or the next block's first step
-            // would cut the corner by up to the arrival deadband.
-            let corner = current.index >= current.count;
-            servo_seq = self.gcode_servo_move(from, to, feed, corner, out);
-            if servo_seq.is_none() {
-                return;
-            }
-            // Dark until the gimbal has arrived once since the start.
-            self.gcode.motion.gimbal_lit = lit && self.gcode.motion.arrived;
-        }
-        if self.actuator.uses_galvo() {
-            let galvo_lit = lit;
-            self.next_seq = self.next_seq.wrapping_add(1);
-            let seq = self.next_seq;
-            let request = if galvo_lit {
-                GalvoRequest::Path {
-                    seq,
-                    path: Figure::Line {
-                        from: cm(from),
-                        to: cm(to),
-                    },
-                }
-            } else {
-                let [x_mm, y_mm] = cm(to).galvo_mm();
-                GalvoRequest::Point {
-                    seq,
-                    x_mm,
-                    y_mm,
-                    dwell_us: 0,
-                }
-            };
-            if !self.send_galvo(request, out) {
-                return;
-            }
-            galvo_seq = Some(seq);
-        }
-        if let Some(c) = self.gcode.motion.current.as_mut() {
-            c.from = from;
-            c.servo_seq = servo_seq;
-            c.galvo_seq = galvo_seq;
-        }
-    }
-
-    /// A servo move to `to` at `feed` mm/min (rapid: servo speed);
-    /// returns its request number.
-    fn gcode_servo_move(
-        &mut self,
-        from: PointMm,
-        to: PointMm,
-        feed: Option<f64>,
-        corner: bool,
-        out: &mut dyn ActionSink,
-    ) -> Option<u32> {
-        let point = cm(to);
-        let Ok(aim) = self.aimer.aim(point) else {
-            self.grbl_alarm(crate::grbl::Alarm::SoftLimit, out);
-            return None;
-        };
-        let by_servo = self.move_interval_ms(&aim);
-        let by_feed = feed.map_or(0.0, |f| {
-            let f = f * f64::from(self.gcode.overrides.feed) / 100.0;
-            60_000.0 * from.distance_to(to) / f.max(1e-3)
-        });
-        let interval_ms = libm::fmax(f64::from(by_servo), by_feed).min(f64::from(u16::MAX)) as u16;
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
-        out.act(Action::Servo(ServoRequest::Move {
-            seq,
-            yaw_tenths: aim.yaw_wire,
-            pitch_tenths: aim.pitch_wire,
-            interval_ms,
-            ids: (self.settings.yaw.id, self.settings.pitch.id),
-            deadband_tenths: if corner {
-                CORNER_DEADBAND_TENTHS
-            } else {
-                (self.settings.deadband_deg * 10.0) as u16
-            },
-            ranges_tenths: super::faults::servo_ranges_tenths(&self.settings),
-        }));
-        out.act(Action::Note(LaserEvent::GimbalMoveSent));
-        self.last_aim = Some((Target { point, grid: None }, aim));
-        Some(seq)
-    }
-
-    /// The servo task reports move `seq` arrived; `true` when it was the
-    /// G-code step's.
-    pub(super) fn gcode_servo_arrived(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
-        let Some(c) = self.gcode.motion.current.as_mut() else {
-            return false;
-        };
-        if c.servo_seq != Some(seq) {
-            return false;
-        }
-        c.servo_seq = None;
-        if c.index >= c.count && c.count > 0 {
-            c.until = Some(
-                self.inputs
-                    .now
-                    .saturating_add(Duration::from_millis(CORNER_SETTLE_MS)),
-            );
-        }
-        self.gcode.motion.arrived = true;
-        out.act(Action::Note(LaserEvent::GimbalArrived));
-        self.gcode_step_done(out);
-        true
-    }
-
-    /// The galvo loop finished job `seq`; `true` when it was the G-code
-    /// step's.
-    pub(super) fn gcode_galvo_done(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
-        let Some(c) = self.gcode.motion.current.as_mut() else {
-            return false;
-        };
-        if c.galvo_seq != Some(seq) {
-            return false;
-        }
-        c.galvo_seq = None;
-        self.gcode_step_done(out);
-        true
-    }
-
-    /// When the dwell deadline passed: the dwell block is done.
-    pub(super) fn gcode_dwell_check(&mut self, out: &mut dyn ActionSink) {
-        let now = self.inputs.now;
-        let Some(c) = self.gcode.motion.current.as_mut() else {
-            return;
-        };
-        if c.until.is_some_and(|until| until <= now) {
-            c.until = None;
-            self.gcode.motion.gimbal_lit = false;
-            self.gcode_step_done(out);
-        }
-    }
-
-    /// When the G-code dwell ends.
-    pub(super) fn gcode_deadline(&self) -> Option<Instant> {
-        self.gcode.motion.current.and_then(|c| c.until)
-    }
-
-    /// Every actuator finished the step in flight: the next step, the next
-    /// block, or the hold.
-    fn gcode_step_done(&mut self, out: &mut dyn ActionSink) {
-        let motion = &mut self.gcode.motion;
-        let Some(mut c) = motion.current else { return };
-        if c.servo_seq.is_some() || c.galvo_seq.is_some() || c.until.is_some() {
-            return;
-        }
-        if c.count > 0 {
-            motion.position = point_at(&c.block, c.index, c.count);
-        }
-        motion.gimbal_lit = false;
-        c.index += 1;
-        let finished = c.index > c.count || c.cancelled;
-        motion.current = (!finished).then_some(c);
-        if motion.hold == Hold::Stopping {
-            motion.hold = Hold::Held;
-            return;
-        }
-        if finished {
-            if c.cancelled {
-                self.grbl_sync_position();
-            }
-            self.grbl_advance(out);
-        } else {
-            self.gcode_send_step(out);
-        }
     }
 
     /// `!`: laser dark at once; the gimbal stops after the step in
@@ -540,23 +347,5 @@ impl Core {
             self.ok(out);
         }
         self.grbl_sync_position();
-    }
-}
-
-impl Core {
-    /// Whether the G-code step waits for servo move `seq`.
-    pub(super) fn gcode_awaits_servo(&self, seq: u32) -> bool {
-        self.gcode
-            .motion
-            .current
-            .is_some_and(|c| c.servo_seq == Some(seq))
-    }
-
-    /// Whether the G-code step waits for galvo job `seq`.
-    pub(super) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
-        self.gcode
-            .motion
-            .current
-            .is_some_and(|c| c.galvo_seq == Some(seq))
     }
 }

@@ -21,13 +21,11 @@
 use embassy_time::Instant;
 
 use super::faults::ServoFaults;
-use super::gcode::Gcode;
 use super::laser::{LaserEvent, laser_wanted};
 use super::run::Run;
 use crate::command::Command;
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, ScanPhase};
-use crate::grbl::GrblError;
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{LoadedRecord, RecordError, Settings};
@@ -151,7 +149,7 @@ pub enum Line {
     /// Closes the reply: `error: <reason>`.
     Error(ReplyText),
     /// Closes a G-code or `$` line's reply: grbl's `error:N`.
-    GrblError(GrblError),
+    GrblError(crate::grbl::GrblError),
 }
 
 /// Where the core writes its actions (the shell applies them at once, a
@@ -222,7 +220,7 @@ pub struct Core {
     /// jobs are sent).
     pub(super) inputs: Inputs,
     /// The grbl session: G-code parser, motion queue, grbl settings.
-    pub(super) gcode: Gcode,
+    pub(super) gcode: super::gcode::Gcode,
 }
 
 impl Core {
@@ -247,7 +245,7 @@ impl Core {
                 now,
                 galvo_room: None,
             },
-            gcode: Gcode::new(),
+            gcode: super::gcode::Gcode::new(),
         }
     }
 
@@ -264,10 +262,7 @@ impl Core {
             Event::StopRequest => self.stop("stop button", out),
             Event::Servo(outcome) => self.servo_outcome(outcome, out),
             Event::Galvo(event) => self.galvo_event(event, out),
-            Event::DwellEnded => {
-                self.dwell_finished(out);
-                self.gcode_dwell_check(out);
-            }
+            Event::DwellEnded => self.dwell_ended(out),
             Event::Tick => self.heartbeat = self.heartbeat.wrapping_add(1),
             Event::CheckStep => self.check_step(super::commands::CHECKS_PER_STEP, out),
             Event::Saved(result) => self.saved(result, out),
@@ -288,9 +283,7 @@ impl Core {
 
     /// When the current dwell ends (`None`: no dwell running).
     pub fn dwell_deadline(&self) -> Option<Instant> {
-        self.run
-            .and_then(|r| r.dwell_until)
-            .or(self.gcode_deadline())
+        self.gcode_deadline_or(self.run.and_then(|r| r.dwell_until))
     }
 
     /// Whether the gimbal laser is on.

@@ -309,24 +309,19 @@ impl Core {
 
     /// The servo task's report.
     pub(super) fn servo_outcome(&mut self, outcome: ServoOutcome, out: &mut dyn ActionSink) {
+        let gcode_fault = self.gcode_servo_outcome(&outcome, out);
         match outcome {
             ServoOutcome::Recovered { id } => self.servo_recovered(id, out),
             ServoOutcome::Arrived {
                 seq,
                 yaw_tenths,
                 pitch_tenths,
-            } => {
-                self.arrived(seq, (yaw_tenths, pitch_tenths), out);
-                self.gcode_servo_arrived(seq, out);
-            }
-            ServoOutcome::Fault { seq, id, fault } => {
-                let gcode_step = self.gcode_awaits_servo(seq);
-                self.servo_fault(seq, id, fault, out);
-                if gcode_step {
-                    self.stop("servo fault during G-code", out);
-                }
-            }
+            } => self.arrived(seq, (yaw_tenths, pitch_tenths), out),
+            ServoOutcome::Fault { seq, id, fault } => self.servo_fault(seq, id, fault, out),
             ServoOutcome::Superseded { .. } => {}
+        }
+        if gcode_fault {
+            self.stop("servo fault during G-code", out);
         }
     }
 
