@@ -177,6 +177,13 @@ impl Core {
         run_deadline.or(self.gcode.motion.current.and_then(|c| c.until))
     }
 
+    /// Whether G-code lights the gimbal laser now: a lit step or dwell
+    /// runs, and the laser mode (`laser auto`) still allows it (`laser off`
+    /// mid-step darkens at once).
+    pub(super) fn gcode_gimbal_lit(&self) -> bool {
+        self.gcode.motion.gimbal_lit && self.settings.laser_mode == crate::settings::LaserMode::Auto
+    }
+
     /// The dwell deadline passed: a run's dwell, or the G-code step's.
     pub(super) fn dwell_ended(&mut self, out: &mut dyn ActionSink) {
         self.dwell_finished(out);

@@ -361,7 +361,7 @@ impl Core {
                 self.settings.laser_mode,
                 phase,
                 self.faults.gimbal_laser_blocked(yaw, pitch, phase),
-            ) || self.gcode.motion.gimbal_lit)
+            ) || self.gcode_gimbal_lit())
             && !self.gate_lost;
         if wanted != self.laser_on {
             self.laser_on = wanted;

@@ -187,3 +187,26 @@ fn buffer_state_shows_with_report_mask_2() {
     // One block runs, one waits: 15 of 16 free; the console had 100 bytes.
     assert!(report.contains("|Bf:15,100|"), "{report}");
 }
+
+#[test]
+fn laser_off_darkens_a_lit_gcode_step_at_once() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let out = line(&mut core, 1, "G0 X1");
+    let seq = move_seq(&out).expect("rapid");
+    arrive(&mut core, 10, seq);
+    let deadline = core.dwell_deadline().expect("settle");
+    on(&mut core, deadline.as_millis(), Event::DwellEnded);
+    let out = line(&mut core, 100, "G1 X20 F600 M3 S1000");
+    assert!(out.contains(&Action::GimbalLaser(true)), "lit G1 step");
+    let command = Command::Laser(crate::settings::LaserMode::Off);
+    let out = on(
+        &mut core,
+        101,
+        Event::Command {
+            command,
+            readings: READINGS,
+        },
+    );
+    assert!(out.contains(&Action::GimbalLaser(false)), "{out:?}");
+    assert!(!core.laser_on());
+}
