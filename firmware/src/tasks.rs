@@ -2,17 +2,20 @@
 //! generic, so each runs one of `laser-app`'s task bodies for this board's
 //! part types, and [`TaskSpawner`] is the board's spawn hook for
 //! `laser_app::app::wire`. The USB device stack is the board's own task.
+//! Every task runs in thread mode except the galvo loop, which runs on
+//! the galvo executor (an interrupt, `main.rs`) so that nothing in thread
+//! mode can delay a refill.
 
-use embassy_executor::Spawner;
-use embassy_stm32::mode::Async;
-use embassy_stm32::usart::{RingBufferedUartRx, UartTx};
+use embassy_executor::{SendSpawner, Spawner};
+use embassy_stm32::usart::{BufferedUartRx, BufferedUartTx};
 use embassy_usb::UsbDevice;
 use laser_app::app::{
-    ConsoleTask, GalvoTask, IndicatorTask, NoGalvoDac, SequencerTask, ServoBusTask, Spawn,
-    StopButtonTask, WatchdogTask,
+    ConsoleTask, GalvoTask, IndicatorTask, SequencerTask, ServoBusTask, Spawn, StopButtonTask,
+    WatchdogTask,
 };
 
 use crate::board::Stm32Board;
+use crate::galvo_dac::Stm32GalvoDac;
 use crate::parts::{IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::FlashSettings;
 
@@ -28,15 +31,21 @@ async fn console(task: ConsoleTask<UsbConsole>) -> ! {
     task.run().await
 }
 
-/// Owns the servo UART (USART2, DMA both ways).
+/// Owns the servo UART (USART2, interrupt-driven).
 #[embassy_executor::task]
-async fn servo_bus(task: ServoBusTask<RingBufferedUartRx<'static>, UartTx<'static, Async>>) -> ! {
+async fn servo_bus(task: ServoBusTask<BufferedUartRx<'static>, BufferedUartTx<'static>>) -> ! {
     task.run().await
 }
 
 /// Runs the sequencer (commands, patterns, laser).
 #[embassy_executor::task]
 async fn sequencer(task: SequencerTask<LaserPin, FlashSettings>) -> ! {
+    task.run().await
+}
+
+/// The galvo loop (on the galvo executor): feeds the DAC stream.
+#[embassy_executor::task]
+async fn galvo(task: GalvoTask<Stm32GalvoDac>) {
     task.run().await
 }
 
@@ -59,39 +68,41 @@ async fn watchdog(task: WatchdogTask<IndependentDog>) -> ! {
     task.run().await
 }
 
-/// Spawns the task bodies on the embassy executor (each task's pool holds
+/// Spawns the task bodies on the embassy executors (each task's pool holds
 /// one: the wiring spawns each once).
-pub struct TaskSpawner(pub Spawner);
+pub struct TaskSpawner {
+    /// The thread-mode executor.
+    pub thread: Spawner,
+    /// The galvo executor (interrupt priority `board::GALVO_PRIORITY`).
+    pub galvo: SendSpawner,
+}
 
 impl Spawn<Stm32Board> for TaskSpawner {
     fn console(&mut self, task: ConsoleTask<UsbConsole>) {
-        self.0.spawn(defmt::unwrap!(console(task)));
+        self.thread.spawn(defmt::unwrap!(console(task)));
     }
 
-    fn servo_bus(
-        &mut self,
-        task: ServoBusTask<RingBufferedUartRx<'static>, UartTx<'static, Async>>,
-    ) {
-        self.0.spawn(defmt::unwrap!(servo_bus(task)));
+    fn servo_bus(&mut self, task: ServoBusTask<BufferedUartRx<'static>, BufferedUartTx<'static>>) {
+        self.thread.spawn(defmt::unwrap!(servo_bus(task)));
     }
 
     fn sequencer(&mut self, task: SequencerTask<LaserPin, FlashSettings>) {
-        self.0.spawn(defmt::unwrap!(sequencer(task)));
+        self.thread.spawn(defmt::unwrap!(sequencer(task)));
     }
 
-    fn galvo(&mut self, task: GalvoTask<NoGalvoDac>) {
-        task.unreachable()
+    fn galvo(&mut self, task: GalvoTask<Stm32GalvoDac>) {
+        self.galvo.spawn(defmt::unwrap!(galvo(task)));
     }
 
     fn indicators(&mut self, task: IndicatorTask<StatusLeds>) {
-        self.0.spawn(defmt::unwrap!(indicators(task)));
+        self.thread.spawn(defmt::unwrap!(indicators(task)));
     }
 
     fn stop_button(&mut self, task: StopButtonTask<UserButton>) {
-        self.0.spawn(defmt::unwrap!(stop_button(task)));
+        self.thread.spawn(defmt::unwrap!(stop_button(task)));
     }
 
     fn watchdog(&mut self, task: WatchdogTask<IndependentDog>) {
-        self.0.spawn(defmt::unwrap!(watchdog(task)));
+        self.thread.spawn(defmt::unwrap!(watchdog(task)));
     }
 }

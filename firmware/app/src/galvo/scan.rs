@@ -297,6 +297,7 @@ impl GalvoLoop {
                     computed,
                 })
                 .await;
+            link.publish_refill(dac.worst_refill());
             release_drawn(&mut drawing, link);
             if let Err(underrun) = written {
                 generation = gate.close();
