@@ -21,6 +21,7 @@ const READINGS: Readings = Readings {
         queued: 0,
         underruns: 0,
         halves: 0,
+        refill: None,
     },
     implausible_readings: 0,
 };
