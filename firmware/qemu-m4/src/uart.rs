@@ -12,7 +12,7 @@
 use core::cell::RefCell;
 use core::convert::Infallible;
 use core::future::poll_fn;
-use core::task::Poll;
+use core::task::{Context, Poll};
 
 use critical_section::{CriticalSection, Mutex};
 use embassy_sync::waitqueue::WakerRegistration;
@@ -222,46 +222,59 @@ impl embedded_io_async::Read for Uart {
     }
 }
 
+impl UartState {
+    /// `Ready` when the UART has room for a byte; otherwise the transmit
+    /// interrupt is on and the waker registered.
+    ///
+    /// QEMU's UART raises the transmit interrupt only for a byte that
+    /// leaves while the interrupt is enabled, and a byte can leave (on
+    /// QEMU's I/O thread) between reading STATE and enabling it: so after
+    /// enabling, STATE is read again, and a UART with room is reported at
+    /// once instead of waiting for an interrupt that never comes.
+    fn poll_room(&self, cx: &mut Context<'_>, s: &mut Shared) -> Poll<()> {
+        if self.regs.state().read() & STATE_TX_FULL == 0 {
+            return Poll::Ready(());
+        }
+        s.tx_waker.register(cx.waker());
+        self.regs.ctrl().set_bits(CTRL_TX_IRQ);
+        if self.regs.state().read() & STATE_TX_FULL != 0 {
+            return Poll::Pending;
+        }
+        self.regs.ctrl().clear_bits(CTRL_TX_IRQ);
+        Poll::Ready(())
+    }
+
+    /// Writes what fits into the UART (at least one byte of a non-empty
+    /// `buf`), or `Pending` while it is full.
+    fn poll_write(&self, cx: &mut Context<'_>, buf: &[u8]) -> Poll<usize> {
+        self.with(|_, s| {
+            if self.poll_room(cx, s).is_pending() {
+                return Poll::Pending;
+            }
+            let mut n = 0;
+            while n < buf.len() && self.regs.state().read() & STATE_TX_FULL == 0 {
+                self.regs.data().write(u32::from(buf[n]));
+                n += 1;
+            }
+            Poll::Ready(n)
+        })
+    }
+}
+
 impl embedded_io_async::Write for Uart {
     async fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
         if buf.is_empty() {
             return Ok(0);
         }
         let state = self.state;
-        let n = poll_fn(|cx| {
-            state.with(|_, s| {
-                let mut n = 0;
-                while n < buf.len() && state.regs.state().read() & STATE_TX_FULL == 0 {
-                    state.regs.data().write(u32::from(buf[n]));
-                    n += 1;
-                }
-                if n > 0 {
-                    Poll::Ready(n)
-                } else {
-                    s.tx_waker.register(cx.waker());
-                    state.regs.ctrl().set_bits(CTRL_TX_IRQ);
-                    Poll::Pending
-                }
-            })
-        })
-        .await;
-        Ok(n)
+        Ok(poll_fn(|cx| state.poll_write(cx, buf)).await)
     }
 
+    /// Waits until the UART has room again (QEMU sends each byte as it is
+    /// written, so room means sent).
     async fn flush(&mut self) -> Result<(), Infallible> {
         let state = self.state;
-        poll_fn(|cx| {
-            state.with(|_, s| {
-                if state.regs.state().read() & STATE_TX_FULL == 0 {
-                    Poll::Ready(())
-                } else {
-                    s.tx_waker.register(cx.waker());
-                    state.regs.ctrl().set_bits(CTRL_TX_IRQ);
-                    Poll::Pending
-                }
-            })
-        })
-        .await;
+        poll_fn(|cx| state.with(|_, s| state.poll_room(cx, s))).await;
         Ok(())
     }
 }

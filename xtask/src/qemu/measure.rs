@@ -103,7 +103,7 @@ fn instructions(elf: &Path) -> Result<()> {
     for command in COMMANDS {
         let before = stats(&mut m)?;
         m.type_line(command)?;
-        if !m.replies_read(Instant::now() + Duration::from_secs(10)) {
+        if !m.replies_read(Instant::now() + Duration::from_secs(60)) {
             bail!("no reply to {command}");
         }
         let after = stats(&mut m)?;
