@@ -163,6 +163,36 @@ pub struct GalvoLoop {
     off_delay_samples: u32,
 }
 
+/// The galvo loop's memory: the loop (its prepared steps and jump
+/// integrator, about 30 KB) and the half buffer it computes into. A board
+/// keeps it in a `static` and hands it to
+/// [`GalvoTask::run_in`](crate::app::GalvoTask::run_in), so it is counted
+/// once and the task's future holds only a reference.
+pub struct GalvoMemory {
+    pub(crate) galvo: Option<GalvoLoop>,
+    pub(crate) half: [DacSample; MAX_HALF_LEN],
+}
+
+impl GalvoMemory {
+    /// No loop yet, a dark half buffer (usable in a `static`).
+    pub const fn new() -> Self {
+        Self {
+            galvo: None,
+            half: [DacSample {
+                x_code: 0,
+                y_code: 0,
+                laser: false,
+            }; MAX_HALF_LEN],
+        }
+    }
+}
+
+impl Default for GalvoMemory {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 fn samples_for(us: u32, ts_s: f64) -> u32 {
     // Whole samples, rounded up: a delay is never shorter than asked.
     libm::ceil(f64::from(us) * 1e-6 / ts_s - 1e-9).max(0.0) as u32
@@ -250,9 +280,22 @@ impl GalvoLoop {
         link: &GalvoLink,
         gate: &LaserGate,
     ) -> ! {
+        let mut half = [DacSample::default(); MAX_HALF_LEN];
+        self.run_with(dac, link, gate, &mut half).await
+    }
+
+    /// [`Self::run`], computing each half in `half` (the caller's memory:
+    /// a board keeps it in a `static`, see [`GalvoMemory`], so the task's
+    /// future does not hold it).
+    pub async fn run_with<D: DacStream>(
+        &mut self,
+        dac: &mut D,
+        link: &GalvoLink,
+        gate: &LaserGate,
+        half: &mut [DacSample; MAX_HALF_LEN],
+    ) -> ! {
         link.attach();
         let n = dac.half_len().clamp(1, MAX_HALF_LEN);
-        let mut half = [DacSample::default(); MAX_HALF_LEN];
         let mut period_s = self.config.sample_period_s;
         let mut generation = gate.generation();
         // `Done` events waiting for their samples to be output, with the
