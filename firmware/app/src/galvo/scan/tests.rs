@@ -482,3 +482,25 @@ fn halves_of_any_length_give_the_same_samples() {
         assert!(stream(half_len) == whole, "half of {half_len}");
     }
 }
+
+#[test]
+fn the_path_planner_holds_the_longest_stroke() {
+    // One block per segment: the loop loads a whole stroke before marking.
+    let capacity = crate::domain::Segments::new().capacity();
+    assert!(
+        MARK_BLOCKS >= capacity,
+        "{MARK_BLOCKS} blocks < {capacity} segments"
+    );
+}
+
+/// The loop's own memory on the host (64-bit: at least the target's),
+/// held in the board's `static` (`GalvoMemory`). Budget: the galvo task
+/// must stay well under 30 KB of the target's 96 KB static RAM.
+const GALVO_LOOP_MAX_BYTES: usize = 24 * 1024;
+
+#[test]
+fn the_galvo_loop_stays_within_its_memory_budget() {
+    let size = core::mem::size_of::<GalvoLoop>();
+    std::println!("GalvoLoop: {size} B on the host");
+    assert!(size <= GALVO_LOOP_MAX_BYTES, "GalvoLoop is {size} B");
+}
