@@ -18,7 +18,7 @@ use laser_app::galvo::GalvoMemory;
 use static_cell::StaticCell;
 
 use crate::board::Stm32Board;
-use crate::galvo_dac::Stm32GalvoDac;
+use crate::galvo_dac::{self, Stm32GalvoDac};
 use crate::parts::{IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::FlashSettings;
 
@@ -50,7 +50,7 @@ async fn sequencer(task: SequencerTask<LaserPin, FlashSettings>) -> ! {
 #[embassy_executor::task]
 async fn galvo(task: GalvoTask<Stm32GalvoDac>) {
     // The loop's memory in a static, not in this task's future.
-    static MEMORY: StaticCell<GalvoMemory> = StaticCell::new();
+    static MEMORY: StaticCell<GalvoMemory<{ galvo_dac::HALF_LEN }>> = StaticCell::new();
     task.run_in(MEMORY.init_with(GalvoMemory::new)).await
 }
 

@@ -101,13 +101,23 @@ impl<D: DacStream> GalvoTask<D> {
     /// The loop lives inside this task's future (a few tens of KB): a
     /// board with little RAM uses [`Self::run_in`].
     pub async fn run(self) {
-        let mut memory = GalvoMemory::new();
+        let mut memory: GalvoMemory = GalvoMemory::new();
         self.run_in(&mut memory).await
     }
 
     /// [`Self::run`] with the loop and its half buffer in `memory` (a
     /// board's `static`): the future holds only the reference.
-    pub async fn run_in(mut self, memory: &mut GalvoMemory) {
+    /// Ends at once (logged) when its half buffer is shorter than the
+    /// DAC's halves.
+    pub async fn run_in<const HALF: usize>(mut self, memory: &mut GalvoMemory<HALF>) {
+        if !GalvoLoop::fits(&self.dac, HALF) {
+            log::error!(
+                "galvo loop not started: the DAC's {}-sample halves exceed its {}-sample buffer",
+                self.dac.half_len(),
+                HALF
+            );
+            return;
+        }
         let GalvoMemory { galvo, half } = memory;
         let galvo = match GalvoLoop::new(GalvoConfig::default()) {
             Ok(built) => galvo.insert(built),

@@ -164,30 +164,34 @@ pub struct GalvoLoop {
 }
 
 /// The galvo loop's memory: the loop (its prepared steps and jump
-/// integrator, about 30 KB) and the half buffer it computes into. A board
+/// integrator, about 22 KB) and the half buffer of `HALF` samples it
+/// computes into (at least the DAC's [`DacStream::half_len`]). A board
 /// keeps it in a `static` and hands it to
 /// [`GalvoTask::run_in`](crate::app::GalvoTask::run_in), so it is counted
 /// once and the task's future holds only a reference.
-pub struct GalvoMemory {
+pub struct GalvoMemory<const HALF: usize = MAX_HALF_LEN> {
     pub(crate) galvo: Option<GalvoLoop>,
-    pub(crate) half: [DacSample; MAX_HALF_LEN],
+    pub(crate) half: [DacSample; HALF],
 }
 
-impl GalvoMemory {
+impl<const HALF: usize> GalvoMemory<HALF> {
+    const HALF_OK: () = assert!(HALF > 0 && HALF <= MAX_HALF_LEN, "HALF in 1..=512");
+
     /// No loop yet, a dark half buffer (usable in a `static`).
     pub const fn new() -> Self {
+        let () = Self::HALF_OK;
         Self {
             galvo: None,
             half: [DacSample {
                 x_code: 0,
                 y_code: 0,
                 laser: false,
-            }; MAX_HALF_LEN],
+            }; HALF],
         }
     }
 }
 
-impl Default for GalvoMemory {
+impl<const HALF: usize> Default for GalvoMemory<HALF> {
     fn default() -> Self {
         Self::new()
     }
@@ -257,6 +261,11 @@ impl GalvoLoop {
         self.queue.len()
     }
 
+    /// Whether a half buffer of `half` samples holds the DAC's halves.
+    pub fn fits(dac: &impl DacStream, half: usize) -> bool {
+        (1..=half.min(MAX_HALF_LEN)).contains(&dac.half_len())
+    }
+
     /// Runs the loop forever: requests between half buffers, one half per
     /// wake-up, laser through the master `gate`.
     ///
@@ -286,16 +295,18 @@ impl GalvoLoop {
 
     /// [`Self::run`], computing each half in `half` (the caller's memory:
     /// a board keeps it in a `static`, see [`GalvoMemory`], so the task's
-    /// future does not hold it).
-    pub async fn run_with<D: DacStream>(
+    /// future does not hold it). Halves of the DAC's
+    /// [`DacStream::half_len`] samples, at most `half.len()` (a shorter
+    /// buffer shortens every half: check with [`Self::fits`] first).
+    pub async fn run_with<D: DacStream, const HALF: usize>(
         &mut self,
         dac: &mut D,
         link: &GalvoLink,
         gate: &LaserGate,
-        half: &mut [DacSample; MAX_HALF_LEN],
+        half: &mut [DacSample; HALF],
     ) -> ! {
         link.attach();
-        let n = dac.half_len().clamp(1, MAX_HALF_LEN);
+        let n = dac.half_len().clamp(1, MAX_HALF_LEN).min(HALF).max(1);
         let mut period_s = self.config.sample_period_s;
         let mut generation = gate.generation();
         // `Done` events waiting for their samples to be output, with the
