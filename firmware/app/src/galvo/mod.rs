@@ -78,6 +78,13 @@ pub struct Half<'a> {
 /// a half the DAC replays because the loop was late is output dark.
 #[allow(async_fn_in_trait)]
 pub trait DacStream {
+    /// Whether the CPU that runs the loop on this board can afford jump
+    /// planning by the patent's bisection (`planner seed`): 1.6–7.5 M
+    /// instructions per axis on the M4 (bench-m4's `plan.seed.*`), 18–90×
+    /// the 1.28 ms refill window. A board that cannot (the default) has
+    /// `planner seed` refused with a clear error.
+    const PLANS_BISECTION: bool = false;
+
     /// Samples per half buffer.
     fn half_len(&self) -> usize;
 
@@ -223,6 +230,9 @@ pub struct GalvoLink {
     queued: AtomicU8,
     /// A galvo loop serves the link (set when it starts).
     attached: AtomicBool,
+    /// The serving loop's board plans bisection jumps
+    /// ([`DacStream::PLANS_BISECTION`]).
+    bisection: AtomicBool,
     /// The DAC's worst refill, when the board measures it.
     refill: RefillStat,
 }
@@ -247,6 +257,12 @@ impl GalvoLink {
     /// Marks the link served ([`GalvoLoop::run`] calls it when it starts).
     pub fn attach(&self) {
         self.attached.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether the serving loop's board plans jumps by bisection
+    /// (`planner seed`, see [`DacStream::PLANS_BISECTION`]).
+    pub fn plans_bisection(&self) -> bool {
+        self.bisection.load(Ordering::Relaxed)
     }
 
     /// Lets the galvo light its dwells and strokes (`true`, laser modes
@@ -312,6 +328,7 @@ impl GalvoLink {
             phase: AtomicU8::new(0),
             queued: AtomicU8::new(0),
             attached: AtomicBool::new(false),
+            bisection: AtomicBool::new(false),
             refill: RefillStat::new(),
         }
     }

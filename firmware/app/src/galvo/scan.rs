@@ -67,6 +67,9 @@ pub enum GalvoError {
     QueueFull,
     /// An underrun latched the laser off; a `Stop` clears it.
     Faulted,
+    /// The board cannot plan jumps by bisection (`planner seed`) in time
+    /// ([`DacStream::PLANS_BISECTION`]).
+    SeedTooSlow,
 }
 
 impl fmt::Display for GalvoError {
@@ -77,6 +80,9 @@ impl fmt::Display for GalvoError {
             GalvoError::Planner => "galvo planner refused the move",
             GalvoError::QueueFull => "galvo job queue is full",
             GalvoError::Faulted => "galvo underrun: send stop before new points",
+            GalvoError::SeedTooSlow => {
+"planner seed does not fit this board (bisection: 12-58 ms per jump axis); use planner optimal"
+            }
         })
     }
 }
@@ -161,6 +167,9 @@ pub struct GalvoLoop {
     pending_config: Option<GalvoConfig>,
     on_delay_samples: u32,
     off_delay_samples: u32,
+    /// Jumps may be planned by bisection (`false` on a board that cannot
+    /// afford it: [`DacStream::PLANS_BISECTION`]).
+    bisection_allowed: bool,
 }
 
 /// The galvo loop's memory: the loop (its prepared steps and jump
@@ -246,6 +255,7 @@ impl GalvoLoop {
             pending_config: None,
             on_delay_samples: samples_for(config.laser_on_delay_us, ts),
             off_delay_samples: samples_for(config.laser_off_delay_us, ts),
+            bisection_allowed: true,
             config,
         })
     }
@@ -305,6 +315,12 @@ impl GalvoLoop {
         gate: &LaserGate,
         half: &mut [DacSample; HALF],
     ) -> ! {
+        link.bisection.store(D::PLANS_BISECTION, Ordering::Relaxed);
+        self.bisection_allowed = D::PLANS_BISECTION;
+        if !self.bisection_allowed && matches!(self.config.method, Method::Bisection(_)) {
+            log::error!("galvo: {}; planning time-optimal", GalvoError::SeedTooSlow);
+            self.config.method = Method::TimeOptimal;
+        }
         link.attach();
         let n = dac.half_len().clamp(1, MAX_HALF_LEN).min(HALF).max(1);
         let mut period_s = self.config.sample_period_s;

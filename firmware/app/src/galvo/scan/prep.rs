@@ -15,7 +15,7 @@
 //! jump and drops the prepared steps if it broke.
 
 use galvo_planner::blocks::{PRECOMPUTED_JUMP, jump_angles};
-use galvo_planner::{JumpSync, MarkLimits, PathPlanner, XyJump, plan_xy_jump};
+use galvo_planner::{JumpSync, MarkLimits, MethodKind, PathPlanner, XyJump, plan_xy_jump};
 use kinematics_core::PointMm;
 
 use super::{GalvoError, GalvoLoop, INTEGRATOR_CAPACITY, JUNCTION_DEVIATION_MM, Job, MARK_BLOCKS};
@@ -98,9 +98,17 @@ impl GalvoLoop {
                 break;
             };
             let stroke = step.marker.is_some();
+            let bisected = match &step.jump {
+                Ok(jump) => [&jump.x, &jump.y]
+                    .iter()
+                    .filter(|plan| plan.method() == MethodKind::Bisection)
+                    .count(),
+                Err(_) => 0,
+            };
             if !self.steps.push_back(step) {
                 break;
             }
+            self.work.bisection_axes += bisected as u32;
             if stroke {
                 self.work.strokes_prepared += 1;
             } else {

@@ -504,3 +504,33 @@ fn the_galvo_loop_stays_within_its_memory_budget() {
     std::println!("GalvoLoop: {size} B on the host");
     assert!(size <= GALVO_LOOP_MAX_BYTES, "GalvoLoop is {size} B");
 }
+
+#[test]
+fn a_board_that_cannot_afford_bisection_refuses_seed_parameters() {
+    let seed = GalvoConfig {
+        method: Method::BISECTION,
+        ..GalvoConfig::default()
+    };
+    // The M4 (`DacStream::PLANS_BISECTION` false): refused, nothing changes.
+    let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
+    galvo.bisection_allowed = false;
+    galvo.configure(seed);
+    assert_eq!(
+        galvo.apply_pending_config(true),
+        Some(GalvoEvent::ConfigRefused(GalvoError::SeedTooSlow))
+    );
+    assert_eq!(galvo.config.method, Method::TimeOptimal);
+    // A host loop plans by bisection, and counts it for the cost model.
+    let mut host = GalvoLoop::new(GalvoConfig::default()).unwrap();
+    host.configure(seed);
+    assert_eq!(host.apply_pending_config(true), None);
+    host.request(GalvoRequest::Point {
+        seq: 1,
+        x_mm: 20.0,
+        y_mm: -10.0,
+        dwell_us: 0,
+    });
+    host.work = crate::galvo::LoopWork::default();
+    host.prep();
+    assert_eq!(host.work.bisection_axes, 2);
+}
