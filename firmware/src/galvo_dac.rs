@@ -254,7 +254,7 @@ impl Stm32GalvoDac {
 impl DacStream for Stm32GalvoDac {
     /// Bisection jump planning (`planner seed`) takes 1.6–7.5 M
     /// instructions per axis here (bench-m4): refused.
-    const PLANS_BISECTION: bool = false;
+    const F64_PLANNING: bool = false;
 
     fn half_len(&self) -> usize {
         HALF_LEN

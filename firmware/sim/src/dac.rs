@@ -188,7 +188,7 @@ impl DacStream for SimDac {
     /// Allowed for comparison with the time-optimal planner, and charged
     /// its M4 cost ([`M4_COST`]`.bisection_axis`): a seed-planned pattern
     /// underruns here as it would on the M4.
-    const PLANS_BISECTION: bool = true;
+    const F64_PLANNING: bool = true;
 
     fn half_len(&self) -> usize {
         self.half_len

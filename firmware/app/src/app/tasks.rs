@@ -119,7 +119,7 @@ impl<D: DacStream> GalvoTask<D> {
             return;
         }
         let GalvoMemory { galvo, half } = memory;
-        let galvo = match GalvoLoop::new(GalvoConfig::default()) {
+        let galvo = match GalvoLoop::for_dac::<D>(GalvoConfig::default()) {
             Ok(built) => galvo.insert(built),
             Err(e) => {
                 log::error!("galvo loop not started: {}", e);

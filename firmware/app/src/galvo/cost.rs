@@ -98,9 +98,9 @@ pub const M4_COST: CostModel = CostModel {
     // `loop.jump.prep`.
     point_prepared: 66_320,
     // `loop.tuning.prep`: the dearest stroke step, a jump and a stroke.
-    stroke_prepared: 80_610,
+    stroke_prepared: 67_420,
     // `plan.seed.0.1deg`, the cheapest bisection plan (a lower bound).
-    bisection_axis: 1_571_840,
+    bisection_axis: 1_572_240,
     // `loop.reconfigure`.
     rebuild: 4_520,
     // `loop.new`.

@@ -78,12 +78,15 @@ pub struct Half<'a> {
 /// a half the DAC replays because the loop was late is output dark.
 #[allow(async_fn_in_trait)]
 pub trait DacStream {
-    /// Whether the CPU that runs the loop on this board can afford jump
-    /// planning by the patent's bisection (`planner seed`): 1.6–7.5 M
-    /// instructions per axis on the M4 (bench-m4's `plan.seed.*`), 18–90×
-    /// the 1.28 ms refill window. A board that cannot (the default) has
-    /// `planner seed` refused with a clear error.
-    const PLANS_BISECTION: bool = false;
+    /// Whether the CPU that runs the loop on this board plans jumps in
+    /// `f64` in time: the patent's bisection (`planner seed`) and the
+    /// `f64` fallback of the time-optimal planner. Not on the M4F (the
+    /// default): its FPU is single precision, bisection takes 1.6–7.5 M
+    /// instructions per axis (bench-m4's `plan.seed.*`, 9–46× the 1.28 ms
+    /// refill window), so `planner seed` is refused with a clear error,
+    /// jumps are planned time-optimal in `f32` only, and the `f64`
+    /// planners are not linked into the image.
+    const F64_PLANNING: bool = false;
 
     /// Samples per half buffer.
     fn half_len(&self) -> usize;
@@ -231,7 +234,7 @@ pub struct GalvoLink {
     /// A galvo loop serves the link (set when it starts).
     attached: AtomicBool,
     /// The serving loop's board plans bisection jumps
-    /// ([`DacStream::PLANS_BISECTION`]).
+    /// ([`DacStream::F64_PLANNING`]).
     bisection: AtomicBool,
     /// The DAC's worst refill, when the board measures it.
     refill: RefillStat,
@@ -260,7 +263,7 @@ impl GalvoLink {
     }
 
     /// Whether the serving loop's board plans jumps by bisection
-    /// (`planner seed`, see [`DacStream::PLANS_BISECTION`]).
+    /// (`planner seed`, see [`DacStream::F64_PLANNING`]).
     pub fn plans_bisection(&self) -> bool {
         self.bisection.load(Ordering::Relaxed)
     }

@@ -68,7 +68,7 @@ pub enum GalvoError {
     /// An underrun latched the laser off; a `Stop` clears it.
     Faulted,
     /// The board cannot plan jumps by bisection (`planner seed`) in time
-    /// ([`DacStream::PLANS_BISECTION`]).
+    /// ([`DacStream::F64_PLANNING`]).
     SeedTooSlow,
 }
 
@@ -167,9 +167,8 @@ pub struct GalvoLoop {
     pending_config: Option<GalvoConfig>,
     on_delay_samples: u32,
     off_delay_samples: u32,
-    /// Jumps may be planned by bisection (`false` on a board that cannot
-    /// afford it: [`DacStream::PLANS_BISECTION`]).
-    bisection_allowed: bool,
+    /// How jumps are planned on this board ([`DacStream::F64_PLANNING`]).
+    jump_planning: prep::Planning,
 }
 
 /// The galvo loop's memory: the loop (its prepared steps and jump
@@ -216,7 +215,23 @@ impl GalvoLoop {
     ///
     /// Errors: [`GalvoError::Planner`] for an invalid mirror model or
     /// sample period, [`GalvoError::Kinematics`] for invalid geometry.
+    ///
+    /// It plans jumps with every method, in `f64` where the method needs
+    /// it (a host); a board's loop is built by [`Self::for_dac`].
     pub fn new(config: GalvoConfig) -> Result<Self, GalvoError> {
+        Self::with_planning(config, prep::Planning::HOST)
+    }
+
+    /// [`Self::new`] for the loop that feeds `D`, planning jumps as its
+    /// board can ([`DacStream::F64_PLANNING`]); also
+    /// [`GalvoError::SeedTooSlow`] for `planner seed` where it cannot.
+    pub fn for_dac<D: DacStream>(config: GalvoConfig) -> Result<Self, GalvoError> {
+        let planning = prep::Planning::of::<D>();
+        planning.check(config.method)?;
+        Self::with_planning(config, planning)
+    }
+
+    fn with_planning(config: GalvoConfig, planning: prep::Planning) -> Result<Self, GalvoError> {
         let angles_rad = [0.0, 0.0];
         let disc = config
             .mirrors
@@ -255,7 +270,7 @@ impl GalvoLoop {
             pending_config: None,
             on_delay_samples: samples_for(config.laser_on_delay_us, ts),
             off_delay_samples: samples_for(config.laser_off_delay_us, ts),
-            bisection_allowed: true,
+            jump_planning: planning,
             config,
         })
     }
@@ -315,10 +330,10 @@ impl GalvoLoop {
         gate: &LaserGate,
         half: &mut [DacSample; HALF],
     ) -> ! {
-        link.bisection.store(D::PLANS_BISECTION, Ordering::Relaxed);
-        self.bisection_allowed = D::PLANS_BISECTION;
-        if !self.bisection_allowed && matches!(self.config.method, Method::Bisection(_)) {
-            log::error!("galvo: {}; planning time-optimal", GalvoError::SeedTooSlow);
+        link.bisection.store(D::F64_PLANNING, Ordering::Relaxed);
+        self.jump_planning = prep::Planning::of::<D>();
+        if let Err(e) = self.jump_planning.check(self.config.method) {
+            log::error!("galvo: {}; planning time-optimal", e);
             self.config.method = Method::TimeOptimal;
         }
         link.attach();

@@ -3,7 +3,7 @@
 
 use kinematics_core::PointMm;
 
-use galvo_planner::{Method, XyIntegrator};
+use galvo_planner::XyIntegrator;
 use kinematics_core::SampleMap;
 
 use super::mark::Motion;
@@ -120,9 +120,7 @@ impl GalvoLoop {
     /// mirrors or the sample rate changed; nothing else is rebuilt (the
     /// loop's buffers stay where they are, not copied).
     fn reconfigure(&mut self, config: GalvoConfig) -> Result<(), GalvoError> {
-        if !self.bisection_allowed && matches!(config.method, Method::Bisection(_)) {
-            return Err(GalvoError::SeedTooSlow);
-        }
+        self.jump_planning.check(config.method)?;
         let angles_rad = self.mirrors.end_position_rad();
         let sample_map = SampleMap::new(&config.galvo).map_err(|_| GalvoError::Kinematics)?;
         let codes = sample_map
