@@ -98,11 +98,12 @@ pub const M4_COST: CostModel = CostModel {
     // `loop.jump.prep`.
     point_prepared: 66_320,
     // `loop.tuning.prep`: the dearest stroke step, a jump and a stroke.
-    stroke_prepared: 67_420,
-    // `plan.seed.0.1deg`, the cheapest bisection plan (a lower bound).
-    bisection_axis: 1_572_240,
+    stroke_prepared: 68_670,
+    // `plan.seed.0.1deg` (1.572 M), rounded up: the cheapest bisection
+    // plan, a lower bound for any jump.
+    bisection_axis: 1_580_000,
     // `loop.reconfigure`.
-    rebuild: 4_520,
+    rebuild: 4_560,
     // `loop.new`.
     model_sampled: 462_560,
     cpi: 1.3,
