@@ -2,6 +2,7 @@
 //! through the simulator and read what happened.
 
 pub mod console;
+pub mod gcode_job;
 mod random;
 pub mod spec_patterns;
 

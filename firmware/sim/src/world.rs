@@ -109,6 +109,10 @@ pub struct SimOptions {
     /// The board has a galvo DAC (`false`: a board like the target's,
     /// which has none yet, so no galvo loop runs).
     pub galvo_dac: bool,
+    /// Serve the console on a pseudo-terminal instead of the script
+    /// (real time; the run ends when its stop flag is set).
+    #[cfg(unix)]
+    pub pty: Option<crate::pty::PtyOptions>,
 }
 
 impl Default for SimOptions {
@@ -129,6 +133,8 @@ impl Default for SimOptions {
             physical: PhysicalGimbal::default(),
             galvo_cost_ns_per_sample: 0,
             galvo_dac: true,
+            #[cfg(unix)]
+            pty: None,
         }
     }
 }
@@ -179,7 +185,7 @@ fn is_idle(status: &StatusBoard) -> bool {
     match s.activity {
         Activity::Idle => true,
         Activity::Goto => s.phase == Some(Phase::Holding),
-        Activity::Pattern(_) => false,
+        Activity::Pattern(_) | Activity::Gcode => false,
     }
 }
 
@@ -274,12 +280,16 @@ impl World {
     /// Wires the firmware onto the simulated board (the terminal plugged
     /// into its console), then starts the spot sampler.
     fn start(&self, spawner: Spawner, options: &SimOptions) {
-        let host_tasks = host_tasks(
-            options.interactive,
-            options.script.clone(),
-            self.host.clone(),
-            self.button.clone(),
-        );
+        let host_tasks: Box<dyn FnOnce(&Spawner)> = match &options.pty {
+            #[cfg(unix)]
+            Some(pty) => Box::new(crate::pty::host_start(self.host.clone(), pty.clone())),
+            _ => Box::new(host_tasks(
+                options.interactive,
+                options.script.clone(),
+                self.host.clone(),
+                self.button.clone(),
+            )),
+        };
         let mut sim_spawner = SimSpawner::new(spawner, host_tasks);
         wire(self.board(options), self.links, &mut sim_spawner);
         executor::spawn_task(

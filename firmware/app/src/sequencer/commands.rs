@@ -76,6 +76,7 @@ impl Core {
                 self.pending = Some(Pending::Save);
                 out.act(Action::Save);
             }
+            Command::Grbl(line) => self.grbl_line(line.as_str(), out),
         }
     }
 

@@ -65,6 +65,8 @@ pub enum Event {
     /// galvo loop, on an underrun) closed it since the core last did. The
     /// gimbal laser stays dark until the core closes it again.
     GateLost,
+    /// A grbl realtime command from the console (`?`, `!`, `~`, 0x18, …).
+    Realtime(crate::command::RealtimeRequest),
 }
 
 /// What the shell reads from the links when a command arrives.
@@ -151,6 +153,8 @@ pub enum Line {
     Ok,
     /// Closes the reply: `error: <reason>`.
     Error(ReplyText),
+    /// Closes a G-code or `$` line's reply: grbl's `error:N`.
+    GrblError(crate::grbl::GrblError),
 }
 
 /// Where the core writes its actions (the shell applies them at once, a
@@ -220,6 +224,8 @@ pub struct Core {
     /// Inputs of the event being handled (the galvo room counts down as
     /// jobs are sent).
     pub(super) inputs: Inputs,
+    /// The grbl session: G-code parser, motion queue, grbl settings.
+    pub(super) gcode: super::gcode::Gcode,
 }
 
 impl Core {
@@ -245,6 +251,7 @@ impl Core {
                 galvo_room: None,
                 galvo_bisection: false,
             },
+            gcode: super::gcode::Gcode::new(),
         }
     }
 
@@ -261,12 +268,13 @@ impl Core {
             Event::StopRequest => self.stop("stop button", out),
             Event::Servo(outcome) => self.servo_outcome(outcome, out),
             Event::Galvo(event) => self.galvo_event(event, out),
-            Event::DwellEnded => self.dwell_finished(out),
+            Event::DwellEnded => self.dwell_ended(out),
             Event::Tick => self.heartbeat = self.heartbeat.wrapping_add(1),
             Event::CheckStep => self.check_step(super::commands::CHECKS_PER_STEP, out),
             Event::Saved(result) => self.saved(result, out),
             Event::SettingsLoaded(loaded) => self.settings_loaded(loaded, out),
             Event::GateLost => self.gate_lost = true,
+            Event::Realtime(request) => self.grbl_realtime(request, out),
         }
         // A command in check has not changed anything yet.
         if !matches!(self.pending, Some(Pending::Check { .. })) {
@@ -281,7 +289,7 @@ impl Core {
 
     /// When the current dwell ends (`None`: no dwell running).
     pub fn dwell_deadline(&self) -> Option<Instant> {
-        self.run.and_then(|r| r.dwell_until)
+        self.gcode_deadline_or(self.run.and_then(|r| r.dwell_until))
     }
 
     /// Whether the gimbal laser is on.
@@ -294,6 +302,7 @@ impl Core {
         let run = self.run;
         Snapshot {
             activity: match run {
+                None if !self.gcode.motion.is_idle() => Activity::Gcode,
                 None => Activity::Idle,
                 Some(r) => match r.kind.pattern() {
                     Some(p) => Activity::Pattern(p),
@@ -354,11 +363,11 @@ impl Core {
         // is the gimbal's. Dark once the gate was closed by someone else
         // (a galvo underrun) until the run is stopped or restarted.
         let wanted = self.actuator.uses_gimbal()
-            && laser_wanted(
+            && (laser_wanted(
                 self.settings.laser_mode,
                 phase,
                 self.faults.gimbal_laser_blocked(yaw, pitch, phase),
-            )
+            ) || self.gcode_gimbal_lit())
             && !self.gate_lost;
         if wanted != self.laser_on {
             self.laser_on = wanted;
