@@ -553,7 +553,7 @@ fn a_board_that_cannot_afford_bisection_refuses_seed_parameters() {
         galvo.request(point);
         assert_eq!(galvo.prep(), 1);
     }
-    let jump = |g: &GalvoLoop| g.steps.get(0).map(|s| s.jump.clone());
+    let jump = |g: &GalvoLoop| g.steps.get(0).map(|s| s.jump);
     assert!(matches!(jump(&m4), Some(Ok(_))));
     assert_eq!(jump(&m4), jump(&host));
     // A host loop plans by bisection, and counts it for the cost model.
