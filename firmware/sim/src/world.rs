@@ -106,6 +106,10 @@ pub struct SimOptions {
     /// Galvo loop compute time charged per DAC sample, ns (0: the loop
     /// is instant; above the sample period it underruns).
     pub galvo_cost_ns_per_sample: u64,
+    /// Charge the galvo loop's work at the M4's cost (default; `false`:
+    /// the loop's work is free, to compare what the jump planners draw,
+    /// `planner seed` included).
+    pub galvo_m4_cost: bool,
     /// The board has a galvo DAC (`false`: a board like the target's,
     /// which has none yet, so no galvo loop runs).
     pub galvo_dac: bool,
@@ -132,6 +136,7 @@ impl Default for SimOptions {
             settings_flash_cut: None,
             physical: PhysicalGimbal::default(),
             galvo_cost_ns_per_sample: 0,
+            galvo_m4_cost: true,
             galvo_dac: true,
             #[cfg(unix)]
             pty: None,
@@ -261,12 +266,17 @@ impl World {
             laser,
             settings: settings_store(self.flash.clone()),
             galvo_dac: options.galvo_dac.then(|| {
-                SimDac::new(
+                let dac = SimDac::new(
                     GALVO_HALF_LEN,
                     period_ns,
                     options.galvo_cost_ns_per_sample,
                     self.dac.clone(),
-                )
+                );
+                if options.galvo_m4_cost {
+                    dac
+                } else {
+                    dac.without_m4_cost()
+                }
             }),
             leds: SimLeds(self.panel.clone()),
             stop_button: SimStopButton {

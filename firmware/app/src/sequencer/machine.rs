@@ -103,6 +103,9 @@ pub struct Inputs {
     /// requests are applied); `None` when no galvo loop serves the link
     /// (a board without a galvo DAC): galvo commands are refused.
     pub galvo_room: Option<usize>,
+    /// The galvo loop's board plans jumps by bisection (`planner seed`;
+    /// refused where it does not fit the target's time).
+    pub galvo_bisection: bool,
 }
 
 /// Something the core wants done, in order.
@@ -246,6 +249,7 @@ impl Core {
             inputs: Inputs {
                 now,
                 galvo_room: None,
+                galvo_bisection: false,
             },
             gcode: super::gcode::Gcode::new(),
         }

@@ -216,6 +216,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             let inputs = Inputs {
                 now: Instant::now(),
                 galvo_room: galvo.attached().then(|| galvo.requests.free_capacity()),
+                galvo_bisection: galvo.plans_bisection(),
             };
             self.core.on(inputs, event, &mut self.io);
             let follow_up = core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing);

@@ -30,6 +30,7 @@ fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
     let inputs = Inputs {
         now: Instant::from_millis(ms),
         galvo_room: None,
+        galvo_bisection: false,
     };
     let mut out = Vec::new();
     core.on(inputs, event, &mut out);
