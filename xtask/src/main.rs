@@ -7,6 +7,8 @@ mod fuzz;
 mod json_out;
 mod kin;
 mod plan;
+mod qemu;
+mod scenario;
 mod sim;
 mod size_gcode;
 mod toolchain;
@@ -36,6 +38,8 @@ enum Command {
     Size,
     /// Run the firmware tasks on the host against simulated servos (virtual time).
     Sim(sim::SimArgs),
+    /// Run the firmware on QEMU's mps2-an386 (Cortex-M4F) against the simulator's servos.
+    Qemu(qemu::QemuArgs),
     /// Gimbal kinematics: `kin ik`, `kin fk`, `kin grid-error`.
     Kin(kin::KinArgs),
     /// Error-model calibration: `calib fit --input FILE.csv`.
@@ -60,6 +64,7 @@ fn main() -> ExitCode {
         Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => sim::run_sim(args),
+        Command::Qemu(args) => qemu::run(args),
         Command::Kin(args) => kin::run(args),
         Command::Calib(args) => calib::run(args),
         Command::Plan(args) => plan::run(args),
