@@ -16,6 +16,7 @@ mod budgets;
 pub(crate) mod qemu;
 mod report;
 
+use std::path::PathBuf;
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
@@ -65,8 +66,9 @@ pub fn cargo_in(manifest: &str, args: &[&str]) -> Result<()> {
     Ok(())
 }
 
-/// `cargo xtask bench-m4`.
-pub fn bench_m4() -> Result<()> {
+/// `cargo xtask bench-m4`: runs the benchmark on QEMU, prints and writes
+/// its table, checks the budgets; returns the JSON table's path.
+pub fn bench_m4() -> Result<PathBuf> {
     ensure_qemu()?;
     ensure_flip_link()?;
     cargo(&["build", "--release", "--target", TARGET])?;
@@ -78,7 +80,8 @@ pub fn bench_m4() -> Result<()> {
     std::fs::write(&json, serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("could not write {}", json.display()))?;
     println!("table written to {}", json.display());
-    check(&report)
+    check(&report)?;
+    Ok(json)
 }
 
 #[cfg(test)]

@@ -60,7 +60,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Test => toolchain::test().map(|()| ExitCode::SUCCESS),
         Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
-        Command::BenchM4 => bench_m4::bench_m4().map(|()| ExitCode::SUCCESS),
+        Command::BenchM4 => bench_m4::bench_m4().map(|_table| ExitCode::SUCCESS),
         Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => sim::run_sim(args),

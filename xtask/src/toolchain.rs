@@ -48,9 +48,15 @@ pub fn workspace_root() -> PathBuf {
 /// Runs a command in the workspace root, echoing it first; fails on a
 /// non-zero exit.
 pub fn run(program: &str, args: &[&str]) -> Result<()> {
+    run_with_env(program, args, &[])
+}
+
+/// [`run`] with extra environment variables (`(name, value)` pairs).
+pub fn run_with_env(program: &str, args: &[&str], env: &[(&str, &Path)]) -> Result<()> {
     println!("$ {program} {}", args.join(" "));
     let status = Command::new(program)
         .args(args)
+        .envs(env.iter().copied())
         .current_dir(workspace_root())
         .status()
         .with_context(|| format!("could not start `{program}`"))?;
@@ -141,16 +147,18 @@ pub fn test() -> Result<()> {
     build_libs.extend(package_args(&TARGET_LIBRARIES));
     run("cargo", &build_libs)?;
 
+    // The per-sample and refill budgets on the target's instruction set,
+    // before the host tests: the simulator's M4 cost model is checked
+    // against this run's table (`tests/tests/galvo_cost.rs`).
+    let bench_table = crate::bench_m4::bench_m4()?;
+
     // Unit, integration (tests/) and doc tests of every host crate.
     let mut tests = vec!["test"];
     tests.extend(package_args(&HOST_PACKAGES));
-    run("cargo", &tests)?;
+    run_with_env("cargo", &tests, &[("BENCH_M4_JSON", &bench_table)])?;
 
     build_firmware()?;
     size()?;
-
-    // The per-sample and refill budgets on the target's instruction set.
-    crate::bench_m4::bench_m4()?;
 
     // The shared scenarios on the emulated Cortex-M4F (the simulator runs
     // them in xtask's tests above).
