@@ -34,7 +34,13 @@ async fn sequencer(task: SequencerTask<LaserPin, RamSettings>) -> ! {
 #[cfg(feature = "galvo-dac")]
 #[embassy_executor::task]
 async fn galvo(task: GalvoTask<crate::galvo_dac::QemuDac>) {
-    task.run().await
+    // The loop's memory in a static, not in this task's future (as on the
+    // STM32 board).
+    static MEMORY: static_cell::StaticCell<
+        laser_app::galvo::GalvoMemory<{ crate::galvo_dac::HALF_LEN }>,
+    > = static_cell::StaticCell::new();
+    task.run_in(MEMORY.init_with(laser_app::galvo::GalvoMemory::new))
+        .await
 }
 
 #[embassy_executor::task]
