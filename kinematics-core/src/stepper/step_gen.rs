@@ -93,8 +93,13 @@ impl StepGenerator {
     fn load(&mut self, seg: Segment) {
         if seg.starts_block {
             self.block = seg.block;
-            // Half an event: keeps each axis within half a step of the line.
-            self.counter = [seg.block.event_count >> 1; 2];
+            // Start at ⌈n/2⌉ (grbl's signed −⌊n/2⌋ offset by n): with the
+            // strict `> n` test the counter then ends every block at
+            // ⌈n/2⌉ ∈ [1, n], so each axis emits exactly its steps (a
+            // ⌊n/2⌋ start loses the only step of a one-event block) and
+            // stays within half a step of the line.
+            let n = seg.block.event_count;
+            self.counter = [n - (n >> 1); 2];
         }
         self.left = seg.events;
         self.segment = (seg.events > 0).then_some(seg);
