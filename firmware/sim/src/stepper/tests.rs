@@ -1,4 +1,5 @@
 use super::*;
+use kinematics_core::frames::BoardPoint;
 use kinematics_core::stepper::{Planner, SegmentPrep, SegmentQueue, StepGenerator, StepMove};
 
 const TIMER_HZ: u32 = 1_000_000;
