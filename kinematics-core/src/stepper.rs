@@ -12,6 +12,8 @@
 //! planned profiles into short constant-rate [`Segment`]s ahead of time, and
 //! the [`StepGenerator`] only executes those (Bresenham, integers only).
 
+#[cfg(test)]
+mod hold_tests;
 pub mod motion;
 #[cfg(test)]
 mod motion_tests;

@@ -8,11 +8,11 @@ use crate::stepper::StepperAxis;
 use proptest::prelude::*;
 use std::vec::Vec;
 
-const TIMER_HZ: u32 = 1_000_000;
+pub(super) const TIMER_HZ: u32 = 1_000_000;
 
 /// Property-test configuration with `default` cases, or `PROPTEST_CASES`
 /// when set (for stress runs: `PROPTEST_CASES=5000`).
-fn cases(default: u32) -> ProptestConfig {
+pub(super) fn cases(default: u32) -> ProptestConfig {
     let n = std::env::var("PROPTEST_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -22,14 +22,14 @@ fn cases(default: u32) -> ProptestConfig {
         ..ProptestConfig::default()
     }
 }
-const SEGMENT_S: f64 = 0.0015;
+pub(super) const SEGMENT_S: f64 = 0.0015;
 
 /// One executed step event: the tick, with the time it lasted.
 #[derive(Debug, Clone, Copy)]
-struct Event {
-    tick: StepTick,
+pub(super) struct Event {
+    pub(super) tick: StepTick,
     /// Rate of the segment the event belongs to, events/s.
-    rate: f64,
+    pub(super) rate: f64,
 }
 
 /// Runs `moves` through the whole pipeline, pushing each move after
@@ -64,7 +64,7 @@ fn events_of(mv: &StepMove) -> usize {
     mv.steps[0].unsigned_abs().max(mv.steps[1].unsigned_abs()) as usize
 }
 
-fn arb_move() -> impl Strategy<Value = StepMove> {
+pub(super) fn arb_move() -> impl Strategy<Value = StepMove> {
     (
         (-1500i32..1500, -1500i32..1500),
         1.0f64..20_000.0,
@@ -108,6 +108,36 @@ fn windows<'a>(moves: &[StepMove], events: &'a [Event]) -> Vec<&'a [Event]> {
     }
     assert_eq!(start, events.len(), "one event per dominant-axis step");
     out
+}
+
+/// Between segments the rate changes no faster than the acceleration
+/// limit (`limits[i]` for event `i`) allows, plus one period's rounding.
+pub(super) fn accel_bounded(events: &[Event], limits: &[f64]) -> Result<(), TestCaseError> {
+    let mut prev: Option<(f64, f64)> = None; // (rate, segment time)
+    let mut i = 0;
+    while i < events.len() {
+        let rate = events[i].rate;
+        let mut j = i;
+        while j < events.len() && events[j].tick.period_ticks == events[i].tick.period_ticks {
+            j += 1;
+        }
+        let dt = (j - i) as f64 / rate;
+        if let Some((r0, dt0)) = prev {
+            let a = limits[i].max(limits[i - 1]);
+            let quant = (r0 * r0 + rate * rate) / f64::from(TIMER_HZ);
+            prop_assert!(
+                (rate - r0).abs() <= a * (dt0 + dt) / 2.0 * (1.0 + 1e-6) + quant + 1e-9,
+                "rate {} -> {} over {} s at {}",
+                r0,
+                rate,
+                dt0 + dt,
+                a
+            );
+        }
+        prev = Some((rate, dt));
+        i = j;
+    }
+    Ok(())
 }
 
 proptest! {
@@ -160,24 +190,7 @@ proptest! {
         // From rest over the first event: mean rate √(a/2).
         prop_assert!(events[0].rate <= libm::sqrt(a_first / 2.0) * (1.0 + 1e-9));
         prop_assert!(events[events.len() - 1].rate <= libm::sqrt(a_last / 2.0) * (1.0 + 1e-9));
-        let mut prev: Option<(f64, f64)> = None; // (rate, segment time)
-        let mut i = 0;
-        while i < events.len() {
-            let rate = events[i].rate;
-            let mut j = i;
-            while j < events.len() && events[j].tick.period_ticks == events[i].tick.period_ticks {
-                j += 1;
-            }
-            let dt = (j - i) as f64 / rate;
-            if let Some((r0, dt0)) = prev {
-                let a = limits[i].max(limits[i - 1]);
-                let quant = (r0 * r0 + rate * rate) / f64::from(TIMER_HZ);
-                prop_assert!((rate - r0).abs() <= a * (dt0 + dt) / 2.0 * (1.0 + 1e-6) + quant + 1e-9,
-                    "rate {} -> {} over {} s at {}", r0, rate, dt0 + dt, a);
-            }
-            prev = Some((rate, dt));
-            i = j;
-        }
+        accel_bounded(&events, &limits)?;
     }
 
     /// The planned entry of a junction never exceeds grbl's deviation

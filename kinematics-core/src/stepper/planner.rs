@@ -157,6 +157,13 @@ impl<const N: usize> Planner<N> {
         Ok(())
     }
 
+    /// Drops every queued block (after a hold or a halt); the next block
+    /// starts from rest.
+    pub fn clear(&mut self) {
+        self.len = 0;
+        self.frozen_head_entry = None;
+    }
+
     /// Takes the head block for execution, with its exit rate set. The
     /// next block's entry rate is then fixed: later blocks can only raise
     /// the speeds of the blocks before them, so that entry stays feasible.

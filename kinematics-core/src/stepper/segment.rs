@@ -168,15 +168,65 @@ impl<const N: usize> SegmentQueue<N> {
     }
 }
 
+/// The block being cut and where the cutting is.
+#[derive(Debug, Clone, Copy)]
+struct Cutting {
+    block: StepBlock,
+    /// Profile of events `start..end` of the block.
+    profile: Profile,
+    accel: f64,
+    start: u32,
+    /// Events of the block already cut.
+    done: u32,
+    /// Events of the block to cut (fewer than the block's on a hold).
+    end: u32,
+    /// Whether the next segment is the block's first.
+    fresh: bool,
+}
+
+impl Cutting {
+    /// Rate where the cutting is, steps/s.
+    fn rate_now(&self) -> f64 {
+        self.profile.rate_at(f64::from(self.done - self.start))
+    }
+
+    /// Replaces the rest of the profile by a deceleration at the limit
+    /// from `rate` (steps/s). Returns the exit rate: 0 when it stops
+    /// within the block (the cutting then ends where it stops).
+    fn decelerate_from(&mut self, rate: f64) -> f64 {
+        let left = self.block.event_count - self.done;
+        let a = self.accel;
+        let stop_events = libm::ceil(rate * rate / (2.0 * a));
+        let (events, exit) = if stop_events <= f64::from(left) {
+            // In range (≤ left): the cast is exact.
+            (stop_events as u32, 0.0)
+        } else {
+            let exit = libm::sqrt((rate * rate - 2.0 * a * f64::from(left)).max(0.0));
+            (left, exit)
+        };
+        self.profile = Profile::of(&PlannedBlock {
+            event_count: events,
+            nominal_rate_steps_per_s: rate,
+            accel_steps_per_s2: a,
+            entry_rate_steps_per_s: rate,
+            exit_rate_steps_per_s: exit,
+            ..PlannedBlock::default()
+        });
+        self.start = self.done;
+        self.end = self.done + events;
+        exit
+    }
+}
+
 /// The prep stage: pulls blocks from the planner and cuts them into
 /// segments of about `segment_s` seconds.
 #[derive(Debug, Clone)]
 pub struct SegmentPrep {
     timer_hz: f64,
     segment_s: f64,
-    current: Option<(StepBlock, Profile)>,
-    /// Events of the current block already cut.
-    done: u32,
+    current: Option<Cutting>,
+    /// On a hold: the rate the next block starts at, steps/s.
+    hold_rate: Option<f64>,
 }
 
 impl SegmentPrep {
@@ -193,13 +243,51 @@ impl SegmentPrep {
             timer_hz: f64::from(timer_hz),
             segment_s,
             current: None,
-            done: 0,
+            hold_rate: None,
         })
     }
 
     /// Whether a block is being cut.
     pub fn is_busy(&self) -> bool {
         self.current.is_some()
+    }
+
+    /// Whether a hold is decelerating (until it has cut its last segment).
+    pub fn is_holding(&self) -> bool {
+        self.hold_rate.is_some()
+    }
+
+    /// A feed hold (grbl's): from where the cutting is, the rest is cut
+    /// as a deceleration at each block's acceleration limit along the
+    /// queued path, to rest; the blocks after the stop are dropped from
+    /// `planner`. The segments already prepared run as they are (the
+    /// deceleration follows them). Nothing to do at rest.
+    pub fn hold<const P: usize>(&mut self, planner: &mut Planner<P>) {
+        let rate = match self.current.as_mut() {
+            Some(c) => {
+                let now = c.rate_now();
+                c.decelerate_from(now)
+            }
+            // The prepared segments end at the next block's entry rate.
+            None => planner.block(0).map_or(0.0, |b| b.entry_rate_steps_per_s),
+        };
+        if rate > 0.0 {
+            self.hold_rate = Some(rate);
+        } else {
+            self.stop_holding(planner);
+        }
+    }
+
+    fn stop_holding<const P: usize>(&mut self, planner: &mut Planner<P>) {
+        planner.clear();
+        self.hold_rate = None;
+    }
+
+    /// Forgets the block being cut and any hold (after the step generator
+    /// was halted: nothing prepared will run).
+    pub fn reset(&mut self) {
+        self.current = None;
+        self.hold_rate = None;
     }
 
     /// Prepares segments into `queue` until it is full or the planner has
@@ -222,38 +310,65 @@ impl SegmentPrep {
         added
     }
 
-    /// Cuts the next segment, taking a new block from `planner` when the
-    /// current one is finished.
-    pub fn next_segment<const P: usize>(&mut self, planner: &mut Planner<P>) -> Option<Segment> {
-        let starts_block = self.current.is_none();
-        if starts_block {
-            let b = planner.pop()?;
-            let block = StepBlock {
+    /// Takes the next block from `planner` (decelerating on a hold).
+    fn start_block<const P: usize>(&mut self, planner: &mut Planner<P>) -> Option<Cutting> {
+        let b = planner.pop()?;
+        let mut cutting = Cutting {
+            block: StepBlock {
                 steps: [b.steps[0].unsigned_abs(), b.steps[1].unsigned_abs()],
                 negative: [b.steps[0] < 0, b.steps[1] < 0],
                 event_count: b.event_count,
-            };
-            self.current = Some((block, Profile::of(&b)));
-            self.done = 0;
+            },
+            profile: Profile::of(&b),
+            accel: b.accel_steps_per_s2,
+            start: 0,
+            done: 0,
+            end: b.event_count,
+            fresh: true,
+        };
+        if let Some(rate) = self.hold_rate {
+            let exit = cutting.decelerate_from(rate);
+            self.hold_rate = Some(exit);
         }
-        let (block, profile) = self.current?;
-        let remaining = block.event_count - self.done;
-        let s0 = f64::from(self.done);
-        let want = libm::floor(profile.rate_at(s0) * self.segment_s);
-        // Saturating float→int conversion; at least one event.
-        let events = (want as u32).clamp(1, remaining);
-        let dt = profile.time_at(s0 + f64::from(events)) - profile.time_at(s0);
-        let ticks = libm::ceil(dt * self.timer_hz / f64::from(events));
-        let period_ticks = (ticks as u32).max(1);
-        self.done += events;
-        if self.done >= block.event_count {
+        Some(cutting)
+    }
+
+    /// Cuts the next segment, taking a new block from `planner` when the
+    /// current one is finished.
+    pub fn next_segment<const P: usize>(&mut self, planner: &mut Planner<P>) -> Option<Segment> {
+        if self.current.is_none() {
+            self.current = self.start_block(planner);
+            if self.current.is_none() {
+                // Nothing left: a hold ends here too.
+                self.hold_rate = None;
+                return None;
+            }
+        }
+        let mut c = self.current?;
+        if c.done >= c.end {
+            // A hold that stopped right here.
             self.current = None;
+            self.stop_holding(planner);
+            return None;
         }
-        Some(Segment {
-            block,
-            starts_block,
+        let s0 = f64::from(c.done - c.start);
+        let want = libm::floor(c.profile.rate_at(s0) * self.segment_s);
+        // Saturating float→int conversion; at least one event.
+        let events = (want as u32).clamp(1, c.end - c.done);
+        let dt = c.profile.time_at(s0 + f64::from(events)) - c.profile.time_at(s0);
+        let ticks = libm::ceil(dt * self.timer_hz / f64::from(events));
+        let segment = Segment {
+            block: c.block,
+            starts_block: c.fresh,
             events,
-            period_ticks,
-        })
+            period_ticks: (ticks as u32).max(1),
+        };
+        c.done += events;
+        c.fresh = false;
+        self.current = (c.done < c.end).then_some(c);
+        if c.done >= c.end && self.hold_rate == Some(0.0) {
+            self.stop_holding(planner);
+        }
+        Some(segment)
     }
 }
