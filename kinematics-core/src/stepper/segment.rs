@@ -119,15 +119,39 @@ pub struct SegmentQueue<const N: usize> {
 
 impl<const N: usize> Default for SegmentQueue<N> {
     fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Segment {
+    /// No steps (a placeholder in empty queue slots).
+    pub const EMPTY: Self = Self {
+        block: StepBlock {
+            steps: [0; 2],
+            negative: [false; 2],
+            event_count: 0,
+        },
+        starts_block: false,
+        events: 0,
+        period_ticks: 0,
+    };
+}
+
+impl<const N: usize> SegmentQueue<N> {
+    /// An empty queue (usable in a `static`).
+    pub const fn new() -> Self {
         Self {
-            items: [Segment::default(); N],
+            items: [Segment::EMPTY; N],
             head: 0,
             len: 0,
         }
     }
-}
 
-impl<const N: usize> SegmentQueue<N> {
+    /// Drops every prepared segment.
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
     /// Number of prepared segments.
     pub fn len(&self) -> usize {
         self.len

@@ -17,7 +17,7 @@ pub struct StepTick {
 }
 
 /// Bresenham state over the current block plus the current segment.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct StepGenerator {
     block: StepBlock,
     counter: [u32; 2],
@@ -28,10 +28,22 @@ pub struct StepGenerator {
     position: [i32; 2],
 }
 
+impl Default for StepGenerator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl StepGenerator {
-    /// A generator at rest at position 0.
-    pub fn new() -> Self {
-        Self::default()
+    /// A generator at rest at position 0 (usable in a `static`).
+    pub const fn new() -> Self {
+        Self {
+            block: Segment::EMPTY.block,
+            counter: [0; 2],
+            segment: None,
+            left: 0,
+            position: [0; 2],
+        }
     }
 
     /// Position counted from the emitted steps, microsteps `[pan, tilt]`.
