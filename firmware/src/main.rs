@@ -31,6 +31,8 @@ static SERVO_LINK: ServoLink = ServoLink::new();
 static GALVO_LINK: GalvoLink = GalvoLink::new();
 /// Shared state for LEDs and the watchdog.
 static STATUS: StatusBoard = StatusBoard::new();
+/// Sequencer ↔ stepper task ↔ step timer.
+static STEPPER_LINK: laser_app::stepper::StepperLink = laser_app::stepper::StepperLink::new();
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
@@ -41,6 +43,7 @@ async fn main(spawner: Spawner) {
         galvo: &GALVO_LINK,
         status: &STATUS,
         gate: &board::LASER_GATE,
+        stepper: &STEPPER_LINK,
     };
     wire(board, links, &mut tasks::TaskSpawner(spawner));
 }

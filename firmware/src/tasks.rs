@@ -13,7 +13,11 @@ use laser_app::app::{
 };
 
 use crate::board::Stm32Board;
-use crate::parts::{IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton};
+use laser_app::stepper::{StepPulseTask, StepperTask};
+
+use crate::parts::{
+    GpioStepper, IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton,
+};
 use crate::settings_flash::FlashSettings;
 
 /// Runs the USB device stack (enumeration, control requests).
@@ -37,6 +41,18 @@ async fn servo_bus(task: ServoBusTask<RingBufferedUartRx<'static>, UartTx<'stati
 /// Runs the sequencer (commands, patterns, laser).
 #[embassy_executor::task]
 async fn sequencer(task: SequencerTask<LaserPin, FlashSettings>) -> ! {
+    task.run().await
+}
+
+/// The stepper step timer: executes the prepared segments on PE9–PE13.
+#[embassy_executor::task]
+async fn step_pulses(task: StepPulseTask<GpioStepper>) -> ! {
+    task.run().await
+}
+
+/// The stepper task: planning and segment prep for the pan/tilt.
+#[embassy_executor::task]
+async fn stepper(task: StepperTask) {
     task.run().await
 }
 
@@ -81,6 +97,14 @@ impl Spawn<Stm32Board> for TaskSpawner {
 
     fn galvo(&mut self, task: GalvoTask<NoGalvoDac>) {
         task.unreachable()
+    }
+
+    fn step_pulses(&mut self, task: StepPulseTask<GpioStepper>) {
+        self.0.spawn(defmt::unwrap!(step_pulses(task)));
+    }
+
+    fn stepper(&mut self, task: StepperTask) {
+        self.0.spawn(defmt::unwrap!(stepper(task)));
     }
 
     fn indicators(&mut self, task: IndicatorTask<StatusLeds>) {

@@ -28,8 +28,10 @@
 //! The spot comes from the counted steps through the exact gimbal FK
 //! ([`StepperGeometry::spot_cm`]).
 
+mod drive;
 mod pan_tilt;
 
+pub use drive::SimStepperDrive;
 pub use pan_tilt::{PanTiltDrivers, StepEdge, StepPin, StepperGeometry};
 
 /// Timing a driver needs on its inputs, ns.

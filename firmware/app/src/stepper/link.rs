@@ -13,7 +13,7 @@ use embassy_sync::signal::Signal;
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::stepper::{SegmentQueue, StepGenerator, StepTick};
 
-use super::{PulseTiming, StepperConfig};
+use super::{DriverSignals, StepperConfig};
 
 /// Prepared segments ahead of the step generator.
 pub const STEP_QUEUE_LEN: usize = 8;
@@ -104,10 +104,12 @@ pub struct StepperLink {
     pub(super) enabled: AtomicBool,
     /// A stepper task serves the link.
     attached: AtomicBool,
-    /// STEP pulse width and DIR setup time, ns (the stepper task sets
-    /// them, the step timer applies them when it starts).
+    /// STEP pulse width and DIR setup time, ns, ENABLE polarity (the
+    /// stepper task sets them, the step timer applies them when it
+    /// starts).
     pulse_ns: AtomicU32,
     dir_setup_ns: AtomicU32,
+    enable_active_high: AtomicBool,
 }
 
 impl Default for StepperLink {
@@ -134,6 +136,7 @@ impl StepperLink {
             attached: AtomicBool::new(false),
             pulse_ns: AtomicU32::new(0),
             dir_setup_ns: AtomicU32::new(0),
+            enable_active_high: AtomicBool::new(false),
         }
     }
 
@@ -147,16 +150,19 @@ impl StepperLink {
         self.attached.store(true, Ordering::Relaxed);
     }
 
-    pub(super) fn set_timing(&self, timing: PulseTiming) {
-        self.pulse_ns.store(timing.pulse_ns, Ordering::Relaxed);
+    pub(super) fn set_signals(&self, signals: DriverSignals) {
+        self.pulse_ns.store(signals.pulse_ns, Ordering::Relaxed);
         self.dir_setup_ns
-            .store(timing.dir_setup_ns, Ordering::Relaxed);
+            .store(signals.dir_setup_ns, Ordering::Relaxed);
+        self.enable_active_high
+            .store(signals.enable_active_high, Ordering::Relaxed);
     }
 
-    pub(super) fn timing(&self) -> PulseTiming {
-        PulseTiming {
+    pub(super) fn signals(&self) -> DriverSignals {
+        DriverSignals {
             pulse_ns: self.pulse_ns.load(Ordering::Relaxed),
             dir_setup_ns: self.dir_setup_ns.load(Ordering::Relaxed),
+            enable_active_high: self.enable_active_high.load(Ordering::Relaxed),
         }
     }
 

@@ -31,14 +31,18 @@ pub const STEP_TIMER_HZ: u32 = 1_000_000;
 /// Length of a prepared segment, s (grbl's order of magnitude).
 pub const SEGMENT_S: f64 = 0.0015;
 
-/// STEP pulse width and DIR setup time, ns.
+/// How the driver inputs are signalled: STEP pulse width, DIR setup
+/// time, ENABLE polarity.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct PulseTiming {
+pub struct DriverSignals {
     /// STEP high time, ns.
     pub pulse_ns: u32,
     /// DIR stable before the rising STEP edge, ns.
     pub dir_setup_ns: u32,
+    /// ENABLE is active high (else active low, as on TB6600-class
+    /// drivers' ENA− input).
+    pub enable_active_high: bool,
 }
 
 /// The board's stepper outputs and step timer.
@@ -47,8 +51,8 @@ pub trait StepperDrive {
     /// Energises (`true`) or releases the drivers (the board applies the
     /// configured ENABLE polarity).
     fn set_enabled(&mut self, enabled: bool);
-    /// The pulse timing of every later step.
-    fn set_timing(&mut self, timing: PulseTiming);
+    /// The pulse timing and ENABLE polarity from now on.
+    fn set_signals(&mut self, signals: DriverSignals);
     /// One step event: DIR to `negative` (high = negative) on both axes,
     /// then — the DIR setup time later — a STEP pulse on each axis in
     /// `step`.
@@ -81,8 +85,8 @@ pub struct StepperConfig {
     pub accel_deg_s2: f64,
     /// grbl's junction deviation, degrees of joint travel.
     pub junction_deviation_deg: f64,
-    /// STEP pulse width and DIR setup time.
-    pub timing: PulseTiming,
+    /// STEP pulse width, DIR setup time, ENABLE polarity.
+    pub signals: DriverSignals,
     /// Drivers released after this long at rest, ms (0: always held).
     pub idle_release_ms: u32,
     /// The pointing geometry: the exact model with the pan/tilt's OL.
@@ -92,7 +96,8 @@ pub struct StepperConfig {
 impl Default for StepperConfig {
     /// The seed's pan/tilt: 1.8° at 32 microsteps (0.05625° per step), OL
     /// = 0, ±60° soft limits, 90 °/s, 900 °/s², junction deviation 0.01°,
-    /// 2.5 µs pulses, 5 µs DIR setup, held 1 s after a move.
+    /// 2.5 µs pulses, 5 µs DIR setup, ENABLE active low, held 1 s after a
+    /// move.
     fn default() -> Self {
         Self {
             full_step_deg: SEED_FULL_STEP_DEG,
@@ -104,9 +109,10 @@ impl Default for StepperConfig {
             max_speed_deg_s: 90.0,
             accel_deg_s2: 900.0,
             junction_deviation_deg: 0.01,
-            timing: PulseTiming {
+            signals: DriverSignals {
                 pulse_ns: 2_500,
                 dir_setup_ns: 5_000,
+                enable_active_high: false,
             },
             idle_release_ms: 1_000,
             gimbal: Gimbal {

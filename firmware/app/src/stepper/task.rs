@@ -23,10 +23,19 @@ pub struct StepPulseTask<D> {
     pub(crate) link: &'static StepperLink,
 }
 
+impl StepPulseTask<crate::app::NoStepper> {
+    /// A board without stepper outputs never gets a step timer task:
+    /// its spawner's `step_pulses` hook is this.
+    pub fn unreachable(self) -> ! {
+        match self.drive {}
+    }
+}
+
 impl<D: StepperDrive> StepPulseTask<D> {
     /// Steps whatever is prepared; sleeps when nothing is.
     pub async fn run(mut self) -> ! {
         let mut enabled = false;
+        self.drive.set_signals(self.link.signals());
         self.drive.set_enabled(false);
         loop {
             let want = self.link.enabled.load(Ordering::Relaxed);
@@ -42,7 +51,7 @@ impl<D: StepperDrive> StepPulseTask<D> {
                 None => {
                     self.link.drained.signal(());
                     self.link.ready.wait().await;
-                    self.drive.set_timing(self.link.timing());
+                    self.drive.set_signals(self.link.signals());
                     self.drive.restart();
                 }
             }
@@ -79,7 +88,7 @@ impl StepperTask {
             }
         };
         let link = self.link;
-        link.set_timing(self.config.timing);
+        link.set_signals(self.config.signals);
         link.attach();
         let mut state = Running {
             motion,
@@ -172,7 +181,7 @@ impl Running {
 
     fn apply(&mut self, config: StepperConfig, link: &StepperLink) {
         match self.motion.configure(config) {
-            Ok(()) => link.set_timing(config.timing),
+            Ok(()) => link.set_signals(config.signals),
             Err(e) => log::error!("stepper: parameters refused: {:?}", e),
         }
     }
