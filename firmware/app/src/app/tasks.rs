@@ -15,7 +15,7 @@ use crate::command::CommandLink;
 use crate::galvo::{DacStream, GalvoConfig, GalvoLink, GalvoLoop};
 use crate::laser_gate::LaserGate;
 use crate::log;
-use crate::sequencer::{LaserSwitch, Sequencer, SettingsStore};
+use crate::sequencer::{ActuatorLinks, LaserSwitch, Sequencer, SettingsStore};
 use crate::servo::task::{ServoBus, ServoBusConfig, ServoLink};
 use crate::status::StatusBoard;
 use crate::stepper::StepperLink;
@@ -80,10 +80,13 @@ impl<L: LaserSwitch, S: SettingsStore> SequencerTask<L, S> {
             galvo,
             status,
             gate,
-            stepper: _,
+            stepper,
         } = self.links;
-        let mut sequencer =
-            Sequencer::new(command, servo, galvo, status, self.laser, gate, self.store).await;
+        let actuators = ActuatorLinks { galvo, stepper };
+        let mut sequencer = Sequencer::new(
+            command, servo, actuators, status, self.laser, gate, self.store,
+        )
+        .await;
         sequencer.run().await
     }
 }

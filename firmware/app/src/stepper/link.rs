@@ -10,6 +10,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
+use kinematics_core::Rotation;
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::stepper::{SegmentQueue, StepGenerator, StepTick};
 
@@ -21,21 +22,38 @@ pub const STEP_QUEUE_LEN: usize = 8;
 /// What the sequencer asks of the stepper task.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum StepperRequest {
-    /// Go to a board point (cm). `line`: along the straight board line
-    /// from the previous target (IK per piece end, the spot within
-    /// [`LINE_TOLERANCE_MM`](super::LINE_TOLERANCE_MM) of it); otherwise
-    /// straight in joint space (travel, laser dark).
+    /// Go to a board point (cm) the way `shape` says: board lines and
+    /// arcs from the previous target are cut into pieces (IK per piece
+    /// end) that keep the spot within
+    /// [`LINE_TOLERANCE_MM`](super::LINE_TOLERANCE_MM) of them.
     MoveTo {
         /// Request number.
         seq: u32,
         /// Board point, cm.
         point: BoardPoint,
-        /// Along the board line from the previous target.
-        line: bool,
+        /// How to get there.
+        shape: MoveShape,
     },
     /// Decelerate to rest at the acceleration limit along the path, drop
     /// the rest.
     Stop,
+}
+
+/// How a move gets to its point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MoveShape {
+    /// Straight in joint space (travel: the spot's board path is curved).
+    Travel,
+    /// Along the straight board line from the previous target.
+    Line,
+    /// Along the board arc about `centre` (cm) from the previous target;
+    /// ending where it started is a full circle.
+    Arc {
+        /// Centre, cm.
+        centre: BoardPoint,
+        /// Direction.
+        rotation: Rotation,
+    },
 }
 
 /// Why a move was refused (nothing moved for it).

@@ -18,7 +18,9 @@ mod link;
 mod motion;
 mod task;
 
-pub use self::link::{STEP_QUEUE_LEN, StepperEvent, StepperLink, StepperRefusal, StepperRequest};
+pub use self::link::{
+    MoveShape, STEP_QUEUE_LEN, StepperEvent, StepperLink, StepperRefusal, StepperRequest,
+};
 pub use self::motion::{LINE_TOLERANCE_MM, StepperMotion};
 pub use self::task::{StepPulseTask, StepperTask};
 
@@ -87,7 +89,8 @@ pub struct StepperConfig {
     pub junction_deviation_deg: f64,
     /// STEP pulse width, DIR setup time, ENABLE polarity.
     pub signals: DriverSignals,
-    /// Drivers released after this long at rest, ms (0: always held).
+    /// Drivers released after this long at rest, ms (0: always held, the
+    /// default: a released pan/tilt may sag off the point it holds).
     pub idle_release_ms: u32,
     /// The pointing geometry: the exact model with the pan/tilt's OL.
     pub gimbal: Gimbal,
@@ -96,8 +99,7 @@ pub struct StepperConfig {
 impl Default for StepperConfig {
     /// The seed's pan/tilt: 1.8° at 32 microsteps (0.05625° per step), OL
     /// = 0, ±60° soft limits, 90 °/s, 900 °/s², junction deviation 0.01°,
-    /// 2.5 µs pulses, 5 µs DIR setup, ENABLE active low, held 1 s after a
-    /// move.
+    /// 2.5 µs pulses, 5 µs DIR setup, ENABLE active low, always held.
     fn default() -> Self {
         Self {
             full_step_deg: SEED_FULL_STEP_DEG,
@@ -114,7 +116,7 @@ impl Default for StepperConfig {
                 dir_setup_ns: 5_000,
                 enable_active_high: false,
             },
-            idle_release_ms: 1_000,
+            idle_release_ms: 0,
             gimbal: Gimbal {
                 model: GimbalModel::Exact,
                 geometry: GimbalGeometry {

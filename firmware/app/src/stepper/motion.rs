@@ -1,17 +1,18 @@
 //! The stepper task's low-priority work, pure: targets → joint angles →
-//! microstep moves → planner → segment prep. Board lines are cut into
-//! pieces whose ends go through the IK and whose insides are straight in
-//! steps, enough pieces that the spot stays within [`LINE_TOLERANCE_MM`]
-//! of the board line.
+//! microstep moves → planner → segment prep. Board lines and arcs are cut
+//! into pieces whose ends go through the IK and whose insides are
+//! straight in steps, enough pieces (a power of two) that the spot stays
+//! within [`LINE_TOLERANCE_MM`] of the board curve.
 
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::JointAngles;
 use kinematics_core::stepper::{Planner, Segment, SegmentPrep, StepMove};
 
-use super::{SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
+use super::{MoveShape, SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
+use kinematics_core::Rotation;
 
 /// Largest distance of the pieces' joint-space insides from the board
-/// line, mm (the steps' own rounding, ≤ half a step per axis, comes on
+/// curve, mm (the steps' own rounding, ≤ half a step per axis, comes on
 /// top).
 pub const LINE_TOLERANCE_MM: f64 = 0.05;
 /// Most pieces one line is cut into.
@@ -19,23 +20,113 @@ const MAX_PIECES: u32 = 4096;
 /// Look-ahead depth of the planner, blocks.
 const PLANNER_LEN: usize = 16;
 
-/// A board line being cut into pieces.
+/// The board curve of a move being cut into pieces.
 #[derive(Debug, Clone, Copy)]
-struct LineCut {
-    from: BoardPoint,
-    to: BoardPoint,
+enum Curve {
+    Line {
+        from: BoardPoint,
+        to: BoardPoint,
+    },
+    Arc {
+        centre: BoardPoint,
+        radius_cm: f64,
+        /// Angle of the start about the centre, rad.
+        start_rad: f64,
+        /// Signed angle swept (negative: clockwise), rad.
+        sweep_rad: f64,
+    },
+}
+
+impl Curve {
+    /// The curve from `from` to `to` as `shape` says (`None`: travel).
+    fn of(from: BoardPoint, to: BoardPoint, shape: MoveShape) -> Option<Self> {
+        match shape {
+            MoveShape::Travel => None,
+            MoveShape::Line => Some(Curve::Line { from, to }),
+            MoveShape::Arc { centre, rotation } => {
+                let angle = |p: BoardPoint| libm::atan2(p.y_cm - centre.y_cm, p.x_cm - centre.x_cm);
+                let (start_rad, end_rad) = (angle(from), angle(to));
+                let turn = 2.0 * core::f64::consts::PI;
+                let diff = libm::fmod(end_rad - start_rad, turn);
+                let mut ccw = if diff < 0.0 { diff + turn } else { diff };
+                // The same point: a full circle.
+                if ccw < 1e-12 {
+                    ccw = turn;
+                }
+                let sweep_rad = match rotation {
+                    Rotation::Ccw => ccw,
+                    Rotation::Cw => ccw - turn,
+                };
+                let sweep_rad = if sweep_rad == 0.0 { -turn } else { sweep_rad };
+                Some(Curve::Arc {
+                    centre,
+                    radius_cm: libm::hypot(from.x_cm - centre.x_cm, from.y_cm - centre.y_cm),
+                    start_rad,
+                    sweep_rad,
+                })
+            }
+        }
+    }
+
+    /// The point a fraction `t` (0..=1) along the curve.
+    fn at(&self, t: f64) -> BoardPoint {
+        match *self {
+            Curve::Line { from, to } => BoardPoint {
+                x_cm: from.x_cm + t * (to.x_cm - from.x_cm),
+                y_cm: from.y_cm + t * (to.y_cm - from.y_cm),
+            },
+            Curve::Arc {
+                centre,
+                radius_cm,
+                start_rad,
+                sweep_rad,
+            } => {
+                let (s, c) = libm::sincos(start_rad + t * sweep_rad);
+                BoardPoint {
+                    x_cm: centre.x_cm + radius_cm * c,
+                    y_cm: centre.y_cm + radius_cm * s,
+                }
+            }
+        }
+    }
+
+    /// Pieces to start from: arcs in pieces of at most 22.5° (so a
+    /// piece's midpoint tells its deviation; a full circle is not one
+    /// piece from its start to itself).
+    fn fewest_pieces(&self) -> u32 {
+        match *self {
+            Curve::Line { .. } => 1,
+            Curve::Arc { sweep_rad, .. } => {
+                let wanted = libm::ceil(sweep_rad.abs() / (core::f64::consts::PI / 8.0));
+                // ≤ 16 for |sweep| ≤ 2π: the cast is exact.
+                (wanted as u32).max(1).next_power_of_two()
+            }
+        }
+    }
+
+    /// Distance of `p` from the curve (near it), cm.
+    fn distance_cm(&self, p: BoardPoint) -> f64 {
+        match *self {
+            Curve::Line { from, to } => distance_to_segment_cm(p, from, to),
+            Curve::Arc {
+                centre, radius_cm, ..
+            } => (libm::hypot(p.x_cm - centre.x_cm, p.y_cm - centre.y_cm) - radius_cm).abs(),
+        }
+    }
+}
+
+/// A board curve being cut into pieces.
+#[derive(Debug, Clone, Copy)]
+struct PieceCut {
+    curve: Curve,
     pieces: u32,
     /// Next piece end to queue (1..=pieces).
     next: u32,
 }
 
-impl LineCut {
+impl PieceCut {
     fn point(&self, k: u32) -> BoardPoint {
-        let t = f64::from(k) / f64::from(self.pieces);
-        BoardPoint {
-            x_cm: self.from.x_cm + t * (self.to.x_cm - self.from.x_cm),
-            y_cm: self.from.y_cm + t * (self.to.y_cm - self.from.y_cm),
-        }
+        self.curve.at(f64::from(k) / f64::from(self.pieces))
     }
 }
 
@@ -49,7 +140,7 @@ pub struct StepperMotion {
     planned: [i32; 2],
     /// Board point of the last target (`None` after a stop).
     last_point: Option<BoardPoint>,
-    line: Option<LineCut>,
+    line: Option<PieceCut>,
     /// The move in flight, reported when its last step has run.
     pending: Option<u32>,
 }
@@ -117,8 +208,9 @@ impl StepperMotion {
         self.line.is_none() && self.planner.is_empty() && !self.prep.is_busy()
     }
 
-    /// Queues move `seq` to the board point `point` (cm); along the board
-    /// line from the previous target when `line` (and there is one).
+    /// Queues move `seq` to the board point `point` (cm), along the board
+    /// line or arc from the previous target when `shape` says so (and
+    /// there is one; else as travel).
     ///
     /// Errors: [`StepperRefusal`] (nothing queued; [`StepperRefusal::Busy`]
     /// while a line is still being cut).
@@ -126,18 +218,20 @@ impl StepperMotion {
         &mut self,
         seq: u32,
         point: BoardPoint,
-        line: bool,
+        shape: MoveShape,
     ) -> Result<(), StepperRefusal> {
         if self.line.is_some() {
             return Err(StepperRefusal::Busy);
         }
         let end = self.steps_at(point)?;
-        match self.last_point.filter(|_| line) {
-            Some(from) => {
-                let pieces = self.pieces_for(from, point)?;
-                self.line = Some(LineCut {
-                    from,
-                    to: point,
+        match self
+            .last_point
+            .and_then(|from| Curve::of(from, point, shape))
+        {
+            Some(curve) => {
+                let pieces = self.pieces_for(curve)?;
+                self.line = Some(PieceCut {
+                    curve,
                     pieces,
                     next: 1,
                 });
@@ -166,14 +260,13 @@ impl StepperMotion {
     }
 
     /// The fewest pieces (a power of two) whose joint-space midpoints lie
-    /// within [`LINE_TOLERANCE_MM`] of the line; every piece end within
+    /// within [`LINE_TOLERANCE_MM`] of the curve; every piece end within
     /// the soft limits.
-    fn pieces_for(&self, from: BoardPoint, to: BoardPoint) -> Result<u32, StepperRefusal> {
-        let mut pieces = 1;
+    fn pieces_for(&self, curve: Curve) -> Result<u32, StepperRefusal> {
+        let mut pieces = curve.fewest_pieces();
         loop {
-            let cut = LineCut {
-                from,
-                to,
+            let cut = PieceCut {
+                curve,
                 pieces,
                 next: 1,
             };
@@ -184,8 +277,9 @@ impl StepperMotion {
         }
     }
 
-    /// Largest distance of a piece's joint-space midpoint from the line, mm.
-    fn max_deviation_mm(&self, cut: &LineCut) -> Result<f64, StepperRefusal> {
+    /// Largest distance of a piece's joint-space midpoint from the curve,
+    /// mm.
+    fn max_deviation_mm(&self, cut: &PieceCut) -> Result<f64, StepperRefusal> {
         let mut worst = 0.0_f64;
         let mut a = self.joints_at(cut.point(0))?;
         for k in 1..=cut.pieces {
@@ -200,7 +294,7 @@ impl StepperMotion {
                 .gimbal
                 .fk(mid)
                 .map_err(|_| StepperRefusal::Unreachable)?;
-            worst = worst.max(10.0 * distance_to_segment_cm(spot, cut.from, cut.to));
+            worst = worst.max(10.0 * cut.curve.distance_cm(spot));
             a = b;
         }
         Ok(worst)

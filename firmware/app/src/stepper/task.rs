@@ -72,6 +72,8 @@ struct Running {
     stopping: bool,
     /// Parameters to apply once at rest.
     pending_config: Option<StepperConfig>,
+    /// A move that arrived during a stop: queued once at rest.
+    deferred: Option<StepperRequest>,
     /// When the axes came to rest (for the ENABLE release).
     rest_since: Option<Instant>,
 }
@@ -94,6 +96,7 @@ impl StepperTask {
             motion,
             stopping: false,
             pending_config: None,
+            deferred: None,
             rest_since: Some(Instant::now()),
         };
         loop {
@@ -167,6 +170,9 @@ impl Running {
         if let Some(config) = self.pending_config.take() {
             self.apply(config, link);
         }
+        if let Some(request) = self.deferred.take() {
+            self.move_to(request, link).await;
+        }
         let now = Instant::now();
         let since = *self.rest_since.get_or_insert(now);
         let release_ms = self.motion.config().idle_release_ms;
@@ -188,16 +194,26 @@ impl Running {
 
     async fn request(&mut self, request: StepperRequest, link: &StepperLink) {
         match request {
-            StepperRequest::MoveTo { seq, point, line } => {
-                if let Err(why) = self.motion.move_to(seq, point, line) {
-                    log::warning!("stepper: move {} refused: {:?}", seq, why);
-                    link.events.send(StepperEvent::Refused { seq, why }).await;
-                }
+            StepperRequest::MoveTo { .. } if self.stopping => {
+                // Planned from where the stop comes to rest.
+                self.deferred = Some(request);
             }
+            StepperRequest::MoveTo { .. } => self.move_to(request, link).await,
             StepperRequest::Stop => {
                 self.motion.stop();
+                self.deferred = None;
                 self.stopping = true;
             }
+        }
+    }
+
+    async fn move_to(&mut self, request: StepperRequest, link: &StepperLink) {
+        let StepperRequest::MoveTo { seq, point, shape } = request else {
+            return;
+        };
+        if let Err(why) = self.motion.move_to(seq, point, shape) {
+            log::warning!("stepper: move {} refused: {:?}", seq, why);
+            link.events.send(StepperEvent::Refused { seq, why }).await;
         }
     }
 

@@ -66,7 +66,7 @@ fn move_to_a_point_ends_within_half_a_step() {
     let config = StepperConfig::default();
     let mut motion = StepperMotion::new(config).unwrap();
     let target = BoardPoint::new(6.0, -3.5);
-    motion.move_to(7, target, false).unwrap();
+    motion.move_to(7, target, MoveShape::Travel).unwrap();
     let positions = drain(&mut motion, link);
     let end = *positions.last().unwrap();
     let j = config.gimbal.ik(target).unwrap();
@@ -79,18 +79,26 @@ fn move_to_a_point_ends_within_half_a_step() {
     assert_eq!(motion.take_arrived(true), None);
 }
 
-/// Spot displacement of half a step on both axes near `p`, mm.
-fn half_step_mm(config: &StepperConfig, p: BoardPoint) -> f64 {
+/// Largest spot displacement near `p` when each joint is off by up to
+/// one step, mm: a piece's ends are rounded to whole steps (≤ ½ step
+/// each) and Bresenham keeps within ½ step of the straight line between
+/// them, so the spot may be off the piece's joint-space line by that.
+fn one_step_mm(config: &StepperConfig, p: BoardPoint) -> f64 {
     let j = config.gimbal.ik(p).unwrap();
-    let h = config.deg_per_step() / 2.0;
-    let moved = config
-        .gimbal
-        .fk(JointAngles {
-            yaw_deg: j.yaw_deg + h,
-            pitch_deg: j.pitch_deg + h,
+    let h = config.deg_per_step();
+    [(h, h), (h, -h), (-h, h), (-h, -h)]
+        .into_iter()
+        .map(|(dy, dp)| {
+            let moved = config
+                .gimbal
+                .fk(JointAngles {
+                    yaw_deg: j.yaw_deg + dy,
+                    pitch_deg: j.pitch_deg + dp,
+                })
+                .unwrap();
+            10.0 * (moved.x_cm - p.x_cm).hypot(moved.y_cm - p.y_cm)
         })
-        .unwrap();
-    10.0 * (moved.x_cm - p.x_cm).hypot(moved.y_cm - p.y_cm)
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -99,9 +107,9 @@ fn board_line_stays_on_the_line() {
     let config = StepperConfig::default();
     let mut motion = StepperMotion::new(config).unwrap();
     let (a, b) = (BoardPoint::new(-12.0, 10.0), BoardPoint::new(12.0, -8.0));
-    motion.move_to(1, a, false).unwrap();
+    motion.move_to(1, a, MoveShape::Travel).unwrap();
     drain(&mut motion, link);
-    motion.move_to(2, b, true).unwrap();
+    motion.move_to(2, b, MoveShape::Line).unwrap();
     let positions = drain(&mut motion, link);
     assert!(positions.len() > 500);
     let (dx, dy) = (b.x_cm - a.x_cm, b.y_cm - a.y_cm);
@@ -110,7 +118,7 @@ fn board_line_stays_on_the_line() {
     for steps in &positions {
         let spot = config.gimbal.fk(config.joints_of(*steps).unwrap()).unwrap();
         let off_mm = 10.0 * ((spot.x_cm - a.x_cm) * dy - (spot.y_cm - a.y_cm) * dx).abs() / len;
-        let bound = LINE_TOLERANCE_MM + half_step_mm(&config, spot);
+        let bound = LINE_TOLERANCE_MM + one_step_mm(&config, spot);
         assert!(off_mm <= bound, "{off_mm} mm > {bound} at {steps:?}");
         worst = worst.max(off_mm);
     }
@@ -126,7 +134,7 @@ fn refusals_change_nothing() {
     let mut motion = StepperMotion::new(StepperConfig::default()).unwrap();
     // 60° of pan at 25 cm is 43 cm: beyond the soft limit.
     assert_eq!(
-        motion.move_to(1, BoardPoint::new(50.0, 0.0), false),
+        motion.move_to(1, BoardPoint::new(50.0, 0.0), MoveShape::Travel),
         Err(StepperRefusal::SoftLimit)
     );
     assert!(motion.is_planned_out());
@@ -148,7 +156,7 @@ fn halt_drops_everything_prepared() {
     let link = link();
     let mut motion = StepperMotion::new(StepperConfig::default()).unwrap();
     motion
-        .move_to(1, BoardPoint::new(10.0, 0.0), false)
+        .move_to(1, BoardPoint::new(10.0, 0.0), MoveShape::Travel)
         .unwrap();
     for _ in 0..200 {
         while !link.with_queue(|q| q.is_full()) {
@@ -177,7 +185,7 @@ fn stop_decelerates_to_rest_short_of_the_target() {
     let config = StepperConfig::default();
     let mut motion = StepperMotion::new(config).unwrap();
     motion
-        .move_to(1, BoardPoint::new(14.0, 0.0), false)
+        .move_to(1, BoardPoint::new(14.0, 0.0), MoveShape::Travel)
         .unwrap();
     for _ in 0..400 {
         while !link.with_queue(|q| q.is_full()) {
@@ -199,4 +207,39 @@ fn stop_decelerates_to_rest_short_of_the_target() {
         "{end} vs {target}"
     );
     assert_eq!(motion.take_arrived(true), None);
+}
+
+#[test]
+fn board_circle_stays_on_the_circle() {
+    let link = link();
+    let config = StepperConfig::default();
+    let mut motion = StepperMotion::new(config).unwrap();
+    let centre = BoardPoint::new(2.0, -1.0);
+    let top = BoardPoint::new(2.0, 7.0);
+    motion.move_to(1, top, MoveShape::Travel).unwrap();
+    drain(&mut motion, link);
+    let shape = MoveShape::Arc {
+        centre,
+        rotation: kinematics_core::Rotation::Cw,
+    };
+    motion.move_to(2, top, shape).unwrap();
+    let positions = drain(&mut motion, link);
+    let mut angles = Vec::new();
+    for steps in &positions {
+        let spot = config.gimbal.fk(config.joints_of(*steps).unwrap()).unwrap();
+        let (dx, dy) = (spot.x_cm - centre.x_cm, spot.y_cm - centre.y_cm);
+        let off_mm = 10.0 * (dx.hypot(dy) - 8.0).abs();
+        let bound = LINE_TOLERANCE_MM + one_step_mm(&config, spot);
+        assert!(off_mm <= bound, "{off_mm} mm > {bound} at {steps:?}");
+        angles.push(dy.atan2(dx));
+    }
+    // All the way round, clockwise: from the top through the right side.
+    let right = angles.iter().position(|a| a.abs() < 0.05).unwrap();
+    let left = angles
+        .iter()
+        .position(|a| (a.abs() - core::f64::consts::PI).abs() < 0.05)
+        .unwrap();
+    assert!(right < left);
+    let start = config.steps_of(config.gimbal.ik(top).unwrap()).unwrap();
+    assert_eq!(*positions.last().unwrap(), start);
 }

@@ -35,6 +35,7 @@ fn on_with(core: &mut Core, ms: u64, galvo: bool, event: Event) -> Vec<Action> {
     let inputs = Inputs {
         now: Instant::from_millis(ms),
         galvo_room: galvo.then_some(GALVO_REQUEST_DEPTH),
+        stepper_attached: galvo,
     };
     let mut out = Vec::new();
     core.on(inputs, event, &mut out);
