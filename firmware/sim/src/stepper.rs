@@ -277,8 +277,14 @@ impl AxisDriver {
         let damping = 2.0 * DAMPING_RATIO * omega;
         let target = self.counted as f64;
         while self.rotor_ns < t_ns {
-            let h_ns = (t_ns - self.rotor_ns).min((ROTOR_DT_S * 1e9) as u64);
             let v_cmd = self.commanded_rate_at(self.rotor_ns);
+            // At rest in its detent with nothing commanded: nothing moves.
+            let at_rest = (self.rotor - self.slip_offset - target).abs() < 1e-6;
+            if v_cmd == 0.0 && self.rotor_rate.abs() < 1e-6 && at_rest {
+                self.rotor_ns = t_ns;
+                break;
+            }
+            let h_ns = (t_ns - self.rotor_ns).min((ROTOR_DT_S * 1e9) as u64);
             let h = h_ns as f64 * 1e-9;
             let lag = self.rotor - target;
             let derate = (1.0 - self.rotor_rate.abs() / self.limits.max_rate_steps_per_s).max(0.0);

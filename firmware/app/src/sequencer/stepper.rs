@@ -11,7 +11,7 @@ use kinematics_core::gimbal::{Gimbal, GimbalModel};
 
 use super::machine::{Action, ActionSink, Core};
 use super::run::RunKind;
-use crate::domain::{Pattern, PointCm, Segment, Target, Unit};
+use crate::domain::{Aim, Pattern, PointCm, Segment, Target, Unit};
 use crate::log;
 use crate::stepper::{MoveShape, StepperConfig, StepperEvent, StepperRequest};
 use crate::text::Fixed;
@@ -80,6 +80,16 @@ impl Core {
         if let Some(run) = self.run.as_mut() {
             run.seq = seq;
         }
+        // What `status` and the recorders show: the target and its joint
+        // angles on the stepper (no servo: wire 0).
+        let joints = self.stepper_config().gimbal.ik(point).unwrap_or_default();
+        let aim = Aim {
+            yaw_deg: joints.yaw_deg,
+            pitch_deg: joints.pitch_deg,
+            yaw_wire: 0,
+            pitch_wire: 0,
+        };
+        self.last_aim = Some((target, aim));
         true
     }
 

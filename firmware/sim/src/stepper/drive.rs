@@ -46,14 +46,33 @@ impl StepperDrive for SimStepperDrive {
     /// Records the logical state (the ENABLE pin's level follows the
     /// configured polarity).
     fn set_enabled(&mut self, enabled: bool) {
-        self.drivers.borrow_mut().enable.push((now_ns(), enabled));
+        crate::executor::simulator_work(|| {
+            self.drivers.borrow_mut().enable.push((now_ns(), enabled));
+        });
     }
 
     fn set_signals(&mut self, signals: DriverSignals) {
         self.signals = signals;
     }
 
+    /// The edges go to the driver models as simulator work (not charged
+    /// to the firmware task).
     fn step(&mut self, step: [bool; 2], negative: [bool; 2]) {
+        crate::executor::simulator_work(|| self.record_step(step, negative));
+    }
+
+    async fn wait_ticks(&mut self, ticks: u32) {
+        self.next += Duration::from_ticks(u64::from(ticks));
+        Timer::at(self.next).await;
+    }
+
+    fn restart(&mut self) {
+        self.next = Instant::now();
+    }
+}
+
+impl SimStepperDrive {
+    fn record_step(&mut self, step: [bool; 2], negative: [bool; 2]) {
         let t = now_ns();
         let rise = t + u64::from(self.signals.dir_setup_ns);
         let fall = rise + u64::from(self.signals.pulse_ns);
@@ -80,14 +99,5 @@ impl StepperDrive for SimStepperDrive {
                 }
             }
         }
-    }
-
-    async fn wait_ticks(&mut self, ticks: u32) {
-        self.next += Duration::from_ticks(u64::from(ticks));
-        Timer::at(self.next).await;
-    }
-
-    fn restart(&mut self) {
-        self.next = Instant::now();
     }
 }
