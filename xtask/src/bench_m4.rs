@@ -15,6 +15,7 @@
 mod budgets;
 mod qemu;
 mod report;
+mod stepper_rows;
 
 use std::process::Command;
 
