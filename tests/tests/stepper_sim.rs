@@ -275,3 +275,25 @@ fn stepper_runs_keep_the_safety_invariants() {
     assert_eq!(report.recording.dwells.len(), 4, "the corners");
     assert!(report.recording.spot.iter().filter(|s| s.laser).count() > 200);
 }
+
+#[test]
+fn the_stop_button_halts_the_steps_at_once() {
+    let report = run_with(
+        "target stepper\npattern line -14 0 14 0 once\nwait 900\n@button\nwait 500\n",
+        SimOptions::default(),
+    );
+    let pressed_us = *report.panel.button_presses.first().expect("pressed");
+    assert!(
+        gimbal_dark_after(&report, pressed_us) <= 1_000,
+        "laser dark within 1 ms"
+    );
+    let steps = rising_steps(&report, 0);
+    let before = steps.iter().filter(|&&t| t < pressed_us * 1000).count();
+    assert!(before > 300, "it was drawing: {before} steps");
+    // At most the step in flight (one ≤ 1 ms period at 1 600 steps/s) after the press.
+    let after = steps
+        .iter()
+        .filter(|&&t| t > pressed_us * 1000 + 1_000_000)
+        .count();
+    assert_eq!(after, 0, "steps after the halt");
+}
