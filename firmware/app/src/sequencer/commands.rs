@@ -80,7 +80,8 @@ impl Core {
     }
 
     /// `target`, `planner` and `galvo status`: refused when no galvo loop
-    /// serves the link (except `target gimbal`).
+    /// serves the link (except `target gimbal`, and `target stepper`,
+    /// refused when no stepper task serves its link).
     fn galvo_command(&mut self, command: Command, readings: &Readings, out: &mut dyn ActionSink) {
         let gimbal = command == Command::Target(Actuator::Gimbal);
         if command == Command::Target(Actuator::Stepper) {

@@ -72,10 +72,10 @@ impl Core {
         }));
         out.act(Action::Note(super::laser::LaserEvent::GimbalMoveSent));
         log::info!(
-            "stepper target ({}, {}) cm ({:?})",
+            "stepper target ({}, {}) cm ({})",
             target.point.x_cm,
             target.point.y_cm,
-            shape
+            shape.name()
         );
         if let Some(run) = self.run.as_mut() {
             run.seq = seq;

@@ -56,6 +56,17 @@ pub enum MoveShape {
     },
 }
 
+impl MoveShape {
+    /// `travel`, `line` or `arc` (for logs).
+    pub fn name(&self) -> &'static str {
+        match self {
+            MoveShape::Travel => "travel",
+            MoveShape::Line => "line",
+            MoveShape::Arc { .. } => "arc",
+        }
+    }
+}
+
 /// Why a move was refused (nothing moved for it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
