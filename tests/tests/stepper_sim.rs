@@ -297,3 +297,19 @@ fn the_stop_button_halts_the_steps_at_once() {
         .count();
     assert_eq!(after, 0, "steps after the halt");
 }
+
+/// The seed's point-by-point comparison method, kept for comparison
+/// (`model seed`): its staircase of 2 mm steps is off the circle by up to
+/// about half a step; the exact trace is not.
+#[test]
+fn the_seeds_point_by_point_method_is_kept_for_comparison() {
+    let off = |model: &str| {
+        let report = run(&format!("model {model}\npattern circle 1 -2 8 ccw once\n"));
+        assert_clean_drive(&report);
+        lit_off_figure_mm(&report, |x, y| ((x - 1.0).hypot(y + 2.0) - 8.0).abs()).0
+    };
+    let (seed, exact) = (off("seed"), off("exact"));
+    eprintln!("circle r = 8 cm: seed point-by-point {seed:.3} mm, exact {exact:.3} mm");
+    assert!(seed > 0.5 && seed < 2.0, "{seed}");
+    assert!(exact <= LINE_TOLERANCE_MM + ONE_STEP_MM, "{exact}");
+}

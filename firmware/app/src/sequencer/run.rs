@@ -6,7 +6,7 @@ use embassy_time::{Duration, Instant};
 use super::faults;
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
-use crate::domain::{Aim, GridPattern, PathCursor, Pattern, Target};
+use crate::domain::{Aim, AimModel, GridPattern, PathCursor, Pattern, Target};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::status::Phase;
@@ -172,7 +172,9 @@ impl Core {
         if let Pattern::Grid(pattern) = pattern {
             return Some(RunKind::Grid { pattern, once });
         }
-        if self.actuator.uses_stepper() {
+        // The stepper traces paths exactly; with `model seed` it keeps the
+        // seed's point-by-point method (for comparison), as the gimbal.
+        if self.actuator.uses_stepper() && self.model == AimModel::Exact {
             return Self::traced(pattern, once);
         }
         if self.actuator.uses_galvo() {

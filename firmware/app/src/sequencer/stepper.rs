@@ -1,6 +1,7 @@
 //! The core's side of the stepper pan/tilt (`target stepper`): each point
 //! of a run to the stepper task (grid and goto points straight in joint
-//! space, path points along the board line from the previous one), its
+//! space, paths as their exact lines and arcs — or, with `model seed`, the
+//! seed's point-by-point interpolation joined by board lines), its
 //! arrivals back into the dwell, its refusals into an error and a stop,
 //! a stop into a deceleration at the limit (the laser dark at once:
 //! [`Core::stop`] closes the gate first). The stop button halts the steps
@@ -60,6 +61,9 @@ impl Core {
         let Some(run) = self.run else { return false };
         let shape = match (run.kind, approach) {
             (RunKind::Traced { pattern, .. }, false) => Self::traced_shape(&pattern, run.index),
+            // The seed's point-by-point method: straight board lines between
+            // the interpolated points.
+            (RunKind::Path { .. }, false) => MoveShape::Line,
             _ => MoveShape::Travel,
         };
         self.next_seq = self.next_seq.wrapping_add(1);
