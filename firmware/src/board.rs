@@ -11,7 +11,7 @@
 //! | laser enable        | PB0 (active high) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
-//! | stepper pan STEP / DIR  | PE9 / PE10 (STEP on a TIM1 channel pin, for a later one-pulse timer) |
+//! | stepper pan STEP / DIR  | PE9 / PE10 (STEP on a TIM1 channel pin, for a later one-pulse timer; the step timer runs on an interrupt executor, `tasks.rs`) |
 //! | stepper tilt STEP / DIR | PE11 / PE12 (likewise) |
 //! | stepper ENABLE (both)   | PE13 (polarity a parameter; released = the idle level) |
 //!

@@ -3,7 +3,9 @@
 //! part types, and [`TaskSpawner`] is the board's spawn hook for
 //! `laser_app::app::wire`. The USB device stack is the board's own task.
 
-use embassy_executor::Spawner;
+use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_stm32::interrupt;
+use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::mode::Async;
 use embassy_stm32::usart::{RingBufferedUartRx, UartTx};
 use embassy_usb::UsbDevice;
@@ -45,9 +47,22 @@ async fn sequencer(task: SequencerTask<LaserPin, FlashSettings>) -> ! {
 }
 
 /// The stepper step timer: executes the prepared segments on PE9–PE13.
+/// Runs on [`STEP_EXECUTOR`], above every thread-mode task.
 #[embassy_executor::task]
 async fn step_pulses(task: StepPulseTask<GpioStepper>) -> ! {
     task.run().await
+}
+
+/// The step timer's executor: an interrupt executor on CAN2_RX1 (a
+/// peripheral interrupt this board does not use, pended in software) at
+/// priority 2, so the step timer preempts USB, the sequencer and the
+/// stepper task's planning.
+static STEP_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
+
+#[interrupt]
+unsafe fn CAN2_RX1() {
+    // SAFETY: the interrupt `STEP_EXECUTOR` was started on (below).
+    unsafe { STEP_EXECUTOR.on_interrupt() }
 }
 
 /// The stepper task: planning and segment prep for the pan/tilt.
@@ -100,7 +115,9 @@ impl Spawn<Stm32Board> for TaskSpawner {
     }
 
     fn step_pulses(&mut self, task: StepPulseTask<GpioStepper>) {
-        self.0.spawn(defmt::unwrap!(step_pulses(task)));
+        interrupt::CAN2_RX1.set_priority(Priority::P2);
+        let spawner = STEP_EXECUTOR.start(interrupt::CAN2_RX1);
+        spawner.spawn(defmt::unwrap!(step_pulses(task)));
     }
 
     fn stepper(&mut self, task: StepperTask) {
