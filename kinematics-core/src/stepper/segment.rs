@@ -57,8 +57,12 @@ impl Profile {
         let d = f64::from(block.event_count);
         let meet = libm::sqrt(a * d + 0.5 * (v0 * v0 + v1 * v1));
         let peak = meet.min(block.nominal_rate_steps_per_s).max(v0).max(v1);
-        let d_acc = ((peak * peak - v0 * v0) / (2.0 * a)).clamp(0.0, d);
-        let d_dec = ((peak * peak - v1 * v1) / (2.0 * a)).clamp(0.0, d - d_acc);
+        // max/min, not `f64::clamp`: its panic path formats floats (10 KB
+        // of flash on the target).
+        let d_acc = ((peak * peak - v0 * v0) / (2.0 * a)).max(0.0).min(d);
+        let d_dec = ((peak * peak - v1 * v1) / (2.0 * a))
+            .max(0.0)
+            .min(d - d_acc);
         Self {
             d,
             entry: v0,
@@ -378,7 +382,7 @@ impl SegmentPrep {
         let s0 = f64::from(c.done - c.start);
         let want = libm::floor(c.profile.rate_at(s0) * self.segment_s);
         // Saturating float→int conversion; at least one event.
-        let events = (want as u32).clamp(1, c.end - c.done);
+        let events = (want as u32).max(1).min(c.end - c.done);
         let dt = c.profile.time_at(s0 + f64::from(events)) - c.profile.time_at(s0);
         let ticks = libm::ceil(dt * self.timer_hz / f64::from(events));
         let segment = Segment {

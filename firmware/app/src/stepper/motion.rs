@@ -379,7 +379,9 @@ fn distance_to_segment_cm(p: BoardPoint, a: BoardPoint, b: BoardPoint) -> f64 {
     let (dx, dy) = (b.x_cm - a.x_cm, b.y_cm - a.y_cm);
     let len2 = dx * dx + dy * dy;
     let t = if len2 > 0.0 {
-        (((p.x_cm - a.x_cm) * dx + (p.y_cm - a.y_cm) * dy) / len2).clamp(0.0, 1.0)
+        (((p.x_cm - a.x_cm) * dx + (p.y_cm - a.y_cm) * dy) / len2)
+            .max(0.0)
+            .min(1.0)
     } else {
         0.0
     };
