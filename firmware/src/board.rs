@@ -6,9 +6,9 @@
 //! | function            | pin(s)            |
 //! |---------------------|-------------------|
 //! | USB OTG FS (CDC-ACM)| PA11 DM, PA12 DP  |
-//! | servo bus USART2    | PA2 TX, PA3 RX    |
-//! | galvo DAC1 X / Y    | PA4 / PA5 (not driven yet: no galvo DAC stream, no galvo loop) |
-//! | laser enable        | PB0 (active high) |
+//! | servo bus USART2    | PA2 TX, PA3 RX (interrupt-driven, no DMA) |
+//! | galvo DAC1 X / Y    | PA4 / PA5, dual channel, TIM8-triggered, DMA1 stream 5 ch 7 |
+//! | laser enable        | PB0 (active high); galvo laser stream DMA2 stream 1 ch 7 (TIM8_UP) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
 //! | stepper pan STEP / DIR  | PE9 / PE10 (STEP on a TIM1 channel pin, for a later one-pulse timer; the step timer runs on an interrupt executor, `tasks.rs`) |
@@ -17,23 +17,30 @@
 //!
 //! Flash: the image in sectors 0–5 (≤ 256 KiB), the saved settings in
 //! sectors 10 and 11 (`settings_flash`, `memory.x`).
+//!
+//! DMA: DAC1 channel 1's request is DMA1 stream 5, where USART2's receive
+//! request also sits, so the servo UART is interrupt-driven (buffered)
+//! instead. Interrupt priorities: every peripheral interrupt at P0 (short
+//! handlers), the galvo executor at [`GALVO_PRIORITY`] below them and above
+//! thread mode (USB, sequencer, servo bus).
 
 use embassy_executor::Spawner;
 use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::flash::{self, Flash};
 use embassy_stm32::gpio::{Level, Output, Pull, Speed};
-use embassy_stm32::mode::Async;
-use embassy_stm32::peripherals::{DMA1_CH5, DMA1_CH6, PA2, PA3, PA11, PA12, USART2, USB_OTG_FS};
+use embassy_stm32::interrupt::Priority;
+use embassy_stm32::peripherals::{PA2, PA3, PA11, PA12, USART2, USB_OTG_FS};
 use embassy_stm32::time::Hertz;
-use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
-use embassy_stm32::{Peri, bind_interrupts, dma, exti, pac, peripherals, usb};
+use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
+use embassy_stm32::{Peri, bind_interrupts, exti, pac, peripherals, usb};
 use embassy_time::Instant;
 use embassy_usb::UsbDevice;
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
-use laser_app::app::{Board, NoGalvoDac, Parts};
+use laser_app::app::{Board, Parts};
 use laser_app::laser_gate::{GateState, LaserGate};
 use static_cell::StaticCell;
 
+use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac, darken_laser_stream};
 use crate::parts::{
     GpioStepper, IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton,
 };
@@ -41,9 +48,8 @@ use crate::settings_flash::{FlashSettings, settings_store};
 
 bind_interrupts!(struct Irqs {
     OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
-    USART2 => usart::InterruptHandler<peripherals::USART2>;
-    DMA1_STREAM5 => dma::InterruptHandler<peripherals::DMA1_CH5>;
-    DMA1_STREAM6 => dma::InterruptHandler<peripherals::DMA1_CH6>;
+    USART2 => usart::BufferedInterruptHandler<peripherals::USART2>;
+    DMA1_STREAM5 => HalfInterrupt;
     EXTI0 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI0>;
     FLASH => flash::InterruptHandler;
 });
@@ -52,6 +58,13 @@ bind_interrupts!(struct Irqs {
 const USB_PACKET_BYTES: u16 = 64;
 /// Servo bus baud rate (FashionStar default).
 const SERVO_BAUD: u32 = 115_200;
+/// Servo UART software buffers, bytes each way.
+const SERVO_BUFFER_BYTES: usize = 256;
+
+/// Priority of the galvo executor's interrupt: below every peripheral
+/// interrupt (P0: the DMA half interrupt, USART2, USB, the time driver),
+/// above thread mode.
+pub const GALVO_PRIORITY: Priority = Priority::P1;
 
 /// System clock, Hz (from the 8 MHz HSE crystal through the PLL).
 pub const SYSCLK_HZ: u32 = 168_000_000;
@@ -86,15 +99,17 @@ pub const LASER_PIN_BIT: usize = 0;
 
 /// The master laser gate (see `laser_app::laser_gate`): the sequencer
 /// closes it on every stop, fault and button press, the galvo loop on an
-/// underrun; closing pulls PB0 low at once.
+/// underrun; closing darkens the galvo's laser stream and pulls PB0 low
+/// at once.
 pub static LASER_GATE: LaserGate = LaserGate::with_hook(laser_gate_changed);
 
-/// The gate's hook: when it closes, PB0 goes low straight through the
-/// GPIO's set/reset register (one atomic store, safe from any task or
-/// interrupt), whoever holds the pin. (The galvo's laser stream is not
-/// wired on this board yet; when it is, closing also stops that stream.)
+/// The gate's hook: when it closes, every word of the galvo's laser
+/// stream is zeroed (none can set the pin again), then PB0 goes low
+/// straight through the GPIO's set/reset register (one atomic store, safe
+/// from any task or interrupt), whoever holds the pin.
 pub fn laser_gate_changed(state: GateState) {
     if !state.open {
+        darken_laser_stream();
         pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
     }
 }
@@ -105,10 +120,12 @@ pub struct Stm32Board {
     pub laser: LaserPin,
     /// The command line on USB CDC-ACM.
     pub console: UsbConsole,
-    /// Servo UART transmit (DMA).
-    pub servo_tx: UartTx<'static, Async>,
-    /// Servo UART receive (DMA ring buffer).
-    pub servo_rx: RingBufferedUartRx<'static>,
+    /// Servo UART transmit (interrupt-driven, buffered).
+    pub servo_tx: BufferedUartTx<'static>,
+    /// Servo UART receive (interrupt-driven, buffered).
+    pub servo_rx: BufferedUartRx<'static>,
+    /// The galvo DAC stream (TIM8, DAC1, DMA1 stream 5, DMA2 stream 1).
+    pub galvo: Stm32GalvoDac,
     /// Heartbeat, laser and fault LEDs (PD12–PD14).
     pub leds: StatusLeds,
     /// User button (PA0).
@@ -123,12 +140,11 @@ pub struct Stm32Board {
 
 impl Board for Stm32Board {
     type Console = UsbConsole;
-    type ServoRx = RingBufferedUartRx<'static>;
-    type ServoTx = UartTx<'static, Async>;
+    type ServoRx = BufferedUartRx<'static>;
+    type ServoTx = BufferedUartTx<'static>;
     type Laser = LaserPin;
     type Settings = FlashSettings;
-    // The DAC1 output is not wired yet (see README, Status).
-    type GalvoDac = NoGalvoDac;
+    type GalvoDac = Stm32GalvoDac;
     type Stepper = GpioStepper;
     type Indicators = StatusLeds;
     type StopButton = UserButton;
@@ -141,7 +157,7 @@ impl Board for Stm32Board {
             servo_tx: self.servo_tx,
             laser: self.laser,
             settings: self.settings,
-            galvo_dac: None,
+            galvo_dac: Some(self.galvo),
             stepper: Some(self.stepper),
             indicators: self.leds,
             stop_button: self.button,
@@ -168,12 +184,35 @@ pub fn init(spawner: Spawner) -> Stm32Board {
     );
     let (usb_device, console) = usb_console(p.USB_OTG_FS, p.PA12, p.PA11);
     spawner.spawn(defmt::unwrap!(crate::tasks::usb_device(usb_device)));
-    let (servo_tx, servo_rx) = servo_uart(p.USART2, p.PA3, p.PA2, p.DMA1_CH6, p.DMA1_CH5);
+    let (servo_tx, servo_rx) = servo_uart(p.USART2, p.PA3, p.PA2);
+    enable_cycle_counter();
+    // The HardFault handler's hand-written register addresses.
+    defmt::assert!(
+        pac::TIM8.cr1().as_ptr() as u32 == crate::panic::TIM8_CR1
+            && pac::DMA2.st(1).cr().as_ptr() as u32 == crate::panic::DMA2_S1CR
+            && pac::GPIOB.bsrr().as_ptr() as u32 == crate::panic::GPIOB_BSRR
+    );
+    let galvo_parts = GalvoDacPeripherals {
+        timer: p.TIM8,
+        dac: p.DAC1,
+        dac_dma: p.DMA1_CH5,
+        laser_dma: p.DMA2_CH1,
+        x: p.PA4,
+        y: p.PA5,
+    };
+    let galvo = Stm32GalvoDac::new(
+        galvo_parts,
+        &LASER_GATE,
+        LASER_PIN_BIT as u8,
+        SYSCLK_HZ,
+        Irqs,
+    );
     Stm32Board {
         laser,
         console,
         servo_tx,
         servo_rx,
+        galvo,
         leds: StatusLeds {
             heartbeat: Output::new(p.PD12, Level::Low, Speed::Low),
             laser: Output::new(p.PD13, Level::Low, Speed::Low),
@@ -241,22 +280,42 @@ fn usb_console(
     (device, UsbConsole { tx, rx })
 }
 
-/// Servo bus: USART2 (PA2 TX, PA3 RX), DMA1 stream 6 (TX) / 5 (RX).
+/// Servo bus: USART2 (PA2 TX, PA3 RX), interrupt-driven both ways (its
+/// receive DMA request would be DMA1 stream 5, the galvo DAC's). Its
+/// interrupt stays at P0, above the galvo executor: at 115 200 baud a
+/// byte arrives every 87 µs and the USART holds only one.
 fn servo_uart(
     usart: Peri<'static, USART2>,
     rx_pin: Peri<'static, PA3>,
     tx_pin: Peri<'static, PA2>,
-    tx_dma: Peri<'static, DMA1_CH6>,
-    rx_dma: Peri<'static, DMA1_CH5>,
-) -> (UartTx<'static, Async>, RingBufferedUartRx<'static>) {
+) -> (BufferedUartTx<'static>, BufferedUartRx<'static>) {
     let mut uart_config = usart::Config::default();
     uart_config.baudrate = SERVO_BAUD;
-    static SERVO_RX_DMA: StaticCell<[u8; 256]> = StaticCell::new();
-    match Uart::new(usart, rx_pin, tx_pin, tx_dma, rx_dma, Irqs, uart_config) {
-        Ok(uart) => {
-            let (tx, rx) = uart.split();
-            (tx, rx.into_ring_buffered(SERVO_RX_DMA.init([0; 256])))
-        }
+    static SERVO_TX_BUFFER: StaticCell<[u8; SERVO_BUFFER_BYTES]> = StaticCell::new();
+    static SERVO_RX_BUFFER: StaticCell<[u8; SERVO_BUFFER_BYTES]> = StaticCell::new();
+    let tx_buffer = SERVO_TX_BUFFER.init([0; SERVO_BUFFER_BYTES]);
+    let rx_buffer = SERVO_RX_BUFFER.init([0; SERVO_BUFFER_BYTES]);
+    match BufferedUart::new(
+        usart,
+        rx_pin,
+        tx_pin,
+        tx_buffer,
+        rx_buffer,
+        Irqs,
+        uart_config,
+    ) {
+        Ok(uart) => uart.split(),
         Err(_) => defmt::panic!("USART2 configuration rejected"),
+    }
+}
+
+/// Starts the DWT cycle counter (the galvo refill timing).
+fn enable_cycle_counter() {
+    match cortex_m::Peripherals::take() {
+        Some(mut core) => {
+            core.DCB.enable_trace();
+            core.DWT.enable_cycle_counter();
+        }
+        None => defmt::panic!("core peripherals already taken"),
     }
 }

@@ -4,19 +4,23 @@
 //! starts the USB device stack; `laser_app::app::wire` then builds the
 //! application's tasks from the board's parts — the same wiring the host
 //! simulator runs: console → command channel → sequencer → servo bus
-//! (USART2); LEDs, stop button and watchdog alongside. This board has no
-//! galvo DAC output yet, so no galvo loop runs.
+//! (USART2); the galvo loop on its own executor (an interrupt above
+//! thread mode) feeding the DAC stream (`galvo_dac`); LEDs, stop button
+//! and watchdog alongside.
 #![no_std]
 #![no_main]
 
 mod board;
+mod galvo_dac;
 mod panic;
 mod parts;
 mod settings_flash;
 mod tasks;
 
 use defmt_rtt as _;
-use embassy_executor::Spawner;
+use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_stm32::interrupt;
+use embassy_stm32::interrupt::InterruptExt;
 use laser_app::app::{Links, wire};
 use laser_app::command::CommandLink;
 use laser_app::galvo::GalvoLink;
@@ -27,12 +31,20 @@ use laser_app::status::StatusBoard;
 static COMMAND_LINK: CommandLink = CommandLink::new();
 /// Sequencer ↔ servo task channels.
 static SERVO_LINK: ServoLink = ServoLink::new();
-/// Sequencer ↔ galvo loop channels (no loop serves them on this board).
+/// Sequencer ↔ galvo loop channels.
 static GALVO_LINK: GalvoLink = GalvoLink::new();
 /// Shared state for LEDs and the watchdog.
 static STATUS: StatusBoard = StatusBoard::new();
 /// Sequencer ↔ stepper task ↔ step timer.
 static STEPPER_LINK: laser_app::stepper::StepperLink = laser_app::stepper::StepperLink::new();
+/// Runs the galvo loop in the UART4 interrupt (UART4 itself is unused).
+static GALVO_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
+
+#[interrupt]
+unsafe fn UART4() {
+    // SAFETY: the galvo executor's own interrupt, started below.
+    unsafe { GALVO_EXECUTOR.on_interrupt() }
+}
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
@@ -45,5 +57,11 @@ async fn main(spawner: Spawner) {
         gate: &board::LASER_GATE,
         stepper: &STEPPER_LINK,
     };
-    wire(board, links, &mut tasks::TaskSpawner(spawner));
+    interrupt::UART4.set_priority(board::GALVO_PRIORITY);
+    let galvo = GALVO_EXECUTOR.start(interrupt::UART4);
+    let mut spawners = tasks::TaskSpawner {
+        thread: spawner,
+        galvo,
+    };
+    wire(board, links, &mut spawners);
 }

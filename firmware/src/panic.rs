@@ -1,4 +1,5 @@
-//! Panic and HardFault handlers: laser off first (straight through the GPIO
+//! Panic and HardFault handlers: laser off first (the galvo's sample clock
+//! and laser stream stopped, then the pin low, straight through the
 //! registers, as nothing else can be trusted), then log and halt. The
 //! watchdog then resets the MCU; the laser stays off through reset.
 //!
@@ -15,17 +16,27 @@ use embassy_stm32::pac;
 
 /// Address of GPIOB's bit set/reset register (RM0090 §8.4.7), for the
 /// HardFault handler's assembly.
-const GPIOB_BSRR: u32 = 0x4002_0418;
+pub const GPIOB_BSRR: u32 = 0x4002_0418;
+/// Address of TIM8's control register 1 (RM0090 §17.4.1): writing 0 stops
+/// the galvo's sample clock, so neither DMA stream gets another request.
+pub const TIM8_CR1: u32 = 0x4001_0400;
+/// Address of DMA2 stream 1's configuration register (RM0090 §10.5.5,
+/// 0x10 + 0x18 · stream): writing 0 disables the galvo's laser stream.
+pub const DMA2_S1CR: u32 = 0x4002_6428;
 
 /// Set by the panic handler: its `udf` ends in the HardFault handler, which
 /// then has nothing new to report.
 static PANICKED: AtomicBool = AtomicBool::new(false);
 
-/// Laser off now: one store to GPIOB's bit set/reset register (atomic, no
-/// read-modify-write, no stack use once inlined), whatever state the
-/// program is in. Shared by the panic and HardFault handlers.
+/// Laser off now: the galvo's sample clock and laser stream stopped (no
+/// queued BSRR word can set the pin again), then one store to GPIOB's bit
+/// set/reset register (atomic, no read-modify-write, no stack use once
+/// inlined), whatever state the program is in. Shared by the panic and
+/// HardFault handlers.
 #[inline(always)]
 fn laser_off_now() {
+    pac::TIM8.cr1().write(|_| {});
+    pac::DMA2.st(1).cr().write(|_| {});
     pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
 }
 use crate::board::LASER_PIN_BIT;
@@ -63,13 +74,21 @@ unsafe extern "C" {
 #[unsafe(link_section = ".HardFault.user")]
 unsafe extern "C" fn HardFault() -> ! {
     core::arch::naked_asm!(
-        // GPIOB BSRR: reset bit of the laser pin (see `laser_off_now`).
+        // TIM8 and the laser stream off, then GPIOB BSRR: reset bit of
+        // the laser pin (see `laser_off_now`).
+        "movs r1, #0",
+        "ldr r0, ={tim8_cr1}",
+        "str r1, [r0]",
+        "ldr r0, ={dma2_s1cr}",
+        "str r1, [r0]",
         "ldr r0, ={bsrr}",
         "ldr r1, ={reset_laser}",
         "str r1, [r0]",
         "ldr r0, ={top}",
         "msr MSP, r0",
         "b {log}",
+        tim8_cr1 = const TIM8_CR1,
+        dma2_s1cr = const DMA2_S1CR,
         bsrr = const GPIOB_BSRR,
         reset_laser = const 1u32 << (16 + LASER_PIN_BIT),
         top = sym _stack_start,

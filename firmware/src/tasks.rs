@@ -2,25 +2,28 @@
 //! generic, so each runs one of `laser-app`'s task bodies for this board's
 //! part types, and [`TaskSpawner`] is the board's spawn hook for
 //! `laser_app::app::wire`. The USB device stack is the board's own task.
+//! Every task runs in thread mode except the galvo loop, which runs on
+//! the galvo executor (an interrupt, `main.rs`) so that nothing in thread
+//! mode can delay a refill, and the stepper's step timer, on its own
+//! interrupt executor above it (below).
 
-use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_executor::{InterruptExecutor, SendSpawner, Spawner};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
-use embassy_stm32::mode::Async;
-use embassy_stm32::usart::{RingBufferedUartRx, UartTx};
+use embassy_stm32::usart::{BufferedUartRx, BufferedUartTx};
 use embassy_usb::UsbDevice;
 use laser_app::app::{
-    ConsoleTask, GalvoTask, IndicatorTask, NoGalvoDac, SequencerTask, ServoBusTask, Spawn,
-    StopButtonTask, WatchdogTask,
+    ConsoleTask, GalvoTask, IndicatorTask, SequencerTask, ServoBusTask, Spawn, StopButtonTask,
+    WatchdogTask,
 };
 
 use crate::board::Stm32Board;
-use laser_app::stepper::{StepPulseTask, StepperTask};
-
+use crate::galvo_dac::Stm32GalvoDac;
 use crate::parts::{
     GpioStepper, IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton,
 };
 use crate::settings_flash::FlashSettings;
+use laser_app::stepper::{StepPulseTask, StepperTask};
 
 /// Runs the USB device stack (enumeration, control requests).
 #[embassy_executor::task]
@@ -34,9 +37,9 @@ async fn console(task: ConsoleTask<UsbConsole>) -> ! {
     task.run().await
 }
 
-/// Owns the servo UART (USART2, DMA both ways).
+/// Owns the servo UART (USART2, interrupt-driven).
 #[embassy_executor::task]
-async fn servo_bus(task: ServoBusTask<RingBufferedUartRx<'static>, UartTx<'static, Async>>) -> ! {
+async fn servo_bus(task: ServoBusTask<BufferedUartRx<'static>, BufferedUartTx<'static>>) -> ! {
     task.run().await
 }
 
@@ -46,17 +49,27 @@ async fn sequencer(task: SequencerTask<LaserPin, FlashSettings>) -> ! {
     task.run().await
 }
 
+/// The galvo loop (on the galvo executor): feeds the DAC stream.
+#[embassy_executor::task]
+async fn galvo(task: GalvoTask<Stm32GalvoDac>) {
+    task.run().await
+}
+
 /// The stepper step timer: executes the prepared segments on PE9–PE13.
-/// Runs on [`STEP_EXECUTOR`], above every thread-mode task.
+/// Runs on [`STEP_EXECUTOR`], above the galvo executor and thread mode.
 #[embassy_executor::task]
 async fn step_pulses(task: StepPulseTask<GpioStepper>) -> ! {
     task.run().await
 }
 
+/// Priority of the step timer's executor: P0, with the short peripheral
+/// handlers (one step event is ≤ 8 µs with the busy-waited pulse and DIR
+/// setup), above the galvo executor (P1), whose refills (up to ~0.5 ms)
+/// would otherwise delay steps by most of a period at 1 600 steps/s.
+const STEP_PRIORITY: Priority = Priority::P0;
+
 /// The step timer's executor: an interrupt executor on CAN2_RX1 (a
-/// peripheral interrupt this board does not use, pended in software) at
-/// priority 2, so the step timer preempts USB, the sequencer and the
-/// stepper task's planning.
+/// peripheral interrupt this board does not use, pended in software).
 static STEP_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 
 #[interrupt]
@@ -90,49 +103,51 @@ async fn watchdog(task: WatchdogTask<IndependentDog>) -> ! {
     task.run().await
 }
 
-/// Spawns the task bodies on the embassy executor (each task's pool holds
+/// Spawns the task bodies on the embassy executors (each task's pool holds
 /// one: the wiring spawns each once).
-pub struct TaskSpawner(pub Spawner);
+pub struct TaskSpawner {
+    /// The thread-mode executor.
+    pub thread: Spawner,
+    /// The galvo executor (interrupt priority `board::GALVO_PRIORITY`).
+    pub galvo: SendSpawner,
+}
 
 impl Spawn<Stm32Board> for TaskSpawner {
     fn console(&mut self, task: ConsoleTask<UsbConsole>) {
-        self.0.spawn(defmt::unwrap!(console(task)));
+        self.thread.spawn(defmt::unwrap!(console(task)));
     }
 
-    fn servo_bus(
-        &mut self,
-        task: ServoBusTask<RingBufferedUartRx<'static>, UartTx<'static, Async>>,
-    ) {
-        self.0.spawn(defmt::unwrap!(servo_bus(task)));
+    fn servo_bus(&mut self, task: ServoBusTask<BufferedUartRx<'static>, BufferedUartTx<'static>>) {
+        self.thread.spawn(defmt::unwrap!(servo_bus(task)));
     }
 
     fn sequencer(&mut self, task: SequencerTask<LaserPin, FlashSettings>) {
-        self.0.spawn(defmt::unwrap!(sequencer(task)));
+        self.thread.spawn(defmt::unwrap!(sequencer(task)));
     }
 
-    fn galvo(&mut self, task: GalvoTask<NoGalvoDac>) {
-        task.unreachable()
+    fn galvo(&mut self, task: GalvoTask<Stm32GalvoDac>) {
+        self.galvo.spawn(defmt::unwrap!(galvo(task)));
     }
 
     fn step_pulses(&mut self, task: StepPulseTask<GpioStepper>) {
-        interrupt::CAN2_RX1.set_priority(Priority::P2);
+        interrupt::CAN2_RX1.set_priority(STEP_PRIORITY);
         let spawner = STEP_EXECUTOR.start(interrupt::CAN2_RX1);
         spawner.spawn(defmt::unwrap!(step_pulses(task)));
     }
 
     fn stepper(&mut self, task: StepperTask) {
-        self.0.spawn(defmt::unwrap!(stepper(task)));
+        self.thread.spawn(defmt::unwrap!(stepper(task)));
     }
 
     fn indicators(&mut self, task: IndicatorTask<StatusLeds>) {
-        self.0.spawn(defmt::unwrap!(indicators(task)));
+        self.thread.spawn(defmt::unwrap!(indicators(task)));
     }
 
     fn stop_button(&mut self, task: StopButtonTask<UserButton>) {
-        self.0.spawn(defmt::unwrap!(stop_button(task)));
+        self.thread.spawn(defmt::unwrap!(stop_button(task)));
     }
 
     fn watchdog(&mut self, task: WatchdogTask<IndependentDog>) {
-        self.0.spawn(defmt::unwrap!(watchdog(task)));
+        self.thread.spawn(defmt::unwrap!(watchdog(task)));
     }
 }

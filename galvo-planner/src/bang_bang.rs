@@ -89,6 +89,27 @@ impl BangBang {
         }
     }
 
+    /// Calls `f(k, u_k as f32)` for k = N−1, …, 0: the values of
+    /// [`Self::u_v`] rounded to `f32`, with the saturated ones (all but
+    /// the switch samples and the last) computed and rounded once, not
+    /// per sample in soft-float `f64` (the M4F's cost).
+    pub(crate) fn for_each_rev_f32(&self, mut f: impl FnMut(usize, f32)) {
+        let high = (self.sign * self.u_max_v) as f32;
+        let low = (-self.sign * self.u_max_v) as f32;
+        for k in (0..self.n).rev() {
+            let saturated = k + 1 != self.n
+                && k != self.k1
+                && k != self.k2
+                && (k < self.k1 || k > self.k2 || (k > self.k1 && k < self.k2));
+            let u = match saturated {
+                true if k > self.k1 && k < self.k2 => low,
+                true => high,
+                false => self.u_v(k) as f32,
+            };
+            f(k, u);
+        }
+    }
+
     /// Voltage of sample `k`.
     pub(crate) fn u_v(&self, k: usize) -> f64 {
         if k + 1 == self.n {

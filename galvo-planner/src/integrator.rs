@@ -42,6 +42,7 @@ use crate::model::{Discrete, THETA};
 use crate::plan::JumpPlan;
 use kinematics_core::numeric::finite;
 
+mod run;
 mod xy;
 pub use xy::XyIntegrator;
 
@@ -211,6 +212,18 @@ impl<const S: usize, const CAP: usize, const Q: usize> Integrator<S, CAP, Q> {
     /// Appends `plan` behind the queued moves. Its voltages are copied into
     /// the ring (as `f32`); the plan itself is not kept.
     pub fn queue(&mut self, plan: &JumpPlan<S>) -> Result<(), Error> {
+        self.enqueue(plan, true)
+    }
+
+    /// Appends `plan` like [`Self::queue`], for a move whose samples
+    /// someone else computes (the same plan stepped from the same state,
+    /// e.g. ahead of time): its inputs are not copied, and it is passed
+    /// over with [`Self::skip`], not stepped.
+    pub fn queue_skipped(&mut self, plan: &JumpPlan<S>) -> Result<(), Error> {
+        self.enqueue(plan, false)
+    }
+
+    fn enqueue(&mut self, plan: &JumpPlan<S>, inputs: bool) -> Result<(), Error> {
         self.check_queue(plan)?;
         let n = plan.samples();
         if n == 0 {
@@ -218,11 +231,13 @@ impl<const S: usize, const CAP: usize, const Q: usize> Integrator<S, CAP, Q> {
         }
         let tail = (self.read + self.queued) % CAP;
         let ring = &mut self.ring;
-        plan.for_each_input_rev(|k, u| {
-            if let Some(slot) = ring.get_mut((tail + k) % CAP) {
-                *slot = u as f32;
-            }
-        });
+        if inputs {
+            plan.for_each_input_rev_f32(|k, u| {
+                if let Some(slot) = ring.get_mut((tail + k) % CAP) {
+                    *slot = u;
+                }
+            });
+        }
         let slot = (self.move_read + self.move_count) % Q;
         if let Some(m) = self.moves.get_mut(slot) {
             *m = QueuedMove {
@@ -250,24 +265,21 @@ impl<const S: usize, const CAP: usize, const Q: usize> Integrator<S, CAP, Q> {
         advance(&self.a_minus_i, &self.bd, &mut self.z, &mut self.comp, u);
         self.k_in_move += 1;
         let running = self.moves.get(self.move_read).map(|m| m.samples);
-        if running.is_some_and(|samples| self.k_in_move >= samples) {
-            // Land exactly on the planned target (once per move).
-            if let Some(m) = self.moves.get(self.move_read) {
-                self.z = to_f32(&m.target);
-            }
-            self.comp = [0.0; S];
-            self.k_in_move = 0;
-            self.move_read = (self.move_read + 1) % Q;
-            self.move_count -= 1;
+        if running.is_some_and(|samples| self.k_in_move >= samples)
+            && let Some(m) = self.moves.get(self.move_read).copied()
+        {
+            self.land(&m.target);
         }
         self.position_rad()
     }
 
-    /// Fills `out` with the commanded angle of the next `out.len()` samples.
-    pub fn fill(&mut self, out: &mut [f32]) {
-        for o in out.iter_mut() {
-            *o = self.step();
-        }
+    /// The running move is over: land exactly on its planned target.
+    fn land(&mut self, target: &Vector<S>) {
+        self.z = to_f32(target);
+        self.comp = [0.0; S];
+        self.k_in_move = 0;
+        self.move_read = (self.move_read + 1) % Q;
+        self.move_count = self.move_count.saturating_sub(1);
     }
 
     /// Commanded motor angle now, rad.

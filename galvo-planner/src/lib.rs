@@ -32,6 +32,7 @@
 //! | [`profile`] | T-curve / S-curve baselines ([`motion_profile`]: the profiles and their inverse-dynamics voltage) | [`profile::plan_profile`], [`profile::Profile`], [`profile::ProfileLimits::from_drive`] |
 //! | [`integrator`] | per-sample `f32` state update, move queue, two axes | [`Integrator`], [`XyIntegrator`] |
 //! | [`path`] | look-ahead marking of lines and arcs in the board plane | [`PathPlanner`], [`MarkLimits`], [`MarkSample`], [`BlockEnd`] |
+//! | [`blocks`] | the galvo loop's per-sample blocks, compiled here for speed | [`blocks::fill_jump`], [`blocks::fill_marks`] |
 //! | [`linalg`] | small fixed-size matrices, matrix exponential | [`linalg::expm_and_integral`] |
 //!
 //! Modules, bottom to top (each uses only those below it):
@@ -112,6 +113,7 @@
 
 pub mod bang_bang;
 pub mod bisection;
+pub mod blocks;
 pub mod error;
 pub mod fast_optimal;
 pub mod gramian;

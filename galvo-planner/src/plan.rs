@@ -239,6 +239,16 @@ impl<const S: usize> JumpPlan<S> {
         }
     }
 
+    /// [`Self::for_each_input_rev`] with each `u_k` rounded to `f32`
+    /// (what the integrator runs on), the bang-bang law's saturated
+    /// samples without per-sample `f64` work.
+    pub fn for_each_input_rev_f32(&self, mut f: impl FnMut(usize, f32)) {
+        match &self.law {
+            InputLaw::BangBang(bb) => bb.for_each_rev_f32(f),
+            _ => self.for_each_input_rev(|k, u| f(k, u as f32)),
+        }
+    }
+
     /// Writes the `N` voltages into `out[..N]` and returns `N`.
     pub fn write_u_v(&self, out: &mut [f64]) -> Result<usize, Error> {
         if out.len() < self.samples {

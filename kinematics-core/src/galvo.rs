@@ -59,7 +59,7 @@ impl<F: Real> Default for GalvoGeometry<F> {
 
 impl<F: Real> GalvoGeometry<F> {
     #[inline]
-    fn validate(&self) -> Result<(), Error> {
+    pub(crate) fn validate(&self) -> Result<(), Error> {
         if self.d_mm <= F::ZERO || !self.d_mm.is_finite() {
             return Err(Error::InvalidConfig {
                 what: "galvo d_mm must be finite and > 0",
@@ -202,7 +202,7 @@ impl<F: Real> DacAxis<F> {
 /// is truncated to an integer (one `VCVT` in `f32`) and the remainder,
 /// exact in `F`, decides the rounding.
 #[inline]
-fn round_to_code<F: Real>(value: F) -> DacCode {
+pub(crate) fn round_to_code<F: Real>(value: F) -> DacCode {
     // round(value) < 0 ⇔ value ≤ −½; round(value) > 4095 ⇔ value ≥ 4095½.
     let top = F::from_u16(DAC_MAX_CODE) + F::HALF;
     if value <= -F::HALF {
@@ -328,77 +328,8 @@ impl<F: Real> Galvo<F> {
     }
 }
 
-/// The per-sample form of a [`Galvo<f32>`]: checked once when built, then
-/// board point or mirror angles → DAC codes with no per-call validation
-/// and no error plumbing, all in `f32` on the FPU (two `atanf`, one
-/// `VSQRT`, two divisions, two direct conversions). Its codes are those
-/// of [`Galvo::<f32>::board_to_codes`] / [`Galvo::angles_to_codes`], bit
-/// for bit (tests).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SampleMap {
-    d_mm: f32,
-    d2_mm2: f32,
-    e_mm: f32,
-    dac_x: DacAxis<f32>,
-    dac_y: DacAxis<f32>,
-}
-
-impl SampleMap {
-    /// The per-sample map of `galvo`.
-    ///
-    /// Errors: [`Error::InvalidConfig`] (geometry, or a zero / non-finite
-    /// DAC mapping).
-    pub fn new(galvo: &Galvo<f32>) -> Result<Self, Error> {
-        galvo.geometry.validate()?;
-        for dac in [galvo.dac_x, galvo.dac_y] {
-            if !dac.codes_per_rad.is_finite()
-                || dac.codes_per_rad == 0.0
-                || !dac.offset_code.is_finite()
-            {
-                return Err(Error::InvalidConfig {
-                    what: "DAC codes_per_rad must be finite and non-zero",
-                });
-            }
-        }
-        let d = galvo.geometry.d_mm;
-        Ok(Self {
-            d_mm: d,
-            d2_mm2: d * d,
-            e_mm: galvo.geometry.e_mm,
-            dac_x: galvo.dac_x,
-            dac_y: galvo.dac_y,
-        })
-    }
-
-    /// DAC codes for board point (`x_mm`, `y_mm`); `None` for a
-    /// non-finite coordinate.
-    #[inline]
-    pub fn board_to_codes(&self, x_mm: f32, y_mm: f32) -> Option<DacCodes> {
-        if !(x_mm.is_finite() && y_mm.is_finite()) {
-            return None;
-        }
-        // As GalvoGeometry::ik, operation for operation.
-        let y_rad = libm::atanf(y_mm / self.d_mm) * 0.5;
-        let path_mm = crate::real::sqrt_f32(self.d2_mm2 + y_mm * y_mm) + self.e_mm;
-        let x_rad = libm::atanf(x_mm / path_mm) * 0.5;
-        self.angles_to_codes(x_rad, y_rad)
-    }
-
-    /// DAC codes for mechanical mirror angles (rad); `None` for a
-    /// non-finite angle.
-    #[inline]
-    pub fn angles_to_codes(&self, x_rad: f32, y_rad: f32) -> Option<DacCodes> {
-        let x = self.dac_x.offset_code + self.dac_x.codes_per_rad * x_rad;
-        let y = self.dac_y.offset_code + self.dac_y.codes_per_rad * y_rad;
-        if !(x.is_finite() && y.is_finite()) {
-            return None;
-        }
-        Some(DacCodes {
-            x: round_to_code(x),
-            y: round_to_code(y),
-        })
-    }
-}
-
+mod sample_map;
 #[cfg(test)]
 mod tests;
+
+pub use sample_map::{SampleMap, atan_f32};

@@ -39,6 +39,18 @@ fn run_loop(
     limit_us: u64,
     driver: impl Future<Output = ()> + 'static,
 ) -> RunEnd {
+    run_loop_with(GalvoConfig::default(), dac, link, gate, limit_us, driver)
+}
+
+/// [`run_loop`] with the loop's `config`.
+fn run_loop_with(
+    config: GalvoConfig,
+    dac: SimDac,
+    link: &'static GalvoLink,
+    gate: &'static LaserGate,
+    limit_us: u64,
+    driver: impl Future<Output = ()> + 'static,
+) -> RunEnd {
     let finished = Rc::new(RefCell::new(false));
     let fin = finished.clone();
     executor::run(
@@ -47,7 +59,7 @@ fn run_loop(
         move |spawner| {
             executor::spawn(&spawner, async move {
                 let mut dac = dac;
-                let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default galvo");
+                let mut galvo = GalvoLoop::new(config).expect("galvo config");
                 galvo.run(&mut dac, link, gate).await;
             });
             executor::spawn(&spawner, async move {
@@ -287,4 +299,46 @@ fn closing_the_gate_stops_the_loop_even_when_no_stop_request_gets_through() {
             .stream_runs()
             .all(|(t, _, _, s, _)| t < closed_ns + 3 * 1_280_000 || !s.laser)
     );
+}
+
+/// Marks a 40 mm circle with the loop at `sample_period_s`, charged only
+/// the Cortex-M4F cost model (`laser_app::galvo::M4_COST`); returns the
+/// underruns.
+fn mark_circle_at(sample_period_s: f64) -> u32 {
+    let link: &'static GalvoLink = Box::leak(Box::new(GalvoLink::new()));
+    let recording = Rc::new(RefCell::new(DacRecording::default()));
+    let gate = laser_sim::laser::recorded_gate(&recording);
+    let period_ns = (sample_period_s * 1e9) as u64;
+    let dac = SimDac::new(128, period_ns, 0, recording.clone());
+    let config = GalvoConfig {
+        sample_period_s,
+        ..GalvoConfig::default()
+    };
+    let circle = laser_app::domain::Figure::Circle {
+        centre: laser_app::domain::PointCm::new(0.0, 0.0),
+        radius_cm: 4.0,
+        rotation: laser_app::domain::Rotation::Ccw,
+    };
+    run_loop_with(config, dac, link, gate, 2_000_000, async move {
+        link.requests
+            .send(GalvoRequest::Path {
+                seq: 1,
+                path: circle,
+            })
+            .await;
+        // Done, refused or an underrun.
+        link.events.receive().await;
+        embassy_time::Timer::after_millis(5).await;
+    });
+    link.underruns.load(Ordering::Relaxed)
+}
+
+/// The simulator charges what the loop did at the M4's cost: marking
+/// costs ≈ 2 µs per sample on the target, so at 1 µs per sample the loop
+/// cannot keep up and underruns (as it would on the board), while at the
+/// default 10 µs it keeps up with room to spare.
+#[test]
+fn an_overloaded_loop_underruns_at_the_m4_cost_and_the_default_keeps_up() {
+    assert!(mark_circle_at(1e-6) > 0, "1 µs per sample is overloaded");
+    assert_eq!(mark_circle_at(10e-6), 0);
 }

@@ -89,6 +89,7 @@ pub fn loop_halves(b: &mut Bench) {
     };
     let mut half = [DacSample::default(); HALF];
     holding(b, &mut galvo, &mut half);
+    reconfigure(b, &mut galvo, config, &mut half);
     marking(b, &mut galvo, &mut half);
     jumping(b, config, &mut half);
 }
@@ -138,6 +139,29 @@ fn holding(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
     b.report("loop.hold_sample", ticks, 64);
 }
 
+/// New parameters, mirror model kept (a new marking speed), applied at a
+/// half boundary with the loop idle: the rebuild and one held sample.
+#[inline(always)]
+fn reconfigure(
+    b: &mut Bench,
+    galvo: &mut GalvoLoop,
+    config: GalvoConfig,
+    half: &mut [DacSample; HALF],
+) {
+    let faster = GalvoConfig {
+        mark_speed_mm_s: config.mark_speed_mm_s * 1.5,
+        ..config
+    };
+    let ticks = window(|| {
+        galvo.configure(faster);
+        galvo.fill(&mut half[..1], |_| {});
+    });
+    b.report("loop.reconfigure", ticks, 1);
+    // Back to the benchmarked parameters (not measured).
+    galvo.configure(config);
+    galvo.fill(&mut half[..1], |_| {});
+}
+
 /// Marking a line and a circle (r = 40 mm), half by half.
 #[inline(always)]
 fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
@@ -161,6 +185,17 @@ fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
                 centre: PointCm::new(0.0, 0.0),
                 radius_cm: 4.0,
                 rotation: Rotation::Ccw,
+            },
+        ),
+        (
+            "loop.tuning",
+            [-40.0f32, 40.0],
+            // The tuning figure, 80 mm: a square, a circle and a cross,
+            // with jumps between the strokes (its steps: a jump and a
+            // stroke each).
+            Figure::Tuning {
+                centre: PointCm::new(0.0, 0.0),
+                size_cm: 8.0,
             },
         ),
     ];

@@ -6,9 +6,12 @@
 //! halves, then outputs half after half without gaps. A half's physical
 //! buffer is free once the DAC has moved on to the half before it, and
 //! must be written before the DAC reaches it. The loop's compute time is
-//! modelled by charging `compute_ns_per_sample` per sample the loop
-//! computed, before the deadline check (a hold the loop lets the DAC
-//! replay costs nothing). A late write makes the DAC replay the stale
+//! what the half's work ([`Half::work`]: samples per phase, steps started
+//! and prepared) costs on the Cortex-M4F by the cost model fitted to
+//! `cargo xtask bench-m4` ([`M4_COST`]), plus `compute_ns_per_sample` per
+//! computed sample (0 unless a test slows the loop down), charged before
+//! the deadline check (a hold the loop lets the DAC replay costs
+//! nothing). A late write makes the DAC replay the stale
 //! content of each half it reaches, exactly as circular DMA does, with
 //! the laser masked off (the replay is an underrun, and the target's DMA
 //! interrupt stops the laser stream).
@@ -22,7 +25,7 @@ use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
 use embassy_time::{Instant, Timer};
-use laser_app::galvo::{DacSample, DacStream, Half, Underrun};
+use laser_app::galvo::{DacSample, DacStream, Half, M4_COST, Underrun};
 
 mod recording;
 
@@ -204,7 +207,9 @@ impl DacStream for SimDac {
         // The loop computed the half just before handing it over.
         let computed_ns = now_ns();
         let computed = half.computed.min(half.samples.len()) as u64;
-        let compute_ns = self.compute_ns_per_sample.get() * computed;
+        // What the loop did, at the Cortex-M4F's cost (bench-m4's figures),
+        // plus any extra per-sample cost a test sets.
+        let compute_ns = M4_COST.ns(&half.work) + self.compute_ns_per_sample.get() * computed;
         Timer::after_micros(compute_ns.div_ceil(1000)).await;
         if !self.started() {
             // Priming: the DAC starts once both halves are written.

@@ -101,6 +101,52 @@ fn fill_equals_stepping() {
     assert_eq!(filled, stepped);
 }
 
+/// Runs of any length, across move ends (two moves queued back to back)
+/// and into the idle hold, give the stepped angles bit for bit, for both
+/// axes of an [`XyIntegrator`].
+#[test]
+fn fill_runs_equal_stepping_across_moves() {
+    let d = rigid(10e-6);
+    let first = plan_xy_jump(
+        &d,
+        &d,
+        [0.0, 0.0],
+        [3.0 * DEG, -DEG],
+        Method::TimeOptimal,
+        JumpSync::Independent,
+        512,
+    )
+    .expect("plan");
+    let second = plan_xy_jump(
+        &d,
+        &d,
+        [3.0 * DEG, -DEG],
+        [-4.0 * DEG, 2.5 * DEG],
+        Method::TimeOptimal,
+        JumpSync::Independent,
+        512,
+    )
+    .expect("plan");
+    for block in [1usize, 3, 7, 32, 100] {
+        let mut a: XyIntegrator<3, 1024> =
+            XyIntegrator::new(&d, &d, [0.0, 0.0]).expect("integrator");
+        a.queue_jump(&first).expect("queue");
+        a.queue_jump(&second).expect("queue");
+        let mut b = a.clone();
+        let total = first.samples() + second.samples() + 20;
+        let mut filled = Vec::new();
+        let mut buf = [[0.0f32; 2]; 100];
+        while filled.len() < total {
+            a.fill(&mut buf[..block]);
+            filled.extend_from_slice(&buf[..block]);
+        }
+        let stepped: Vec<[f32; 2]> = (0..filled.len()).map(|_| b.step()).collect();
+        assert_eq!(filled, stepped, "block {block}");
+        assert!(a.is_idle());
+        assert_eq!(a.x.state(), b.x.state());
+    }
+}
+
 #[test]
 fn queue_errors() {
     let d = rigid(10e-6);
@@ -232,5 +278,70 @@ proptest! {
             prop_assert!(st.is_idle());
             prop_assert_eq!(st.position_rad(), (t * DEG) as f32);
         }
+    }
+}
+
+/// The `f32` inputs the integrator queues are the plan's `f64` inputs
+/// rounded, for bang-bang plans of many lengths (switches anywhere) and
+/// the other laws.
+#[test]
+fn f32_inputs_are_the_rounded_f64_inputs() {
+    let d = rigid(10e-6);
+    let mut plans = Vec::new();
+    for k in 1..40 {
+        let to = f64::from(k) * 0.37 * DEG - 6.0 * DEG;
+        plans.push(plan_jump(&d, 0.0, to, Method::TimeOptimal, 1024).expect("plan"));
+    }
+    plans.push(plan_jump(&d, 0.0, 2.0 * DEG, Method::BISECTION, 1024).expect("plan"));
+    for plan in &plans {
+        let mut wide = Vec::new();
+        plan.for_each_input_rev(|k, u| wide.push((k, u as f32)));
+        let mut narrow = Vec::new();
+        plan.for_each_input_rev_f32(|k, u| narrow.push((k, u)));
+        assert_eq!(wide, narrow);
+    }
+}
+
+/// A jump's angles computed ahead (`plan_angles`, `blocks::jump_angles`)
+/// are what the integrator steps for it, bit for bit; an integrator that
+/// skips the jump's samples lands where stepping lands.
+#[test]
+fn angles_ahead_equal_stepping_and_skipping_lands() {
+    let d = rigid(10e-6);
+    let from = [2.0 * DEG, -3.0 * DEG];
+    for to in [
+        [-6.0 * DEG, 5.0 * DEG],
+        [2.0 * DEG, 4.0 * DEG],
+        [9.0 * DEG, -3.5 * DEG],
+    ] {
+        let jump = plan_xy_jump(
+            &d,
+            &d,
+            from,
+            to,
+            Method::TimeOptimal,
+            JumpSync::Independent,
+            1024,
+        )
+        .expect("plan");
+        let mut stepped: crate::blocks::LoopIntegrator =
+            XyIntegrator::new(&d, &d, from).expect("integrator");
+        let mut x = [0.0f32; crate::blocks::PRECOMPUTED_JUMP];
+        let mut y = [0.0f32; crate::blocks::PRECOMPUTED_JUMP];
+        let n = crate::blocks::jump_angles(&stepped, &jump, &mut x, &mut y).expect("angles");
+        assert_eq!(n, jump.samples());
+        let ahead: Vec<[f32; 2]> = x.iter().zip(&y).map(|(x, y)| [*x, *y]).collect();
+        let mut skipped = stepped.clone();
+        stepped.queue_jump(&jump).expect("queue");
+        skipped.queue_jump_skipped(&jump).expect("queue");
+        let steps: Vec<[f32; 2]> = (0..n).map(|_| stepped.step()).collect();
+        assert_eq!(&ahead[..n], &steps[..]);
+        skipped.skip(n / 2);
+        assert!(!skipped.is_idle());
+        skipped.skip(n - n / 2);
+        assert!(skipped.is_idle());
+        assert_eq!(skipped.x.state(), stepped.x.state());
+        assert_eq!(skipped.y.state(), stepped.y.state());
+        assert_eq!(skipped.step(), stepped.step());
     }
 }

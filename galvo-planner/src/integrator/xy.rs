@@ -37,17 +37,46 @@ impl<const S: usize, const CAP: usize, const Q: usize> XyIntegrator<S, CAP, Q> {
         self.y.queue(&jump.y)
     }
 
+    /// Queues both axes of a jump whose samples someone else computes
+    /// (see [`Integrator::queue_skipped`]), or neither.
+    pub fn queue_jump_skipped(&mut self, jump: &XyJump<S>) -> Result<(), Error> {
+        self.x.check_queue(&jump.x)?;
+        self.y.check_queue(&jump.y)?;
+        self.x.queue_skipped(&jump.x)?;
+        self.y.queue_skipped(&jump.y)
+    }
+
+    /// Passes over `n` samples of both axes ([`Integrator::skip`]).
+    pub fn skip(&mut self, n: usize) {
+        self.x.skip(n);
+        self.y.skip(n);
+    }
+
     /// One sample of both axes: `[θx, θy]`, rad.
     #[inline]
     pub fn step(&mut self) -> [f32; 2] {
         [self.x.step(), self.y.step()]
     }
 
-    /// Fills a block of `[θx, θy]` samples.
+    /// Fills a block of `[θx, θy]` samples: what as many [`Self::step`]
+    /// calls return, bit for bit, each axis as runs of tight loops
+    /// ([`Integrator::fill_each`]).
+    #[inline]
     pub fn fill(&mut self, out: &mut [[f32; 2]]) {
-        for o in out.iter_mut() {
-            *o = self.step();
+        let n = out.len();
+        for axis in 0..2 {
+            let integrator = if axis == 0 { &mut self.x } else { &mut self.y };
+            integrator.fill_each(n, |i, theta| {
+                if let Some(o) = out.get_mut(i).and_then(|o| o.get_mut(axis)) {
+                    *o = theta;
+                }
+            });
         }
+    }
+
+    /// Samples until both axes hold position.
+    pub fn remaining_samples(&self) -> usize {
+        self.x.remaining_samples().max(self.y.remaining_samples())
     }
 
     /// True when both axes hold position.

@@ -143,7 +143,6 @@ fn measured(id: &str, instructions: f64) -> Measured {
         share,
         status: budget.map(|(_, _, e)| match e {
             Enforcement::Enforced => "enforced".to_owned(),
-            Enforcement::NotYetMet(why) => format!("reported, not yet met ({why})"),
         }),
         over_budget: budget.is_some_and(|(b, _, e)| e == Enforcement::Enforced && us > b),
     }

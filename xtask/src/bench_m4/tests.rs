@@ -8,6 +8,8 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench loop.arc_r40.refill 100 1\nbench loop.jump.refill 1000 1\n\
     bench loop.jump.prep 1500 1\nbench loop.line.prep 2000 1\n\
     bench loop.arc_r40.prep 2000 1\n\
+    bench loop.tuning.steady 100 128\nbench loop.tuning.refill 100 1\n\
+    bench loop.tuning.prep 2000 1\nbench loop.reconfigure 150 1\n\
     bench plan.xy.optimal.1lsb 250 1\nbench plan.xy.optimal.160mm 300 1\n\
     bench plan.seed.1deg 100 1\n\
     bench stepper.step_tick.event 100 50\nbench stepper.step_tick.segment 20 8\n\
@@ -83,7 +85,7 @@ fn an_enforced_budget_over_fails() {
         let err = check(&parse(&out).unwrap()).unwrap_err().to_string();
         assert!(err.contains(id), "{err}");
     }
-    // A budget not yet met is reported, not failed: 1000 ticks for 40
+    // So are the per-sample jump and marking budgets: 1000 ticks for 40
     // jump samples, 1000 instructions (7.7 µs) each, over its 1 µs.
     let jumping = OUT.replace(
         "bench loop.jump.steady 10 40",
@@ -91,14 +93,10 @@ fn an_enforced_budget_over_fails() {
     );
     let r = parse(&jumping).unwrap();
     let m = r.rows.iter().find(|m| m.id == "loop.jump.steady").unwrap();
-    assert!(m.share.unwrap() > 1.0 && !m.over_budget);
-    assert!(
-        m.status
-            .as_deref()
-            .unwrap()
-            .starts_with("reported, not yet met")
-    );
-    assert!(check(&r).is_ok());
+    assert!(m.share.unwrap() > 1.0 && m.over_budget);
+    assert_eq!(m.status.as_deref(), Some("enforced"));
+    let err = check(&r).unwrap_err().to_string();
+    assert!(err.contains("loop.jump.steady"), "{err}");
 }
 
 fn manifest(path: &str) -> toml::Table {

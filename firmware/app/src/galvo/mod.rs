@@ -19,8 +19,10 @@
 //! the simulator feeds a simulated DAC. Not wired yet: the target's
 //! timer-triggered DAC DMA (see the README's status).
 
+mod cost;
 mod scan;
 
+pub use cost::{CostModel, LoopWork, M4_COST};
 pub use scan::{GalvoConfig, GalvoError, GalvoLoop, ScanPhase};
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
@@ -63,6 +65,9 @@ pub struct Half<'a> {
     /// Samples the loop actually computed; the rest repeat a hold sample
     /// (the simulated DAC charges loop time per computed sample).
     pub computed: usize,
+    /// What computing the half (and preparing steps before it) took, for
+    /// the simulated DAC's M4 cost model ([`M4_COST`]).
+    pub work: LoopWork,
 }
 
 /// A hardware-timed DAC fed from a double buffer: a timer-triggered DMA
@@ -94,6 +99,46 @@ pub trait DacStream {
     /// an identical hold is the intended output, so this is never an
     /// underrun, however late.
     async fn repeat_half(&mut self);
+
+    /// The worst refill so far as the board measured it (the target
+    /// times it with the CPU's cycle counter); `None` where nothing
+    /// measures it (the simulator charges modelled costs instead).
+    fn worst_refill(&self) -> Option<RefillTime> {
+        None
+    }
+}
+
+/// A refill time measured in CPU cycles (`galvo status`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RefillTime {
+    /// CPU cycles of the worst refill (the loop computing a half plus
+    /// copying it into the DMA buffer, its wait for the free half not
+    /// counted).
+    pub cycles: u32,
+    /// CPU clock, Hz.
+    pub cpu_hz: u32,
+    /// CPU cycles one half buffer lasts at the current sample period:
+    /// the refill's window.
+    pub window_cycles: u32,
+}
+
+/// The worst refill time, published by the loop for `galvo status`
+/// (zero cycles: nothing measured).
+struct RefillStat {
+    cycles: AtomicU32,
+    cpu_hz: AtomicU32,
+    window_cycles: AtomicU32,
+}
+
+impl RefillStat {
+    const fn new() -> Self {
+        Self {
+            cycles: AtomicU32::new(0),
+            cpu_hz: AtomicU32::new(0),
+            window_cycles: AtomicU32::new(0),
+        }
+    }
 }
 
 /// What the sequencer asks of the galvo loop.
@@ -178,6 +223,8 @@ pub struct GalvoLink {
     queued: AtomicU8,
     /// A galvo loop serves the link (set when it starts).
     attached: AtomicBool,
+    /// The DAC's worst refill, when the board measures it.
+    refill: RefillStat,
 }
 
 const PHASES: [ScanPhase; 7] = [
@@ -224,6 +271,27 @@ impl GalvoLink {
         (phase, usize::from(self.queued.load(Ordering::Relaxed)))
     }
 
+    /// Publishes the DAC's worst refill (the loop, after each half).
+    pub fn publish_refill(&self, refill: Option<RefillTime>) {
+        if let Some(t) = refill {
+            self.refill.cpu_hz.store(t.cpu_hz, Ordering::Relaxed);
+            self.refill
+                .window_cycles
+                .store(t.window_cycles, Ordering::Relaxed);
+            self.refill.cycles.store(t.cycles, Ordering::Relaxed);
+        }
+    }
+
+    /// The worst refill last published (`None`: not measured).
+    pub fn refill(&self) -> Option<RefillTime> {
+        let cycles = self.refill.cycles.load(Ordering::Relaxed);
+        (cycles > 0).then(|| RefillTime {
+            cycles,
+            cpu_hz: self.refill.cpu_hz.load(Ordering::Relaxed),
+            window_cycles: self.refill.window_cycles.load(Ordering::Relaxed),
+        })
+    }
+
     fn publish(&self, phase: ScanPhase, queued: usize) {
         let code = PHASES.iter().position(|p| *p == phase).unwrap_or(0);
         self.phase.store(code as u8, Ordering::Relaxed);
@@ -244,6 +312,7 @@ impl GalvoLink {
             phase: AtomicU8::new(0),
             queued: AtomicU8::new(0),
             attached: AtomicBool::new(false),
+            refill: RefillStat::new(),
         }
     }
 }

@@ -4,6 +4,7 @@
 use core::fmt;
 use core::sync::atomic::Ordering;
 
+use galvo_planner::blocks::LoopIntegrator;
 use galvo_planner::{Discrete, Method, RigidParams, XyIntegrator};
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
@@ -16,13 +17,17 @@ use crate::log;
 
 /// Jump input samples the integrator holds per axis (10.24 ms at 100 kHz,
 /// longer than any full-range time-optimal jump of the reference galvo).
-pub const INTEGRATOR_CAPACITY: usize = 1024;
+pub const INTEGRATOR_CAPACITY: usize = galvo_planner::blocks::JUMP_CAPACITY;
 /// Longest half buffer the loop fills, samples.
 pub const MAX_HALF_LEN: usize = 512;
+/// Steps the prep stage prepares per half buffer in [`GalvoLoop::run`]:
+/// one stroke step and the refill fit the 1.28 ms window (bench-m4's
+/// `loop.*.prep` and `loop.*.refill`); more could overrun it.
+const PREP_PER_HALF: usize = 1;
 /// Jobs queued inside the loop (beyond the request channel).
 const JOB_QUEUE: usize = 4;
 /// Look-ahead blocks of the path planner (a stroke has at most 4).
-const MARK_BLOCKS: usize = 16;
+const MARK_BLOCKS: usize = galvo_planner::blocks::MARK_BLOCKS;
 /// GRBL's default junction deviation, mm.
 const JUNCTION_DEVIATION_MM: f64 = 0.01;
 
@@ -130,14 +135,20 @@ pub struct GalvoLoop {
     sample_map: SampleMap,
     planning: Galvo<f64>,
     disc: Discrete<3>,
-    mirrors: XyIntegrator<3, INTEGRATOR_CAPACITY>,
+    mirrors: LoopIntegrator,
     /// The running step (when `running`) and the steps planned ahead of
     /// the refill by [`GalvoLoop::prep`].
     steps: StepRing,
     /// Whether the oldest of `steps` is the running one.
     running: bool,
+    /// The running jump's codes (prepared), and the next one to output
+    /// (`None`: the jump is stepped on the integrator).
+    jump_codes: prep::JumpCodes,
+    jump_cursor: Option<usize>,
     /// Where the running step leaves the mirrors, rad.
     active_end_rad: [f64; 2],
+    /// Work since the last half buffer (the cost model's input).
+    work: super::LoopWork,
     /// Samples held dark for want of a prepared step.
     unprepared_samples: u32,
     motion: Motion,
@@ -163,11 +174,7 @@ impl GalvoLoop {
     /// Errors: [`GalvoError::Planner`] for an invalid mirror model or
     /// sample period, [`GalvoError::Kinematics`] for invalid geometry.
     pub fn new(config: GalvoConfig) -> Result<Self, GalvoError> {
-        Self::holding_at(config, [0.0, 0.0])
-    }
-
-    /// A loop holding the mirrors at `angles_rad`, laser off.
-    fn holding_at(config: GalvoConfig, angles_rad: [f64; 2]) -> Result<Self, GalvoError> {
+        let angles_rad = [0.0, 0.0];
         let disc = config
             .mirrors
             .model()
@@ -188,8 +195,11 @@ impl GalvoLoop {
             mirrors,
             steps: StepRing::new(),
             running: false,
+            jump_codes: prep::JumpCodes::EMPTY,
+            jump_cursor: None,
             active_end_rad: angles_rad,
             unprepared_samples: 0,
+            work: super::LoopWork::default(),
             motion: Motion::default(),
             queue: heapless::Deque::new(),
             active: None,
@@ -250,6 +260,7 @@ impl GalvoLoop {
         let mut drawing: heapless::Deque<(GalvoEvent, u8), DONE_QUEUE> = heapless::Deque::new();
         dac.set_sample_period(period_s);
         loop {
+            self.work = super::LoopWork::default();
             let now = gate.generation();
             if now != generation {
                 self.stop();
@@ -278,7 +289,7 @@ impl GalvoLoop {
                 continue;
             }
             // Plan ahead, outside the refill: the refill only steps plans.
-            self.prep();
+            self.prep_up_to(PREP_PER_HALF);
             let out = &mut half[..n];
             let computed = self.refill(out, |event| hold_done(&mut drawing, link, event));
             link.publish(self.phase(), self.queue.len());
@@ -295,8 +306,10 @@ impl GalvoLoop {
                     samples: out,
                     generation,
                     computed,
+                    work: self.work,
                 })
                 .await;
+            link.publish_refill(dac.worst_refill());
             release_drawn(&mut drawing, link);
             if let Err(underrun) = written {
                 generation = gate.close();
@@ -370,6 +383,7 @@ impl Active {
 mod jobs;
 mod mark;
 mod prep;
+mod runs;
 mod samples;
 #[cfg(test)]
 mod tests;

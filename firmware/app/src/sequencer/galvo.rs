@@ -224,5 +224,19 @@ impl Core {
                 galvo.underruns, galvo.halves
             ),
         );
+        if let Some(t) = galvo.refill {
+            let us = |cycles: u32| u64::from(cycles) * 1_000_000 / u64::from(t.cpu_hz.max(1));
+            let percent = u64::from(t.cycles) * 100 / u64::from(t.window_cycles.max(1));
+            self.data(
+                out,
+                format_args!(
+                    "worst refill: {} cycles = {} us, {} % of the {} us half",
+                    t.cycles,
+                    us(t.cycles),
+                    percent,
+                    us(t.window_cycles)
+                ),
+            );
+        }
     }
 }

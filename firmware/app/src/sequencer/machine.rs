@@ -25,7 +25,7 @@ use super::laser::{LaserEvent, laser_wanted};
 use super::run::Run;
 use crate::command::Command;
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
-use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, ScanPhase};
+use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, RefillTime, ScanPhase};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{LoadedRecord, RecordError, Settings};
@@ -90,6 +90,8 @@ pub struct GalvoReadout {
     pub underruns: u32,
     /// Half buffers written since boot.
     pub halves: u32,
+    /// The DAC's worst refill, when the board measures it.
+    pub refill: Option<RefillTime>,
 }
 
 /// What the shell knows just before the core handles an event.

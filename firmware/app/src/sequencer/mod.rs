@@ -257,6 +257,7 @@ impl<L: LaserSwitch, S: SettingsStore> Io<'_, L, S> {
                 queued,
                 underruns: galvo.underruns.load(Relaxed),
                 halves: galvo.halves.load(Relaxed),
+                refill: galvo.refill(),
             },
             implausible_readings: self.servo.implausible_readings.load(Relaxed),
         }

@@ -19,6 +19,7 @@ fn half(samples: &[DacSample], generation: u32) -> Half<'_> {
         samples,
         generation,
         computed: samples.len(),
+        work: Default::default(),
     }
 }
 
@@ -143,6 +144,7 @@ fn repeating_a_hold_costs_nothing_and_is_never_an_underrun() {
                 samples: &h,
                 generation: 0,
                 computed: 0,
+                work: Default::default(),
             })
             .await
             .unwrap();

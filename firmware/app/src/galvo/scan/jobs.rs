@@ -3,9 +3,13 @@
 
 use kinematics_core::PointMm;
 
-use super::{Active, GalvoConfig, GalvoError, GalvoLoop, Job, ScanPhase};
+use galvo_planner::XyIntegrator;
+use kinematics_core::SampleMap;
+
+use super::mark::Motion;
+use super::{Active, GalvoConfig, GalvoError, GalvoLoop, Job, ScanPhase, samples_for};
 use crate::domain::Unit;
-use crate::galvo::{GalvoEvent, GalvoRequest};
+use crate::galvo::{DacSample, GalvoEvent, GalvoRequest};
 use crate::log;
 
 impl GalvoLoop {
@@ -100,16 +104,62 @@ impl GalvoLoop {
         if config == self.config {
             return None;
         }
-        match Self::holding_at(config, self.mirrors.end_position_rad()) {
-            Ok(mut fresh) => {
-                fresh.queue = core::mem::take(&mut self.queue);
-                fresh.faulted = self.faulted;
-                *self = fresh;
+        match self.reconfigure(config) {
+            Ok(()) => {
                 log::info!("galvo: new parameters applied");
                 None
             }
             Err(error) => Some(GalvoEvent::ConfigRefused(error)),
         }
+    }
+
+    /// Applies `config` in place, the mirrors holding where they are:
+    /// everything is checked and built first, so a refused configuration
+    /// changes nothing. The mirror model is sampled again (the `f64`
+    /// matrix exponential, most of the cost on the M4) only when the
+    /// mirrors or the sample rate changed; nothing else is rebuilt (the
+    /// loop's buffers stay where they are, not copied).
+    fn reconfigure(&mut self, config: GalvoConfig) -> Result<(), GalvoError> {
+        let angles_rad = self.mirrors.end_position_rad();
+        let sample_map = SampleMap::new(&config.galvo).map_err(|_| GalvoError::Kinematics)?;
+        let codes = sample_map
+            .angles_to_codes(angles_rad[0] as f32, angles_rad[1] as f32)
+            .ok_or(GalvoError::Kinematics)?;
+        let same_model = config.mirrors == self.config.mirrors
+            && config.sample_period_s == self.config.sample_period_s;
+        if same_model {
+            self.mirrors
+                .hold_at(angles_rad)
+                .map_err(|_| GalvoError::Planner)?;
+            self.work.rebuilds += 1;
+        } else {
+            let disc = config
+                .mirrors
+                .model()
+                .and_then(|m| m.discretize(config.sample_period_s))
+                .map_err(|_| GalvoError::Planner)?;
+            self.mirrors =
+                XyIntegrator::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
+            self.disc = disc;
+            self.work.models_sampled += 1;
+        }
+        let ts = config.sample_period_s;
+        self.sample_map = sample_map;
+        self.planning = config.galvo.cast();
+        self.steps.clear();
+        self.running = false;
+        self.jump_cursor = None;
+        self.active_end_rad = angles_rad;
+        self.motion = Motion::default();
+        self.last = DacSample {
+            x_code: codes.x.code,
+            y_code: codes.y.code,
+            laser: false,
+        };
+        self.on_delay_samples = samples_for(config.laser_on_delay_us, ts);
+        self.off_delay_samples = samples_for(config.laser_off_delay_us, ts);
+        self.config = config;
+        Ok(())
     }
 
     /// Drops queued jobs and turns the laser off from the next sample; a

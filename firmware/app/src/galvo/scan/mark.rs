@@ -2,12 +2,12 @@
 //! galvo kinematics to DAC codes, the end of a stroke, and braking along
 //! the path when stopped mid-stroke.
 
-use galvo_planner::{MarkSample, PathPlanner};
 use kinematics_core::PointMm;
 
-use super::{GalvoError, GalvoLoop, MARK_BLOCKS, ScanPhase};
+use super::runs::{BLOCK, write_codes};
+use super::{GalvoError, GalvoLoop, ScanPhase};
 use crate::domain::{Figure, Unit};
-use crate::galvo::GalvoEvent;
+use crate::galvo::{DacSample, GalvoEvent};
 
 /// The spot while marking or braking: position (mm) and its change over
 /// the last sample (mm per sample).
@@ -20,14 +20,6 @@ pub(super) struct Motion {
 }
 
 impl GalvoLoop {
-    /// The running step's stroke planner (where the prep stage left it).
-    fn running_stroke(&mut self) -> Option<&mut PathPlanner<MARK_BLOCKS>> {
-        if !self.running {
-            return None;
-        }
-        self.steps.get_mut(0)?.marker.as_mut()?.as_mut().ok()
-    }
-
     /// DAC codes of a board position (mm).
     fn codes_at(&self, position_mm: [f32; 2]) -> Option<(u16, u16)> {
         let [x_mm, y_mm] = position_mm;
@@ -36,25 +28,72 @@ impl GalvoLoop {
             .map(|c| (c.x.code, c.y.code))
     }
 
-    /// The next marking sample; at the end of the stroke the mirrors hold
-    /// there and the laser-off delay starts.
-    pub(super) fn mark_sample(
+    /// Marking, laser on: the running stroke's samples through the galvo
+    /// IK to DAC codes until `out` is full or the stroke ends. The end
+    /// (mirrors held there, laser off) is the laser-off delay's first
+    /// sample. Returns how many samples it wrote.
+    pub(super) fn mark_run(
         &mut self,
+        out: &mut [DacSample],
         on_event: &mut impl FnMut(GalvoEvent),
-    ) -> Option<(u16, u16)> {
-        let sample = self.running_stroke().map(|m| m.next_sample());
-        if let Some(MarkSample::Mark { x_mm, y_mm, .. }) = sample {
-            let [px, py] = self.motion.position_mm;
-            self.motion = Motion {
-                position_mm: [x_mm, y_mm],
-                step_mm: [x_mm - px, y_mm - py],
-                ..self.motion
-            };
-            return self.codes_at([x_mm, y_mm]);
+    ) -> usize {
+        let mut points = [[0.0f32; 2]; BLOCK];
+        let mut codes = [[0u16; 2]; BLOCK];
+        let mut last = [self.last.x_code, self.last.y_code];
+        let [mut prev, mut position] = [self.motion.position_mm; 2];
+        let mut n = 0;
+        if let Some(stroke) = self
+            .steps
+            .get_mut(0)
+            .filter(|_| self.running)
+            .and_then(|step| step.marker.as_mut())
+            .and_then(|m| m.as_mut().ok())
+        {
+            for chunk in out.chunks_mut(BLOCK) {
+                let points = points.get_mut(..chunk.len()).unwrap_or_default();
+                let got = galvo_planner::blocks::fill_marks(stroke, points);
+                let points = points.get(..got).unwrap_or_default();
+                // Marked positions stay inside the checked range; on a
+                // conversion error the last codes hold.
+                last = self.sample_map.board_block(points, &mut codes, last);
+                write_codes(chunk, &codes[..got.min(BLOCK)], true);
+                if let [.., before, end] = points {
+                    (prev, position) = (*before, *end);
+                } else if let [end] = points {
+                    (prev, position) = (position, *end);
+                }
+                n += got;
+                if got < chunk.len() {
+                    break;
+                }
+            }
         }
-        // Stroke done (planner idle): hold at its end, laser off. The
-        // sampler landed exactly on the stroke's end (in f32), whose angles
-        // the prep stage computed: no f64 IK here.
+        self.last = DacSample {
+            x_code: last[0],
+            y_code: last[1],
+            laser: n > 0 || self.last.laser,
+        };
+        self.motion.position_mm = position;
+        if n > 0 {
+            self.motion.step_mm = [position[0] - prev[0], position[1] - prev[1]];
+        }
+        let n = match out.get_mut(n..) {
+            Some(rest) if !rest.is_empty() => n + self.end_stroke(rest, on_event),
+            _ => n,
+        };
+        self.work.marked += n as u32;
+        n
+    }
+
+    /// The stroke is done (planner idle): the mirrors hold at its end,
+    /// laser off, and the laser-off delay starts with this sample. The
+    /// sampler landed exactly on the stroke's end (in f32), whose angles
+    /// the prep stage computed: no f64 IK here.
+    fn end_stroke(
+        &mut self,
+        out: &mut [DacSample],
+        on_event: &mut impl FnMut(GalvoEvent),
+    ) -> usize {
         let seated = self.mirrors.hold_at(self.active_end_rad);
         if let (Err(_), Some(a)) = (seated, self.active) {
             on_event(GalvoEvent::Refused {
@@ -63,9 +102,14 @@ impl GalvoLoop {
             });
         }
         if let Some(a) = self.active.as_mut() {
-            a.enter(ScanPhase::LaserOffDelay, self.off_delay_samples);
+            // This sample is the delay's first.
+            a.enter(
+                ScanPhase::LaserOffDelay,
+                self.off_delay_samples.saturating_sub(1),
+            );
         }
-        self.codes_at(self.motion.position_mm)
+        let codes = self.codes_at(self.motion.position_mm);
+        self.emit(out, codes, false)
     }
 
     /// One braking sample: along the last direction, slowing at the

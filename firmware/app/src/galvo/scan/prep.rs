@@ -14,6 +14,7 @@
 //! at the running loop; the refill checks that chain when it queues the
 //! jump and drops the prepared steps if it broke.
 
+use galvo_planner::blocks::{PRECOMPUTED_JUMP, jump_angles};
 use galvo_planner::{JumpSync, MarkLimits, PathPlanner, XyJump, plan_xy_jump};
 use kinematics_core::PointMm;
 
@@ -27,6 +28,23 @@ pub(super) const PREP_DEPTH: usize = 4;
 /// A stroke loaded into the look-ahead path planner, or why it was refused.
 pub(super) type LoadedStroke = Result<PathPlanner<MARK_BLOCKS>, GalvoError>;
 
+/// A jump's DAC codes, sample by sample.
+#[derive(Debug, Clone)]
+pub(super) struct JumpCodes {
+    /// Samples of the jump.
+    pub(super) len: usize,
+    /// `[x, y]` codes; the first `len` are the jump's.
+    pub(super) codes: [[u16; 2]; PRECOMPUTED_JUMP],
+}
+
+impl JumpCodes {
+    /// No samples.
+    pub(super) const EMPTY: Self = Self {
+        len: 0,
+        codes: [[0; 2]; PRECOMPUTED_JUMP],
+    };
+}
+
 /// One prepared step: the jump to its start and, for a stroke, the loaded
 /// path planner.
 #[derive(Debug, Clone)]
@@ -38,6 +56,9 @@ pub(super) struct Prepared {
     starts_job: bool,
     /// Both axes' jump plans, or why the jump was refused.
     pub(super) jump: Result<XyJump<3>, GalvoError>,
+    /// The jump's DAC codes, computed here when it is short enough
+    /// (the refill copies them instead of stepping the integrator).
+    pub(super) jump_codes: Option<JumpCodes>,
     /// The stroke, for a path step.
     pub(super) marker: Option<LoadedStroke>,
     /// Mirror angles where this step leaves the mirrors, rad.
@@ -65,13 +86,25 @@ impl GalvoLoop {
     /// half buffers, never inside the refill. Returns how many steps it
     /// prepared.
     pub fn prep(&mut self) -> usize {
+        self.prep_up_to(PREP_DEPTH)
+    }
+
+    /// [`Self::prep`], preparing at most `max_steps` steps (the run loop
+    /// prepares one per half buffer, to stay within its window).
+    pub fn prep_up_to(&mut self, max_steps: usize) -> usize {
         let mut prepared = 0;
-        while self.steps.len() - self.started() < PREP_DEPTH {
+        while prepared < max_steps && self.steps.len() - self.started() < PREP_DEPTH {
             let Some(step) = self.next_unprepared_step() else {
                 break;
             };
+            let stroke = step.marker.is_some();
             if !self.steps.push_back(step) {
                 break;
+            }
+            if stroke {
+                self.work.strokes_prepared += 1;
+            } else {
+                self.work.points_prepared += 1;
             }
             prepared += 1;
         }
@@ -158,24 +191,56 @@ impl GalvoLoop {
         });
         let end_rad = match (&jump, &marker, end_mm) {
             (Err(_), _, _) => start_rad,
-            // Where the path sampler lands: the stroke's end in f32.
-            (Ok(_), Some(Ok(_)), Some([x, y])) => self
-                .angles_for(PointMm {
+            // Where the path sampler lands: the stroke's end in f32 (a
+            // closed stroke whose start is exact in f32 ends at its start:
+            // the same IK, not computed twice).
+            (Ok((_, target_rad)), Some(Ok(_)), Some([x, y])) => {
+                let end = PointMm {
                     x_mm: f64::from(x as f32),
                     y_mm: f64::from(y as f32),
-                })
-                .unwrap_or(start_rad),
+                };
+                if Ok(end) == target_mm {
+                    *target_rad
+                } else {
+                    self.angles_for(end).unwrap_or(start_rad)
+                }
+            }
             (Ok((_, target_rad)), _, _) => *target_rad,
+        };
+        let jump_codes = match &jump {
+            Ok((jump, _)) => self.jump_codes(jump),
+            Err(_) => None,
         };
         Prepared {
             seq,
             job,
             stroke,
             starts_job,
+            jump_codes,
             jump: jump.map(|(jump, _)| jump),
             marker,
             end_rad,
         }
+    }
+
+    /// The DAC codes of every sample of `jump` from rest at its start
+    /// (`None` for a jump longer than [`PRECOMPUTED_JUMP`]: the refill
+    /// steps it).
+    fn jump_codes(&self, jump: &XyJump<3>) -> Option<JumpCodes> {
+        if jump.samples() == 0 {
+            // Already there: nothing to output.
+            return None;
+        }
+        let (mut x, mut y) = ([0.0f32; PRECOMPUTED_JUMP], [0.0f32; PRECOMPUTED_JUMP]);
+        let len = jump_angles(&self.mirrors, jump, &mut x, &mut y).ok()?;
+        let mut codes = JumpCodes {
+            len,
+            codes: [[0; 2]; PRECOMPUTED_JUMP],
+        };
+        let hold = [self.last.x_code, self.last.y_code];
+        self.sample_map
+            .axes_block(x.get(..len)?, y.get(..len)?, &mut codes.codes, hold);
+        Some(codes)
     }
 
     /// Loads a stroke (its start and segments) into a fresh path planner.

@@ -3,6 +3,7 @@
 
 use galvo_planner::Error as PlannerError;
 
+use super::runs::queue_jump;
 use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase, samples_for};
 use crate::domain::Unit;
 use crate::galvo::{DacSample, GalvoEvent};
@@ -58,37 +59,25 @@ impl GalvoLoop {
         on_event: &mut impl FnMut(GalvoEvent),
         on_demand: bool,
     ) -> usize {
+        self.work.refills += 1;
         if let Some(hold) = self.hold_sample() {
+            self.work.held += out.len() as u32;
             out.fill(hold);
             self.last = hold;
             return out.len().min(1);
         }
-        for slot in out.iter_mut() {
-            if self.advance(on_event, on_demand) == Advance::Unprepared {
+        // Run by run: each phase produces as many samples as it has (or
+        // the half takes) in a tight loop of its own (scan/runs.rs).
+        let mut done = 0;
+        while let Some(rest) = out.get_mut(done..).filter(|rest| !rest.is_empty()) {
+            let n = if self.advance(on_event, on_demand) == Advance::Unprepared {
                 self.unprepared_samples = self.unprepared_samples.saturating_add(1);
-            }
-            let codes = match self.phase() {
-                ScanPhase::Marking => self.mark_sample(on_event),
-                ScanPhase::Braking => self.brake_sample(),
-                _ => {
-                    let [x_rad, y_rad] = self.mirrors.step();
-                    self.sample_map
-                        .angles_to_codes(x_rad, y_rad)
-                        .map(|c| (c.x.code, c.y.code))
-                }
+                let one = rest.len().min(1);
+                self.held_run(&mut rest[..one])
+            } else {
+                self.phase_run(rest, on_event)
             };
-            // Angles and marked positions stay inside the checked range;
-            // on a conversion error hold the last codes rather than output
-            // garbage.
-            if let Some((x_code, y_code)) = codes {
-                self.last.x_code = x_code;
-                self.last.y_code = y_code;
-            }
-            self.last.laser = matches!(self.phase(), ScanPhase::Dwelling | ScanPhase::Marking);
-            *slot = self.last;
-            if let Some(a) = self.active.as_mut() {
-                a.samples_left = a.samples_left.saturating_sub(1);
-            }
+            done += n.max(1);
         }
         out.len()
     }
@@ -129,6 +118,12 @@ impl GalvoLoop {
         on_event: &mut impl FnMut(GalvoEvent),
         on_demand: bool,
     ) -> Option<Advance> {
+        if self.pending_config.is_some() && !on_demand {
+            // New parameters wait for the next half boundary
+            // (`GalvoLoop::run` applies them there): no rebuild inside
+            // the refill. The mirrors hold, laser off, until then.
+            return Some(Advance::Ready);
+        }
         if let Some(event) = self.apply_pending_config(false) {
             on_event(event);
         }
@@ -257,7 +252,13 @@ impl GalvoLoop {
             // `Err(None)`: planned from somewhere the mirrors are not (stale).
             let queued = match &step.jump {
                 Err(error) => Err(Some(*error)),
-                Ok(jump) => match self.mirrors.queue_jump(jump) {
+                Ok(jump) => match queue_jump(
+                    &mut self.mirrors,
+                    &mut self.jump_codes,
+                    &mut self.jump_cursor,
+                    jump,
+                    step.jump_codes.as_ref(),
+                ) {
                     Ok(()) => Ok(()),
                     Err(PlannerError::DiscontinuousMove) => Err(None),
                     Err(_) => Err(Some(GalvoError::Planner)),
@@ -275,6 +276,7 @@ impl GalvoLoop {
                     });
                     self.running = true;
                     self.active_end_rad = end_rad;
+                    self.work.steps_started += 1;
                     return StepStart::Started;
                 }
                 Err(None) => self.steps.clear(),

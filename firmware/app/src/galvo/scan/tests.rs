@@ -434,3 +434,51 @@ fn stop_while_marking_brakes_dark_without_a_jump() {
     let (_, events) = run(&mut galvo, done(2));
     assert_eq!(events.len(), 1);
 }
+
+/// The refill works run by run (a phase's samples in a loop of its own):
+/// how the samples are cut into halves changes nothing, across jumps,
+/// dwells, strokes, stroke ends and a stop while marking.
+#[test]
+fn halves_of_any_length_give_the_same_samples() {
+    let stream = |half_len: usize| {
+        let mut galvo = GalvoLoop::new(GalvoConfig::default()).unwrap();
+        let jobs = [
+            point(1, 60.0, -35.0, 500),
+            path(
+                2,
+                Figure::Tuning {
+                    centre: PointCm::new(0.5, -0.3),
+                    size_cm: 6.0,
+                },
+            ),
+            point(3, -10.0, 5.0, 0),
+            path(
+                4,
+                Figure::Rect {
+                    a: PointCm::new(-3.0, -3.0),
+                    b: PointCm::new(3.0, 2.0),
+                },
+            ),
+        ];
+        for job in jobs {
+            assert_eq!(galvo.request(job), None);
+        }
+        let mut samples = Vec::new();
+        let mut half = [DacSample::default(); 128];
+        while samples.len() < 60_000 {
+            // A stop at the same sample for every half length.
+            if samples.len() == 51_200 {
+                galvo.request(GalvoRequest::Stop);
+            }
+            galvo.fill(&mut half[..half_len], |_| {});
+            samples.extend_from_slice(&half[..half_len]);
+        }
+        samples.truncate(60_000);
+        samples
+    };
+    let whole = stream(128);
+    assert!(whole.iter().filter(|s| s.laser).count() > 10_000);
+    for half_len in [1, 32, 100] {
+        assert!(stream(half_len) == whole, "half of {half_len}");
+    }
+}

@@ -198,6 +198,7 @@ impl Harness {
                 queued: GALVO_REQUEST_DEPTH - self.galvo_room,
                 underruns: 0,
                 halves: 0,
+                refill: None,
             },
             implausible_readings: 0,
         }

@@ -27,6 +27,7 @@ const READINGS: Readings = Readings {
         queued: 0,
         underruns: 0,
         halves: 0,
+        refill: None,
     },
     implausible_readings: 0,
 };
@@ -126,6 +127,36 @@ fn galvo_commands_are_refused_while_no_galvo_loop_serves_the_link() {
     let galvo = command(&mut core, 1, Command::Target(Actuator::Galvo), GALVO);
     assert!(galvo.iter().any(|a| matches!(a, Action::ConfigureGalvo(_))));
     assert_eq!(galvo.last(), Some(&Action::Line(Line::Ok)));
+}
+
+#[test]
+fn galvo_status_reports_the_measured_worst_refill_only_where_measured() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let data = |actions: &[Action]| -> Vec<std::string::String> {
+        actions
+            .iter()
+            .filter_map(|a| match a {
+                Action::Line(Line::Data(text)) => Some(std::string::String::from(text.as_str())),
+                _ => None,
+            })
+            .collect()
+    };
+    let unmeasured = command(&mut core, 1, Command::GalvoStatus, GALVO);
+    assert!(!data(&unmeasured).iter().any(|l| l.contains("refill")));
+    let mut readings = READINGS;
+    // 20 160 cycles at 168 MHz = 120 us of a 1280 us half (128 samples at 10 us).
+    readings.galvo.refill = Some(crate::galvo::RefillTime {
+        cycles: 20_160,
+        cpu_hz: 168_000_000,
+        window_cycles: 215_040,
+    });
+    let command = Command::GalvoStatus;
+    let measured = on_with(&mut core, 1, GALVO, Event::Command { command, readings });
+    assert!(
+        data(&measured)
+            .contains(&"worst refill: 20160 cycles = 120 us, 9 % of the 1280 us half".into()),
+        "{measured:?}"
+    );
 }
 
 #[test]
