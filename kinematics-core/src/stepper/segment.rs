@@ -9,6 +9,7 @@
 
 use super::motion::{MAX_TIMER_HZ, MotionError};
 use super::planner::{PlannedBlock, Planner};
+use crate::numeric::clamp;
 
 /// What the step generator needs of a block: step counts and directions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -57,12 +58,10 @@ impl Profile {
         let d = f64::from(block.event_count);
         let meet = libm::sqrt(a * d + 0.5 * (v0 * v0 + v1 * v1));
         let peak = meet.min(block.nominal_rate_steps_per_s).max(v0).max(v1);
-        // max/min, not `f64::clamp`: its panic path formats floats (10 KB
-        // of flash on the target).
-        let d_acc = ((peak * peak - v0 * v0) / (2.0 * a)).max(0.0).min(d);
-        let d_dec = ((peak * peak - v1 * v1) / (2.0 * a))
-            .max(0.0)
-            .min(d - d_acc);
+        // `numeric::clamp`, not `f64::clamp`: its panic path formats floats
+        // (10 KB of flash on the target).
+        let d_acc = clamp((peak * peak - v0 * v0) / (2.0 * a), 0.0, d);
+        let d_dec = clamp((peak * peak - v1 * v1) / (2.0 * a), 0.0, d - d_acc);
         Self {
             d,
             entry: v0,

@@ -10,6 +10,7 @@ use kinematics_core::stepper::{Planner, Segment, SegmentPrep, StepMove};
 
 use super::{MoveShape, SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
 use kinematics_core::Rotation;
+use kinematics_core::numeric::clamp;
 
 /// Largest distance of the pieces' joint-space insides from the board
 /// curve, mm (the steps' own rounding, ≤ half a step per axis, comes on
@@ -379,9 +380,11 @@ fn distance_to_segment_cm(p: BoardPoint, a: BoardPoint, b: BoardPoint) -> f64 {
     let (dx, dy) = (b.x_cm - a.x_cm, b.y_cm - a.y_cm);
     let len2 = dx * dx + dy * dy;
     let t = if len2 > 0.0 {
-        (((p.x_cm - a.x_cm) * dx + (p.y_cm - a.y_cm) * dy) / len2)
-            .max(0.0)
-            .min(1.0)
+        clamp(
+            ((p.x_cm - a.x_cm) * dx + (p.y_cm - a.y_cm) * dy) / len2,
+            0.0,
+            1.0,
+        )
     } else {
         0.0
     };
