@@ -252,6 +252,10 @@ impl Stm32GalvoDac {
 }
 
 impl DacStream for Stm32GalvoDac {
+    /// Bisection jump planning (`planner seed`) takes 1.6–7.5 M
+    /// instructions per axis here (bench-m4): refused.
+    const F64_PLANNING: bool = false;
+
     fn half_len(&self) -> usize {
         HALF_LEN
     }

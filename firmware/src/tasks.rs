@@ -16,9 +16,12 @@ use laser_app::app::{
     ConsoleTask, GalvoTask, IndicatorTask, SequencerTask, ServoBusTask, Spawn, StopButtonTask,
     WatchdogTask,
 };
+use laser_app::galvo::GalvoMemory;
+
+use static_cell::StaticCell;
 
 use crate::board::Stm32Board;
-use crate::galvo_dac::Stm32GalvoDac;
+use crate::galvo_dac::{self, Stm32GalvoDac};
 use crate::parts::{
     GpioStepper, IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton,
 };
@@ -52,7 +55,9 @@ async fn sequencer(task: SequencerTask<LaserPin, FlashSettings>) -> ! {
 /// The galvo loop (on the galvo executor): feeds the DAC stream.
 #[embassy_executor::task]
 async fn galvo(task: GalvoTask<Stm32GalvoDac>) {
-    task.run().await
+    // The loop's memory in a static, not in this task's future.
+    static MEMORY: StaticCell<GalvoMemory<{ galvo_dac::HALF_LEN }>> = StaticCell::new();
+    task.run_in(MEMORY.init_with(GalvoMemory::new)).await
 }
 
 /// The stepper step timer: executes the prepared segments on PE9–PE13.

@@ -11,7 +11,7 @@
 
 use crate::error::Error;
 use crate::integrator::XyIntegrator;
-use crate::path::{MIN_CAPACITY, MarkSample, PathPlanner};
+use crate::path::{MarkSample, PathPlanner};
 use crate::plan::XyJump;
 
 /// Jump input samples the loop's integrator holds per axis (10.24 ms at
@@ -19,8 +19,11 @@ use crate::plan::XyJump;
 /// galvo).
 pub const JUMP_CAPACITY: usize = 1024;
 
-/// Look-ahead blocks of the loop's path planner.
-pub const MARK_BLOCKS: usize = MIN_CAPACITY;
+/// Blocks of the loop's path planner: the loop loads a whole stroke (at
+/// most 4 segments in laser-app's figures, one block each) before marking
+/// it, so its look-ahead is the whole stroke. Each block is ~150 B and the
+/// loop keeps five planners (the running step and four prepared).
+pub const MARK_BLOCKS: usize = 4;
 
 /// Longest jump (samples) whose angles [`jump_angles`] computes ahead of
 /// time (the reference galvo's 160 mm diagonal jump takes 49 samples, its

@@ -236,6 +236,35 @@ pub fn plan_time_optimal_fast<const S: usize>(
     to_rad: f64,
     capacity: usize,
 ) -> Result<JumpPlan<S>, Error> {
+    plan_f32_or(disc, from_rad, to_rad, capacity, |_| {
+        plan_time_optimal(disc, from_rad, to_rad, capacity)
+    })
+}
+
+/// [`plan_time_optimal_fast`] without its `f64` fallback, for a CPU with
+/// a single-precision FPU only (the M4F, where the `f64` planner takes
+/// milliseconds): the same plan where the `f32` modal form applies, else
+/// [`Error::UnsupportedModel`] (no rigid modal form) or
+/// [`Error::NoConvergence`] (the `f32` solve found no plan). A caller
+/// that uses only this links none of the `f64` time-optimal planner.
+pub fn plan_time_optimal_f32<const S: usize>(
+    disc: &Discrete<S>,
+    from_rad: f64,
+    to_rad: f64,
+    capacity: usize,
+) -> Result<JumpPlan<S>, Error> {
+    plan_f32_or(disc, from_rad, to_rad, capacity, Err)
+}
+
+/// The `f32` plan, or `fallback` with why it does not apply.
+#[inline(always)]
+fn plan_f32_or<const S: usize>(
+    disc: &Discrete<S>,
+    from_rad: f64,
+    to_rad: f64,
+    capacity: usize,
+    fallback: impl FnOnce(Error) -> Result<JumpPlan<S>, Error>,
+) -> Result<JumpPlan<S>, Error> {
     let RigidMove::Move {
         from_rad,
         to_rad,
@@ -253,7 +282,7 @@ pub fn plan_time_optimal_fast<const S: usize>(
         (delta, 1.0)
     };
     let Some(fast) = disc.rigid_modes() else {
-        return plan_time_optimal(disc, from_rad, to_rad, capacity);
+        return fallback(Error::UnsupportedModel);
     };
     let modes = fast.modes;
     let u_max = disc.u_max_v();
@@ -261,10 +290,10 @@ pub fn plan_time_optimal_fast<const S: usize>(
     // M = S0/Umax = D·Kt/(Ts·Umax), samples.
     let m = (d as f32) * fast.m_per_rad;
     if !(m.is_finite() && m > 0.0) || m > 1.0e6 {
-        return plan_time_optimal(disc, from_rad, to_rad, capacity);
+        return fallback(Error::NoConvergence);
     }
     let Some(sol) = fast_plan(&modes, m, u_max32, capacity)? else {
-        return plan_time_optimal(disc, from_rad, to_rad, capacity);
+        return fallback(Error::NoConvergence);
     };
     solution_plan(disc, (z0, z1), sign, u_max, fast.ts_s, sol)
 }

@@ -143,5 +143,36 @@ pub fn plan_xy_jump<const S: usize>(
     Ok(XyJump { x, y })
 }
 
+/// Both axes' time-optimal jumps planned in `f32` only
+/// ([`plan_time_optimal_f32`](crate::fast_optimal::plan_time_optimal_f32):
+/// no `f64` fallback, no other method), each axis as fast as it can
+/// ([`JumpSync::Independent`]). For a CPU with a single-precision FPU only
+/// (the M4F): it links none of the `f64` planners.
+pub fn plan_xy_jump_f32<const S: usize>(
+    disc_x: &Discrete<S>,
+    disc_y: &Discrete<S>,
+    from_rad: [f64; 2],
+    to_rad: [f64; 2],
+    capacity: usize,
+) -> Result<XyJump<S>, Error> {
+    if disc_x.ts_s() != disc_y.ts_s() {
+        return Err(Error::InvalidSamplePeriod {
+            ts_s: disc_y.ts_s(),
+        });
+    }
+    let plan = |disc, from: f64, to: f64| {
+        crate::fast_optimal::plan_time_optimal_f32(
+            disc,
+            finite(from, "from_rad")?,
+            finite(to, "to_rad")?,
+            capacity,
+        )
+    };
+    Ok(XyJump {
+        x: plan(disc_x, from_rad[0], to_rad[0])?,
+        y: plan(disc_y, from_rad[1], to_rad[1])?,
+    })
+}
+
 #[cfg(test)]
 mod tests;

@@ -1,7 +1,9 @@
 //! Path marking with look-ahead (GRBL style) in the board plane.
 //!
 //! Segments (lines and circular arcs, mm) are added to a fixed-capacity
-//! planner buffer (`CAP ≥ 16` blocks). Each block gets a speed cap (the
+//! planner buffer (`CAP` blocks, one per segment: 16 or more give a
+//! streamed path GRBL's look-ahead; a caller that loads a whole stroke
+//! before sampling it needs only the stroke's segments). Each block gets a speed cap (the
 //! marking speed; on arcs also `√(a·r/√2)` so the centripetal acceleration
 //! stays ≤ `a/√2`) and a tangential acceleration limit (`a` on lines,
 //! `a/√2` on arcs, so the total acceleration on an arc is ≤ `a`). The speed
@@ -126,7 +128,7 @@ pub enum BlockEnd {
 /// ```compile_fail
 /// use galvo_planner::path::{MarkLimits, PathPlanner};
 /// let limits = MarkLimits { speed_mm_s: 1000.0, accel_mm_s2: 1e5, junction_deviation_mm: 0.01, ts_s: 1e-5 };
-/// let _too_small = PathPlanner::<8>::new(limits, [0.0, 0.0]);
+/// let _too_small = PathPlanner::<0>::new(limits, [0.0, 0.0]);
 /// ```
 #[derive(Debug, Clone)]
 pub struct PathPlanner<const CAP: usize> {
@@ -144,11 +146,13 @@ pub struct PathPlanner<const CAP: usize> {
     position: [f32; 2],
 }
 
-/// The planner buffer must hold at least this many blocks.
-pub const MIN_CAPACITY: usize = 16;
+/// The planner buffer must hold at least this many blocks (one segment;
+/// the backward pass always ends the buffer at rest, so fewer blocks only
+/// shorten the look-ahead of a streamed path, never break it).
+pub const MIN_CAPACITY: usize = 1;
 
 impl<const CAP: usize> PathPlanner<CAP> {
-    const CAPACITY_OK: () = assert!(CAP >= MIN_CAPACITY, "PathPlanner needs CAP >= 16");
+    const CAPACITY_OK: () = assert!(CAP >= MIN_CAPACITY, "PathPlanner needs CAP >= 1");
 
     /// An empty planner with the spot at rest at `start_mm`.
     pub fn new(limits: MarkLimits, start_mm: [f64; 2]) -> Result<Self, Error> {

@@ -2,6 +2,7 @@
 //! through the simulator and read what happened.
 
 pub mod console;
+pub mod gcode_job;
 mod random;
 pub mod spec_patterns;
 
@@ -31,7 +32,12 @@ pub fn run_with(script: &str, options: SimOptions) -> SimReport {
 /// the safety invariants (tolerating [`UNTIL_STEP_FIXES`]) and succeeded
 /// (every line answered `ok`, idle at the end).
 pub fn run_succeeding(script: &str) -> SimReport {
-    let report = run_checked_allowing(script, SimOptions::default(), UNTIL_STEP_FIXES);
+    run_succeeding_with(script, SimOptions::default())
+}
+
+/// [`run_succeeding`] with `options`.
+pub fn run_succeeding_with(script: &str, options: SimOptions) -> SimReport {
+    let report = run_checked_allowing(script, options, UNTIL_STEP_FIXES);
     assert!(
         report.succeeded(false),
         "{script:?}: {:?}",

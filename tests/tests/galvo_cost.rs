@@ -88,6 +88,11 @@ fn m4_cost_model_matches_the_bench_table() {
         .max(row(&table, "loop.line.prep"));
     fits("stroke_prepared", m.stroke_prepared, stroke);
     fits("rebuild", m.rebuild, row(&table, "loop.reconfigure"));
+    fits(
+        "bisection_axis",
+        m.bisection_axis,
+        row(&table, "plan.seed.0.1deg"),
+    );
     fits("model_sampled", m.model_sampled, row(&table, "loop.new"));
 }
 
@@ -98,4 +103,19 @@ fn the_demo_keeps_up_at_the_m4_cost() {
     let report = run_to_idle(DEMO_SCRIPT);
     assert_eq!(report.galvo_underruns, 0);
     assert!(report.dac.iter().any(|(_, s)| s.laser), "the galvo marked");
+}
+
+/// `planner seed` in the simulator: allowed (for comparison), charged its
+/// M4 cost (bisection, ≥ 1.57 M instructions per jump axis), so the
+/// pattern underruns as it would on the M4 — where the board refuses the
+/// planner instead.
+#[test]
+fn a_seed_planned_pattern_underruns_at_the_m4_cost() {
+    let report = run_to_idle("planner seed\ntarget galvo\npattern tuning 0 0 8 once\nwait 1500\n");
+    assert!(
+        report.galvo_underruns > 0,
+        "seed planning kept up on the M4's cost"
+    );
+    let optimal = run_to_idle("target galvo\npattern tuning 0 0 8 once\nwait 1500\n");
+    assert_eq!(optimal.galvo_underruns, 0);
 }

@@ -8,6 +8,7 @@ mod json_out;
 mod kin;
 mod plan;
 mod sim;
+mod size_gcode;
 mod toolchain;
 
 use std::process::ExitCode;
@@ -44,6 +45,10 @@ enum Command {
     /// Run the cargo-fuzz targets (nightly; installed when missing) and
     /// merge new inputs into tests/fuzz/corpus.
     Fuzz(fuzz::FuzzArgs),
+    /// Real G-code senders (PyPI's grbl-streamer and pygrbl-streamer,
+    /// pip-installed into target/senders when missing) stream a laser job
+    /// to the simulator through its PTY console, in real time (~30 s).
+    Senders,
 }
 
 fn main() -> ExitCode {
@@ -59,6 +64,21 @@ fn main() -> ExitCode {
         Command::Calib(args) => calib::run(args),
         Command::Plan(args) => plan::run(args),
         Command::Fuzz(args) => fuzz::fuzz(args).map(|()| ExitCode::SUCCESS),
+        Command::Senders => toolchain::run(
+            "cargo",
+            &[
+                "test",
+                "-p",
+                "system-tests",
+                "--test",
+                "gcode_senders",
+                "--",
+                "--ignored",
+                "--test-threads",
+                "1",
+            ],
+        )
+        .map(|()| ExitCode::SUCCESS),
     };
     match result {
         Ok(code) => code,

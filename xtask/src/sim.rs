@@ -60,8 +60,14 @@ pub struct SimArgs {
     /// serial terminal on the board (end with Ctrl-D). Implies --realtime.
     #[arg(long, conflicts_with = "script")]
     interactive: bool,
+    /// Serve the console on a pseudo-terminal in real time, so any serial
+    /// program (picocom, a G-code sender) connects as to the board; prints
+    /// the device path, and makes PATH a symlink to it when given. Runs
+    /// until Ctrl-C / SIGTERM (or --max-time-s), then writes the outputs.
+    #[arg(long, num_args = 0..=1, default_missing_value = "", conflicts_with_all = ["script", "interactive"])]
+    pty: Option<PathBuf>,
     /// Stop after this much simulated time, s (default 600; no limit with
-    /// --interactive).
+    /// --interactive or --pty).
     #[arg(long)]
     max_time_s: Option<f64>,
     /// Check the safety invariants after the run (laser dark within 1 ms
@@ -154,7 +160,7 @@ fn read_stdin() -> Result<String> {
 /// The script to run and whether it is the demo (no script given).
 fn script_text(args: &SimArgs) -> Result<(String, bool)> {
     let script_text = match &args.script {
-        _ if args.interactive => String::new(),
+        _ if args.interactive || args.pty.is_some() => String::new(),
         Some(path) if path.as_os_str() == "-" => read_stdin()?,
         Some(path) => std::fs::read_to_string(path)
             .with_context(|| format!("cannot read script {}", path.display()))?,
@@ -162,7 +168,10 @@ fn script_text(args: &SimArgs) -> Result<(String, bool)> {
         None if std::io::IsTerminal::is_terminal(&std::io::stdin()) => String::new(),
         None => read_stdin()?,
     };
-    let demo = !args.interactive && args.script.is_none() && script_text.trim().is_empty();
+    let demo = !args.interactive
+        && args.pty.is_none()
+        && args.script.is_none()
+        && script_text.trim().is_empty();
     let script_text = if demo {
         DEMO_SCRIPT.to_owned()
     } else {
@@ -192,7 +201,7 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         Some(s) if s.is_finite() && s > 0.0 => s,
         Some(_) => bail!("--max-time-s must be positive"),
         // A year of simulated time: no limit in practice.
-        None if args.interactive => 3.2e7,
+        None if args.interactive || args.pty.is_some() => 3.2e7,
         None => 600.0,
     };
     if args.interactive {
@@ -201,9 +210,18 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
     if demo {
         eprintln!("xtask sim: no script given, running the demo:\n{DEMO_SCRIPT}");
     }
+    let pty = args.pty.as_ref().map(|link| {
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        laser_sim::pty::stop_on_signals(stop.clone());
+        laser_sim::pty::PtyOptions {
+            link: (!link.as_os_str().is_empty()).then(|| link.clone()),
+            stop,
+        }
+    });
     let report = run(SimOptions {
         script,
-        realtime: args.realtime || args.interactive,
+        pty,
+        realtime: args.realtime || args.interactive || args.pty.is_some(),
         interactive: args.interactive,
         until_idle,
         faults,

@@ -290,6 +290,7 @@ pub fn size() -> Result<()> {
         RAM_BUDGET_BYTES,
         100.0 * size.ram_bytes() as f64 / RAM_BUDGET_BYTES as f64
     );
+    crate::size_gcode::report(&elf, &llvm_size)?;
     check_budget(size)
 }
 

@@ -15,6 +15,7 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 
 use crate::domain::{Actuator, AimModel, Pattern, PointCm};
+use crate::grbl::realtime::Realtime;
 use crate::outbound::{LineKind, Outbound};
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
 use crate::text::{ReplyText, Shortest};
@@ -95,6 +96,40 @@ pub enum Command {
     Planner(JumpPlanner),
     /// Galvo loop state.
     GalvoStatus,
+    /// A G-code or `$` line for the grbl layer (answered `ok` once its
+    /// motion is queued, `error:N` when refused).
+    Grbl(GrblLine),
+}
+
+/// Longest accepted command line, bytes (excluding the terminator).
+pub const MAX_LINE_LEN: usize = 128;
+
+/// A G-code or `$` line as the console assembled it: printable ASCII, at
+/// most [`MAX_LINE_LEN`] bytes (a plain array, so [`Command`] stays `Copy`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct GrblLine {
+    bytes: [u8; MAX_LINE_LEN],
+    len: u8,
+}
+
+impl GrblLine {
+    /// The line `text`; `None` when longer than [`MAX_LINE_LEN`] bytes.
+    pub fn new(text: &str) -> Option<Self> {
+        let mut bytes = [0u8; MAX_LINE_LEN];
+        bytes
+            .get_mut(..text.len())?
+            .copy_from_slice(text.as_bytes());
+        Some(Self {
+            bytes,
+            len: u8::try_from(text.len()).ok()?,
+        })
+    }
+
+    /// The text.
+    pub fn as_str(&self) -> &str {
+        let bytes = self.bytes.get(..usize::from(self.len)).unwrap_or(&[]);
+        core::str::from_utf8(bytes).unwrap_or("")
+    }
 }
 
 impl Command {
@@ -117,6 +152,7 @@ impl Command {
             Command::Target(_) => "target",
             Command::Planner(_) => "planner",
             Command::GalvoStatus => "galvo status",
+            Command::Grbl(_) => "grbl",
         }
     }
 
@@ -152,6 +188,7 @@ impl fmt::Debug for Command {
             Command::Model(AimModel::Seed) => f.write_str("model seed"),
             Command::Set { param, value } => write!(f, "set {} {}", param.name, Shortest(*value)),
             Command::Get(param) => write!(f, "get {}", param.name),
+            Command::Grbl(line) => f.write_str(line.as_str()),
             other => f.write_str(other.name()),
         }
     }
@@ -180,6 +217,7 @@ impl PartialEq for Command {
                 a.name == b.name && x == y
             }
             (Command::Get(a), Command::Get(b)) => a.name == b.name,
+            (Command::Grbl(a), Command::Grbl(b)) => a == b,
             (a, b) => core::mem::discriminant(a) == core::mem::discriminant(b),
         }
     }
@@ -206,7 +244,26 @@ pub struct CommandLink {
     pub outbound: Outbound,
     /// Stop request from the board's button: stop and laser off, no reply.
     pub stop_request: Signal<CriticalSectionRawMutex, ()>,
+    /// grbl realtime commands (`?`, `!`, `~`, 0x18, …) taken out of the
+    /// console's byte stream, in arrival order; acted on at once, also
+    /// while a line waits for room in the motion queue. When full (a host
+    /// flooding `?`), further ones are dropped.
+    pub realtime: Channel<CriticalSectionRawMutex, RealtimeRequest, REALTIME_QUEUE_DEPTH>,
 }
+
+/// A realtime command as the console took it out of the byte stream.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RealtimeRequest {
+    /// The command.
+    pub command: Realtime,
+    /// Free bytes in the console's RX buffer when it arrived (grbl's
+    /// `Bf:` second field).
+    pub rx_free_bytes: u16,
+}
+
+/// Depth of the realtime command queue.
+pub const REALTIME_QUEUE_DEPTH: usize = 8;
 
 impl CommandLink {
     /// Empty channels (usable in a `static`).
@@ -215,6 +272,7 @@ impl CommandLink {
             commands: Channel::new(),
             outbound: Outbound::new(),
             stop_request: Signal::new(),
+            realtime: Channel::new(),
         }
     }
 
@@ -241,6 +299,13 @@ impl CommandLink {
     /// has room).
     pub fn ok(&self) {
         self.outbound.push(LineKind::Ok, "");
+    }
+
+    /// Closes the current reply with grbl's `error:N` (never waits; a
+    /// closer always has room).
+    pub fn grbl_error(&self, error: crate::grbl::GrblError) {
+        self.outbound
+            .push_fmt(LineKind::GrblError, format_args!("{}", error.code()));
     }
 
     /// Closes the current reply with `error: <reason>` (never waits; a

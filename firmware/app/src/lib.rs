@@ -15,7 +15,7 @@
 //! state for LEDs/watchdog/simulator in [`status`], the master laser gate
 //! that no laser command or sample stream can override in [`laser_gate`].
 //! The grbl 1.1 G-code protocol (realtime bytes, G-code parser, replies),
-//! pure and not yet wired to the console or a motion queue, is [`grbl`].
+//! is [`grbl`]; the sequencer runs its G-code session and motion queue.
 //! On top, [`app`] says what a board provides and wires every task once,
 //! for the target and the simulator alike.
 

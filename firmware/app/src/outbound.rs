@@ -62,12 +62,15 @@ pub enum LineKind {
     Error,
     /// An unsolicited notice, printed in brackets: `[<text>]`.
     Notice,
+    /// The closing `error:<text>` of a G-code or `$` line (grbl's form,
+    /// no space: the text is grbl's error number).
+    GrblError,
 }
 
 impl LineKind {
     /// Whether this line closes a reply.
     pub fn is_closer(self) -> bool {
-        matches!(self, LineKind::Ok | LineKind::Error)
+        matches!(self, LineKind::Ok | LineKind::Error | LineKind::GrblError)
     }
 
     fn code(self) -> u8 {
@@ -76,6 +79,7 @@ impl LineKind {
             LineKind::Ok => 1,
             LineKind::Error => 2,
             LineKind::Notice => 3,
+            LineKind::GrblError => 4,
         }
     }
 
@@ -85,6 +89,7 @@ impl LineKind {
             1 => Some(LineKind::Ok),
             2 => Some(LineKind::Error),
             3 => Some(LineKind::Notice),
+            4 => Some(LineKind::GrblError),
             _ => None,
         }
     }
@@ -94,7 +99,7 @@ impl LineKind {
         match self {
             LineKind::Data => DATA_LIMIT,
             LineKind::Notice => NOTICE_LIMIT,
-            LineKind::Ok | LineKind::Error => OUTBOUND_BYTES,
+            LineKind::Ok | LineKind::Error | LineKind::GrblError => OUTBOUND_BYTES,
         }
     }
 }
@@ -124,7 +129,9 @@ impl Dropped {
             LineKind::Notice => self.notices = self.notices.saturating_add(1),
             // Closers always have room (see the module doc); should one
             // ever be refused it is counted with the data lines.
-            LineKind::Ok | LineKind::Error => self.data_lines = self.data_lines.saturating_add(1),
+            LineKind::Ok | LineKind::Error | LineKind::GrblError => {
+                self.data_lines = self.data_lines.saturating_add(1)
+            }
         }
     }
 }

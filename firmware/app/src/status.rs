@@ -18,6 +18,8 @@ pub enum Activity {
     Pattern(Pattern),
     /// Holding a goto/grid target.
     Goto,
+    /// Running (or holding) queued G-code motion.
+    Gcode,
 }
 
 /// Where the current point is in its cycle.

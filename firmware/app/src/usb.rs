@@ -24,11 +24,17 @@ use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, with_timeout};
 use embedded_io_async::{Read, Write};
 
+use heapless::Deque;
+
 use crate::cli::line::LineAssembler;
 use crate::cli::parse::parse_line;
-use crate::command::CommandLink;
+use crate::command::{Command, CommandLink, GrblLine, RealtimeRequest};
+use crate::grbl::classify::{LineKind, classify};
+use crate::grbl::realtime::{self, Filtered, Realtime};
+use crate::grbl::report::BANNER;
+use crate::grbl::{GrblError, RX_BUFFER_BYTES};
 use crate::log;
-use crate::outbound::{LineKind, OutLine, Outbound};
+use crate::outbound::{LineKind as OutKind, OutLine, Outbound};
 use crate::text::REPLY_LINE_LEN;
 
 /// Before a command whose reply has data lines, the console waits this long
@@ -76,66 +82,192 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
     // A command sent before a reconnect is answered first.
     out.wait_until(|o| !o.awaiting_close()).await;
     let mut assembler = LineAssembler::new();
-    let mut chunk = [0u8; 64];
+    let mut input = RxBuffer::new();
     // The host let a `HOST_STALL` pass without reading, and the queue has
     // not drained since.
     let mut host_not_reading = false;
     let mut owed = OwedClosers::default();
     loop {
-        let read = async {
-            if owed.is_empty() {
-                Either::First(rx.read(&mut chunk).await)
-            } else {
-                // Pay the owed closers as soon as the host reads again,
-                // even if it types nothing more.
-                select(
-                    rx.read(&mut chunk),
-                    out.wait_until(Outbound::has_closer_room),
-                )
-                .await
-            }
-        };
-        let n = match read.await {
-            Either::First(Ok(0)) => return ConsoleEnd::EndOfInput,
-            Either::First(Ok(n)) => n,
-            Either::First(Err(_)) => return ConsoleEnd::ReadFailed,
-            Either::Second(()) => {
-                owed.pay(link);
-                continue;
-            }
-        };
-        for &byte in chunk.iter().take(n) {
-            let Some(line) = assembler.push(byte) else {
-                continue;
+        let Some(byte) = input.bytes.pop_front() else {
+            let read = async {
+                if owed.is_empty() {
+                    Either::First(input.fill(rx, link).await)
+                } else {
+                    // Pay the owed closers as soon as the host reads again,
+                    // even if it types nothing more.
+                    select(
+                        input.fill(rx, link),
+                        out.wait_until(Outbound::has_closer_room),
+                    )
+                    .await
+                }
             };
-            owed.pay(link);
-            if !owed.is_empty() || !out.has_closer_room() {
-                // The host types ahead but reads nothing, and its replies
-                // fill the queue: this line cannot be answered in order
-                // now. A `stop` still stops at once (as the button does);
-                // every line is owed its closer, paid in order once the
-                // host reads.
-                let is_stop = matches!(
-                    line.as_ref().map(|l| parse_line(l.as_str())),
-                    Ok(Ok(Some(crate::command::Command::Stop)))
-                );
-                if is_stop {
-                    log::warning!("usb: stop typed while the host is not reading: stopping now");
-                    link.stop_request.signal(());
+            match read.await {
+                Either::First(Ok(Filled::Bytes)) => {}
+                Either::First(Ok(Filled::SoftReset)) => assembler = LineAssembler::new(),
+                Either::First(Err(end)) => return end,
+                Either::Second(()) => owed.pay(link),
+            }
+            continue;
+        };
+        let Some(line) = assembler.push(byte) else {
+            continue;
+        };
+        owed.pay(link);
+        if !owed.is_empty() || !out.has_closer_room() {
+            // The host types ahead but reads nothing, and its replies
+            // fill the queue: this line cannot be answered in order
+            // now. A `stop` still stops at once (as the button does);
+            // every line is owed its closer, paid in order once the
+            // host reads.
+            let is_stop = matches!(
+                line.as_ref().map(|l| parse_line(l.as_str())),
+                Ok(Ok(Some(crate::command::Command::Stop)))
+            );
+            if is_stop {
+                log::warning!("usb: stop typed while the host is not reading: stopping now");
+                link.stop_request.signal(());
+            }
+            if owed.owe(is_stop) {
+                continue;
+            }
+            // More alternations than it remembers: the host's input
+            // waits until its replies fit.
+            while !owed.is_empty() || !out.has_closer_room() {
+                out.wait_until(Outbound::has_closer_room).await;
+                owed.pay(link);
+            }
+        }
+        match line {
+            Err(e) => link.error(e),
+            Ok(line) if classify(line.as_str()) == LineKind::Product => {
+                dispatch(line.as_str(), link, &mut host_not_reading).await;
+            }
+            Ok(line) => match dispatch_grbl(line.as_str(), rx, &mut input, link).await {
+                Ok(Filled::Bytes) => {}
+                Ok(Filled::SoftReset) => assembler = LineAssembler::new(),
+                Err(end) => return end,
+            },
+        }
+    }
+}
+
+/// What [`RxBuffer::fill`] read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Filled {
+    /// Bytes (possibly only realtime commands).
+    Bytes,
+    /// A soft reset (0x18): the bytes before it were dropped, as grbl
+    /// flushes its buffer; the line being assembled must be too.
+    SoftReset,
+}
+
+/// The console's input between the host and the line assembler (grbl's
+/// RX buffer, [`RX_BUFFER_BYTES`]), with grbl's realtime bytes taken out as
+/// they arrive. A host sending more than fits just waits (USB or PTY
+/// back-pressure: nothing is lost).
+struct RxBuffer {
+    bytes: Deque<u8, RX_BUFFER_BYTES>,
+    /// grbl's banner was sent on this connection (before the first grbl
+    /// line or realtime byte; the product's own console prints none, so a
+    /// session of product commands reads as it always did).
+    greeted: bool,
+}
+
+impl RxBuffer {
+    fn new() -> Self {
+        Self {
+            bytes: Deque::new(),
+            greeted: false,
+        }
+    }
+
+    /// Sends grbl's banner once per connection.
+    fn greet(&mut self, link: &CommandLink) {
+        if !core::mem::replace(&mut self.greeted, true) {
+            link.outbound.push(OutKind::Data, BANNER);
+        }
+    }
+
+    /// Reads what fits (waits while the buffer is full: back-pressure);
+    /// realtime commands go to the sequencer at once.
+    async fn fill<R: Read>(
+        &mut self,
+        rx: &mut R,
+        link: &CommandLink,
+    ) -> Result<Filled, ConsoleEnd> {
+        let room = RX_BUFFER_BYTES - self.bytes.len();
+        if room == 0 {
+            return core::future::pending().await;
+        }
+        let mut chunk = [0u8; 64];
+        let n = match rx.read(&mut chunk[..room.min(64)]).await {
+            Ok(0) => return Err(ConsoleEnd::EndOfInput),
+            Ok(n) => n,
+            Err(_) => return Err(ConsoleEnd::ReadFailed),
+        };
+        let mut filled = Filled::Bytes;
+        for item in realtime::split(chunk.get(..n).unwrap_or(&[])) {
+            match item {
+                Filtered::Line(byte) => {
+                    // Room was checked before the read.
+                    let _ = self.bytes.push_back(byte);
                 }
-                if owed.owe(is_stop) {
-                    continue;
-                }
-                // More alternations than it remembers: the host's input
-                // waits until its replies fit.
-                while !owed.is_empty() || !out.has_closer_room() {
-                    out.wait_until(Outbound::has_closer_room).await;
-                    owed.pay(link);
+                Filtered::Realtime(command) => {
+                    if command == Realtime::SoftReset {
+                        // The sequencer sends the banner after a reset.
+                        self.greeted = true;
+                        self.bytes.clear();
+                        filled = Filled::SoftReset;
+                    } else {
+                        self.greet(link);
+                    }
+                    let rx_free_bytes = (RX_BUFFER_BYTES - self.bytes.len()) as u16;
+                    let request = RealtimeRequest {
+                        command,
+                        rx_free_bytes,
+                    };
+                    if link.realtime.try_send(request).is_err() {
+                        log::warning!("usb: realtime queue full, {:?} dropped", command);
+                    }
                 }
             }
-            match line {
-                Err(e) => link.error(e),
-                Ok(line) => dispatch(line.as_str(), link, &mut host_not_reading).await,
+        }
+        Ok(filled)
+    }
+}
+
+/// Sends a G-code or `$` line to the sequencer and waits for its closer
+/// (`ok` once its motion is queued: with a full queue that is when room
+/// frees), reading on meanwhile so realtime commands (`!`, `~`, `?`,
+/// 0x18) act at once.
+async fn dispatch_grbl<R: Read>(
+    line: &str,
+    rx: &mut R,
+    input: &mut RxBuffer,
+    link: &CommandLink,
+) -> Result<Filled, ConsoleEnd> {
+    let out = &link.outbound;
+    input.greet(link);
+    let Some(line) = GrblLine::new(line) else {
+        link.grbl_error(GrblError::LineOverflow);
+        return Ok(Filled::Bytes);
+    };
+    out.begin_command();
+    if link.commands.try_send(Command::Grbl(line)).is_err() {
+        link.error("busy: the command queue is full");
+        return Ok(Filled::Bytes);
+    }
+    let mut filled = Filled::Bytes;
+    loop {
+        let closed = out.wait_until(|o| !o.awaiting_close());
+        match select(closed, input.fill(rx, link)).await {
+            Either::First(()) => return Ok(filled),
+            Either::Second(Ok(Filled::Bytes)) => {}
+            Either::Second(Ok(Filled::SoftReset)) => filled = Filled::SoftReset,
+            Either::Second(Err(end)) => {
+                out.wait_until(|o| !o.awaiting_close()).await;
+                return Err(end);
             }
         }
     }
@@ -243,13 +375,14 @@ async fn write_lines<W: Write>(tx: &mut W, out: &Outbound) -> ConsoleEnd {
 /// CDC-ACM class sends no zero-length packet).
 async fn write_line<W: Write>(tx: &mut W, line: &OutLine) -> Result<(), W::Error> {
     let (prefix, suffix): (&[u8], &[u8]) = match line.kind {
-        LineKind::Data => (b"", b""),
-        LineKind::Ok => (b"ok", b""),
-        LineKind::Error => (b"error: ", b""),
-        LineKind::Notice => (b"[", b"]"),
+        OutKind::Data => (b"", b""),
+        OutKind::Ok => (b"ok", b""),
+        OutKind::Error => (b"error: ", b""),
+        OutKind::GrblError => (b"error:", b""),
+        OutKind::Notice => (b"[", b"]"),
     };
     let text: &[u8] = match line.kind {
-        LineKind::Ok => b"",
+        OutKind::Ok => b"",
         _ => line.text.as_bytes(),
     };
     let mut wire = heapless::Vec::<u8, WIRE_LINE_MAX>::new();

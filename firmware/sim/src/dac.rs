@@ -69,6 +69,8 @@ pub struct SimDac {
     /// Loop time charged per computed sample, ns (shared: a test can
     /// slow the loop down mid-run).
     compute_ns_per_sample: Rc<Cell<u64>>,
+    /// Charge the loop's work at the M4's cost ([`M4_COST`]).
+    m4_cost: bool,
     recording: Rc<RefCell<DacRecording>>,
 }
 
@@ -99,7 +101,18 @@ impl SimDac {
             next_half: 0,
             buffers: [buffer.clone(), buffer],
             compute_ns_per_sample: Rc::new(Cell::new(compute_ns_per_sample)),
+            m4_cost: true,
             recording,
+        }
+    }
+
+    /// The same DAC with the loop's work free (only
+    /// `compute_ns_per_sample` charged): to compare what the planners
+    /// draw, e.g. `planner seed`, whose M4 cost underruns.
+    pub fn without_m4_cost(self) -> Self {
+        Self {
+            m4_cost: false,
+            ..self
         }
     }
 
@@ -185,6 +198,11 @@ fn now_ns() -> u64 {
 }
 
 impl DacStream for SimDac {
+    /// Allowed for comparison with the time-optimal planner, and charged
+    /// its M4 cost ([`M4_COST`]`.bisection_axis`): a seed-planned pattern
+    /// underruns here as it would on the M4.
+    const F64_PLANNING: bool = true;
+
     fn half_len(&self) -> usize {
         self.half_len
     }
@@ -209,7 +227,12 @@ impl DacStream for SimDac {
         let computed = half.computed.min(half.samples.len()) as u64;
         // What the loop did, at the Cortex-M4F's cost (bench-m4's figures),
         // plus any extra per-sample cost a test sets.
-        let compute_ns = M4_COST.ns(&half.work) + self.compute_ns_per_sample.get() * computed;
+        let m4_ns = if self.m4_cost {
+            M4_COST.ns(&half.work)
+        } else {
+            0
+        };
+        let compute_ns = m4_ns + self.compute_ns_per_sample.get() * computed;
         Timer::after_micros(compute_ns.div_ceil(1000)).await;
         if !self.started() {
             // Priming: the DAC starts once both halves are written.

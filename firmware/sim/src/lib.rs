@@ -12,6 +12,8 @@ pub mod laser;
 pub mod logger;
 pub mod panel;
 pub mod physics;
+#[cfg(unix)]
+pub mod pty;
 pub mod recorder;
 pub mod safety;
 pub mod script;

@@ -87,6 +87,44 @@ impl UsbHost {
         self.transcript.borrow_mut().lines.push((t, line));
     }
 
+    /// Records the lines the host typed (bytes arriving in chunks;
+    /// `typed` holds the unfinished line and whether the last byte was a
+    /// CR). grbl's realtime bytes are not part of lines; CR LF ends one.
+    pub fn record_typed(&self, typed: &mut (Vec<u8>, bool), bytes: &[u8]) {
+        for &b in bytes {
+            if laser_app::grbl::realtime::Realtime::from_byte(b).is_some() {
+                continue;
+            }
+            let after_cr = std::mem::replace(&mut typed.1, b == b'\r');
+            match b {
+                b'\n' if after_cr => {}
+                b'\r' | b'\n' => {
+                    self.record(format!("> {}", String::from_utf8_lossy(&typed.0)));
+                    typed.0.clear();
+                }
+                _ => typed.0.push(b),
+            }
+        }
+    }
+
+    /// Records the device's output lines (bytes arriving in chunks).
+    pub fn record_received(&self, pending: &mut Vec<u8>, bytes: &[u8]) {
+        pending.extend_from_slice(bytes);
+        while let Some(end) = pending.iter().position(|&b| b == b'\n') {
+            let raw: Vec<u8> = pending.drain(..=end).collect();
+            let line = String::from_utf8_lossy(&raw).trim_end().to_owned();
+            let mut transcript = self.transcript.borrow_mut();
+            if line.starts_with('[') {
+                let t = crate::clock::now_us();
+                transcript.notices.push((t, line.clone()));
+            } else if line.starts_with("error:") {
+                transcript.error_replies += 1;
+            }
+            drop(transcript);
+            self.record(line);
+        }
+    }
+
     /// Stops reading the device's output for `ms` from now.
     pub fn stall_read(&self, ms: u64) {
         let until = crate::clock::now_us() + ms * 1000;

@@ -108,6 +108,10 @@ pub struct SimOptions {
     /// Galvo loop compute time charged per DAC sample, ns (0: the loop
     /// is instant; above the sample period it underruns).
     pub galvo_cost_ns_per_sample: u64,
+    /// Charge the galvo loop's work at the M4's cost (default; `false`:
+    /// the loop's work is free, to compare what the jump planners draw,
+    /// `planner seed` included).
+    pub galvo_m4_cost: bool,
     /// The board has a galvo DAC (`false`: a board like the target's,
     /// which has none yet, so no galvo loop runs).
     pub galvo_dac: bool,
@@ -120,6 +124,10 @@ pub struct SimOptions {
     /// The true stepper pan/tilt geometry (the spot comes from its
     /// counted steps).
     pub stepper_geometry: StepperGeometry,
+    /// Serve the console on a pseudo-terminal instead of the script
+    /// (real time; the run ends when its stop flag is set).
+    #[cfg(unix)]
+    pub pty: Option<crate::pty::PtyOptions>,
 }
 
 impl Default for SimOptions {
@@ -139,11 +147,14 @@ impl Default for SimOptions {
             settings_flash_cut: None,
             physical: PhysicalGimbal::default(),
             galvo_cost_ns_per_sample: 0,
+            galvo_m4_cost: true,
             galvo_dac: true,
             stepper: true,
             stepper_timing: DriverTiming::default(),
             stepper_motor: MotorLimits::default(),
             stepper_geometry: StepperGeometry::default(),
+            #[cfg(unix)]
+            pty: None,
         }
     }
 }
@@ -196,7 +207,7 @@ fn is_idle(status: &StatusBoard) -> bool {
     match s.activity {
         Activity::Idle => true,
         Activity::Goto => s.phase == Some(Phase::Holding),
-        Activity::Pattern(_) => false,
+        Activity::Pattern(_) | Activity::Gcode => false,
     }
 }
 
@@ -280,12 +291,17 @@ impl World {
             laser,
             settings: settings_store(self.flash.clone()),
             galvo_dac: options.galvo_dac.then(|| {
-                SimDac::new(
+                let dac = SimDac::new(
                     GALVO_HALF_LEN,
                     period_ns,
                     options.galvo_cost_ns_per_sample,
                     self.dac.clone(),
-                )
+                );
+                if options.galvo_m4_cost {
+                    dac
+                } else {
+                    dac.without_m4_cost()
+                }
             }),
             leds: SimLeds(self.panel.clone()),
             stop_button: SimStopButton {
@@ -302,12 +318,16 @@ impl World {
     /// Wires the firmware onto the simulated board (the terminal plugged
     /// into its console), then starts the spot sampler.
     fn start(&self, spawner: Spawner, options: &SimOptions) {
-        let host_tasks = host_tasks(
-            options.interactive,
-            options.script.clone(),
-            self.host.clone(),
-            self.button.clone(),
-        );
+        let host_tasks: Box<dyn FnOnce(&Spawner)> = match &options.pty {
+            #[cfg(unix)]
+            Some(pty) => Box::new(crate::pty::host_start(self.host.clone(), pty.clone())),
+            _ => Box::new(host_tasks(
+                options.interactive,
+                options.script.clone(),
+                self.host.clone(),
+                self.button.clone(),
+            )),
+        };
         let mut sim_spawner = SimSpawner::new(spawner, host_tasks);
         wire(self.board(options), self.links, &mut sim_spawner);
         executor::spawn_task(

@@ -135,3 +135,38 @@ fn plan_accessors_are_consistent() {
         Err(Error::UnsupportedModel)
     );
 }
+
+#[test]
+fn the_f32_only_xy_jump_is_the_time_optimal_one_or_refused() {
+    let d = rigid(10e-6);
+    // From one LSB-sized step to the full field, both directions.
+    for (x_deg, y_deg) in [(0.001, -0.002), (0.5, 3.0), (-12.5, 7.0), (20.0, -20.0)] {
+        let to = [x_deg * DEG, y_deg * DEG];
+        let f32_only = plan_xy_jump_f32(&d, &d, [0.0, 0.0], to, 1000).expect("f32 plan");
+        let optimal = plan_xy_jump(
+            &d,
+            &d,
+            [0.0, 0.0],
+            to,
+            Method::TimeOptimal,
+            JumpSync::Independent,
+            1000,
+        )
+        .expect("plan");
+        assert_eq!(f32_only, optimal, "{x_deg}°, {y_deg}°");
+        assert_lands(&f32_only.x, true, "x");
+        assert_lands(&f32_only.y, true, "y");
+    }
+    // Where the f32 modal form does not apply (the flexible model), it
+    // refuses instead of falling back to the f64 planner.
+    let flex = crate::test_support::flex(10e-6);
+    assert_eq!(
+        plan_xy_jump_f32(&flex, &flex, [0.0; 2], [DEG, DEG], 1000),
+        Err(Error::UnsupportedModel)
+    );
+    assert!(matches!(
+        plan_xy_jump_f32(&d, &rigid(5e-6), [0.0; 2], [0.1; 2], 1000),
+        Err(Error::InvalidSamplePeriod { .. })
+    ));
+    assert!(plan_xy_jump_f32(&d, &d, [f64::NAN, 0.0], [0.1; 2], 1000).is_err());
+}

@@ -10,14 +10,21 @@
 
 pub mod calib;
 pub mod console;
+pub mod grbl;
 pub mod record;
 pub mod servo;
 
 /// Every fuzz target: the `[[bin]]` names in `tests/fuzz/Cargo.toml` and
 /// the folders of `tests/fuzz/corpus/`. `console` runs [`console::check`],
 /// `servo_protocol` [`servo::check`], `settings_record` [`record::check`],
-/// `calib_csv` [`calib::check`].
-pub const TARGETS: [&str; 4] = ["console", "servo_protocol", "settings_record", "calib_csv"];
+/// `calib_csv` [`calib::check`], `grbl` [`grbl::check`].
+pub const TARGETS: [&str; 5] = [
+    "console",
+    "servo_protocol",
+    "settings_record",
+    "calib_csv",
+    "grbl",
+];
 
 /// Reads fields from fuzz input bytes: past the end every read is 0, so
 /// any input (even empty) yields a value.

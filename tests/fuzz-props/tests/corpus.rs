@@ -9,7 +9,7 @@ use std::collections::BTreeSet;
 use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
 use std::path::{Path, PathBuf};
 
-use fuzz_props::{TARGETS, calib, console, record, servo};
+use fuzz_props::{TARGETS, calib, console, grbl, record, servo};
 
 fn fuzz_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz")
@@ -178,4 +178,19 @@ fn calib_csv_corpus_holds_and_has_a_realistic_file() {
         "no realistic measurement file (≥ 100 rows) in the corpus"
     );
     assert!(all.iter().any(|s| s.error.is_some()), "no refused CSV");
+}
+
+#[test]
+fn grbl_corpus_holds_and_covers_every_block_and_many_errors() {
+    let all = run_all("grbl", grbl::check);
+    let blocks: BTreeSet<&str> = all.iter().flat_map(|s| s.blocks.iter().copied()).collect();
+    for kind in ["rapid", "line", "arc", "dwell", "pause", "end", "jog"] {
+        assert!(
+            blocks.contains(kind),
+            "no corpus input yields a {kind} block"
+        );
+    }
+    let errors: BTreeSet<u8> = all.iter().flat_map(|s| s.errors.iter().copied()).collect();
+    assert!(errors.len() >= 20, "only errors {errors:?} in the corpus");
+    assert!(all.iter().any(|s| s.realtime > 0), "no realtime byte");
 }

@@ -12,7 +12,7 @@ use embedded_io_async::{Read, Write};
 use super::Links;
 use super::board::{Console, Indicators, Leds, StopButton, Watchdog};
 use crate::command::CommandLink;
-use crate::galvo::{DacStream, GalvoConfig, GalvoLink, GalvoLoop};
+use crate::galvo::{DacStream, GalvoConfig, GalvoLink, GalvoLoop, GalvoMemory};
 use crate::laser_gate::LaserGate;
 use crate::log;
 use crate::sequencer::{ActuatorLinks, LaserSwitch, Sequencer, SettingsStore};
@@ -102,11 +102,38 @@ impl<D: DacStream> GalvoTask<D> {
     /// Runs the loop with the default parameters until the sequencer
     /// sends the user's; ends at once (logged) if those defaults are
     /// refused.
-    pub async fn run(mut self) {
-        match GalvoLoop::new(GalvoConfig::default()) {
-            Ok(mut galvo) => galvo.run(&mut self.dac, self.link, self.gate).await,
-            Err(e) => log::error!("galvo loop not started: {}", e),
+    ///
+    /// The loop lives inside this task's future (a few tens of KB): a
+    /// board with little RAM uses [`Self::run_in`].
+    pub async fn run(self) {
+        let mut memory: GalvoMemory = GalvoMemory::new();
+        self.run_in(&mut memory).await
+    }
+
+    /// [`Self::run`] with the loop and its half buffer in `memory` (a
+    /// board's `static`): the future holds only the reference.
+    /// Ends at once (logged) when its half buffer is shorter than the
+    /// DAC's halves.
+    pub async fn run_in<const HALF: usize>(mut self, memory: &mut GalvoMemory<HALF>) {
+        if !GalvoLoop::fits(&self.dac, HALF) {
+            log::error!(
+                "galvo loop not started: the DAC's {}-sample halves exceed its {}-sample buffer",
+                self.dac.half_len(),
+                HALF
+            );
+            return;
         }
+        let GalvoMemory { galvo, half } = memory;
+        let galvo = match GalvoLoop::for_dac::<D>(GalvoConfig::default()) {
+            Ok(built) => galvo.insert(built),
+            Err(e) => {
+                log::error!("galvo loop not started: {}", e);
+                return;
+            }
+        };
+        galvo
+            .run_with(&mut self.dac, self.link, self.gate, half)
+            .await
     }
 }
 

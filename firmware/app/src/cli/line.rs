@@ -12,8 +12,9 @@
 
 use core::fmt;
 
-/// Longest accepted command line, bytes (excluding the terminator).
-pub const MAX_LINE_LEN: usize = 128;
+/// Longest accepted command line, bytes (excluding the terminator);
+/// defined with the command channel, which carries lines of this size.
+pub use crate::command::MAX_LINE_LEN;
 
 /// A complete, printable-ASCII command line (terminator removed).
 pub type Line = heapless::String<MAX_LINE_LEN>;

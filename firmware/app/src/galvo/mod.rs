@@ -23,7 +23,7 @@ mod cost;
 mod scan;
 
 pub use cost::{CostModel, LoopWork, M4_COST};
-pub use scan::{GalvoConfig, GalvoError, GalvoLoop, ScanPhase};
+pub use scan::{GalvoConfig, GalvoError, GalvoLoop, GalvoMemory, MAX_HALF_LEN, ScanPhase};
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
@@ -78,6 +78,16 @@ pub struct Half<'a> {
 /// a half the DAC replays because the loop was late is output dark.
 #[allow(async_fn_in_trait)]
 pub trait DacStream {
+    /// Whether the CPU that runs the loop on this board plans jumps in
+    /// `f64` in time: the patent's bisection (`planner seed`) and the
+    /// `f64` fallback of the time-optimal planner. Not on the M4F (the
+    /// default): its FPU is single precision, bisection takes 1.6–7.5 M
+    /// instructions per axis (bench-m4's `plan.seed.*`, 9–46× the 1.28 ms
+    /// refill window), so `planner seed` is refused with a clear error,
+    /// jumps are planned time-optimal in `f32` only, and the `f64`
+    /// planners are not linked into the image.
+    const F64_PLANNING: bool = false;
+
     /// Samples per half buffer.
     fn half_len(&self) -> usize;
 
@@ -223,6 +233,9 @@ pub struct GalvoLink {
     queued: AtomicU8,
     /// A galvo loop serves the link (set when it starts).
     attached: AtomicBool,
+    /// The serving loop's board plans bisection jumps
+    /// ([`DacStream::F64_PLANNING`]).
+    bisection: AtomicBool,
     /// The DAC's worst refill, when the board measures it.
     refill: RefillStat,
 }
@@ -247,6 +260,12 @@ impl GalvoLink {
     /// Marks the link served ([`GalvoLoop::run`] calls it when it starts).
     pub fn attach(&self) {
         self.attached.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether the serving loop's board plans jumps by bisection
+    /// (`planner seed`, see [`DacStream::F64_PLANNING`]).
+    pub fn plans_bisection(&self) -> bool {
+        self.bisection.load(Ordering::Relaxed)
     }
 
     /// Lets the galvo light its dwells and strokes (`true`, laser modes
@@ -312,6 +331,7 @@ impl GalvoLink {
             phase: AtomicU8::new(0),
             queued: AtomicU8::new(0),
             attached: AtomicBool::new(false),
+            bisection: AtomicBool::new(false),
             refill: RefillStat::new(),
         }
     }

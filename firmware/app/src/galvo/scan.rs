@@ -67,6 +67,9 @@ pub enum GalvoError {
     QueueFull,
     /// An underrun latched the laser off; a `Stop` clears it.
     Faulted,
+    /// The board cannot plan jumps by bisection (`planner seed`) in time
+    /// ([`DacStream::F64_PLANNING`]).
+    SeedTooSlow,
 }
 
 impl fmt::Display for GalvoError {
@@ -77,6 +80,9 @@ impl fmt::Display for GalvoError {
             GalvoError::Planner => "galvo planner refused the move",
             GalvoError::QueueFull => "galvo job queue is full",
             GalvoError::Faulted => "galvo underrun: send stop before new points",
+            GalvoError::SeedTooSlow => {
+"planner seed does not fit this board (bisection: 12-58 ms per jump axis); use planner optimal"
+            }
         })
     }
 }
@@ -161,6 +167,42 @@ pub struct GalvoLoop {
     pending_config: Option<GalvoConfig>,
     on_delay_samples: u32,
     off_delay_samples: u32,
+    /// How jumps are planned on this board ([`DacStream::F64_PLANNING`]).
+    jump_planning: prep::Planning,
+}
+
+/// The galvo loop's memory: the loop (its prepared steps and jump
+/// integrator, about 22 KB) and the half buffer of `HALF` samples it
+/// computes into (at least the DAC's [`DacStream::half_len`]). A board
+/// keeps it in a `static` and hands it to
+/// [`GalvoTask::run_in`](crate::app::GalvoTask::run_in), so it is counted
+/// once and the task's future holds only a reference.
+pub struct GalvoMemory<const HALF: usize = MAX_HALF_LEN> {
+    pub(crate) galvo: Option<GalvoLoop>,
+    pub(crate) half: [DacSample; HALF],
+}
+
+impl<const HALF: usize> GalvoMemory<HALF> {
+    const HALF_OK: () = assert!(HALF > 0 && HALF <= MAX_HALF_LEN, "HALF in 1..=512");
+
+    /// No loop yet, a dark half buffer (usable in a `static`).
+    pub const fn new() -> Self {
+        let () = Self::HALF_OK;
+        Self {
+            galvo: None,
+            half: [DacSample {
+                x_code: 0,
+                y_code: 0,
+                laser: false,
+            }; HALF],
+        }
+    }
+}
+
+impl<const HALF: usize> Default for GalvoMemory<HALF> {
+    fn default() -> Self {
+        Self::new()
+    }
 }
 
 fn samples_for(us: u32, ts_s: f64) -> u32 {
@@ -173,7 +215,23 @@ impl GalvoLoop {
     ///
     /// Errors: [`GalvoError::Planner`] for an invalid mirror model or
     /// sample period, [`GalvoError::Kinematics`] for invalid geometry.
+    ///
+    /// It plans jumps with every method, in `f64` where the method needs
+    /// it (a host); a board's loop is built by [`Self::for_dac`].
     pub fn new(config: GalvoConfig) -> Result<Self, GalvoError> {
+        Self::with_planning(config, prep::Planning::HOST)
+    }
+
+    /// [`Self::new`] for the loop that feeds `D`, planning jumps as its
+    /// board can ([`DacStream::F64_PLANNING`]); also
+    /// [`GalvoError::SeedTooSlow`] for `planner seed` where it cannot.
+    pub fn for_dac<D: DacStream>(config: GalvoConfig) -> Result<Self, GalvoError> {
+        let planning = prep::Planning::of::<D>();
+        planning.check(config.method)?;
+        Self::with_planning(config, planning)
+    }
+
+    fn with_planning(config: GalvoConfig, planning: prep::Planning) -> Result<Self, GalvoError> {
         let angles_rad = [0.0, 0.0];
         let disc = config
             .mirrors
@@ -212,6 +270,7 @@ impl GalvoLoop {
             pending_config: None,
             on_delay_samples: samples_for(config.laser_on_delay_us, ts),
             off_delay_samples: samples_for(config.laser_off_delay_us, ts),
+            jump_planning: planning,
             config,
         })
     }
@@ -225,6 +284,11 @@ impl GalvoLoop {
     /// Jobs waiting behind the current one.
     pub fn queued_points(&self) -> usize {
         self.queue.len()
+    }
+
+    /// Whether a half buffer of `half` samples holds the DAC's halves.
+    pub fn fits(dac: &impl DacStream, half: usize) -> bool {
+        (1..=half.min(MAX_HALF_LEN)).contains(&dac.half_len())
     }
 
     /// Runs the loop forever: requests between half buffers, one half per
@@ -250,9 +314,30 @@ impl GalvoLoop {
         link: &GalvoLink,
         gate: &LaserGate,
     ) -> ! {
-        link.attach();
-        let n = dac.half_len().clamp(1, MAX_HALF_LEN);
         let mut half = [DacSample::default(); MAX_HALF_LEN];
+        self.run_with(dac, link, gate, &mut half).await
+    }
+
+    /// [`Self::run`], computing each half in `half` (the caller's memory:
+    /// a board keeps it in a `static`, see [`GalvoMemory`], so the task's
+    /// future does not hold it). Halves of the DAC's
+    /// [`DacStream::half_len`] samples, at most `half.len()` (a shorter
+    /// buffer shortens every half: check with [`Self::fits`] first).
+    pub async fn run_with<D: DacStream, const HALF: usize>(
+        &mut self,
+        dac: &mut D,
+        link: &GalvoLink,
+        gate: &LaserGate,
+        half: &mut [DacSample; HALF],
+    ) -> ! {
+        link.bisection.store(D::F64_PLANNING, Ordering::Relaxed);
+        self.jump_planning = prep::Planning::of::<D>();
+        if let Err(e) = self.jump_planning.check(self.config.method) {
+            log::error!("galvo: {}; planning time-optimal", e);
+            self.config.method = Method::TimeOptimal;
+        }
+        link.attach();
+        let n = dac.half_len().clamp(1, MAX_HALF_LEN).min(HALF).max(1);
         let mut period_s = self.config.sample_period_s;
         let mut generation = gate.generation();
         // `Done` events waiting for their samples to be output, with the

@@ -26,6 +26,11 @@ pub mod system;
 pub mod words;
 
 pub use block::{Arc, Block, Blocks, Laser, PointMm, SpindleMode};
+
+/// grbl's RX buffer, bytes: the console's input buffer between the host
+/// and line assembly (`$I` advertises it; a character-counting sender
+/// keeps at most this many bytes unanswered).
+pub const RX_BUFFER_BYTES: usize = 128;
 pub use error::{Alarm, GrblError};
 pub use state::ParserState;
 

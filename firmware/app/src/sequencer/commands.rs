@@ -7,6 +7,8 @@ use crate::command::Command;
 use crate::domain::{
     Actuator, AimModel, Pattern, PatternCheck, PatternError, Target, check_target,
 };
+use crate::galvo::GalvoError;
+use crate::settings::JumpPlanner;
 use crate::settings::{PARAMS, ParamLine, ParamSpec};
 
 /// Points a pattern check aims at per executor step. One gimbal IK point
@@ -76,6 +78,7 @@ impl Core {
                 self.pending = Some(Pending::Save);
                 out.act(Action::Save);
             }
+            Command::Grbl(line) => self.grbl_line(line.as_str(), out),
         }
     }
 
@@ -98,6 +101,9 @@ impl Core {
                 self.stop("actuator changed", out);
                 self.actuator = actuator;
                 self.configure_galvo(out);
+            }
+            Command::Planner(JumpPlanner::Seed) if !self.inputs.galvo_bisection => {
+                return self.error(out, GalvoError::SeedTooSlow);
             }
             Command::Planner(planner) => {
                 self.settings.galvo.planner = planner;

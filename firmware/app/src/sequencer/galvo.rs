@@ -61,7 +61,7 @@ impl Core {
 
     /// Queues a job for the galvo loop; `false` (with an error notice,
     /// everything stopped) when the loop does not keep up.
-    fn send_galvo(&mut self, request: GalvoRequest, out: &mut dyn ActionSink) -> bool {
+    pub(super) fn send_galvo(&mut self, request: GalvoRequest, out: &mut dyn ActionSink) -> bool {
         let Some(room) = self.inputs.galvo_room.filter(|room| *room > 0) else {
             log::warning!("galvo: request queue full");
             self.notify(out, format_args!("error: galvo not responding; stopped"));
@@ -140,6 +140,11 @@ impl Core {
     /// Handles an event of the galvo loop.
     pub(super) fn galvo_event(&mut self, event: GalvoEvent, out: &mut dyn ActionSink) {
         match event {
+            GalvoEvent::Done { seq } if self.gcode_galvo_done(seq, out) => {}
+            GalvoEvent::Refused { seq, error } if self.gcode_awaits_galvo(seq) => {
+                self.notify(out, format_args!("MSG:galvo: {error}"));
+                self.grbl_alarm(crate::grbl::Alarm::SoftLimit, out);
+            }
             GalvoEvent::Done { seq } => {
                 if let Some(run) = self.run.as_mut().filter(|r| r.galvo_seq == seq) {
                     run.galvo_busy = false;

@@ -68,6 +68,8 @@ pub enum Event {
     /// galvo loop, on an underrun) closed it since the core last did. The
     /// gimbal laser stays dark until the core closes it again.
     GateLost,
+    /// A grbl realtime command from the console (`?`, `!`, `~`, 0x18, …).
+    Realtime(crate::command::RealtimeRequest),
 }
 
 /// What the shell reads from the links when a command arrives.
@@ -104,6 +106,9 @@ pub struct Inputs {
     /// requests are applied); `None` when no galvo loop serves the link
     /// (a board without a galvo DAC): galvo commands are refused.
     pub galvo_room: Option<usize>,
+    /// The galvo loop's board plans jumps by bisection (`planner seed`;
+    /// refused where it does not fit the target's time).
+    pub galvo_bisection: bool,
     /// A stepper task serves the stepper link (else `target stepper` is
     /// refused).
     pub stepper_attached: bool,
@@ -158,6 +163,8 @@ pub enum Line {
     Ok,
     /// Closes the reply: `error: <reason>`.
     Error(ReplyText),
+    /// Closes a G-code or `$` line's reply: grbl's `error:N`.
+    GrblError(crate::grbl::GrblError),
 }
 
 /// Where the core writes its actions (the shell applies them at once, a
@@ -227,6 +234,8 @@ pub struct Core {
     /// Inputs of the event being handled (the galvo room counts down as
     /// jobs are sent).
     pub(super) inputs: Inputs,
+    /// The grbl session: G-code parser, motion queue, grbl settings.
+    pub(super) gcode: super::gcode::Gcode,
 }
 
 impl Core {
@@ -250,8 +259,10 @@ impl Core {
             inputs: Inputs {
                 now,
                 galvo_room: None,
+                galvo_bisection: false,
                 stepper_attached: false,
             },
+            gcode: super::gcode::Gcode::new(),
         }
     }
 
@@ -269,12 +280,13 @@ impl Core {
             Event::Servo(outcome) => self.servo_outcome(outcome, out),
             Event::Galvo(event) => self.galvo_event(event, out),
             Event::Stepper(event) => self.stepper_event(event, out),
-            Event::DwellEnded => self.dwell_finished(out),
+            Event::DwellEnded => self.dwell_ended(out),
             Event::Tick => self.heartbeat = self.heartbeat.wrapping_add(1),
             Event::CheckStep => self.check_step(super::commands::CHECKS_PER_STEP, out),
             Event::Saved(result) => self.saved(result, out),
             Event::SettingsLoaded(loaded) => self.settings_loaded(loaded, out),
             Event::GateLost => self.gate_lost = true,
+            Event::Realtime(request) => self.grbl_realtime(request, out),
         }
         // A command in check has not changed anything yet.
         if !matches!(self.pending, Some(Pending::Check { .. })) {
@@ -289,7 +301,7 @@ impl Core {
 
     /// When the current dwell ends (`None`: no dwell running).
     pub fn dwell_deadline(&self) -> Option<Instant> {
-        self.run.and_then(|r| r.dwell_until)
+        self.gcode_deadline_or(self.run.and_then(|r| r.dwell_until))
     }
 
     /// Whether the gimbal laser is on.
@@ -302,6 +314,7 @@ impl Core {
         let run = self.run;
         Snapshot {
             activity: match run {
+                None if !self.gcode.motion.is_idle() => Activity::Gcode,
                 None => Activity::Idle,
                 Some(r) => match r.kind.pattern() {
                     Some(p) => Activity::Pattern(p),
@@ -367,7 +380,8 @@ impl Core {
         let servo_blocked =
             !self.actuator.uses_stepper() && self.faults.gimbal_laser_blocked(yaw, pitch, phase);
         let wanted = (self.actuator.uses_gimbal() || self.actuator.uses_stepper())
-            && laser_wanted(self.settings.laser_mode, phase, servo_blocked)
+            && (laser_wanted(self.settings.laser_mode, phase, servo_blocked)
+                || self.gcode_gimbal_lit())
             && !self.gate_lost;
         if wanted != self.laser_on {
             self.laser_on = wanted;

@@ -14,13 +14,18 @@
 mod commands;
 mod faults;
 mod galvo;
+mod gcode;
+mod gcode_motion;
+mod gcode_report;
+mod gcode_settings;
+mod gcode_step;
 mod laser;
 mod machine;
 mod report;
 mod run;
 mod stepper;
 
-use embassy_futures::select::{Either, Either3, Either4, select, select3, select4};
+use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::galvo::config_from;
@@ -39,6 +44,19 @@ use crate::stepper::StepperLink;
 /// Where settings are saved (defined with the settings; named here too,
 /// as the sequencer's store).
 pub use crate::settings::store::SettingsStore;
+
+/// RAM the G-code path adds, bytes (host layout): the sequencer's grbl
+/// session with its motion queue, the realtime command queue and the
+/// console's RX buffer.
+pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::Gcode>()
+    + core::mem::size_of::<
+        embassy_sync::channel::Channel<
+            embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex,
+            crate::command::RealtimeRequest,
+            { crate::command::REALTIME_QUEUE_DEPTH },
+        >,
+    >()
+    + crate::grbl::RX_BUFFER_BYTES;
 
 /// Period of the housekeeping tick (liveness for the watchdog).
 const HOUSEKEEPING: Duration = Duration::from_millis(250);
@@ -178,9 +196,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             command,
             io.servo.outcomes.receive(),
             timer,
-            select3(
+            select4(
                 Timer::at(housekeeping),
                 io.galvo.events.receive(),
+                io.link.realtime.receive(),
                 io.stepper.events.receive(),
             ),
         )
@@ -196,9 +215,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             Either4::First(Either::Second(())) => Event::StopRequest,
             Either4::Second(outcome) => Event::Servo(outcome),
             Either4::Third(()) => Event::DwellEnded,
-            Either4::Fourth(Either3::First(())) => Event::Tick,
-            Either4::Fourth(Either3::Second(event)) => Event::Galvo(event),
-            Either4::Fourth(Either3::Third(event)) => Event::Stepper(event),
+            Either4::Fourth(Either4::First(())) => Event::Tick,
+            Either4::Fourth(Either4::Second(event)) => Event::Galvo(event),
+            Either4::Fourth(Either4::Third(request)) => Event::Realtime(request),
+            Either4::Fourth(Either4::Fourth(event)) => Event::Stepper(event),
         }
     }
 
@@ -213,6 +233,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             let inputs = Inputs {
                 now: Instant::now(),
                 galvo_room: galvo.attached().then(|| galvo.requests.free_capacity()),
+                galvo_bisection: galvo.plans_bisection(),
                 stepper_attached: self.io.stepper.is_attached(),
             };
             self.core.on(inputs, event, &mut self.io);
@@ -320,6 +341,9 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
                     Line::Notice(text) => outbound.push(LineKind::Notice, text),
                     Line::Ok => outbound.push(LineKind::Ok, ""),
                     Line::Error(text) => outbound.push(LineKind::Error, text),
+                    Line::GrblError(error) => {
+                        outbound.push_fmt(LineKind::GrblError, format_args!("{}", error.code()))
+                    }
                 };
             }
             Action::Save => self.follow_up = FollowUp::Save,

@@ -142,6 +142,7 @@ impl Core {
             Start::Pattern { pattern, once } => (pattern.name(), once),
         };
         log::info!("start {} (once={})", name, once);
+        self.gcode_abort(out);
         out.act(Action::Note(LaserEvent::RunStarted));
         // Nothing of an earlier run may shine: a new gate generation, and
         // the galvo drops its points and an underrun latch; the stepper
@@ -204,6 +205,7 @@ impl Core {
         if let Some(run) = self.run.take() {
             log::info!("stop {} ({})", run.kind.name(), why);
         }
+        self.gcode_abort(out);
     }
 
     /// The target of the current point of the run (`None`: past the last
@@ -316,7 +318,7 @@ impl Core {
 
     /// Travel time for a move at the configured speed, from the largest
     /// joint change (at least 20 ms, the SDK's minimum ramp).
-    fn move_interval_ms(&self, aim: &Aim) -> u16 {
+    pub(super) fn move_interval_ms(&self, aim: &Aim) -> u16 {
         let (from_yaw, from_pitch) = self
             .measured
             .or(self.last_aim.map(|(_, a)| (a.yaw_wire, a.pitch_wire)))
@@ -331,6 +333,7 @@ impl Core {
 
     /// The servo task's report.
     pub(super) fn servo_outcome(&mut self, outcome: ServoOutcome, out: &mut dyn ActionSink) {
+        let gcode_fault = self.gcode_servo_outcome(&outcome, out);
         match outcome {
             ServoOutcome::Recovered { id } => self.servo_recovered(id, out),
             ServoOutcome::Arrived {
@@ -340,6 +343,9 @@ impl Core {
             } => self.arrived(seq, (yaw_tenths, pitch_tenths), out),
             ServoOutcome::Fault { seq, id, fault } => self.servo_fault(seq, id, fault, out),
             ServoOutcome::Superseded { .. } => {}
+        }
+        if gcode_fault {
+            self.stop("servo fault during G-code", out);
         }
     }
 

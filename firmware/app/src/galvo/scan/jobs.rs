@@ -120,6 +120,7 @@ impl GalvoLoop {
     /// mirrors or the sample rate changed; nothing else is rebuilt (the
     /// loop's buffers stay where they are, not copied).
     fn reconfigure(&mut self, config: GalvoConfig) -> Result<(), GalvoError> {
+        self.jump_planning.check(config.method)?;
         let angles_rad = self.mirrors.end_position_rad();
         let sample_map = SampleMap::new(&config.galvo).map_err(|_| GalvoError::Kinematics)?;
         let codes = sample_map

@@ -15,15 +15,97 @@
 //! jump and drops the prepared steps if it broke.
 
 use galvo_planner::blocks::{PRECOMPUTED_JUMP, jump_angles};
-use galvo_planner::{JumpSync, MarkLimits, PathPlanner, XyJump, plan_xy_jump};
+use galvo_planner::{
+    Discrete, JumpSync, MarkLimits, Method, MethodKind, PathPlanner, XyJump, plan_xy_jump,
+    plan_xy_jump_f32,
+};
 use kinematics_core::PointMm;
 
 use super::{GalvoError, GalvoLoop, INTEGRATOR_CAPACITY, JUNCTION_DEVIATION_MM, Job, MARK_BLOCKS};
 use crate::domain::{Rotation, Segment, Unit};
+use crate::galvo::DacStream;
 
 /// Steps prepared ahead of the refill (a step takes at least the laser
 /// delays and its jump; four cover a half buffer of the shortest jobs).
 pub(super) const PREP_DEPTH: usize = 4;
+
+/// How the loop plans a two-axis jump from, to (rad) with a method.
+type XyPlanner = fn(&Discrete<3>, [f64; 2], [f64; 2], Method) -> Result<XyJump<3>, GalvoError>;
+
+/// The jump planning a board affords ([`DacStream::F64_PLANNING`]). Set
+/// only where the board's type is known ([`Self::of`]), so a board
+/// without `f64` planning links none of the `f64` planners.
+#[derive(Clone, Copy)]
+pub(super) struct Planning {
+    /// Bisection and the `f64` fallback are allowed.
+    f64: bool,
+    pub(super) plan: XyPlanner,
+}
+
+impl Planning {
+    /// A host: every method, `f64` where it needs it.
+    pub(super) const HOST: Self = Self {
+        f64: true,
+        plan: plan_any,
+    };
+    /// A single-precision FPU (the M4F): time-optimal in `f32` only.
+    pub(super) const F32: Self = Self {
+        f64: false,
+        plan: plan_f32,
+    };
+
+    /// The planning of the board that feeds `D`.
+    pub(super) fn of<D: DacStream>() -> Self {
+        if D::F64_PLANNING {
+            Self::HOST
+        } else {
+            Self::F32
+        }
+    }
+
+    /// `Err` when `method` does not fit this board:
+    /// [`GalvoError::SeedTooSlow`] for bisection.
+    pub(super) fn check(&self, method: Method) -> Result<(), GalvoError> {
+        match method {
+            _ if self.f64 => Ok(()),
+            Method::TimeOptimal => Ok(()),
+            Method::Bisection(_) => Err(GalvoError::SeedTooSlow),
+            _ => Err(GalvoError::Planner),
+        }
+    }
+}
+
+/// Both axes, any method ([`Planning::HOST`]).
+fn plan_any(
+    disc: &Discrete<3>,
+    from_rad: [f64; 2],
+    to_rad: [f64; 2],
+    method: Method,
+) -> Result<XyJump<3>, GalvoError> {
+    let sync = JumpSync::Independent;
+    plan_xy_jump(
+        disc,
+        disc,
+        from_rad,
+        to_rad,
+        method,
+        sync,
+        INTEGRATOR_CAPACITY,
+    )
+    .map_err(|_| GalvoError::Planner)
+}
+
+/// Both axes time-optimal in `f32`, no `f64` fallback ([`Planning::F32`]).
+fn plan_f32(
+    disc: &Discrete<3>,
+    from_rad: [f64; 2],
+    to_rad: [f64; 2],
+    method: Method,
+) -> Result<XyJump<3>, GalvoError> {
+    Planning::F32.check(method)?;
+    plan_xy_jump_f32(disc, disc, from_rad, to_rad, INTEGRATOR_CAPACITY)
+        .map_err(|_| GalvoError::Planner)
+}
 
 /// A stroke loaded into the look-ahead path planner, or why it was refused.
 pub(super) type LoadedStroke = Result<PathPlanner<MARK_BLOCKS>, GalvoError>;
@@ -98,9 +180,17 @@ impl GalvoLoop {
                 break;
             };
             let stroke = step.marker.is_some();
+            let bisected = match &step.jump {
+                Ok(jump) => [&jump.x, &jump.y]
+                    .iter()
+                    .filter(|plan| plan.method() == MethodKind::Bisection)
+                    .count(),
+                Err(_) => 0,
+            };
             if !self.steps.push_back(step) {
                 break;
             }
+            self.work.bisection_axes += bisected as u32;
             if stroke {
                 self.work.strokes_prepared += 1;
             } else {
@@ -177,17 +267,8 @@ impl GalvoLoop {
         };
         let jump = target_mm.and_then(|target| {
             let target_rad = self.angles_for(target)?;
-            plan_xy_jump(
-                &self.disc,
-                &self.disc,
-                start_rad,
-                target_rad,
-                self.config.method,
-                JumpSync::Independent,
-                INTEGRATOR_CAPACITY,
-            )
-            .map(|jump| (jump, target_rad))
-            .map_err(|_| GalvoError::Planner)
+            (self.jump_planning.plan)(&self.disc, start_rad, target_rad, self.config.method)
+                .map(|jump| (jump, target_rad))
         });
         let end_rad = match (&jump, &marker, end_mm) {
             (Err(_), _, _) => start_rad,

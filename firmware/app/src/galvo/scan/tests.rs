@@ -482,3 +482,86 @@ fn halves_of_any_length_give_the_same_samples() {
         assert!(stream(half_len) == whole, "half of {half_len}");
     }
 }
+
+#[test]
+fn the_path_planner_holds_the_longest_stroke() {
+    // One block per segment: the loop loads a whole stroke before marking.
+    let capacity = crate::domain::Segments::new().capacity();
+    assert!(
+        MARK_BLOCKS >= capacity,
+        "{MARK_BLOCKS} blocks < {capacity} segments"
+    );
+}
+
+/// The loop's own memory on the host (64-bit: at least the target's),
+/// held in the board's `static` (`GalvoMemory`). Budget: the galvo task
+/// must stay well under 30 KB of the target's 96 KB static RAM.
+const GALVO_LOOP_MAX_BYTES: usize = 24 * 1024;
+
+#[test]
+fn the_galvo_loop_stays_within_its_memory_budget() {
+    let size = core::mem::size_of::<GalvoLoop>();
+    std::println!("GalvoLoop: {size} B on the host");
+    assert!(size <= GALVO_LOOP_MAX_BYTES, "GalvoLoop is {size} B");
+}
+
+/// A board whose CPU has a single-precision FPU only (the default
+/// [`DacStream::F64_PLANNING`]), like the STM32's.
+struct M4Dac;
+
+impl DacStream for M4Dac {
+    fn half_len(&self) -> usize {
+        128
+    }
+    fn set_sample_period(&mut self, _period_s: f64) {}
+    fn holds(&self, _sample: DacSample) -> bool {
+        false
+    }
+    async fn write_half(&mut self, _half: Half<'_>) -> Result<(), crate::galvo::Underrun> {
+        Ok(())
+    }
+    async fn repeat_half(&mut self) {}
+}
+
+#[test]
+fn a_board_that_cannot_afford_bisection_refuses_seed_parameters() {
+    let seed = GalvoConfig {
+        method: Method::BISECTION,
+        ..GalvoConfig::default()
+    };
+    // The M4: refused, at build and as new parameters (nothing changes).
+    assert_eq!(
+        GalvoLoop::for_dac::<M4Dac>(seed).err(),
+        Some(GalvoError::SeedTooSlow)
+    );
+    let mut m4 = GalvoLoop::for_dac::<M4Dac>(GalvoConfig::default()).unwrap();
+    m4.configure(seed);
+    assert_eq!(
+        m4.apply_pending_config(true),
+        Some(GalvoEvent::ConfigRefused(GalvoError::SeedTooSlow))
+    );
+    assert_eq!(m4.config.method, Method::TimeOptimal);
+    // Its f32-only jump plans are the host's time-optimal ones.
+    let mut host = GalvoLoop::new(GalvoConfig::default()).unwrap();
+    let point = GalvoRequest::Point {
+        seq: 1,
+        x_mm: 80.0,
+        y_mm: -80.0,
+        dwell_us: 0,
+    };
+    for galvo in [&mut m4, &mut host] {
+        galvo.request(point);
+        assert_eq!(galvo.prep(), 1);
+    }
+    let jump = |g: &GalvoLoop| g.steps.get(0).map(|s| s.jump);
+    assert!(matches!(jump(&m4), Some(Ok(_))));
+    assert_eq!(jump(&m4), jump(&host));
+    // A host loop plans by bisection, and counts it for the cost model.
+    let mut host = GalvoLoop::new(GalvoConfig::default()).unwrap();
+    host.configure(seed);
+    assert_eq!(host.apply_pending_config(true), None);
+    host.request(point);
+    host.work = crate::galvo::LoopWork::default();
+    host.prep();
+    assert_eq!(host.work.bisection_axes, 2);
+}

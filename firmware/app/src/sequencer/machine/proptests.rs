@@ -340,6 +340,7 @@ impl Harness {
             let inputs = Inputs {
                 now: self.now,
                 galvo_room: self.attached.then_some(self.galvo_room),
+                galvo_bisection: self.attached,
                 stepper_attached: false,
             };
             self.core.on(inputs, event, &mut actions);

@@ -13,7 +13,7 @@ use crate::domain::{Actuator, GridPattern, Pattern, PointCm};
 use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest, ScanPhase};
 use crate::sequencer::LaserEvent;
 use crate::servo::task::{ServoOutcome, ServoRequest};
-use crate::settings::LaserMode;
+use crate::settings::{JumpPlanner, LaserMode};
 use crate::status::{Activity, Phase};
 use crate::text::reply_text;
 
@@ -36,6 +36,8 @@ fn on_with(core: &mut Core, ms: u64, galvo: bool, event: Event) -> Vec<Action> {
     let inputs = Inputs {
         now: Instant::from_millis(ms),
         galvo_room: galvo.then_some(GALVO_REQUEST_DEPTH),
+        // A host board: bisection allowed (refused on the M4: `planner_seed_*`).
+        galvo_bisection: galvo,
         stepper_attached: galvo,
     };
     let mut out = Vec::new();
@@ -127,6 +129,43 @@ fn galvo_commands_are_refused_while_no_galvo_loop_serves_the_link() {
     let galvo = command(&mut core, 1, Command::Target(Actuator::Galvo), GALVO);
     assert!(galvo.iter().any(|a| matches!(a, Action::ConfigureGalvo(_))));
     assert_eq!(galvo.last(), Some(&Action::Line(Line::Ok)));
+}
+
+#[test]
+fn planner_seed_is_refused_where_the_board_cannot_afford_bisection() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let seed = Command::Planner(JumpPlanner::Seed);
+    let on_board = |core: &mut Core, command, bisection| {
+        let inputs = Inputs {
+            now: Instant::from_millis(1),
+            galvo_room: Some(GALVO_REQUEST_DEPTH),
+            galvo_bisection: bisection,
+            stepper_attached: false,
+        };
+        let mut out = Vec::new();
+        let readings = READINGS;
+        core.on(inputs, Event::Command { command, readings }, &mut out);
+        out
+    };
+    // The STM32 (an M4: 12-58 ms per axis): refused, nothing changes.
+    let refused = on_board(&mut core, seed, false);
+    assert_eq!(
+        refused,
+        vec![error(
+            "planner seed does not fit this board (bisection: 12-58 ms per jump axis); \
+             use planner optimal"
+        )]
+    );
+    assert_eq!(core.settings.galvo.planner, JumpPlanner::Optimal);
+    // `planner optimal` still works there; the simulator takes seed.
+    let optimal = on_board(&mut core, Command::Planner(JumpPlanner::Optimal), false);
+    assert_eq!(optimal.last(), Some(&Action::Line(Line::Ok)));
+    let taken = on_board(&mut core, seed, true);
+    assert!(taken.iter().any(|a| matches!(
+        a,
+        Action::ConfigureGalvo(c) if matches!(c.method, galvo_planner::Method::Bisection(_))
+    )));
+    assert_eq!(core.settings.galvo.planner, JumpPlanner::Seed);
 }
 
 #[test]

@@ -1,0 +1,215 @@
+//! The grbl session in the core: `ok` once queued (back-pressure when the
+//! queue is full), jog cancel, check mode, status states.
+
+extern crate std;
+
+use std::string::String;
+use std::vec::Vec;
+
+use embassy_time::Instant;
+
+use super::super::gcode_motion::PLANNER_BLOCKS;
+use super::super::machine::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
+use crate::command::{Command, GrblLine, RealtimeRequest};
+use crate::galvo::ScanPhase;
+use crate::grbl::realtime::Realtime;
+use crate::servo::task::{ServoOutcome, ServoRequest};
+
+const READINGS: Readings = Readings {
+    galvo: GalvoReadout {
+        phase: ScanPhase::Idle,
+        queued: 0,
+        underruns: 0,
+        halves: 0,
+        refill: None,
+    },
+    implausible_readings: 0,
+};
+
+fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
+    let inputs = Inputs {
+        now: Instant::from_millis(ms),
+        galvo_room: None,
+        galvo_bisection: false,
+        stepper_attached: false,
+    };
+    let mut out = Vec::new();
+    core.on(inputs, event, &mut out);
+    out
+}
+
+fn line(core: &mut Core, ms: u64, text: &str) -> Vec<Action> {
+    let command = Command::Grbl(GrblLine::new(text).expect("short line"));
+    on(
+        core,
+        ms,
+        Event::Command {
+            command,
+            readings: READINGS,
+        },
+    )
+}
+
+fn closers(actions: &[Action]) -> usize {
+    actions
+        .iter()
+        .filter(|a| matches!(a, Action::Line(Line::Ok | Line::GrblError(_))))
+        .count()
+}
+
+fn texts(actions: &[Action]) -> Vec<String> {
+    actions
+        .iter()
+        .filter_map(|a| match a {
+            Action::Line(Line::Data(t) | Line::Notice(t)) => Some(String::from(t.as_str())),
+            _ => None,
+        })
+        .collect()
+}
+
+fn move_seq(actions: &[Action]) -> Option<u32> {
+    actions.iter().find_map(|a| match a {
+        Action::Servo(ServoRequest::Move { seq, .. }) => Some(*seq),
+        _ => None,
+    })
+}
+
+fn arrive(core: &mut Core, ms: u64, seq: u32) -> Vec<Action> {
+    on(
+        core,
+        ms,
+        Event::Servo(ServoOutcome::Arrived {
+            seq,
+            yaw_tenths: 0,
+            pitch_tenths: 0,
+        }),
+    )
+}
+
+fn realtime(core: &mut Core, ms: u64, command: Realtime) -> Vec<Action> {
+    let request = RealtimeRequest {
+        command,
+        rx_free_bytes: 100,
+    };
+    on(core, ms, Event::Realtime(request))
+}
+
+fn status(core: &mut Core, ms: u64) -> String {
+    let out = realtime(core, ms, Realtime::StatusReport);
+    texts(&out).pop().expect("a status report")
+}
+
+#[test]
+fn ok_waits_for_room_in_the_queue() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let mut first_move = None;
+    // The first block starts at once; PLANNER_BLOCKS more fit the queue.
+    for k in 0..=PLANNER_BLOCKS {
+        let out = line(&mut core, 1, &std::format!("G0 X{} Y0", k % 2 + 1));
+        assert_eq!(closers(&out), 1, "line {k} answered at once");
+        first_move = first_move.or(move_seq(&out));
+    }
+    let full = line(&mut core, 2, "G0 X5 Y5");
+    assert_eq!(closers(&full), 0, "no room: the ok waits");
+    assert!(status(&mut core, 3).starts_with("<Run|"));
+    // The first block ends: its successor starts, the waiting line fits.
+    let seq = first_move.expect("the first block moves");
+    let settled = arrive(&mut core, 50, seq);
+    assert_eq!(closers(&settled), 0, "settling at the block end");
+    let deadline = core.dwell_deadline().expect("settle time");
+    let next = on(&mut core, deadline.as_millis(), Event::DwellEnded);
+    assert_eq!(closers(&next), 1, "the waiting line's ok");
+}
+
+#[test]
+fn jog_cancel_stops_after_the_step_in_flight_and_the_parser_follows() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let out = line(&mut core, 1, "$J=G91 X50 F600");
+    assert_eq!(closers(&out), 1);
+    let seq = move_seq(&out).expect("jog step");
+    assert!(status(&mut core, 2).starts_with("<Jog|"));
+    assert_eq!(
+        closers(&line(&mut core, 3, "G1 X1 F100")),
+        1,
+        "G-code refused while jogging"
+    );
+    realtime(&mut core, 4, Realtime::JogCancel);
+    let after = arrive(&mut core, 20, seq);
+    assert_eq!(move_seq(&after), None, "no further step");
+    let report = status(&mut core, 21);
+    assert!(report.starts_with("<Idle|MPos:2.000,0.000"), "{report}");
+    // The parser continues from where the jog stopped.
+    let out = line(&mut core, 22, "$J=G91 X1 F600");
+    assert!(move_seq(&out).is_some());
+    assert_eq!(core.gcode.parser.position.x_mm, 3.0);
+}
+
+#[test]
+fn check_mode_parses_without_moving_and_leaving_resets_the_modes() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let out = line(&mut core, 1, "$C");
+    assert!(texts(&out).contains(&String::from("MSG:Enabled")));
+    let out = line(&mut core, 2, "G1 X10 F100 M3 S500");
+    assert_eq!(closers(&out), 1);
+    assert_eq!(move_seq(&out), None, "check mode does not move");
+    assert!(status(&mut core, 3).starts_with("<Check|"));
+    let out = line(&mut core, 4, "$C");
+    assert!(texts(&out).contains(&String::from("MSG:Disabled")));
+    let out = line(&mut core, 5, "$G");
+    assert_eq!(
+        texts(&out),
+        [String::from("[GC:G0 G54 G17 G21 G90 G94 M5 M9 T0 F0 S0]")]
+    );
+}
+
+#[test]
+fn settings_map_to_product_parameters() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let out = line(&mut core, 1, "$110=30000");
+    assert_eq!(closers(&out), 1);
+    assert_eq!(core.settings.galvo.mark_speed_mm_s, 500.0);
+    let out = line(&mut core, 2, "$130=1");
+    assert!(out.contains(&Action::Line(Line::GrblError(
+        crate::grbl::GrblError::InvalidStatement
+    ))));
+    let out = line(&mut core, 3, "$$");
+    let settings = texts(&out);
+    assert!(settings.contains(&String::from("$110=30000.000")));
+    assert!(settings.contains(&String::from("$32=1")));
+    assert!(settings.iter().any(|s| s.starts_with("$130=229.9")));
+}
+
+#[test]
+fn buffer_state_shows_with_report_mask_2() {
+    let mut core = Core::new(Instant::from_millis(0));
+    assert!(!status(&mut core, 1).contains("|Bf:"));
+    assert_eq!(closers(&line(&mut core, 2, "$10=3")), 1);
+    assert_eq!(closers(&line(&mut core, 3, "G0 X1")), 1);
+    assert_eq!(closers(&line(&mut core, 4, "G0 X2")), 1);
+    let report = status(&mut core, 5);
+    // One block runs, one waits: 15 of 16 free; the console had 100 bytes.
+    assert!(report.contains("|Bf:15,100|"), "{report}");
+}
+
+#[test]
+fn laser_off_darkens_a_lit_gcode_step_at_once() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let out = line(&mut core, 1, "G0 X1");
+    let seq = move_seq(&out).expect("rapid");
+    arrive(&mut core, 10, seq);
+    let deadline = core.dwell_deadline().expect("settle");
+    on(&mut core, deadline.as_millis(), Event::DwellEnded);
+    let out = line(&mut core, 100, "G1 X20 F600 M3 S1000");
+    assert!(out.contains(&Action::GimbalLaser(true)), "lit G1 step");
+    let command = Command::Laser(crate::settings::LaserMode::Off);
+    let out = on(
+        &mut core,
+        101,
+        Event::Command {
+            command,
+            readings: READINGS,
+        },
+    );
+    assert!(out.contains(&Action::GimbalLaser(false)), "{out:?}");
+    assert!(!core.laser_on());
+}

@@ -1,0 +1,257 @@
+//! The G-code step in flight: each actuator that draws gets it
+//! ([`Core::gcode_send_step`], the one place that dispatches per
+//! actuator: add one here), and reports it done (servo arrival, galvo
+//! job done, dwell end); then the next step, block or hold follows.
+
+use embassy_time::{Duration, Instant};
+
+use super::gcode_motion::{CORNER_DEADBAND_TENTHS, CORNER_SETTLE_MS, Hold, cm, point_at};
+use super::laser::LaserEvent;
+use super::machine::{Action, ActionSink, Core};
+use crate::domain::{Figure, Target};
+use crate::galvo::GalvoRequest;
+use crate::grbl::{Block, PointMm};
+use crate::servo::task::{ServoOutcome, ServoRequest};
+
+impl Core {
+    /// Sends the current step to every actuator that draws.
+    pub(super) fn gcode_send_step(&mut self, out: &mut dyn ActionSink) {
+        let motion = &self.gcode.motion;
+        let Some(current) = motion.current else {
+            return;
+        };
+        let to = point_at(&current.block, current.index, current.count);
+        let (feed, lit) = match current.block {
+            Block::Line {
+                feed_mm_min, laser, ..
+            }
+            | Block::Arc {
+                feed_mm_min, laser, ..
+            } => (Some(feed_mm_min), self.gcode_lit(laser.mode, laser.power)),
+            Block::Jog { feed_mm_min, .. } => (Some(feed_mm_min), false),
+            _ => (None, false),
+        };
+        let lit = lit && motion.hold == Hold::None;
+        let from = motion.position;
+        let mut servo_seq = None;
+        let mut galvo_seq = None;
+        if self.actuator.uses_gimbal() {
+            // The last step of a block ends at a corner: it must arrive
+            // within the servo resolution, or the next block's first step
+            // would cut the corner by up to the arrival deadband.
+            let corner = current.index >= current.count;
+            servo_seq = self.gcode_servo_move(from, to, feed, corner, out);
+            if servo_seq.is_none() {
+                return;
+            }
+            // Dark until the gimbal has arrived once since the start.
+            self.gcode.motion.gimbal_lit = lit && self.gcode.motion.arrived;
+        }
+        if self.actuator.uses_galvo() {
+            let galvo_lit = lit;
+            self.next_seq = self.next_seq.wrapping_add(1);
+            let seq = self.next_seq;
+            let request = if galvo_lit {
+                GalvoRequest::Path {
+                    seq,
+                    path: Figure::Line {
+                        from: cm(from),
+                        to: cm(to),
+                    },
+                }
+            } else {
+                let [x_mm, y_mm] = cm(to).galvo_mm();
+                GalvoRequest::Point {
+                    seq,
+                    x_mm,
+                    y_mm,
+                    dwell_us: 0,
+                }
+            };
+            if !self.send_galvo(request, out) {
+                return;
+            }
+            galvo_seq = Some(seq);
+        }
+        if let Some(c) = self.gcode.motion.current.as_mut() {
+            c.from = from;
+            c.servo_seq = servo_seq;
+            c.galvo_seq = galvo_seq;
+        }
+    }
+
+    /// A servo move to `to` at `feed` mm/min (rapid: servo speed);
+    /// returns its request number.
+    fn gcode_servo_move(
+        &mut self,
+        from: PointMm,
+        to: PointMm,
+        feed: Option<f64>,
+        corner: bool,
+        out: &mut dyn ActionSink,
+    ) -> Option<u32> {
+        let point = cm(to);
+        let Ok(aim) = self.aimer.aim(point) else {
+            self.grbl_alarm(crate::grbl::Alarm::SoftLimit, out);
+            return None;
+        };
+        let by_servo = self.move_interval_ms(&aim);
+        let by_feed = feed.map_or(0.0, |f| {
+            let f = f * f64::from(self.gcode.overrides.feed) / 100.0;
+            60_000.0 * from.distance_to(to) / f.max(1e-3)
+        });
+        let interval_ms = libm::fmax(f64::from(by_servo), by_feed).min(f64::from(u16::MAX)) as u16;
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let seq = self.next_seq;
+        out.act(Action::Servo(ServoRequest::Move {
+            seq,
+            yaw_tenths: aim.yaw_wire,
+            pitch_tenths: aim.pitch_wire,
+            interval_ms,
+            ids: (self.settings.yaw.id, self.settings.pitch.id),
+            deadband_tenths: if corner {
+                CORNER_DEADBAND_TENTHS
+            } else {
+                (self.settings.deadband_deg * 10.0) as u16
+            },
+            ranges_tenths: super::faults::servo_ranges_tenths(&self.settings),
+        }));
+        out.act(Action::Note(LaserEvent::GimbalMoveSent));
+        self.last_aim = Some((Target { point, grid: None }, aim));
+        Some(seq)
+    }
+
+    /// The servo task reports move `seq` arrived; `true` when it was the
+    /// G-code step's.
+    fn gcode_servo_arrived(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
+        let Some(c) = self.gcode.motion.current.as_mut() else {
+            return false;
+        };
+        if c.servo_seq != Some(seq) {
+            return false;
+        }
+        c.servo_seq = None;
+        if c.index >= c.count && c.count > 0 {
+            c.until = Some(
+                self.inputs
+                    .now
+                    .saturating_add(Duration::from_millis(CORNER_SETTLE_MS)),
+            );
+        }
+        self.gcode.motion.arrived = true;
+        out.act(Action::Note(LaserEvent::GimbalArrived));
+        self.gcode_step_done(out);
+        true
+    }
+
+    /// The galvo loop finished job `seq`; `true` when it was the G-code
+    /// step's.
+    pub(super) fn gcode_galvo_done(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
+        let Some(c) = self.gcode.motion.current.as_mut() else {
+            return false;
+        };
+        if c.galvo_seq != Some(seq) {
+            return false;
+        }
+        c.galvo_seq = None;
+        self.gcode_step_done(out);
+        true
+    }
+
+    /// When the dwell deadline passed: the dwell block is done.
+    fn gcode_dwell_check(&mut self, out: &mut dyn ActionSink) {
+        let now = self.inputs.now;
+        let Some(c) = self.gcode.motion.current.as_mut() else {
+            return;
+        };
+        if c.until.is_some_and(|until| until <= now) {
+            c.until = None;
+            self.gcode.motion.gimbal_lit = false;
+            self.gcode_step_done(out);
+        }
+    }
+
+    /// `run_deadline` (a run's dwell), or when the G-code dwell or settle
+    /// ends.
+    pub(super) fn gcode_deadline_or(&self, run_deadline: Option<Instant>) -> Option<Instant> {
+        run_deadline.or(self.gcode.motion.current.and_then(|c| c.until))
+    }
+
+    /// Whether G-code lights the gimbal laser now: a lit step or dwell
+    /// runs, and the laser mode (`laser auto`) still allows it (`laser off`
+    /// mid-step darkens at once).
+    pub(super) fn gcode_gimbal_lit(&self) -> bool {
+        self.gcode.motion.gimbal_lit && self.settings.laser_mode == crate::settings::LaserMode::Auto
+    }
+
+    /// The dwell deadline passed: a run's dwell, or the G-code step's.
+    pub(super) fn dwell_ended(&mut self, out: &mut dyn ActionSink) {
+        self.dwell_finished(out);
+        self.gcode_dwell_check(out);
+    }
+
+    /// Every actuator finished the step in flight: the next step, the next
+    /// block, or the hold.
+    pub(super) fn gcode_step_done(&mut self, out: &mut dyn ActionSink) {
+        let motion = &mut self.gcode.motion;
+        let Some(mut c) = motion.current else { return };
+        if c.servo_seq.is_some() || c.galvo_seq.is_some() || c.until.is_some() {
+            return;
+        }
+        if c.count > 0 {
+            motion.position = point_at(&c.block, c.index, c.count);
+        }
+        motion.gimbal_lit = false;
+        c.index += 1;
+        let finished = c.index > c.count || c.cancelled;
+        motion.current = (!finished).then_some(c);
+        if motion.hold == Hold::Stopping {
+            motion.hold = Hold::Held;
+            return;
+        }
+        if finished {
+            if c.cancelled {
+                self.grbl_sync_position();
+            }
+            self.grbl_advance(out);
+        } else {
+            self.gcode_send_step(out);
+        }
+    }
+}
+
+impl Core {
+    /// The G-code side of a servo report: an arrival of the step in flight
+    /// moves on; `true` for a fault of it (the caller stops, after its own
+    /// fault handling).
+    pub(super) fn gcode_servo_outcome(
+        &mut self,
+        outcome: &ServoOutcome,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        match *outcome {
+            ServoOutcome::Arrived { seq, .. } => {
+                self.gcode_servo_arrived(seq, out);
+                false
+            }
+            ServoOutcome::Fault { seq, .. } => self.gcode_awaits_servo(seq),
+            _ => false,
+        }
+    }
+
+    /// Whether the G-code step waits for servo move `seq`.
+    fn gcode_awaits_servo(&self, seq: u32) -> bool {
+        self.gcode
+            .motion
+            .current
+            .is_some_and(|c| c.servo_seq == Some(seq))
+    }
+
+    /// Whether the G-code step waits for galvo job `seq`.
+    pub(super) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
+        self.gcode
+            .motion
+            .current
+            .is_some_and(|c| c.galvo_seq == Some(seq))
+    }
+}

@@ -1,0 +1,268 @@
+//! G-code through the simulated console: grbl's replies, the motion
+//! queue, and what the gimbal and the galvo draw for a realistic laser job.
+
+use kinematics_core::Galvo;
+use laser_sim::world::{SimOptions, SimReport};
+use system_tests::gcode_job::{PathFit, fit, laser_job};
+use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
+
+/// Servo resolution, 0.1°, as a distance on the board at the gimbal's
+/// distance (OQ = 25 cm) and the job's far corner (~50 mm off centre):
+/// 250 mm × tan(0.1°) × (1 + (50/250)²) ≈ 0.45 mm.
+const GIMBAL_TOLERANCE_MM: f64 = 0.45;
+/// The galvo's tolerance (issue 12).
+const GALVO_TOLERANCE_MM: f64 = 0.2;
+
+fn script(prefix: &str, lines: &[String]) -> String {
+    let mut s = String::from(prefix);
+    for l in lines {
+        s.push_str(l);
+        s.push('\n');
+    }
+    s
+}
+
+fn gimbal_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
+    report
+        .recording
+        .spot
+        .iter()
+        .filter(|s| s.laser)
+        .map(|s| [s.x_cm * 10.0, s.y_cm * 10.0])
+        .collect()
+}
+
+fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
+    let galvo = Galvo::<f64>::default();
+    report
+        .dac
+        .iter()
+        .filter(|(_, s)| s.laser)
+        .filter_map(|(_, s)| galvo.codes_to_board(s.x_code, s.y_code).ok())
+        .map(|p| [p.x_mm, p.y_mm])
+        .collect()
+}
+
+fn assert_all_ok(report: &SimReport, label: &str) {
+    let lines = terminal_lines(report);
+    let errors: Vec<&&str> = lines
+        .iter()
+        .filter(|l| l.starts_with("error") || l.starts_with("ALARM"))
+        .collect();
+    assert!(errors.is_empty(), "{label}: {errors:?}");
+    assert!(report.transcript.script_done, "{label}: script not done");
+    assert!(report.idle_at_end, "{label}: still running at the end");
+}
+
+#[test]
+fn a_laser_job_draws_its_toolpath_on_the_gimbal() {
+    let job = laser_job(40.0);
+    let report = run_with(&script("", &job.lines), SimOptions::default());
+    assert_all_ok(&report, "gimbal");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
+    let PathFit {
+        worst_lit_mm,
+        worst_missed_mm,
+        lit,
+        ..
+    } = fit(&gimbal_lit_mm(&report), &job.pieces);
+    eprintln!(
+        "gimbal: {lit} lit samples, worst off path {worst_lit_mm:.3} mm, worst gap {worst_missed_mm:.3} mm, {:.1} s",
+        report.end_time_us as f64 / 1e6
+    );
+    assert!(
+        worst_lit_mm <= GIMBAL_TOLERANCE_MM,
+        "lit {worst_lit_mm:.3} mm off the toolpath"
+    );
+    assert!(
+        worst_missed_mm <= 1.5,
+        "toolpath missed by {worst_missed_mm:.3} mm"
+    );
+}
+
+#[test]
+fn a_laser_job_draws_its_toolpath_on_the_galvo() {
+    let job = laser_job(25.0);
+    let report = run_with(&script("target galvo\n", &job.lines), SimOptions::default());
+    assert_all_ok(&report, "galvo");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
+    let PathFit {
+        worst_lit_mm,
+        worst_missed_mm,
+        lit,
+        ..
+    } = fit(&galvo_lit_mm(&report), &job.pieces);
+    eprintln!(
+        "galvo: {lit} lit samples, worst off path {worst_lit_mm:.3} mm, worst gap {worst_missed_mm:.3} mm, {:.1} s",
+        report.end_time_us as f64 / 1e6
+    );
+    assert!(
+        worst_lit_mm <= GALVO_TOLERANCE_MM,
+        "lit {worst_lit_mm:.3} mm off the toolpath"
+    );
+    assert!(
+        worst_missed_mm <= 0.5,
+        "toolpath missed by {worst_missed_mm:.3} mm"
+    );
+}
+
+/// The reply closing `line` (the first `ok` / `error…` after it).
+fn closer_of<'a>(lines: &[&'a str], line: &str) -> &'a str {
+    let sent = lines
+        .iter()
+        .position(|l| l.strip_prefix("> ") == Some(line))
+        .unwrap_or_else(|| panic!("{line:?} not sent"));
+    lines[sent..]
+        .iter()
+        .find(|l| **l == "ok" || l.starts_with("error"))
+        .unwrap_or_else(|| panic!("no reply to {line:?}"))
+}
+
+#[test]
+fn every_grbl_error_the_controller_emits_is_provoked() {
+    // (line, grbl error number); `$X` between lines that lock.
+    let cases: &[(&str, u8)] = &[
+        ("G1 #1", 1),
+        ("G1 X", 2),
+        ("$Q", 3),
+        ("G1 X1 F-5", 4),
+        ("$J=G1 X1 F10", 16),
+        ("$J=G91 X200 F100", 15),
+        ("G5 X1", 20),
+        ("M100", 20),
+        ("G0 G1 X1", 21),
+        ("G1 X1", 22),
+        ("M3.5", 23),
+        ("G1 G92 X1 F10", 24),
+        ("G0 X1 X2", 25),
+        ("G92", 26),
+        ("N10000000 G0 X0", 27),
+        ("G4", 28),
+        ("G10 L2 P2 X1", 29),
+        ("G55", 29),
+        ("G2 G53 X1 Y1 I1 F100", 30),
+        ("G80 X1", 31),
+        ("G2 Z1 I1 F100", 32),
+        ("G2 X10 Y0 I1 J0 F100", 33),
+        ("G2 X10 R1 F100", 34),
+        ("G2 X10 F100", 35),
+        ("G0 X1 P2", 36),
+        ("T300", 38),
+    ];
+    let mut text = String::from("G80\n");
+    for (line, _) in cases {
+        text.push_str(line);
+        text.push('\n');
+        // Leave the modal state as it was (G80 for the 31 case).
+        text.push_str("G0\n");
+    }
+    // error:8 ($C while a move runs) and error:9 (G-code in alarm).
+    text.push_str("G1 X20 F300\n$C\nG0 X5000\nG0 X1\n$X\nG0 X0\n");
+    let report = run_with(&text, SimOptions::default());
+    let lines = terminal_lines(&report);
+    for (line, code) in cases {
+        assert_eq!(closer_of(&lines, line), format!("error:{code}"), "{line}");
+    }
+    assert_eq!(closer_of(&lines, "$C"), "error:8");
+    // Soft limit: ALARM:2, then G-code locked until $X.
+    let alarm = lines.iter().position(|l| *l == "ALARM:2").expect("ALARM:2");
+    assert_eq!(lines[alarm - 1], "> G0 X5000", "{lines:?}");
+    assert_eq!(closer_of(&lines, "G0 X1"), "error:9");
+    assert_eq!(closer_of(&lines, "$X"), "ok");
+    assert!(lines.contains(&"[MSG:Caution: Unlocked]"));
+    assert_eq!(closer_of(&lines, "G0 X0"), "ok");
+}
+
+#[test]
+fn feed_hold_stops_dark_and_resume_finishes_the_job() {
+    // A 60 mm lit line at 600 mm/min: 6 s. Hold after 2 s for 2 s.
+    let text = "G0 X-30 Y0\nM3 S1000\nG1 X30 F600\nwait 2000\n!\nwait 300\n?\nwait 1700\n?\n~\nwait 200\n?\n";
+    let report = run_with(text, SimOptions::default());
+    let lines = terminal_lines(&report);
+    let statuses: Vec<&&str> = lines.iter().filter(|l| l.starts_with('<')).collect();
+    assert_eq!(statuses.len(), 3, "{lines:?}");
+    assert!(statuses[0].starts_with("<Hold:0|MPos:"), "{statuses:?}");
+    assert!(statuses[1].starts_with("<Hold:0|MPos:"), "{statuses:?}");
+    assert!(statuses[2].starts_with("<Run|MPos:"), "{statuses:?}");
+    // Dark from the hold (+1 ms) to the resume.
+    let sent = |l: &str| system_tests::sent_at(&report, l);
+    let hold_at = sent("!");
+    let resume_at = sent("~");
+    let lit_in_hold = report
+        .recording
+        .spot
+        .iter()
+        .any(|s| s.laser && s.t_us > hold_at + 1_000 && s.t_us < resume_at);
+    assert!(!lit_in_hold, "lit during the hold");
+    // The whole line was drawn all the same, and nothing else.
+    let fit = fit(
+        &gimbal_lit_mm(&report),
+        &[system_tests::gcode_job::Piece::Line {
+            a: [-30.0, 0.0],
+            b: [30.0, 0.0],
+        }],
+    );
+    assert!(fit.worst_lit_mm <= GIMBAL_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 1.5, "{fit:?}");
+    assert!(report.idle_at_end);
+}
+
+#[test]
+fn soft_reset_during_motion_raises_alarm_3_and_keeps_settings() {
+    let text = "$32=1\ntarget gimbal\nG0 X-30\nM3 S1000\nG1 X30 F600\nwait 1000\n\u{18}\nG0 X0\n$X\n$$\n?\n";
+    let report = run_with(text, SimOptions::default());
+    let lines = terminal_lines(&report);
+    let alarm = lines.iter().position(|l| *l == "ALARM:3").expect("ALARM:3");
+    assert_eq!(lines[alarm + 1], "Grbl 1.1h ['$' for help]", "{lines:?}");
+    assert!(lines.contains(&"[MSG:'$H'|'$X' to unlock]"));
+    assert_eq!(closer_of(&lines, "G0 X0"), "error:9");
+    assert!(lines.contains(&"$32=1"));
+    let reset_at = report
+        .transcript
+        .lines
+        .iter()
+        .find(|(_, l)| l == "ALARM:3")
+        .map(|(t, _)| *t)
+        .unwrap();
+    let lit_after = report
+        .recording
+        .laser_events
+        .iter()
+        .filter(|(t, _)| *t >= reset_at)
+        .any(|(_, on)| *on);
+    assert!(!lit_after, "lit after the reset");
+    let last_status = lines.iter().rev().find(|l| l.starts_with('<')).unwrap();
+    assert!(last_status.starts_with("<Idle|MPos:"), "{last_status}");
+}
+
+#[test]
+fn feed_hold_on_the_galvo_is_dark_and_the_job_still_draws_its_toolpath() {
+    let job = laser_job(25.0);
+    // Hold after 40 lines (16 blocks queued ahead), resume 500 ms later.
+    let mut lines = job.lines.clone();
+    lines.insert(40, "!".into());
+    lines.insert(41, "wait 500".into());
+    lines.insert(42, "?".into());
+    lines.insert(43, "~".into());
+    let report = run_with(&script("target galvo\n", &lines), SimOptions::default());
+    assert_all_ok(&report, "galvo hold");
+    let hold_us = system_tests::sent_at(&report, "!");
+    let resume_us = system_tests::sent_at(&report, "~");
+    let lit_in_hold: Vec<u64> = system_tests::lit_sample_times_ns(&report)
+        .into_iter()
+        .filter(|&t| t > (hold_us + 1_000) * 1_000 && t < resume_us * 1_000)
+        .collect();
+    assert!(
+        lit_in_hold.is_empty(),
+        "{} lit samples in the hold",
+        lit_in_hold.len()
+    );
+    let status = terminal_lines(&report)
+        .into_iter()
+        .find(|l| l.starts_with('<'))
+        .expect("a status report");
+    assert!(status.starts_with("<Hold:0|"), "{status}");
+    let fit = fit(&galvo_lit_mm(&report), &job.pieces);
+    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+}
