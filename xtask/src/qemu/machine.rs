@@ -7,6 +7,7 @@ use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc::SyncSender;
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -41,6 +42,8 @@ pub struct MachineOptions {
     pub echo: bool,
     /// Print the board's log records on stderr.
     pub echo_log: bool,
+    /// Also send the console's output here (the `--pty` bridge).
+    pub console_tee: Option<SyncSender<Vec<u8>>>,
 }
 
 /// A running emulated board.
@@ -162,7 +165,10 @@ impl Machine {
         }));
         let mut threads = Vec::new();
         let (term, reader) = (terminal.clone(), console.try_clone()?);
-        threads.push(std::thread::spawn(move || read_console(reader, term, t0)));
+        let tee = options.console_tee.clone();
+        threads.push(std::thread::spawn(move || {
+            read_console(reader, term, t0, tee)
+        }));
         let side = servos.clone();
         threads.push(std::thread::spawn(move || serve(servo, side, t0)));
         let (shared_log, reader, echo_log) =
@@ -227,6 +233,15 @@ impl Machine {
         self.console
             .write_all(format!("{line}\r\n").as_bytes())
             .context("writing to the console socket")
+    }
+
+    /// A second handle on the console socket (bytes written to it are
+    /// typed on the board's console; a write blocks while QEMU holds input
+    /// back).
+    pub fn console_writer(&self) -> Result<UnixStream> {
+        self.console
+            .try_clone()
+            .context("cannot clone the console socket")
     }
 
     /// Waits until every line typed has its closing reply; `false` at
