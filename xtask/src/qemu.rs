@@ -9,6 +9,7 @@
 //! script's waits stay together in real time.
 
 mod board_log;
+mod defmt_log;
 mod machine;
 mod measure;
 mod pty;
@@ -29,6 +30,7 @@ use anyhow::{Context, Result, bail};
 use laser_sim::recorder::{Recording, SpotSample};
 
 pub use board_log::{BoardEvent, BoardLog};
+pub use defmt_log::check_channel as check_defmt_channel;
 pub use machine::{Machine, MachineOptions};
 pub use pty::check_console as check_pty_console;
 pub use script::{BoardStep, parse_board_script, split_at_resets};
@@ -93,6 +95,11 @@ pub struct QemuArgs {
     /// works, and the galvo loop runs on the emulated M4.
     #[arg(long)]
     galvo_dac: bool,
+    /// laser-app's logs as defmt frames on UART3, decoded with
+    /// defmt-decoder against the image (printed with --log) instead of
+    /// the plain-text records.
+    #[arg(long)]
+    defmt_log: bool,
     /// Measure the board (image size, instructions per command and per
     /// second of holding, peak stack per task, the log channel's cost).
     #[arg(long, conflicts_with_all = ["script", "interactive", "scenarios"])]
@@ -288,11 +295,14 @@ pub fn run(args: QemuArgs) -> Result<ExitCode> {
         None if args.interactive || args.pty.is_some() => 3.2e7,
         None => 600.0,
     };
-    let elf = if args.galvo_dac {
-        build_image_with(&["galvo-dac"], false)?
-    } else {
-        build_image()?
-    };
+    let mut features = Vec::new();
+    if args.galvo_dac {
+        features.push("galvo-dac");
+    }
+    if args.defmt_log {
+        features.push("defmt-log");
+    }
+    let elf = build_image_with(&features, args.defmt_log)?;
     if args.interactive {
         eprintln!("xtask qemu: type commands (help lists them); Ctrl-D ends the run");
     }

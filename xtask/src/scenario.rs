@@ -244,6 +244,17 @@ pub fn run_on_qemu() -> Result<()> {
     if let Err(e) = verdict {
         failures.push(format!("--pty console: {e:#}"));
     }
+    let started = std::time::Instant::now();
+    let verdict = crate::qemu::build_image_with(&["defmt-log"], true)
+        .and_then(|elf| crate::qemu::check_defmt_channel(&elf));
+    println!(
+        "the defmt log channel on QEMU: {} ({:.1} s)",
+        if verdict.is_ok() { "ok" } else { "FAILED" },
+        started.elapsed().as_secs_f64()
+    );
+    if let Err(e) = verdict {
+        failures.push(format!("defmt log channel: {e:#}"));
+    }
     if !failures.is_empty() {
         bail!("scenarios failed:\n{}", failures.join("\n"));
     }

@@ -1,4 +1,4 @@
-//! One run of the emulated board: QEMU started on the image with its three
+//! One run of the emulated board: QEMU started on the image with its four
 //! UARTs and its monitor on Unix sockets this process listens on, and the
 //! threads that serve them (console terminal, servo bus, log channel).
 
@@ -17,6 +17,7 @@ use laser_sim::servo_model::SimServoBus;
 use laser_sim::servo_port::{BusFaults, FaultInjector};
 
 use super::board_log::{BoardLog, SharedLog, read_channel};
+use super::defmt_log::read_defmt;
 use super::servo_bus::{ServoSide, serve};
 use super::terminal::{SharedTerminal, Terminal, read_console};
 use crate::bench_m4::qemu::MACHINE_ARGS;
@@ -112,6 +113,8 @@ fn spawn_qemu(elf: &Path, sockets: &[(&str, PathBuf)]) -> Result<Child> {
         .args([
             "-serial",
             "chardev:uart2",
+            "-serial",
+            "chardev:uart3",
             "-mon",
             "chardev=mon,mode=readline",
         ])
@@ -125,7 +128,7 @@ impl Machine {
     /// Starts QEMU on `elf` and waits for the board to boot.
     pub fn start(elf: &Path, options: &MachineOptions) -> Result<Self> {
         let dir = socket_dir()?;
-        let names = ["uart0", "uart1", "uart2", "mon"];
+        let names = ["uart0", "uart1", "uart2", "uart3", "mon"];
         let mut sockets = Vec::new();
         let mut listeners = Vec::new();
         for name in names {
@@ -146,8 +149,10 @@ impl Machine {
                 }
             }
         }
-        let [console, servo, log, monitor] = <[UnixStream; 4]>::try_from(streams)
-            .map_err(|_| anyhow::anyhow!("four sockets expected"))?;
+        let [console, servo, log, defmt, monitor] = <[UnixStream; 5]>::try_from(streams)
+            .map_err(|_| anyhow::anyhow!("five sockets expected"))?;
+        let elf_bytes =
+            std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
         let terminal: SharedTerminal = Arc::new((
             Mutex::new(Terminal {
                 echo: options.echo,
@@ -175,6 +180,10 @@ impl Machine {
             (board_log.clone(), log.try_clone()?, options.echo_log);
         threads.push(std::thread::spawn(move || {
             read_channel(reader, shared_log, echo_log)
+        }));
+        let (shared_log, echo_log) = (board_log.clone(), options.echo_log);
+        threads.push(std::thread::spawn(move || {
+            read_defmt(defmt, elf_bytes, shared_log, echo_log)
         }));
         let machine = Self {
             child,
