@@ -3,7 +3,7 @@
 
 use kinematics_core::Galvo;
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::gcode_job::{PathFit, fit, laser_job};
+use system_tests::gcode_job::{Job, PathFit, SpotMm, fit, laser_job, rapids_dark};
 use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
 
 /// Servo resolution, 0.1°, as a distance on the board at the gimbal's
@@ -43,6 +43,44 @@ fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
         .collect()
 }
 
+fn gimbal_spot_mm(report: &SimReport) -> Vec<SpotMm> {
+    report
+        .recording
+        .spot
+        .iter()
+        .map(|s| (s.t_us, [s.x_cm * 10.0, s.y_cm * 10.0], s.laser))
+        .collect()
+}
+
+fn galvo_spot_mm(report: &SimReport) -> Vec<SpotMm> {
+    let galvo = Galvo::<f64>::default();
+    report
+        .dac
+        .iter()
+        .filter_map(|(t, s)| {
+            let p = galvo.codes_to_board(s.x_code, s.y_code).ok()?;
+            Some((t, [p.x_mm, p.y_mm], s.laser))
+        })
+        .collect()
+}
+
+/// Every G0 of `job` was found on the spot's timeline, crossed with at
+/// least one sample, and not one of them lit.
+fn assert_dark_on_every_rapid(samples: &[SpotMm], job: &Job, tol_mm: f64, label: &str) {
+    let spans =
+        rapids_dark(samples, &job.rapids, tol_mm).unwrap_or_else(|e| panic!("{label}: {e}"));
+    assert_eq!(spans.len(), job.rapids.len(), "{label}: {spans:?}");
+    for (k, span) in spans.iter().enumerate() {
+        assert!(span.samples > 0, "{label}: G0 #{k} not sampled: {span:?}");
+        assert_eq!(span.lit, 0, "{label}: lit during G0 #{k}: {span:?}");
+    }
+    eprintln!(
+        "{label}: {} G0s dark over {} samples",
+        spans.len(),
+        spans.iter().map(|s| s.samples).sum::<usize>()
+    );
+}
+
 fn assert_all_ok(report: &SimReport, label: &str) {
     let lines = terminal_lines(report);
     let errors: Vec<&&str> = lines
@@ -78,6 +116,12 @@ fn a_laser_job_draws_its_toolpath_on_the_gimbal() {
         worst_missed_mm <= 1.5,
         "toolpath missed by {worst_missed_mm:.3} mm"
     );
+    assert_dark_on_every_rapid(
+        &gimbal_spot_mm(&report),
+        &job,
+        GIMBAL_TOLERANCE_MM,
+        "gimbal",
+    );
 }
 
 #[test]
@@ -104,6 +148,7 @@ fn a_laser_job_draws_its_toolpath_on_the_galvo() {
         worst_missed_mm <= 0.5,
         "toolpath missed by {worst_missed_mm:.3} mm"
     );
+    assert_dark_on_every_rapid(&galvo_spot_mm(&report), &job, GALVO_TOLERANCE_MM, "galvo");
 }
 
 /// The reply closing `line` (the first `ok` / `error…` after it).
