@@ -311,3 +311,22 @@ fn feed_hold_on_the_galvo_is_dark_and_the_job_still_draws_its_toolpath() {
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
     assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
 }
+
+#[test]
+fn an_over_long_gcode_line_is_grbl_error_11_and_a_product_line_keeps_its_error() {
+    let long_gcode = format!("G1 X1 F100 ({})", "x".repeat(200));
+    let long_product = format!("goto {}", "1".repeat(200));
+    let text = format!("{long_gcode}\n{long_product}\nG0 X1\n");
+    let report = run_with(&text, SimOptions::default());
+    let lines = terminal_lines(&report);
+    let replies: Vec<&&str> = lines
+        .iter()
+        .filter(|l| *l == &"ok" || l.starts_with("error"))
+        .collect();
+    assert_eq!(
+        replies,
+        [&"error:11", &"error: line too long (max 128 bytes)", &"ok"],
+        "{lines:?}"
+    );
+    assert!(report.idle_at_end);
+}
