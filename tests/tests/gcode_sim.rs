@@ -330,3 +330,33 @@ fn an_over_long_gcode_line_is_grbl_error_11_and_a_product_line_keeps_its_error()
     );
     assert!(report.idle_at_end);
 }
+
+/// Time the galvo laser was lit from first to last lit sample, s.
+fn galvo_lit_span_s(report: &SimReport) -> f64 {
+    let lit = system_tests::lit_sample_times_ns(report);
+    let (first, last) = (lit.first().expect("lit"), lit.last().expect("lit"));
+    (last - first) as f64 / 1e9
+}
+
+#[test]
+fn the_galvo_marks_at_the_programmed_feed() {
+    // A 40 mm line at 600 and at 1200 mm/min: 4 s and 2 s.
+    let mark = |feed: u32| {
+        let text = format!("target galvo\nG0 X-20 Y5\nG1 X20 F{feed} M3 S1000\nM5\nG0 X0 Y0\n");
+        let report = run_with(&text, SimOptions::default());
+        assert_all_ok(&report, "galvo feed");
+        let fit = fit(
+            &galvo_lit_mm(&report),
+            &[system_tests::gcode_job::Piece::Line {
+                a: [-20.0, 5.0],
+                b: [20.0, 5.0],
+            }],
+        );
+        assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+        galvo_lit_span_s(&report)
+    };
+    let (slow, fast) = (mark(600), mark(1200));
+    eprintln!("galvo: 40 mm at F600 {slow:.3} s, at F1200 {fast:.3} s");
+    assert!((slow - 4.0).abs() < 0.05, "F600: {slow} s");
+    assert!((fast - 2.0).abs() < 0.05, "F1200: {fast} s");
+}
