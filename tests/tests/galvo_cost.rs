@@ -8,9 +8,14 @@ use laser_app::galvo::M4_COST;
 use laser_sim::script::DEMO_SCRIPT;
 use system_tests::run_to_idle;
 
-/// bench-m4's JSON table, if a run left one in this build's target
-/// directory.
+/// bench-m4's JSON table: the one `cargo xtask test` names in
+/// `BENCH_M4_JSON` (it runs bench-m4 first, so the table is this build's
+/// and must exist), else one a run left in this build's target directory.
 fn bench_table() -> Option<String> {
+    if let Some(path) = std::env::var_os("BENCH_M4_JSON") {
+        let table = std::fs::read_to_string(&path);
+        return Some(table.unwrap_or_else(|e| panic!("BENCH_M4_JSON {path:?}: {e}")));
+    }
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
         .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target"));

@@ -13,9 +13,10 @@
 //! most), the VDIV/VSQRT latency (14 cycles each), bus contention with DMA.
 
 mod budgets;
-mod qemu;
+pub(crate) mod qemu;
 mod report;
 
+use std::path::PathBuf;
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
@@ -30,20 +31,27 @@ use report::{check, parse, print};
 /// finds the MPS2 board's map before the root's STM32F407 one.
 pub const MANIFEST: &str = "firmware/bench-m4/Cargo.toml";
 
-/// Runs `cargo <args> --manifest-path firmware/bench-m4/Cargo.toml` in the
-/// workspace root (so the root's `.cargo/config.toml` applies: target
-/// rustflags, flip-link) with the root's target directory.
+/// Runs `cargo <args> --manifest-path firmware/bench-m4/Cargo.toml` (see
+/// [`cargo_in`]).
 pub fn cargo(args: &[&str]) -> Result<()> {
+    cargo_in(MANIFEST, args)
+}
+
+/// Runs `cargo <args> --manifest-path <manifest>` in the workspace root (so
+/// the root's `.cargo/config.toml` applies: target rustflags, flip-link)
+/// with the root's target directory: for the workspaces of their own on
+/// the MPS2 board (this bench, `firmware/qemu-m4`).
+pub fn cargo_in(manifest: &str, args: &[&str]) -> Result<()> {
     let (command, rest) = args.split_first().context("cargo without a command")?;
     let target = target_dir();
     println!(
-        "$ CARGO_TARGET_DIR={} cargo {command} --manifest-path {MANIFEST} {}",
+        "$ CARGO_TARGET_DIR={} cargo {command} --manifest-path {manifest} {}",
         target.display(),
         rest.join(" ")
     );
     let status = Command::new("cargo")
         .arg(command)
-        .args(["--manifest-path", MANIFEST])
+        .args(["--manifest-path", manifest])
         .args(rest)
         .env("CARGO_TARGET_DIR", &target)
         .current_dir(workspace_root())
@@ -51,15 +59,16 @@ pub fn cargo(args: &[&str]) -> Result<()> {
         .context("could not start `cargo`")?;
     if !status.success() {
         bail!(
-            "`cargo {}` for {MANIFEST} failed ({status})",
+            "`cargo {}` for {manifest} failed ({status})",
             args.join(" ")
         );
     }
     Ok(())
 }
 
-/// `cargo xtask bench-m4`.
-pub fn bench_m4() -> Result<()> {
+/// `cargo xtask bench-m4`: runs the benchmark on QEMU, prints and writes
+/// its table, checks the budgets; returns the JSON table's path.
+pub fn bench_m4() -> Result<PathBuf> {
     ensure_qemu()?;
     ensure_flip_link()?;
     cargo(&["build", "--release", "--target", TARGET])?;
@@ -71,7 +80,8 @@ pub fn bench_m4() -> Result<()> {
     std::fs::write(&json, serde_json::to_string_pretty(&report)?)
         .with_context(|| format!("could not write {}", json.display()))?;
     println!("table written to {}", json.display());
-    check(&report)
+    check(&report)?;
+    Ok(json)
 }
 
 #[cfg(test)]

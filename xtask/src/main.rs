@@ -7,6 +7,8 @@ mod fuzz;
 mod json_out;
 mod kin;
 mod plan;
+mod qemu;
+mod scenario;
 mod sim;
 mod size_gcode;
 mod toolchain;
@@ -36,6 +38,8 @@ enum Command {
     Size,
     /// Run the firmware tasks on the host against simulated servos (virtual time).
     Sim(sim::SimArgs),
+    /// Run the firmware on QEMU's mps2-an386 (Cortex-M4F) against the simulator's servos.
+    Qemu(qemu::QemuArgs),
     /// Gimbal kinematics: `kin ik`, `kin fk`, `kin grid-error`.
     Kin(kin::KinArgs),
     /// Error-model calibration: `calib fit --input FILE.csv`.
@@ -56,10 +60,11 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Test => toolchain::test().map(|()| ExitCode::SUCCESS),
         Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
-        Command::BenchM4 => bench_m4::bench_m4().map(|()| ExitCode::SUCCESS),
+        Command::BenchM4 => bench_m4::bench_m4().map(|_table| ExitCode::SUCCESS),
         Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => sim::run_sim(args),
+        Command::Qemu(args) => qemu::run(args),
         Command::Kin(args) => kin::run(args),
         Command::Calib(args) => calib::run(args),
         Command::Plan(args) => plan::run(args),

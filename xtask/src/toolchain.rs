@@ -48,9 +48,15 @@ pub fn workspace_root() -> PathBuf {
 /// Runs a command in the workspace root, echoing it first; fails on a
 /// non-zero exit.
 pub fn run(program: &str, args: &[&str]) -> Result<()> {
+    run_with_env(program, args, &[])
+}
+
+/// [`run`] with extra environment variables (`(name, value)` pairs).
+pub fn run_with_env(program: &str, args: &[&str], env: &[(&str, &Path)]) -> Result<()> {
     println!("$ {program} {}", args.join(" "));
     let status = Command::new(program)
         .args(args)
+        .envs(env.iter().copied())
         .current_dir(workspace_root())
         .status()
         .with_context(|| format!("could not start `{program}`"))?;
@@ -94,11 +100,13 @@ fn package_args<'a>(packages: &[&'a str]) -> Vec<&'a str> {
 }
 
 /// `cargo xtask test`: the whole gate, in the order a reviewer would run it
-/// (ends with `bench-m4`, the M4 budgets on QEMU).
+/// (ends on QEMU: `bench-m4`, the M4 budgets, then the shared scenarios on
+/// the emulated board, `firmware/qemu-m4`).
 pub fn test() -> Result<()> {
     ensure_toolchain()?;
     run("cargo", &["fmt", "--all", "--check"])?;
     crate::bench_m4::cargo(&["fmt", "--check"])?;
+    crate::bench_m4::cargo_in(crate::qemu::MANIFEST, &["fmt", "--check"])?;
 
     let mut clippy_host = vec!["clippy", "--all-targets"];
     clippy_host.extend(package_args(&HOST_PACKAGES));
@@ -120,21 +128,41 @@ pub fn test() -> Result<()> {
         "warnings",
     ])?;
 
+    // So is the QEMU board (firmware/qemu-m4/Cargo.toml).
+    crate::bench_m4::cargo_in(
+        crate::qemu::MANIFEST,
+        &[
+            "clippy",
+            "--target",
+            TARGET,
+            "--release",
+            "--",
+            "-D",
+            "warnings",
+        ],
+    )?;
+
     // The libraries for the target.
     let mut build_libs = vec!["build", "--target", TARGET, "--release"];
     build_libs.extend(package_args(&TARGET_LIBRARIES));
     run("cargo", &build_libs)?;
 
+    // The per-sample and refill budgets on the target's instruction set,
+    // before the host tests: the simulator's M4 cost model is checked
+    // against this run's table (`tests/tests/galvo_cost.rs`).
+    let bench_table = crate::bench_m4::bench_m4()?;
+
     // Unit, integration (tests/) and doc tests of every host crate.
     let mut tests = vec!["test"];
     tests.extend(package_args(&HOST_PACKAGES));
-    run("cargo", &tests)?;
+    run_with_env("cargo", &tests, &[("BENCH_M4_JSON", &bench_table)])?;
 
     build_firmware()?;
     size()?;
 
-    // The per-sample and refill budgets on the target's instruction set.
-    crate::bench_m4::bench_m4()
+    // The shared scenarios on the emulated Cortex-M4F (the simulator runs
+    // them in xtask's tests above).
+    crate::scenario::run_on_qemu()
 }
 
 /// Installs flip-link, the firmware's linker wrapper (`.cargo/config.toml`:
@@ -234,7 +262,7 @@ pub fn parse_berkeley_size(output: &str) -> Result<ImageSize> {
     }
 }
 
-fn llvm_size_path() -> Result<PathBuf> {
+pub fn llvm_size_path() -> Result<PathBuf> {
     let out = Command::new("rustc")
         .args(["--print", "sysroot"])
         .current_dir(workspace_root())

@@ -54,15 +54,103 @@ impl SilentWindow {
     }
 }
 
+/// What the injected faults do to the bus: silences by time, and damaged
+/// response bytes (flipped bits, forged angles) drawn from a seeded
+/// generator. Shared by the simulated UART ([`SimServoPort`]) and the
+/// servo bus `cargo xtask qemu` serves to the emulated board.
+#[derive(Debug, Clone)]
+pub struct FaultInjector {
+    faults: BusFaults,
+    rng: u64,
+}
+
+impl FaultInjector {
+    /// The effect of `faults`, with random numbers from `seed` (unless the
+    /// faults name their own seed).
+    pub fn new(faults: BusFaults, seed: u64) -> Self {
+        let rng_seed = if faults.seed != 0 { faults.seed } else { seed };
+        Self {
+            faults,
+            rng: rng_seed | 1,
+        }
+    }
+
+    fn random_unit(&mut self) -> f64 {
+        let x = &mut self.rng;
+        *x ^= *x << 13;
+        *x ^= *x >> 7;
+        *x ^= *x << 17;
+        (*x >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Silences (or lets answer again) each servo a silence window names,
+    /// as the windows say for `now_us`.
+    pub fn apply_silence(&self, bus: &mut SimServoBus, now_us: u64) {
+        for window in &self.faults.silent {
+            let silent = self
+                .faults
+                .silent
+                .iter()
+                .any(|w| w.id == window.id && w.covers(now_us));
+            bus.set_silent(window.id, silent);
+        }
+    }
+
+    /// Damages `response` as the faults say: maybe a forged angle (valid
+    /// checksum), then maybe flipped bits in each byte.
+    pub fn damage(&mut self, response: &mut [u8]) {
+        if self.faults.forge_probability > 0.0 && self.random_unit() < self.faults.forge_probability
+        {
+            self.forge_angle(response);
+        }
+        for byte in response.iter_mut() {
+            if self.faults.corrupt_probability > 0.0
+                && self.random_unit() < self.faults.corrupt_probability
+            {
+                *byte ^= 1 << (self.random_unit() * 8.0) as u32;
+            }
+        }
+    }
+
+    /// Flips two bits of an angle response (code 10, 8 bytes) so that the
+    /// checksum still holds: the same bit set in one angle byte and cleared
+    /// in the other, or set in an angle byte and in the checksum.
+    fn forge_angle(&mut self, frame: &mut [u8]) {
+        const ANGLE_CODE: u8 = 10;
+        if frame.len() != 8 || frame.get(2) != Some(&ANGLE_CODE) {
+            return;
+        }
+        let (lo, hi, cs) = (5, 6, 7);
+        for _ in 0..32 {
+            let mask = 1u8 << (self.random_unit() * 8.0) as u32;
+            let (a, b) = if self.random_unit() < 0.5 {
+                (lo, hi)
+            } else {
+                (hi, lo)
+            };
+            if self.random_unit() < 0.5 {
+                if frame[a] & mask == 0 && frame[b] & mask != 0 {
+                    frame[a] |= mask;
+                    frame[b] &= !mask;
+                    return;
+                }
+            } else if frame[a] & mask == 0 && frame[cs] & mask == 0 {
+                frame[a] |= mask;
+                frame[cs] |= mask;
+                return;
+            }
+        }
+    }
+}
+
 /// The bus seen from the firmware: write requests, read responses.
 pub struct SimServoPort {
     bus: Rc<RefCell<SimServoBus>>,
     recording: Rc<RefCell<Recording>>,
-    faults: BusFaults,
+    injector: RefCell<FaultInjector>,
     /// Response bytes with the time each becomes readable, µs.
     incoming: RefCell<VecDeque<(u64, u8)>>,
     arrived: Signal<CriticalSectionRawMutex, ()>,
-    rng: RefCell<u64>,
 }
 
 impl SimServoPort {
@@ -73,34 +161,12 @@ impl SimServoPort {
         faults: BusFaults,
         seed: u64,
     ) -> Self {
-        let rng_seed = if faults.seed != 0 { faults.seed } else { seed };
         Self {
             bus,
             recording,
-            faults,
+            injector: RefCell::new(FaultInjector::new(faults, seed)),
             incoming: RefCell::default(),
             arrived: Signal::new(),
-            rng: RefCell::new(rng_seed | 1),
-        }
-    }
-
-    fn random_unit(&self) -> f64 {
-        let mut x = self.rng.borrow_mut();
-        *x ^= *x << 13;
-        *x ^= *x >> 7;
-        *x ^= *x << 17;
-        (*x >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn apply_silence(&self, now_us: u64) {
-        let mut bus = self.bus.borrow_mut();
-        for window in &self.faults.silent {
-            let silent = self
-                .faults
-                .silent
-                .iter()
-                .any(|w| w.id == window.id && w.covers(now_us));
-            bus.set_silent(window.id, silent);
         }
     }
 
@@ -112,22 +178,12 @@ impl SimServoPort {
             direction: Direction::Tx,
             bytes: bytes.to_vec(),
         });
-        self.apply_silence(done);
+        let mut injector = self.injector.borrow_mut();
+        injector.apply_silence(&mut self.bus.borrow_mut(), done);
         let responses = self.bus.borrow_mut().receive(done, bytes);
         for (ready_at_us, mut response) in responses {
             let sent = response.clone();
-            if self.faults.forge_probability > 0.0
-                && self.random_unit() < self.faults.forge_probability
-            {
-                self.forge_angle(&mut response);
-            }
-            for byte in response.iter_mut() {
-                if self.faults.corrupt_probability > 0.0
-                    && self.random_unit() < self.faults.corrupt_probability
-                {
-                    *byte ^= 1 << (self.random_unit() * 8.0) as u32;
-                }
-            }
+            injector.damage(&mut response);
             let mut recording = self.recording.borrow_mut();
             if response != sent {
                 recording.clean_rx.push(CorruptedFrame {
@@ -157,36 +213,6 @@ impl SimServoPort {
         // The simulated bus and servos: not firmware work.
         crate::executor::simulator_work(|| self.deliver(start, done, bytes));
         self.arrived.signal(());
-    }
-
-    /// Flips two bits of an angle response (code 10, 8 bytes) so that the
-    /// checksum still holds: the same bit set in one angle byte and cleared
-    /// in the other, or set in an angle byte and in the checksum.
-    fn forge_angle(&self, frame: &mut [u8]) {
-        const ANGLE_CODE: u8 = 10;
-        if frame.len() != 8 || frame.get(2) != Some(&ANGLE_CODE) {
-            return;
-        }
-        let (lo, hi, cs) = (5, 6, 7);
-        for _ in 0..32 {
-            let mask = 1u8 << (self.random_unit() * 8.0) as u32;
-            let (a, b) = if self.random_unit() < 0.5 {
-                (lo, hi)
-            } else {
-                (hi, lo)
-            };
-            if self.random_unit() < 0.5 {
-                if frame[a] & mask == 0 && frame[b] & mask != 0 {
-                    frame[a] |= mask;
-                    frame[b] &= !mask;
-                    return;
-                }
-            } else if frame[a] & mask == 0 && frame[cs] & mask == 0 {
-                frame[a] |= mask;
-                frame[cs] |= mask;
-                return;
-            }
-        }
     }
 
     async fn read_bytes(&self, buf: &mut [u8]) -> usize {

@@ -12,8 +12,20 @@ use crate::toolchain::run;
 /// The whole run may take this long (wall clock) before it is killed.
 const RUN_TIMEOUT: Duration = Duration::from_secs(120);
 
+/// The emulated machine: the MPS2 AN386 (Cortex-M4F) with `-icount
+/// shift=0` (1 ns of virtual time per instruction while running; while the
+/// CPU sleeps in WFI, virtual time follows the host clock).
+pub(crate) const MACHINE_ARGS: [&str; 6] = [
+    "-machine",
+    "mps2-an386",
+    "-cpu",
+    "cortex-m4",
+    "-icount",
+    "shift=0",
+];
+
 /// Installs Debian's `qemu-system-arm` when it is missing.
-pub(super) fn ensure_qemu() -> Result<()> {
+pub(crate) fn ensure_qemu() -> Result<()> {
     if Command::new("qemu-system-arm")
         .arg("--version")
         .output()
@@ -33,13 +45,8 @@ pub(super) fn ensure_qemu() -> Result<()> {
 /// exit or when it runs longer than [`RUN_TIMEOUT`].
 pub(super) fn run_qemu(elf: &PathBuf) -> Result<String> {
     let mut child = Command::new("qemu-system-arm")
+        .args(MACHINE_ARGS)
         .args([
-            "-machine",
-            "mps2-an386",
-            "-cpu",
-            "cortex-m4",
-            "-icount",
-            "shift=0",
             "-nographic",
             "-semihosting-config",
             "enable=on,target=native",

@@ -109,13 +109,13 @@ fn release_profile(manifest: &toml::Table) -> Option<&toml::Value> {
     manifest.get("profile")?.get("release")
 }
 
-/// The bench measures the crates as the firmware builds them: its
-/// workspace's release profile (profiles come from the workspace root
-/// only) must equal the root's, overrides included.
+/// The bench measures the crates as the firmware builds them, and the QEMU
+/// board (`firmware/qemu-m4`) runs them so: each workspace's release
+/// profile (profiles come from the workspace root only) must equal the
+/// root's, overrides included.
 #[test]
 fn bench_release_profile_is_the_firmware_one() {
     let root = manifest("Cargo.toml");
-    let bench = manifest(MANIFEST);
     let root_release = release_profile(&root).expect("root [profile.release]");
     // Not vacuous: the root builds for size, the math crates for speed.
     assert_eq!(
@@ -128,24 +128,25 @@ fn bench_release_profile_is_the_firmware_one() {
             .and_then(|p| p.get("galvo-planner"))
             .is_some()
     );
-    assert_eq!(
-        release_profile(&bench),
-        Some(root_release),
-        "{MANIFEST}'s [profile.release*] differs from the root Cargo.toml's: \
-         copy the root's release profile there"
-    );
-    // A workspace of its own, excluded by the root: otherwise the
-    // linker runs in the root and links the STM32F407 memory map.
-    assert!(bench.get("workspace").is_some_and(toml::Value::is_table));
-    let excluded = root
-        .get("workspace")
-        .and_then(|w| w.get("exclude"))
-        .and_then(toml::Value::as_array)
-        .is_some_and(|e| e.iter().any(|p| p.as_str() == Some("firmware/bench-m4")));
-    assert!(
-        excluded,
-        "the root workspace must exclude firmware/bench-m4"
-    );
+    for path in [MANIFEST, crate::qemu::MANIFEST] {
+        let bench = manifest(path);
+        assert_eq!(
+            release_profile(&bench),
+            Some(root_release),
+            "{path}'s [profile.release*] differs from the root Cargo.toml's: \
+             copy the root's release profile there"
+        );
+        // A workspace of its own, excluded by the root: otherwise the
+        // linker runs in the root and links the STM32F407 memory map.
+        assert!(bench.get("workspace").is_some_and(toml::Value::is_table));
+        let dir = path.trim_end_matches("/Cargo.toml");
+        let excluded = root
+            .get("workspace")
+            .and_then(|w| w.get("exclude"))
+            .and_then(toml::Value::as_array)
+            .is_some_and(|e| e.iter().any(|p| p.as_str() == Some(dir)));
+        assert!(excluded, "the root workspace must exclude {dir}");
+    }
 }
 
 /// The bench's own lock file pins the versions the firmware is built
@@ -166,20 +167,25 @@ fn bench_lock_pins_the_root_versions() {
             .collect()
     };
     let root = versions(&manifest("Cargo.lock"));
-    let bench = versions(&manifest("firmware/bench-m4/Cargo.lock"));
-    assert!(bench.iter().any(|(name, _)| name == "cortex-m-rt"));
-    let drifted: Vec<String> = bench
-        .iter()
-        .filter(|(name, version)| {
-            name != "bench-m4" && !root.iter().any(|(n, v)| n == name && v == version)
-        })
-        .map(|(name, version)| format!("{name} {version}"))
-        .collect();
-    assert!(
-        drifted.is_empty(),
-        "firmware/bench-m4/Cargo.lock has versions the root Cargo.lock does not: {drifted:?} \
-         (copy the root Cargo.lock there and build the bench once)"
-    );
+    for (lock, own) in [
+        ("firmware/bench-m4/Cargo.lock", "bench-m4"),
+        ("firmware/qemu-m4/Cargo.lock", "qemu-m4"),
+    ] {
+        let bench = versions(&manifest(lock));
+        assert!(bench.iter().any(|(name, _)| name == "cortex-m-rt"));
+        let drifted: Vec<String> = bench
+            .iter()
+            .filter(|(name, version)| {
+                name != own && !root.iter().any(|(n, v)| n == name && v == version)
+            })
+            .map(|(name, version)| format!("{name} {version}"))
+            .collect();
+        assert!(
+            drifted.is_empty(),
+            "{lock} has versions the root Cargo.lock does not: {drifted:?} \
+             (copy the root Cargo.lock there and build once)"
+        );
+    }
 }
 
 #[test]

@@ -94,7 +94,7 @@ pub const M4_COST: CostModel = CostModel {
     marked: 256,
     // `loop.jump.refill`, the whole half that starts a jump (its samples
     // included: an upper bound).
-    step_started: 9_480,
+    step_started: 9_520,
     // `loop.jump.prep`.
     point_prepared: 66_320,
     // `loop.tuning.prep`: the dearest stroke step, a jump and a stroke.

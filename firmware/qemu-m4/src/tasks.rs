@@ -1,0 +1,110 @@
+//! Thin `#[embassy_executor::task]` wrappers (embassy tasks cannot be
+//! generic): each runs one of laser-app's task bodies for this board's
+//! part types; [`TaskSpawner`] is the board's spawn hook for
+//! `laser_app::app::wire`.
+
+use embassy_executor::Spawner;
+#[cfg(not(feature = "galvo-dac"))]
+use laser_app::app::NoGalvoDac;
+use laser_app::app::{
+    ConsoleTask, GalvoTask, IndicatorTask, SequencerTask, ServoBusTask, Spawn, StopButtonTask,
+    WatchdogTask,
+};
+
+use crate::board::QemuBoard;
+use crate::parts::{CmsdkWatchdog, LaserPin, ReportedLeds, UartButton, UartConsole};
+use crate::settings_ram::RamSettings;
+use crate::uart::Uart;
+
+#[embassy_executor::task]
+async fn console(task: ConsoleTask<UartConsole>) -> ! {
+    task.run().await
+}
+
+#[embassy_executor::task]
+async fn servo_bus(task: ServoBusTask<Uart, Uart>) -> ! {
+    task.run().await
+}
+
+#[embassy_executor::task]
+async fn sequencer(task: SequencerTask<LaserPin, RamSettings>) -> ! {
+    task.run().await
+}
+
+#[cfg(feature = "galvo-dac")]
+#[embassy_executor::task]
+async fn galvo(task: GalvoTask<crate::galvo_dac::QemuDac>) {
+    // The loop's memory in a static, not in this task's future (as on the
+    // STM32 board).
+    static MEMORY: static_cell::StaticCell<
+        laser_app::galvo::GalvoMemory<{ crate::galvo_dac::HALF_LEN }>,
+    > = static_cell::StaticCell::new();
+    task.run_in(MEMORY.init_with(laser_app::galvo::GalvoMemory::new))
+        .await
+}
+
+#[embassy_executor::task]
+async fn indicators(task: IndicatorTask<ReportedLeds>) -> ! {
+    task.run().await
+}
+
+#[embassy_executor::task]
+async fn stop_button(task: StopButtonTask<UartButton>) -> ! {
+    task.run().await
+}
+
+#[embassy_executor::task]
+async fn watchdog(task: WatchdogTask<CmsdkWatchdog>) -> ! {
+    task.run().await
+}
+
+/// Spawns the task bodies (each pool holds one: the wiring spawns each
+/// once; a second spawn would be a wiring bug, reported and skipped).
+pub struct TaskSpawner(pub Spawner);
+
+fn spawned<S>(
+    name: &str,
+    token: Result<embassy_executor::SpawnToken<S>, embassy_executor::SpawnError>,
+    spawner: &Spawner,
+) {
+    match token {
+        Ok(token) => spawner.spawn(token),
+        Err(_) => log::error!("task {name} spawned twice: not started again"),
+    }
+}
+
+impl Spawn<QemuBoard> for TaskSpawner {
+    fn console(&mut self, task: ConsoleTask<UartConsole>) {
+        spawned("console", console(task), &self.0);
+    }
+
+    fn servo_bus(&mut self, task: ServoBusTask<Uart, Uart>) {
+        spawned("servo bus", servo_bus(task), &self.0);
+    }
+
+    fn sequencer(&mut self, task: SequencerTask<LaserPin, RamSettings>) {
+        spawned("sequencer", sequencer(task), &self.0);
+    }
+
+    #[cfg(not(feature = "galvo-dac"))]
+    fn galvo(&mut self, task: GalvoTask<NoGalvoDac>) {
+        task.unreachable()
+    }
+
+    #[cfg(feature = "galvo-dac")]
+    fn galvo(&mut self, task: GalvoTask<crate::galvo_dac::QemuDac>) {
+        spawned("galvo", galvo(task), &self.0);
+    }
+
+    fn indicators(&mut self, task: IndicatorTask<ReportedLeds>) {
+        spawned("indicators", indicators(task), &self.0);
+    }
+
+    fn stop_button(&mut self, task: StopButtonTask<UartButton>) {
+        spawned("stop button", stop_button(task), &self.0);
+    }
+
+    fn watchdog(&mut self, task: WatchdogTask<CmsdkWatchdog>) {
+        spawned("watchdog", watchdog(task), &self.0);
+    }
+}
