@@ -69,8 +69,20 @@ pub struct Job {
     pub lines: Vec<String>,
     /// What must be drawn lit.
     pub pieces: Vec<Piece>,
-    /// Where each G0 goes (the laser must be dark on the way).
-    pub rapids: Vec<[f64; 2]>,
+    /// Each G0 as (from, to), mm: the laser must be dark on the way.
+    pub rapids: Vec<Rapid>,
+    /// Where the last motion line ends, mm (`None` before the first).
+    at: Option<[f64; 2]>,
+}
+
+/// A G0 move on the board, mm.
+#[derive(Debug, Clone, Copy)]
+pub struct Rapid {
+    /// Where the spot is when the G0 starts (`None`: wherever it was
+    /// before the job).
+    pub from: Option<[f64; 2]>,
+    /// The G0's target.
+    pub to: [f64; 2],
 }
 
 fn num(v: f64) -> String {
@@ -91,7 +103,11 @@ impl Job {
 
     fn rapid(&mut self, p: [f64; 2]) {
         self.line(format!("G0 X{} Y{}", num(p[0]), num(p[1])));
-        self.rapids.push(p);
+        self.rapids.push(Rapid {
+            from: self.at,
+            to: p,
+        });
+        self.at = Some(p);
     }
 
     /// A lit polyline (first point reached by G0).
@@ -105,6 +121,7 @@ impl Job {
             };
             self.line(format!("G1 X{} Y{}{f}", num(w[1][0]), num(w[1][1])));
             self.pieces.push(Piece::Line { a: w[0], b: w[1] });
+            self.at = Some(w[1]);
         }
     }
 
@@ -246,6 +263,7 @@ pub fn laser_job(size: f64) -> Job {
                 num(y),
                 num(power)
             ));
+            job.at = Some([xs[k + 1], y]);
             if lit {
                 job.pieces.push(Piece::Line {
                     a: [xs[k], y],
@@ -324,4 +342,74 @@ pub fn fit(lit: &[[f64; 2]], pieces: &[Piece]) -> PathFit {
         lit: lit.len(),
         worst_piece,
     }
+}
+
+/// A spot sample: time (µs or ns), board position (mm), laser lit.
+pub type SpotMm = (u64, [f64; 2], bool);
+
+/// What [`rapids_dark`] found for one G0.
+#[derive(Debug, Clone, Copy)]
+pub struct RapidSpan {
+    /// Time the spot left the G0's start (last sample within the
+    /// tolerance of it), same unit as the samples.
+    pub left: u64,
+    /// Time the spot reached the G0's target (first sample within the
+    /// tolerance of it).
+    pub arrived: u64,
+    /// Samples strictly between the two.
+    pub samples: usize,
+    /// Of those, samples with the laser lit.
+    pub lit: usize,
+}
+
+/// Maps every G0 of `rapids` longer than 3 × `tol_mm` onto the spot's
+/// timeline `samples` (time order) and counts the lit samples on the way.
+/// Each G0 spans from the last sample within `tol_mm` of its start (the
+/// first sample when its start is unknown) to the first one after it
+/// within `tol_mm` of its target; G0s are searched in order, each after
+/// the previous one's arrival. Err when a G0's start or target is never
+/// reached.
+pub fn rapids_dark(
+    samples: &[SpotMm],
+    rapids: &[Rapid],
+    tol_mm: f64,
+) -> Result<Vec<RapidSpan>, String> {
+    let near = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]) <= tol_mm;
+    let mut cursor = 0;
+    let mut spans = Vec::new();
+    for (k, r) in rapids.iter().enumerate() {
+        let at_start = match r.from {
+            Some(from) if (from[0] - r.to[0]).hypot(from[1] - r.to[1]) <= 3.0 * tol_mm => continue,
+            Some(from) => (cursor..samples.len())
+                .find(|&i| near(samples[i].1, from))
+                .ok_or_else(|| format!("G0 #{k} {r:?}: its start never reached"))?,
+            None => cursor,
+        };
+        let arrival = (at_start..samples.len())
+            .find(|&i| near(samples[i].1, r.to))
+            .ok_or_else(|| {
+                let closest = samples[at_start..]
+                    .iter()
+                    .map(|s| (s.1[0] - r.to[0]).hypot(s.1[1] - r.to[1]))
+                    .fold(f64::INFINITY, f64::min);
+                format!("G0 #{k} {r:?}: its target never reached (closest {closest:.3} mm)")
+            })?;
+        let left = r
+            .from
+            .and_then(|from| {
+                (at_start..arrival)
+                    .rev()
+                    .find(|&i| near(samples[i].1, from))
+            })
+            .unwrap_or(at_start);
+        let inside = &samples[left + 1..arrival];
+        spans.push(RapidSpan {
+            left: samples[left].0,
+            arrived: samples[arrival].0,
+            samples: inside.len(),
+            lit: inside.iter().filter(|s| s.2).count(),
+        });
+        cursor = arrival;
+    }
+    Ok(spans)
 }

@@ -324,6 +324,7 @@ fn mark_circle_at(sample_period_s: f64) -> u32 {
             .send(GalvoRequest::Path {
                 seq: 1,
                 path: circle,
+                mark_speed_mm_s: None,
             })
             .await;
         // Done, refused or an underrun.

@@ -3,7 +3,7 @@
 
 use kinematics_core::Galvo;
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::gcode_job::{PathFit, fit, laser_job};
+use system_tests::gcode_job::{Job, PathFit, SpotMm, fit, laser_job, rapids_dark};
 use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
 
 /// Servo resolution, 0.1°, as a distance on the board at the gimbal's
@@ -43,6 +43,44 @@ fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
         .collect()
 }
 
+fn gimbal_spot_mm(report: &SimReport) -> Vec<SpotMm> {
+    report
+        .recording
+        .spot
+        .iter()
+        .map(|s| (s.t_us, [s.x_cm * 10.0, s.y_cm * 10.0], s.laser))
+        .collect()
+}
+
+fn galvo_spot_mm(report: &SimReport) -> Vec<SpotMm> {
+    let galvo = Galvo::<f64>::default();
+    report
+        .dac
+        .iter()
+        .filter_map(|(t, s)| {
+            let p = galvo.codes_to_board(s.x_code, s.y_code).ok()?;
+            Some((t, [p.x_mm, p.y_mm], s.laser))
+        })
+        .collect()
+}
+
+/// Every G0 of `job` was found on the spot's timeline, crossed with at
+/// least one sample, and not one of them lit.
+fn assert_dark_on_every_rapid(samples: &[SpotMm], job: &Job, tol_mm: f64, label: &str) {
+    let spans =
+        rapids_dark(samples, &job.rapids, tol_mm).unwrap_or_else(|e| panic!("{label}: {e}"));
+    assert_eq!(spans.len(), job.rapids.len(), "{label}: {spans:?}");
+    for (k, span) in spans.iter().enumerate() {
+        assert!(span.samples > 0, "{label}: G0 #{k} not sampled: {span:?}");
+        assert_eq!(span.lit, 0, "{label}: lit during G0 #{k}: {span:?}");
+    }
+    eprintln!(
+        "{label}: {} G0s dark over {} samples",
+        spans.len(),
+        spans.iter().map(|s| s.samples).sum::<usize>()
+    );
+}
+
 fn assert_all_ok(report: &SimReport, label: &str) {
     let lines = terminal_lines(report);
     let errors: Vec<&&str> = lines
@@ -78,6 +116,12 @@ fn a_laser_job_draws_its_toolpath_on_the_gimbal() {
         worst_missed_mm <= 1.5,
         "toolpath missed by {worst_missed_mm:.3} mm"
     );
+    assert_dark_on_every_rapid(
+        &gimbal_spot_mm(&report),
+        &job,
+        GIMBAL_TOLERANCE_MM,
+        "gimbal",
+    );
 }
 
 #[test]
@@ -104,6 +148,7 @@ fn a_laser_job_draws_its_toolpath_on_the_galvo() {
         worst_missed_mm <= 0.5,
         "toolpath missed by {worst_missed_mm:.3} mm"
     );
+    assert_dark_on_every_rapid(&galvo_spot_mm(&report), &job, GALVO_TOLERANCE_MM, "galvo");
 }
 
 /// The reply closing `line` (the first `ok` / `error…` after it).
@@ -265,4 +310,53 @@ fn feed_hold_on_the_galvo_is_dark_and_the_job_still_draws_its_toolpath() {
     let fit = fit(&galvo_lit_mm(&report), &job.pieces);
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
     assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+}
+
+#[test]
+fn an_over_long_gcode_line_is_grbl_error_11_and_a_product_line_keeps_its_error() {
+    let long_gcode = format!("G1 X1 F100 ({})", "x".repeat(200));
+    let long_product = format!("goto {}", "1".repeat(200));
+    let text = format!("{long_gcode}\n{long_product}\nG0 X1\n");
+    let report = run_with(&text, SimOptions::default());
+    let lines = terminal_lines(&report);
+    let replies: Vec<&&str> = lines
+        .iter()
+        .filter(|l| *l == &"ok" || l.starts_with("error"))
+        .collect();
+    assert_eq!(
+        replies,
+        [&"error:11", &"error: line too long (max 128 bytes)", &"ok"],
+        "{lines:?}"
+    );
+    assert!(report.idle_at_end);
+}
+
+/// Time the galvo laser was lit from first to last lit sample, s.
+fn galvo_lit_span_s(report: &SimReport) -> f64 {
+    let lit = system_tests::lit_sample_times_ns(report);
+    let (first, last) = (lit.first().expect("lit"), lit.last().expect("lit"));
+    (last - first) as f64 / 1e9
+}
+
+#[test]
+fn the_galvo_marks_at_the_programmed_feed() {
+    // A 40 mm line at 600 and at 1200 mm/min: 4 s and 2 s.
+    let mark = |feed: u32| {
+        let text = format!("target galvo\nG0 X-20 Y5\nG1 X20 F{feed} M3 S1000\nM5\nG0 X0 Y0\n");
+        let report = run_with(&text, SimOptions::default());
+        assert_all_ok(&report, "galvo feed");
+        let fit = fit(
+            &galvo_lit_mm(&report),
+            &[system_tests::gcode_job::Piece::Line {
+                a: [-20.0, 5.0],
+                b: [20.0, 5.0],
+            }],
+        );
+        assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+        galvo_lit_span_s(&report)
+    };
+    let (slow, fast) = (mark(600), mark(1200));
+    eprintln!("galvo: 40 mm at F600 {slow:.3} s, at F1200 {fast:.3} s");
+    assert!((slow - 4.0).abs() < 0.05, "F600: {slow} s");
+    assert!((fast - 2.0).abs() < 0.05, "F1200: {fast} s");
 }

@@ -59,6 +59,7 @@ fn galvo_loop(c: &mut Criterion) {
                 let mut galvo = GalvoLoop::new(GalvoConfig::default()).expect("default config");
                 galvo.request(GalvoRequest::Path {
                     seq: 1,
+                    mark_speed_mm_s: None,
                     // (-80, 10) mm to (80, -10) mm.
                     path: Figure::Line {
                         from: PointCm::new(-8.0, 1.0),

@@ -26,7 +26,7 @@ use embedded_io_async::{Read, Write};
 
 use heapless::Deque;
 
-use crate::cli::line::LineAssembler;
+use crate::cli::line::{LineAssembler, LineError};
 use crate::cli::parse::parse_line;
 use crate::command::{Command, CommandLink, GrblLine, RealtimeRequest};
 use crate::grbl::classify::{LineKind, classify};
@@ -139,6 +139,12 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
             }
         }
         match line {
+            Err(LineError::TooLong)
+                if classify(assembler.long_line_head()) != LineKind::Product =>
+            {
+                input.greet(link);
+                link.grbl_error(GrblError::LineOverflow);
+            }
             Err(e) => link.error(e),
             Ok(line) if classify(line.as_str()) == LineKind::Product => {
                 dispatch(line.as_str(), link, &mut host_not_reading).await;

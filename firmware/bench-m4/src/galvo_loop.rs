@@ -235,7 +235,11 @@ fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
             dwell_us: 0,
         });
         settle(galvo, half);
-        if let Some(refused) = galvo.request(GalvoRequest::Path { seq, path }) {
+        if let Some(refused) = galvo.request(GalvoRequest::Path {
+            seq,
+            path,
+            mark_speed_mm_s: None,
+        }) {
             b.fail(id, refused);
             continue;
         }

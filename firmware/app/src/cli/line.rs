@@ -46,7 +46,13 @@ pub struct LineAssembler {
     overflowed: bool,
     invalid: Option<u8>,
     previous_was_cr: bool,
+    /// The first [`LONG_LINE_HEAD`] bytes of the last line that overflowed.
+    long_line_head: heapless::Vec<u8, LONG_LINE_HEAD>,
 }
+
+/// Bytes kept from the start of a too-long line, enough to tell which
+/// language it was in (grbl answers `error:11` to its own).
+pub const LONG_LINE_HEAD: usize = 8;
 
 impl LineAssembler {
     /// An empty assembler.
@@ -56,6 +62,7 @@ impl LineAssembler {
             overflowed: false,
             invalid: None,
             previous_was_cr: false,
+            long_line_head: heapless::Vec::new(),
         }
     }
 
@@ -78,11 +85,21 @@ impl LineAssembler {
                 }
                 if !self.overflowed && self.buf.push(byte).is_err() {
                     self.overflowed = true;
+                    self.long_line_head.clear();
+                    let head = self.buf.get(..LONG_LINE_HEAD).unwrap_or(&[]);
+                    let _ = self.long_line_head.extend_from_slice(head);
                     self.buf.clear();
                 }
                 None
             }
         }
+    }
+
+    /// The start of the last line rejected as [`LineError::TooLong`] (up to
+    /// [`LONG_LINE_HEAD`] bytes; empty before any; non-ASCII bytes make it
+    /// empty).
+    pub fn long_line_head(&self) -> &str {
+        core::str::from_utf8(&self.long_line_head).unwrap_or("")
     }
 
     /// Whether bytes of an unfinished line are pending.
@@ -178,6 +195,7 @@ mod tests {
         assert!(feed(&mut asm, &junk).is_empty());
         assert!(asm.is_mid_line());
         assert_eq!(feed(&mut asm, b"\n"), [Err(LineError::TooLong)]);
+        assert_eq!(asm.long_line_head(), "zzzzzzzz");
         // The assembler is clean afterwards.
         assert!(!asm.is_mid_line());
         assert_eq!(feed(&mut asm, b"help\n"), [Ok("help".to_string())]);

@@ -80,11 +80,11 @@ pub struct CostModel {
 /// The STM32F407's loop, fitted to `cargo xtask bench-m4` (each field's
 /// source row below; see the module doc).
 pub const M4_COST: CostModel = CostModel {
-    // `loop.holding.refill` (a whole holding half: 1 800) less its 128
+    // `loop.holding.refill` (a whole holding half: 1 400) less its 128
     // held samples.
-    refill: 1_800 - 128 * 14,
+    refill: 1_400 - 128 * 10,
     // `loop.holding.refill` / 128, rounded down (the rest is `refill`).
-    held: 14,
+    held: 10,
     // `loop.jump.steady`.
     jump_copied: 32,
     // `integrator.xy.step` + `galvo.sample_map.angles_to_codes` (199 + 99
@@ -99,8 +99,9 @@ pub const M4_COST: CostModel = CostModel {
     step_started: 9_560,
     // `loop.jump.prep`.
     point_prepared: 66_320,
-    // `loop.tuning.prep`: the dearest stroke step, a jump and a stroke.
-    stroke_prepared: 68_670,
+    // `loop.tuning.prep` (68 760): the dearest stroke step, a jump and a
+    // stroke; rounded up.
+    stroke_prepared: 68_800,
     // `plan.seed.0.1deg` (1.572 M), rounded up: the cheapest bisection
     // plan, a lower bound for any jump.
     bisection_axis: 1_580_000,

@@ -173,6 +173,9 @@ pub enum GalvoRequest {
         seq: u32,
         /// What to draw (board cm; the loop takes its strokes in mm).
         path: Figure,
+        /// Marking speed, mm/s (`None`: the configured
+        /// `galvo.mark_speed_mm_s`, which also caps it).
+        mark_speed_mm_s: Option<f32>,
     },
     /// Drop queued jobs, laser off at once; the mirrors finish the jump in
     /// flight (a jump is rest to rest) or brake along the stroke being

@@ -114,8 +114,9 @@ enum Job {
     /// Jump to a point and dwell there (µs).
     Point { target_mm: PointMm, dwell_us: u32 },
     /// Mark a path, stroke by stroke (in mm, see
-    /// [`Unit::GalvoMm`](crate::domain::Unit::GalvoMm)).
-    Path(Figure),
+    /// [`Unit::GalvoMm`](crate::domain::Unit::GalvoMm)), at a marking
+    /// speed (mm/s; `None`: the configured one).
+    Path(Figure, Option<f32>),
 }
 
 /// The job being run.

@@ -13,6 +13,14 @@
 //! the image small"), at f32 precision. grbl's lexical rules fit in
 //! [`super::words`] (~100 lines), so no crate is used. (`async-gcode` 0.3
 //! is stream/async oriented, std by default, and has the same mismatch.)
+//! Measured flash cost of `gcode` 0.7.0 (`default-features = false`, its
+//! zero-allocation `core::parse` with a visitor folding every word) in a
+//! throwaway `#![no_std]` thumbv7em-none-eabihf binary, `opt-level = "z"`,
+//! LTO, one codegen unit: +20 962 B over the same binary folding the
+//! line's bytes (text +8 892 B, rodata +12 072 B), of which 14 954 B are
+//! `core`'s f32 parsing (`dec2flt`, its 10.4 KB power-of-five table) that
+//! this firmware does not link otherwise — 8 % of the 256 KiB budget for
+//! the lexical layer alone, before grbl's semantics.
 //! Flash cost of this module (parser, jog, `$` commands, every report and
 //! the settings table) measured in a thumbv7em `opt-level = "z"` LTO build:
 //! ~10 KB of its own code, plus `core::fmt`, `ryu`, `libm` and soft-f64

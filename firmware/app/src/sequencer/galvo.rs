@@ -125,7 +125,14 @@ impl Core {
             self.stop("not a path", out);
             return;
         };
-        if !self.send_galvo_job(|seq| GalvoRequest::Path { seq, path }, out) {
+        if !self.send_galvo_job(
+            |seq| GalvoRequest::Path {
+                seq,
+                path,
+                mark_speed_mm_s: None,
+            },
+            out,
+        ) {
             return;
         }
         if let Some(run) = self.run.as_mut() {

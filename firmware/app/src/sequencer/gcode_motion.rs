@@ -7,7 +7,8 @@
 //!   while a lit G1/G2/G3 step moves, dark on G0 and jogs;
 //! * galvo: a G0 or dark move is a jump ([`GalvoRequest::Point`] without
 //!   dwell), a lit feed move is marked as a line stroke
-//!   ([`GalvoRequest::Path`]), arcs as chords within `$12`.
+//!   ([`GalvoRequest::Path`]) at F with the feed override, capped by
+//!   `galvo.mark_speed_mm_s`; arcs as chords within `$12`.
 //!
 //! Feed hold stops after the step in flight (the galvo at once, braking
 //! along its stroke), laser dark; `~` goes on from there.

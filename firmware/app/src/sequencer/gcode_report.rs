@@ -63,7 +63,11 @@ impl Core {
             _ if motion.is_idle() => MachineState::Idle,
             _ => MachineState::Run,
         };
-        let (feed, power) = motion.feed_and_power(&g.overrides);
+        let (mut feed, power) = motion.feed_and_power(&g.overrides);
+        if self.actuator.uses_galvo() {
+            // The galvo marks at most at its marking speed.
+            feed = feed.min(self.settings.galvo.mark_speed_mm_s * 60.0);
+        }
         let mask = g.values.report_mask;
         let free_blocks = (PLANNER_BLOCKS - motion.queue.len()) as u16;
         let status = Status {

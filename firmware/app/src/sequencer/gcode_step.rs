@@ -58,6 +58,7 @@ impl Core {
                         from: cm(from),
                         to: cm(to),
                     },
+                    mark_speed_mm_s: feed.map(|f| (self.gcode_galvo_feed_mm_min(f) / 60.0) as f32),
                 }
             } else {
                 let [x_mm, y_mm] = cm(to).galvo_mm();
@@ -78,6 +79,14 @@ impl Core {
             c.servo_seq = servo_seq;
             c.galvo_seq = galvo_seq;
         }
+    }
+
+    /// The galvo's marking feed for programmed feed `feed_mm_min`: the feed
+    /// override applied, capped by the galvo's marking speed
+    /// (`galvo.mark_speed_mm_s`), mm/min.
+    pub(super) fn gcode_galvo_feed_mm_min(&self, feed_mm_min: f64) -> f64 {
+        let feed = feed_mm_min * f64::from(self.gcode.overrides.feed) / 100.0;
+        feed.min(self.settings.galvo.mark_speed_mm_s * 60.0)
     }
 
     /// A servo move to `to` at `feed` mm/min (rapid: servo speed);

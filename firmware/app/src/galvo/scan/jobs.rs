@@ -37,7 +37,11 @@ impl GalvoLoop {
                     dwell_us,
                 },
             ),
-            GalvoRequest::Path { seq, path } => (seq, Job::Path(path)),
+            GalvoRequest::Path {
+                seq,
+                path,
+                mark_speed_mm_s,
+            } => (seq, Job::Path(path, mark_speed_mm_s)),
         };
         let checked = if self.faulted {
             Err(GalvoError::Faulted)
@@ -58,7 +62,7 @@ impl GalvoLoop {
     fn check(&self, job: &Job) -> Result<(), GalvoError> {
         match job {
             Job::Point { target_mm, .. } => self.angles_for(*target_mm).map(|_| ()),
-            Job::Path(path) => {
+            Job::Path(path, _) => {
                 for [x_mm, y_mm] in path.bounds(Unit::GalvoMm) {
                     self.angles_for(PointMm { x_mm, y_mm })?;
                 }

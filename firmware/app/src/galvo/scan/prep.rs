@@ -157,7 +157,7 @@ impl Prepared {
 /// What comes after a step of `job`: its next stroke, if it has one.
 fn next_stroke(job: &Job, stroke: usize) -> Option<usize> {
     match job {
-        Job::Path(path) => path.stroke(stroke + 1, Unit::GalvoMm).map(|_| stroke + 1),
+        Job::Path(path, _) => path.stroke(stroke + 1, Unit::GalvoMm).map(|_| stroke + 1),
         Job::Point { .. } => None,
     }
 }
@@ -254,10 +254,10 @@ impl GalvoLoop {
     ) -> Prepared {
         let (target_mm, marker, end_mm) = match job {
             Job::Point { target_mm, .. } => (Ok(target_mm), None, None),
-            Job::Path(path) => match path.stroke(stroke, Unit::GalvoMm) {
+            Job::Path(path, speed_mm_s) => match path.stroke(stroke, Unit::GalvoMm) {
                 Some(stroke) => (
                     Ok(PointMm::new(stroke.start[0], stroke.start[1])),
-                    Some(self.load_stroke(stroke.start, &stroke.segments)),
+                    Some(self.load_stroke(stroke.start, &stroke.segments, speed_mm_s)),
                     stroke.segments.last().map(|s| match *s {
                         Segment::Line { to: end } | Segment::Arc { end, .. } => end,
                     }),
@@ -324,10 +324,21 @@ impl GalvoLoop {
         Some(codes)
     }
 
-    /// Loads a stroke (its start and segments) into a fresh path planner.
-    fn load_stroke(&self, start: [f64; 2], segments: &[Segment]) -> LoadedStroke {
+    /// Loads a stroke (its start and segments) into a fresh path planner,
+    /// marked at `speed_mm_s` (mm/s, capped by the configured marking
+    /// speed; `None`: that speed).
+    fn load_stroke(
+        &self,
+        start: [f64; 2],
+        segments: &[Segment],
+        speed_mm_s: Option<f32>,
+    ) -> LoadedStroke {
+        let configured = self.config.mark_speed_mm_s;
         let limits = MarkLimits {
-            speed_mm_s: self.config.mark_speed_mm_s,
+            speed_mm_s: speed_mm_s
+                .map(f64::from)
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .map_or(configured, |s| s.min(configured)),
             accel_mm_s2: self.config.mark_accel_mm_s2,
             junction_deviation_mm: JUNCTION_DEVIATION_MM,
             ts_s: self.config.sample_period_s,

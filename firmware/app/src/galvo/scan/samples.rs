@@ -168,7 +168,7 @@ impl GalvoLoop {
                     ScanPhase::Dwelling,
                     samples_for(dwell_us, self.config.sample_period_s),
                 ),
-                Job::Path(path) => {
+                Job::Path(path, _) => {
                     self.active = Some(a);
                     if !self.start_marking(path, a.stroke, on_event) {
                         self.active = None;
@@ -196,7 +196,7 @@ impl GalvoLoop {
         on_demand: bool,
     ) -> Option<Advance> {
         let next_stroke = match a.job {
-            Job::Path(path) => path
+            Job::Path(path, _) => path
                 .stroke(a.stroke + 1, Unit::GalvoMm)
                 .map(|_| a.stroke + 1),
             Job::Point { .. } => None,

@@ -293,7 +293,11 @@ fn an_underrun_latches_the_laser_off_until_stop() {
 }
 
 fn path(seq: u32, path: Figure) -> GalvoRequest {
-    GalvoRequest::Path { seq, path }
+    GalvoRequest::Path {
+        seq,
+        path,
+        mark_speed_mm_s: None,
+    }
 }
 
 /// Distance (mm) from `p` to the border of the axis-aligned rectangle.

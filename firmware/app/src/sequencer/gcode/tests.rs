@@ -12,7 +12,7 @@ use super::super::gcode_motion::PLANNER_BLOCKS;
 use super::super::machine::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::{Command, GrblLine, RealtimeRequest};
 use crate::galvo::ScanPhase;
-use crate::grbl::realtime::Realtime;
+use crate::grbl::realtime::{OverrideStep, Realtime};
 use crate::servo::task::{ServoOutcome, ServoRequest};
 
 const READINGS: Readings = Readings {
@@ -29,7 +29,7 @@ const READINGS: Readings = Readings {
 fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
     let inputs = Inputs {
         now: Instant::from_millis(ms),
-        galvo_room: None,
+        galvo_room: Some(8),
         galvo_bisection: false,
         stepper_attached: false,
     };
@@ -212,4 +212,49 @@ fn laser_off_darkens_a_lit_gcode_step_at_once() {
     );
     assert!(out.contains(&Action::GimbalLaser(false)), "{out:?}");
     assert!(!core.laser_on());
+}
+
+/// The marking speed of the galvo path request in `actions`, mm/s.
+fn mark_speed(actions: &[Action]) -> Option<(u32, Option<f32>)> {
+    actions.iter().find_map(|a| match a {
+        Action::Galvo(crate::galvo::GalvoRequest::Path {
+            seq,
+            mark_speed_mm_s,
+            ..
+        }) => Some((*seq, *mark_speed_mm_s)),
+        _ => None,
+    })
+}
+
+#[test]
+fn the_galvo_marks_at_f_with_the_feed_override_capped_by_its_marking_speed() {
+    let mut core = Core::new(Instant::from_millis(0));
+    core.actuator = crate::domain::Actuator::Galvo;
+    let out = line(&mut core, 1, "G1 X10 F600 M3 S1000");
+    let (seq, speed) = mark_speed(&out).expect("a lit galvo stroke");
+    assert_eq!(speed, Some(10.0), "600 mm/min = 10 mm/s");
+    assert!(status(&mut core, 2).contains("|FS:600,1000"));
+    realtime(
+        &mut core,
+        3,
+        Realtime::FeedOverride(OverrideStep::CoarsePlus),
+    );
+    realtime(
+        &mut core,
+        4,
+        Realtime::FeedOverride(OverrideStep::CoarsePlus),
+    );
+    let report = status(&mut core, 5);
+    assert!(report.contains("|FS:720,1000"), "{report}");
+    // A feed beyond the galvo's marking speed (1000 mm/s) marks at it.
+    assert_eq!(closers(&line(&mut core, 6, "G1 X20 F120000")), 1);
+    let out = on(
+        &mut core,
+        7,
+        Event::Galvo(crate::galvo::GalvoEvent::Done { seq }),
+    );
+    let (_, speed) = mark_speed(&out).expect("the next stroke");
+    assert_eq!(speed, Some(1000.0));
+    let report = status(&mut core, 8);
+    assert!(report.contains("|FS:60000,1000"), "{report}");
 }

@@ -64,6 +64,7 @@ fn prepared_refills_output_what_planning_on_demand_does() {
         point(3, -80.0, 80.0, 200),
         GalvoRequest::Path {
             seq: 4,
+            mark_speed_mm_s: None,
             // Centre (10, -5) mm, half size 25 mm.
             path: Figure::Tuning {
                 centre: PointCm::new(1.0, -0.5),
@@ -73,6 +74,7 @@ fn prepared_refills_output_what_planning_on_demand_does() {
         point(5, 0.0, 0.0, 0),
         GalvoRequest::Path {
             seq: 6,
+            mark_speed_mm_s: None,
             // Centre (-20, 10) mm, radius 3 mm.
             path: Figure::Circle {
                 centre: PointCm::new(-2.0, 1.0),
@@ -82,6 +84,7 @@ fn prepared_refills_output_what_planning_on_demand_does() {
         },
         GalvoRequest::Path {
             seq: 7,
+            mark_speed_mm_s: None,
             // (-5, 5) mm to (5, -5) mm.
             path: Figure::Rect {
                 a: PointCm::new(-0.5, 0.5),
