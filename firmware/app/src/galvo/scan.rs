@@ -231,6 +231,20 @@ impl GalvoLoop {
         Self::with_planning(config, planning)
     }
 
+    /// [`Self::for_dac`] into `slot` (replacing what it held), out of
+    /// line: the caller's (async) frame holds no loop; `Err` leaves
+    /// `slot` empty.
+    #[inline(never)]
+    pub fn start_in<D: DacStream>(
+        slot: &mut Option<Self>,
+        config: GalvoConfig,
+    ) -> Result<&mut Self, GalvoError> {
+        *slot = None;
+        let planning = prep::Planning::of::<D>();
+        planning.check(config.method)?;
+        Self::with_planning(config, planning).map(|built| slot.insert(built))
+    }
+
     fn with_planning(config: GalvoConfig, planning: prep::Planning) -> Result<Self, GalvoError> {
         let angles_rad = [0.0, 0.0];
         let disc = config
@@ -414,6 +428,10 @@ impl GalvoLoop {
 
 impl GalvoLoop {
     /// Takes every request waiting in the link; refusals go back as events.
+    // Out of line (as the other per-half stages): the async run loop's
+    // frame, which nests on whatever stack the galvo interrupt
+    // interrupts, holds none of their temporaries.
+    #[inline(never)]
     fn take_requests(&mut self, link: &GalvoLink) {
         while let Ok(request) = link.requests.try_receive() {
             if let Some(event) = self.request(request) {

@@ -93,6 +93,7 @@ impl GalvoLoop {
 
     /// Applies new parameters if no job is running; a refused
     /// configuration is reported and dropped.
+    #[inline(never)]
     pub(super) fn apply_pending_config(&mut self, at_half_boundary: bool) -> Option<GalvoEvent> {
         let config = self.pending_config?;
         if self.active.is_some()
@@ -119,6 +120,7 @@ impl GalvoLoop {
     /// matrix exponential, most of the cost on the M4) only when the
     /// mirrors or the sample rate changed; nothing else is rebuilt (the
     /// loop's buffers stay where they are, not copied).
+    #[inline(never)]
     fn reconfigure(&mut self, config: GalvoConfig) -> Result<(), GalvoError> {
         self.jump_planning.check(config.method)?;
         let angles_rad = self.mirrors.end_position_rad();
