@@ -316,6 +316,41 @@ impl<const S: usize, const CAP: usize, const Q: usize> Integrator<S, CAP, Q> {
         at(&self.end_state, THETA)
     }
 
+    /// [`Self::new`] in place (nothing copied: the sample ring is a few KB):
+    /// the model `disc`, at rest at `theta_rad`, queued moves dropped.
+    /// Fails (changing nothing) for a non-finite `theta_rad`.
+    pub fn reset(&mut self, disc: &Discrete<S>, theta_rad: f64) -> Result<(), Error> {
+        let theta_rad = finite(theta_rad, "theta_rad")?;
+        let rest = disc.model().rest_state(theta_rad);
+        let ad = disc.ad();
+        for (i, row) in self.a_minus_i.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                let a = ad.get(i).map_or(0.0, |r| at(r, j));
+                *v = (if i == j { a - 1.0 } else { a }) as f32;
+            }
+        }
+        self.bd = to_f32(disc.bd());
+        self.ad64 = *ad;
+        self.bd64 = *disc.bd();
+        self.z = to_f32(&rest);
+        self.comp = [0.0; S];
+        self.ring.fill(0.0);
+        self.read = 0;
+        self.queued = 0;
+        for m in &mut self.moves {
+            *m = QueuedMove {
+                samples: 0,
+                target: rest,
+            };
+        }
+        self.move_read = 0;
+        self.move_count = 0;
+        self.k_in_move = 0;
+        self.end_state = rest;
+        self.rest_mask = *disc.model().position_states();
+        Ok(())
+    }
+
     /// Re-seats an idle integrator at rest at `theta_rad` (e.g. where a marked
     /// path, which drives the mirrors directly, left them), so the next jump
     /// is planned and queued from there. Fails with

@@ -3,7 +3,6 @@
 
 use kinematics_core::PointMm;
 
-use galvo_planner::XyIntegrator;
 use kinematics_core::SampleMap;
 
 use super::mark::Motion;
@@ -141,8 +140,10 @@ impl GalvoLoop {
                 .model()
                 .and_then(|m| m.discretize(config.sample_period_s))
                 .map_err(|_| GalvoError::Planner)?;
-            self.mirrors =
-                XyIntegrator::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
+            // In place: a new integrator would be built on the stack.
+            self.mirrors
+                .reset(&disc, &disc, angles_rad)
+                .map_err(|_| GalvoError::Planner)?;
             self.disc = disc;
             self.work.models_sampled += 1;
         }
