@@ -15,6 +15,31 @@ use anyhow::{Context, Result, bail};
 /// the image may hold.
 pub const FRAME_BUDGET_BYTES: u64 = 8 * 1024;
 
+/// Known frames over [`FRAME_BUDGET_BYTES`], each with the ceiling it
+/// may not grow past (name part, bytes): the galvo loop's one-shot start
+/// (the loop built, then moved into its static), its per-half prep (a
+/// prepared step built, then moved into its ring slot), the planner's
+/// integrator constructor, and the largest task poll (the sequencer's,
+/// thread mode; every task's poll shares this name). To be brought under
+/// the budget and removed.
+pub const FRAME_ALLOWANCES: [(&str, u64); 4] = [
+    ("GalvoLoop::start_in", 50 * 1024),
+    ("GalvoLoop>::prep_up_to", 11_776),
+    (
+        "galvo_planner::integrator::Integrator<_,_,_>::new",
+        9 * 1024,
+    ),
+    ("embassy_executor::raw::TaskStorage<F>::poll", 14 * 1024),
+];
+
+/// The frame `function` may have: its allowance or the budget.
+fn limit_of(function: &str, budget: u64, allowances: &[(&str, u64)]) -> u64 {
+    allowances
+        .iter()
+        .find(|(part, _)| function.contains(part))
+        .map_or(budget, |&(_, ceiling)| ceiling.max(budget))
+}
+
 /// Instructions from a function's entry searched for its `sub sp`.
 const PROLOGUE_INSTRUCTIONS: usize = 16;
 
@@ -149,16 +174,19 @@ fn instruction(line: &str) -> Option<(&str, &str)> {
     Some((mnemonic, fields.next().unwrap_or("")))
 }
 
-/// Fails, naming them, when frames exceed `budget` bytes.
-pub fn check_frames(frames: &[Frame], budget: u64) -> Result<()> {
+/// Fails, naming them, when frames exceed `budget` bytes (or their
+/// ceiling in `allowances`).
+pub fn check_frames(frames: &[Frame], budget: u64, allowances: &[(&str, u64)]) -> Result<()> {
     let over: Vec<String> = frames
         .iter()
-        .filter(|f| f.bytes > budget)
-        .map(|f| format!("{} B {}", f.bytes, f.function))
+        .filter_map(|f| {
+            let limit = limit_of(&f.function, budget, allowances);
+            (f.bytes > limit).then(|| format!("{} B (limit {} B) {}", f.bytes, limit, f.function))
+        })
         .collect();
     if !over.is_empty() {
         bail!(
-            "{} stack frame(s) exceed the {} B budget:\n  {}",
+            "{} stack frame(s) exceed the {} B budget or their allowance:\n  {}",
             over.len(),
             budget,
             over.join("\n  ")
@@ -190,7 +218,7 @@ pub fn report(elf: &Path, llvm_size: &Path) -> Result<()> {
     for frame in frames.iter().take(5) {
         println!("  {:>7} B  {}", frame.bytes, frame.function);
     }
-    check_frames(&frames, FRAME_BUDGET_BYTES)
+    check_frames(&frames, FRAME_BUDGET_BYTES, &FRAME_ALLOWANCES)
 }
 
 #[cfg(test)]
@@ -274,16 +302,35 @@ Disassembly of section .text:
     #[test]
     fn a_frame_over_budget_fails_the_check_and_is_named() {
         let frames = frames_of(SNIPPET);
-        let err = check_frames(&frames, FRAME_BUDGET_BYTES)
+        let err = check_frames(&frames, FRAME_BUDGET_BYTES, &[])
             .unwrap_err()
             .to_string();
         assert!(err.contains("2 stack frame(s)"), "{err}");
         assert!(
-            err.contains("71172 B embassy_executor::raw::TaskStorage<F>::poll"),
+            err.contains("71172 B (limit 8192 B) embassy_executor::raw::TaskStorage<F>::poll"),
             "{err}"
         );
         assert!(err.contains("big_by_register"), "{err}");
         assert!(!err.contains("apply_pending_config"), "{err}");
-        assert!(check_frames(&frames[2..], FRAME_BUDGET_BYTES).is_ok());
+        assert!(check_frames(&frames[2..], FRAME_BUDGET_BYTES, &[]).is_ok());
+        // An allowance lifts one function's limit, and only up to its ceiling.
+        let allow = [
+            ("big_by_register", 0x1_2345),
+            ("TaskStorage<F>::poll", 0x11603),
+        ];
+        let err = check_frames(&frames, FRAME_BUDGET_BYTES, &allow)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("1 stack frame(s)") && err.contains("poll"),
+            "{err}"
+        );
+        let allow = [
+            ("big_by_register", 0x1_2345),
+            ("TaskStorage<F>::poll", 0x11604),
+        ];
+        assert!(check_frames(&frames, FRAME_BUDGET_BYTES, &allow).is_ok());
+        // The galvo task's 71 KB poll frame (the boot defect) fails the real check.
+        assert!(check_frames(&frames[1..2], FRAME_BUDGET_BYTES, &FRAME_ALLOWANCES).is_err());
     }
 }
