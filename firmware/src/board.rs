@@ -11,6 +11,9 @@
 //! | laser enable        | PB0 (active high); galvo laser stream DMA2 stream 1 ch 7 (TIM8_UP) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
+//! | stepper pan STEP / DIR  | PE9 / PE10 (STEP on a TIM1 channel pin, for a later one-pulse timer; the step timer runs on an interrupt executor, `tasks.rs`) |
+//! | stepper tilt STEP / DIR | PE11 / PE12 (likewise) |
+//! | stepper ENABLE (both)   | PE13 (polarity a parameter; released = the idle level) |
 //!
 //! Flash: the image in sectors 0–5 (≤ 256 KiB), the saved settings in
 //! sectors 10 and 11 (`settings_flash`, `memory.x`).
@@ -38,7 +41,9 @@ use laser_app::laser_gate::{GateState, LaserGate};
 use static_cell::StaticCell;
 
 use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac, darken_laser_stream};
-use crate::parts::{IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton};
+use crate::parts::{
+    GpioStepper, IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton,
+};
 use crate::settings_flash::{FlashSettings, settings_store};
 
 bind_interrupts!(struct Irqs {
@@ -129,6 +134,8 @@ pub struct Stm32Board {
     pub settings: FlashSettings,
     /// Independent watchdog (not started).
     pub watchdog: IndependentDog,
+    /// Stepper pan/tilt driver inputs (PE9–PE13).
+    pub stepper: GpioStepper,
 }
 
 impl Board for Stm32Board {
@@ -138,6 +145,7 @@ impl Board for Stm32Board {
     type Laser = LaserPin;
     type Settings = FlashSettings;
     type GalvoDac = Stm32GalvoDac;
+    type Stepper = GpioStepper;
     type Indicators = StatusLeds;
     type StopButton = UserButton;
     type Watchdog = IndependentDog;
@@ -150,6 +158,7 @@ impl Board for Stm32Board {
             laser: self.laser,
             settings: self.settings,
             galvo_dac: Some(self.galvo),
+            stepper: Some(self.stepper),
             indicators: self.leds,
             stop_button: self.button,
             watchdog: self.watchdog,
@@ -215,6 +224,20 @@ pub fn init(spawner: Spawner) -> Stm32Board {
         },
         settings: settings_store(Flash::new(p.FLASH, Irqs)),
         watchdog: IndependentDog::new(p.IWDG),
+        stepper: GpioStepper {
+            step: [
+                Output::new(p.PE9, Level::Low, Speed::VeryHigh),
+                Output::new(p.PE11, Level::Low, Speed::VeryHigh),
+            ],
+            dir: [
+                Output::new(p.PE10, Level::Low, Speed::VeryHigh),
+                Output::new(p.PE12, Level::Low, Speed::VeryHigh),
+            ],
+            // Active-low ENABLE by default: high = released at reset.
+            enable: Output::new(p.PE13, Level::High, Speed::Low),
+            signals: laser_app::stepper::StepperConfig::default().signals,
+            next: Instant::MIN,
+        },
     }
 }
 

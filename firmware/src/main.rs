@@ -35,6 +35,8 @@ static SERVO_LINK: ServoLink = ServoLink::new();
 static GALVO_LINK: GalvoLink = GalvoLink::new();
 /// Shared state for LEDs and the watchdog.
 static STATUS: StatusBoard = StatusBoard::new();
+/// Sequencer ↔ stepper task ↔ step timer.
+static STEPPER_LINK: laser_app::stepper::StepperLink = laser_app::stepper::StepperLink::new();
 /// Runs the galvo loop in the UART4 interrupt (UART4 itself is unused).
 static GALVO_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 
@@ -53,6 +55,7 @@ async fn main(spawner: Spawner) {
         galvo: &GALVO_LINK,
         status: &STATUS,
         gate: &board::LASER_GATE,
+        stepper: &STEPPER_LINK,
     };
     interrupt::UART4.set_priority(board::GALVO_PRIORITY);
     let galvo = GALVO_EXECUTOR.start(interrupt::UART4);

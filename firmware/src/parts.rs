@@ -123,3 +123,66 @@ impl Watchdog for IndependentDog {
         self.dog.pet();
     }
 }
+
+/// The stepper pan/tilt's driver inputs: STEP and DIR per axis (PE9/PE10
+/// pan, PE11/PE12 tilt) and the shared ENABLE (PE13). Pulses are timed by
+/// busy-waiting on the cycle counter's clock (2.5 µs STEP, 5 µs DIR setup
+/// by default); the step schedule is embassy-time deadlines (1 µs ticks).
+pub struct GpioStepper {
+    /// STEP outputs, `[pan, tilt]`.
+    pub step: [Output<'static>; 2],
+    /// DIR outputs, `[pan, tilt]` (high = negative).
+    pub dir: [Output<'static>; 2],
+    /// The drivers' shared ENABLE.
+    pub enable: Output<'static>,
+    /// Current pulse timing and ENABLE polarity.
+    pub signals: laser_app::stepper::DriverSignals,
+    /// Deadline of the next step event.
+    pub next: Instant,
+}
+
+/// CPU cycles for `ns` nanoseconds at SYSCLK (rounded up).
+fn cycles_for_ns(ns: u32) -> u32 {
+    let per_us = crate::board::SYSCLK_HZ / 1_000_000;
+    ns.div_ceil(1000).saturating_mul(per_us)
+}
+
+impl laser_app::stepper::StepperDrive for GpioStepper {
+    fn set_enabled(&mut self, enabled: bool) {
+        self.enable
+            .set_level((enabled == self.signals.enable_active_high).into());
+    }
+
+    fn set_signals(&mut self, signals: laser_app::stepper::DriverSignals) {
+        self.signals = signals;
+    }
+
+    fn step(&mut self, step: [bool; 2], negative: [bool; 2]) {
+        let mut dir_changed = false;
+        for (pin, negative) in self.dir.iter_mut().zip(negative) {
+            if pin.is_set_high() != negative {
+                pin.set_level(negative.into());
+                dir_changed = true;
+            }
+        }
+        if dir_changed {
+            cortex_m::asm::delay(cycles_for_ns(self.signals.dir_setup_ns));
+        }
+        for (pin, _) in self.step.iter_mut().zip(step).filter(|(_, s)| *s) {
+            pin.set_high();
+        }
+        cortex_m::asm::delay(cycles_for_ns(self.signals.pulse_ns));
+        for pin in &mut self.step {
+            pin.set_low();
+        }
+    }
+
+    async fn wait_ticks(&mut self, ticks: u32) {
+        self.next += Duration::from_ticks(u64::from(ticks));
+        Timer::at(self.next).await;
+    }
+
+    fn restart(&mut self) {
+        self.next = Instant::now();
+    }
+}

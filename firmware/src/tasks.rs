@@ -4,9 +4,12 @@
 //! `laser_app::app::wire`. The USB device stack is the board's own task.
 //! Every task runs in thread mode except the galvo loop, which runs on
 //! the galvo executor (an interrupt, `main.rs`) so that nothing in thread
-//! mode can delay a refill.
+//! mode can delay a refill, and the stepper's step timer, on its own
+//! interrupt executor above it (below).
 
-use embassy_executor::{SendSpawner, Spawner};
+use embassy_executor::{InterruptExecutor, SendSpawner, Spawner};
+use embassy_stm32::interrupt;
+use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::usart::{BufferedUartRx, BufferedUartTx};
 use embassy_usb::UsbDevice;
 use laser_app::app::{
@@ -19,8 +22,11 @@ use static_cell::ConstStaticCell;
 
 use crate::board::Stm32Board;
 use crate::galvo_dac::{self, Stm32GalvoDac};
-use crate::parts::{IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton};
+use crate::parts::{
+    GpioStepper, IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton,
+};
 use crate::settings_flash::FlashSettings;
+use laser_app::stepper::{StepPulseTask, StepperTask};
 
 /// Runs the USB device stack (enumeration, control requests).
 #[embassy_executor::task]
@@ -54,6 +60,35 @@ async fn galvo(task: GalvoTask<Stm32GalvoDac>) {
     static MEMORY: ConstStaticCell<GalvoMemory<{ galvo_dac::HALF_LEN }>> =
         ConstStaticCell::new(GalvoMemory::new());
     task.run_in(MEMORY.take()).await
+}
+
+/// The stepper step timer: executes the prepared segments on PE9–PE13.
+/// Runs on [`STEP_EXECUTOR`], above the galvo executor and thread mode.
+#[embassy_executor::task]
+async fn step_pulses(task: StepPulseTask<GpioStepper>) -> ! {
+    task.run().await
+}
+
+/// Priority of the step timer's executor: P0, with the short peripheral
+/// handlers (one step event is ≤ 8 µs with the busy-waited pulse and DIR
+/// setup), above the galvo executor (P1), whose refills (up to ~0.5 ms)
+/// would otherwise delay steps by most of a period at 1 600 steps/s.
+const STEP_PRIORITY: Priority = Priority::P0;
+
+/// The step timer's executor: an interrupt executor on CAN2_RX1 (a
+/// peripheral interrupt this board does not use, pended in software).
+static STEP_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
+
+#[interrupt]
+unsafe fn CAN2_RX1() {
+    // SAFETY: the interrupt `STEP_EXECUTOR` was started on (below).
+    unsafe { STEP_EXECUTOR.on_interrupt() }
+}
+
+/// The stepper task: planning and segment prep for the pan/tilt.
+#[embassy_executor::task]
+async fn stepper(task: StepperTask) {
+    task.run().await
 }
 
 /// Status LEDs: heartbeat (green), laser (orange), fault (red).
@@ -99,6 +134,16 @@ impl Spawn<Stm32Board> for TaskSpawner {
 
     fn galvo(&mut self, task: GalvoTask<Stm32GalvoDac>) {
         self.galvo.spawn(defmt::unwrap!(galvo(task)));
+    }
+
+    fn step_pulses(&mut self, task: StepPulseTask<GpioStepper>) {
+        interrupt::CAN2_RX1.set_priority(STEP_PRIORITY);
+        let spawner = STEP_EXECUTOR.start(interrupt::CAN2_RX1);
+        spawner.spawn(defmt::unwrap!(step_pulses(task)));
+    }
+
+    fn stepper(&mut self, task: StepperTask) {
+        self.thread.spawn(defmt::unwrap!(stepper(task)));
     }
 
     fn indicators(&mut self, task: IndicatorTask<StatusLeds>) {

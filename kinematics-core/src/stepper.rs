@@ -6,6 +6,25 @@
 //! `angle_y = atan(y / √(x² + op²))`) is the exact gimbal model with
 //! OL = 0, so a stepper pan/tilt uses [`crate::gimbal::exact`] with
 //! `ol_cm = 0` for its joint angles and this module for the steps.
+//!
+//! Motion in grbl's shape (seed: grbl-pan-tilt-controller): moves in
+//! microsteps enter the look-ahead [`Planner`], the [`SegmentPrep`] cuts the
+//! planned profiles into short constant-rate [`Segment`]s ahead of time, and
+//! the [`StepGenerator`] only executes those (Bresenham, integers only).
+
+#[cfg(test)]
+mod hold_tests;
+pub mod motion;
+#[cfg(test)]
+mod motion_tests;
+pub mod planner;
+pub mod segment;
+pub mod step_gen;
+
+pub use motion::MotionError;
+pub use planner::{PlannedBlock, Planner, StepMove, junction_rate_steps_per_s};
+pub use segment::{Profile, Segment, SegmentPrep, SegmentQueue, StepBlock};
+pub use step_gen::{StepGenerator, StepTick};
 
 use crate::error::Error;
 use crate::numeric::finite;

@@ -15,6 +15,7 @@
 mod budgets;
 pub(crate) mod qemu;
 mod report;
+mod stepper_rows;
 
 use std::path::PathBuf;
 use std::process::Command;

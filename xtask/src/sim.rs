@@ -34,6 +34,9 @@ pub struct SimArgs {
     /// Write every galvo DAC sample as CSV `k,t_s,dac_x,dac_y,laser`.
     #[arg(long)]
     dac: Option<PathBuf>,
+    /// Write every stepper STEP/DIR edge as CSV `t_ns,axis,pin,level`.
+    #[arg(long)]
+    steps: Option<PathBuf>,
     /// Galvo loop compute time per DAC sample, ns (models a slower CPU:
     /// above the 10 µs sample period the loop underruns).
     #[arg(long, default_value_t = 0)]
@@ -259,6 +262,10 @@ fn write_outputs(args: &SimArgs, svg: Option<&Path>, report: &SimReport) -> Resu
         std::fs::write(path, report.dac.csv())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
+    if let Some(path) = &args.steps {
+        std::fs::write(path, report.stepper.edges_csv())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     Ok(())
 }
 
@@ -274,6 +281,9 @@ fn print_summary(report: &SimReport) {
         report.galvo_underruns,
         report.transcript.error_replies
     );
+    if !report.stepper.edges.is_empty() {
+        eprint!("xtask sim: {}", report.stepper.report());
+    }
 }
 
 /// Checks the run against the safety rules and prints the verdict and

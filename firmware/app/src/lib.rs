@@ -33,5 +33,6 @@ pub mod sequencer;
 pub mod servo;
 pub mod settings;
 pub mod status;
+pub mod stepper;
 pub mod text;
 pub mod usb;

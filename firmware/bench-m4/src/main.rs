@@ -32,6 +32,7 @@ mod kinematics;
 mod path;
 mod planning;
 mod semihosting;
+mod stepper;
 mod timer;
 
 use harness::{Bench, calibration_loop, window};
@@ -63,6 +64,7 @@ fn main() -> ! {
     path::integrator_and_path(&mut b);
     galvo_loop::loop_halves(&mut b);
     planning::planning(&mut b);
+    stepper::stepper(&mut b);
 
     let _ = writeln!(b.out, "done {}", b.failures);
     b.out.flush();

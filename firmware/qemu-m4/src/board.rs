@@ -45,6 +45,7 @@ impl Board for QemuBoard {
     type Indicators = ReportedLeds;
     type StopButton = UartButton;
     type Watchdog = CmsdkWatchdog;
+    type Stepper = laser_app::app::NoStepper;
 
     fn into_parts(self) -> Parts<Self> {
         Parts {
@@ -60,6 +61,7 @@ impl Board for QemuBoard {
             indicators: ReportedLeds { shown: None },
             stop_button: self.button,
             watchdog: CmsdkWatchdog,
+            stepper: None,
         }
     }
 }

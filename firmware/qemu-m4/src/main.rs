@@ -32,6 +32,9 @@ static COMMAND_LINK: CommandLink = CommandLink::new();
 static SERVO_LINK: ServoLink = ServoLink::new();
 /// Sequencer ↔ galvo loop channels (no loop serves them on this board).
 static GALVO_LINK: GalvoLink = GalvoLink::new();
+/// Sequencer ↔ stepper channels (no stepper task serves them on this board:
+/// `target stepper` is refused).
+static STEPPER_LINK: laser_app::stepper::StepperLink = laser_app::stepper::StepperLink::new();
 /// Shared state for LEDs and the watchdog.
 static STATUS: StatusBoard = StatusBoard::new();
 
@@ -54,6 +57,7 @@ fn main() -> ! {
         command: &COMMAND_LINK,
         servo: &SERVO_LINK,
         galvo: &GALVO_LINK,
+        stepper: &STEPPER_LINK,
         status: &STATUS,
         gate: &parts::LASER_GATE,
     };

@@ -7,9 +7,10 @@ use embassy_executor::Spawner;
 #[cfg(not(feature = "galvo-dac"))]
 use laser_app::app::NoGalvoDac;
 use laser_app::app::{
-    ConsoleTask, GalvoTask, IndicatorTask, SequencerTask, ServoBusTask, Spawn, StopButtonTask,
-    WatchdogTask,
+    ConsoleTask, GalvoTask, IndicatorTask, NoStepper, SequencerTask, ServoBusTask, Spawn,
+    StopButtonTask, WatchdogTask,
 };
+use laser_app::stepper::{StepPulseTask, StepperTask};
 
 use crate::board::QemuBoard;
 use crate::parts::{CmsdkWatchdog, LaserPin, ReportedLeds, UartButton, UartConsole};
@@ -40,6 +41,14 @@ async fn galvo(task: GalvoTask<crate::galvo_dac::QemuDac>) {
         laser_app::galvo::GalvoMemory<{ crate::galvo_dac::HALF_LEN }>,
     > = static_cell::ConstStaticCell::new(laser_app::galvo::GalvoMemory::new());
     task.run_in(MEMORY.take()).await
+}
+
+/// The stepper task (planning, segment prep). The board has no stepper
+/// outputs, so `wire` never spawns it; it is here so the board's spawn hooks
+/// are complete, as on the STM32 board.
+#[embassy_executor::task]
+async fn stepper(task: StepperTask) {
+    task.run().await
 }
 
 #[embassy_executor::task]
@@ -93,6 +102,14 @@ impl Spawn<QemuBoard> for TaskSpawner {
     #[cfg(feature = "galvo-dac")]
     fn galvo(&mut self, task: GalvoTask<crate::galvo_dac::QemuDac>) {
         spawned("galvo", galvo(task), &self.0);
+    }
+
+    fn step_pulses(&mut self, task: StepPulseTask<NoStepper>) {
+        task.unreachable()
+    }
+
+    fn stepper(&mut self, task: StepperTask) {
+        spawned("stepper", stepper(task), &self.0);
     }
 
     fn indicators(&mut self, task: IndicatorTask<ReportedLeds>) {

@@ -10,6 +10,7 @@
 //! | laser pin     | the recording gated pin ([`RecordingLaser`])      |
 //! | settings      | sectors 10 and 11 of the simulated flash          |
 //! | galvo DAC     | the simulated double-buffered DAC ([`SimDac`]), or none |
+//! | stepper STEP/DIR/ENABLE | the driver models ([`SimStepperDrive`]), or none |
 //! | LEDs, button, watchdog | recorded models ([`crate::panel`])       |
 
 use std::convert::Infallible;
@@ -21,12 +22,14 @@ use laser_app::app::{
     Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::settings::store::FlashSettingsStore;
+use laser_app::stepper::{StepPulseTask, StepperTask};
 
 use crate::dac::SimDac;
 use crate::executor::{TaskKind, spawn_task};
 use crate::panel::{SimLeds, SimStopButton, SimWatchdog};
 use crate::servo_port::{PortHandle, SimServoPort};
 use crate::spot::RecordingLaser;
+use crate::stepper::SimStepperDrive;
 use crate::usb_host::UsbHost;
 use crate::world::SettingsFlash;
 
@@ -42,6 +45,8 @@ pub struct SimBoard {
     pub settings: FlashSettingsStore<SettingsFlash>,
     /// The galvo DAC, if the board has one.
     pub galvo_dac: Option<SimDac>,
+    /// The stepper outputs, if the board has them.
+    pub stepper: Option<SimStepperDrive>,
     /// The status LEDs.
     pub leds: SimLeds,
     /// The stop button.
@@ -57,6 +62,7 @@ impl Board for SimBoard {
     type Laser = RecordingLaser;
     type Settings = FlashSettingsStore<SettingsFlash>;
     type GalvoDac = SimDac;
+    type Stepper = SimStepperDrive;
     type Indicators = SimLeds;
     type StopButton = SimStopButton;
     type Watchdog = SimWatchdog;
@@ -73,6 +79,7 @@ impl Board for SimBoard {
             laser: self.laser,
             settings: self.settings,
             galvo_dac: self.galvo_dac,
+            stepper: self.stepper,
             indicators: self.leds,
             stop_button: self.stop_button,
             watchdog: self.watchdog,
@@ -179,6 +186,14 @@ impl Spawn<SimBoard> for SimSpawner {
 
     fn galvo(&mut self, task: GalvoTask<SimDac>) {
         self.firmware("galvo", task.run());
+    }
+
+    fn step_pulses(&mut self, task: StepPulseTask<SimStepperDrive>) {
+        self.firmware("step pulses", task.run());
+    }
+
+    fn stepper(&mut self, task: StepperTask) {
+        self.firmware("stepper", task.run());
     }
 
     fn indicators(&mut self, task: IndicatorTask<SimLeds>) {

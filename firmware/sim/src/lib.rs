@@ -20,6 +20,7 @@ pub mod script;
 pub mod servo_model;
 pub mod servo_port;
 pub mod spot;
+pub mod stepper;
 pub mod usb_host;
 pub mod world;
 

@@ -92,6 +92,10 @@ fn servo_sample(bus: &SimServoBus, gimbal: PhysicalGimbal, t_us: u64, laser: boo
     }
 }
 
+/// Where the pointing actuator's spot is at a time (µs), cm (`None`: off
+/// the board).
+pub type SpotFn = Rc<dyn Fn(u64) -> Option<(f64, f64)>>;
+
 /// Where the gimbal spot is at `t_us` (from the simulated servos' true
 /// angles through the exact forward kinematics), board cm.
 pub fn gimbal_spot_cm(
@@ -105,10 +109,12 @@ pub fn gimbal_spot_cm(
     gimbal.spot_cm(yaw_deg, pitch_deg)
 }
 
-/// Samples the spot from the simulated servos' true angles, and records
+/// Samples the spot (`spot_at`: the gimbal's from the simulated servos'
+/// true angles, or the stepper's from its counted steps), and records
 /// where it was at the end of each dwell.
 pub async fn spot_sampler(
     bus: Rc<RefCell<SimServoBus>>,
+    spot_at: SpotFn,
     recording: Rc<RefCell<Recording>>,
     status: &'static StatusBoard,
     gimbal: PhysicalGimbal,
@@ -117,7 +123,7 @@ pub async fn spot_sampler(
     let mut open_dwell: Option<(DwellKey, usize)> = None;
     loop {
         let t_us = crate::clock::now_us();
-        let spot = gimbal_spot_cm(&bus, gimbal, t_us);
+        let spot = spot_at(t_us);
         {
             let mut rec = recording.borrow_mut();
             let laser = rec.laser_at(t_us);

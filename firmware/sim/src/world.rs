@@ -18,6 +18,7 @@ use laser_app::sequencer::SettingsStore;
 use laser_app::servo::task::ServoLink;
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::status::{Activity, Phase, StatusBoard};
+use laser_app::stepper::StepperLink;
 use sequential_storage::map::MapConfig;
 
 use crate::board::{SimBoard, SimSpawner};
@@ -31,7 +32,8 @@ use crate::recorder::{Recording, SpotSample};
 use crate::script::Step;
 use crate::servo_model::SimServoBus;
 use crate::servo_port::{BusFaults, SimServoPort};
-use crate::spot::{RecordingLaser, gimbal_spot_cm, spot_sampler};
+use crate::spot::{RecordingLaser, SpotFn, gimbal_spot_cm, spot_sampler};
+use crate::stepper::{DriverTiming, MotorLimits, PanTiltDrivers, SimStepperDrive, StepperGeometry};
 use crate::usb_host::{Transcript, UsbHost, host_tasks};
 
 /// Samples per galvo DAC half buffer (1.28 ms at 100 kHz).
@@ -113,6 +115,15 @@ pub struct SimOptions {
     /// The board has a galvo DAC (`false`: a board like the target's,
     /// which has none yet, so no galvo loop runs).
     pub galvo_dac: bool,
+    /// The board has the stepper pan/tilt's outputs.
+    pub stepper: bool,
+    /// The stepper drivers' input timing.
+    pub stepper_timing: DriverTiming,
+    /// What the stepper motors can do (the pull-out model).
+    pub stepper_motor: MotorLimits,
+    /// The true stepper pan/tilt geometry (the spot comes from its
+    /// counted steps).
+    pub stepper_geometry: StepperGeometry,
     /// Serve the console on a pseudo-terminal instead of the script
     /// (real time; the run ends when its stop flag is set).
     #[cfg(unix)]
@@ -138,6 +149,10 @@ impl Default for SimOptions {
             galvo_cost_ns_per_sample: 0,
             galvo_m4_cost: true,
             galvo_dac: true,
+            stepper: true,
+            stepper_timing: DriverTiming::default(),
+            stepper_motor: MotorLimits::default(),
+            stepper_geometry: StepperGeometry::default(),
             #[cfg(unix)]
             pty: None,
         }
@@ -172,6 +187,8 @@ pub struct SimReport {
     pub task_steps: Vec<executor::TaskSteps>,
     /// What the board's LEDs, stop button and watchdog did.
     pub panel: PanelRecord,
+    /// The stepper drivers: counted steps, pulse timing, stalls, edges.
+    pub stepper: PanTiltDrivers,
 }
 
 impl SimReport {
@@ -207,6 +224,9 @@ struct World {
     bus: Rc<RefCell<SimServoBus>>,
     port: Rc<SimServoPort>,
     gimbal: PhysicalGimbal,
+    stepper: Rc<RefCell<PanTiltDrivers>>,
+    /// Where the pointing actuator's spot is at a time (µs), cm.
+    spot: SpotFn,
 }
 
 impl World {
@@ -219,6 +239,7 @@ impl World {
             galvo: Box::leak(Box::new(GalvoLink::new())),
             status: Box::leak(Box::new(StatusBoard::new())),
             gate: recorded_gate(&dac),
+            stepper: Box::leak(Box::new(StepperLink::new())),
         };
         let recording = Rc::new(RefCell::new(Recording::default()));
         let gimbal = options.physical;
@@ -232,8 +253,15 @@ impl World {
             options.faults.clone(),
             0x5eed,
         ));
+        let stepper = Rc::new(RefCell::new(PanTiltDrivers::new(
+            options.stepper_timing,
+            options.stepper_motor,
+        )));
+        let spot = pointing_spot(&bus, gimbal, &stepper, options.stepper_geometry);
         Self {
             links,
+            stepper,
+            spot,
             host: Rc::new(UsbHost::new(options.echo)),
             recording,
             dac,
@@ -249,12 +277,9 @@ impl World {
     /// The simulated board (its laser pin records into this run; call
     /// after the gate of [`World::new`]).
     fn board(&self, options: &SimOptions) -> SimBoard {
-        let (spot_bus, gimbal) = (self.bus.clone(), self.gimbal);
+        let (spot, gimbal) = (self.spot.clone(), self.gimbal);
         let laser = RecordingLaser {
-            pin: GatedLaserPin::new(
-                self.recording.clone(),
-                Box::new(move |t_us| gimbal_spot_cm(&spot_bus, gimbal, t_us)),
-            ),
+            pin: GatedLaserPin::new(self.recording.clone(), Box::new(move |t_us| spot(t_us))),
             recording: self.recording.clone(),
             bus: self.bus.clone(),
             gimbal,
@@ -284,6 +309,9 @@ impl World {
                 panel: self.panel.clone(),
             },
             watchdog: SimWatchdog(self.panel.clone()),
+            stepper: options
+                .stepper
+                .then(|| SimStepperDrive::new(self.stepper.clone())),
         }
     }
 
@@ -308,6 +336,7 @@ impl World {
             TaskKind::Simulator,
             spot_sampler(
                 self.bus.clone(),
+                self.spot.clone(),
                 self.recording.clone(),
                 self.links.status,
                 self.gimbal,
@@ -334,14 +363,24 @@ impl World {
             galvo_underruns: self.links.galvo.underruns.load(Ordering::Relaxed),
             task_steps: executor::task_steps(),
             panel: self.panel_at_end(end_time_us),
+            stepper: self.stepper_at_end(end_time_us),
         }
+    }
+
+    /// The drivers with the rotors run on to the end time.
+    fn stepper_at_end(&self, end_time_us: u64) -> PanTiltDrivers {
+        let mut drivers = self.stepper.borrow().clone();
+        for axis in &mut drivers.axes {
+            axis.settle(end_time_us * 1000);
+        }
+        drivers
     }
 
     /// The trace ends with the laser's final state at the end time.
     fn final_spot(&self, end_time_us: u64) {
         let mut rec = self.recording.borrow_mut();
         if rec.spot.last().is_none_or(|s| s.t_us < end_time_us)
-            && let Some((x_cm, y_cm)) = gimbal_spot_cm(&self.bus, self.gimbal, end_time_us)
+            && let Some((x_cm, y_cm)) = (self.spot)(end_time_us)
         {
             let laser = crate::laser::gimbal_lit();
             rec.spot.push(SpotSample {
@@ -358,6 +397,26 @@ impl World {
         panel.watchdog = panel.watchdog.at_end(end_time_us);
         panel
     }
+}
+
+/// The pointing actuator's spot: the stepper's (from its counted steps)
+/// once it has stepped, else the gimbal's.
+fn pointing_spot(
+    bus: &Rc<RefCell<SimServoBus>>,
+    gimbal: PhysicalGimbal,
+    stepper: &Rc<RefCell<PanTiltDrivers>>,
+    geometry: StepperGeometry,
+) -> SpotFn {
+    let (bus, stepper) = (bus.clone(), stepper.clone());
+    Rc::new(move |t_us| {
+        let drivers = stepper.borrow();
+        if drivers.edges.is_empty() {
+            return gimbal_spot_cm(&bus, gimbal, t_us);
+        }
+        geometry
+            .spot_cm(drivers.counted_steps())
+            .map(|p| (p.x_cm, p.y_cm))
+    })
 }
 
 /// Runs one simulation to its end. Independent runs may execute on

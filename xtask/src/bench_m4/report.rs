@@ -4,7 +4,13 @@
 use anyhow::{Context, Result, bail};
 use serde::Serialize;
 
-use super::budgets::{Enforcement, ROWS, plan_row};
+use super::budgets::{Enforcement, ROWS, Row, plan_row};
+use super::stepper_rows::STEPPER_ROWS;
+
+/// Every row with a description: the galvo's and the stepper's.
+fn all_rows() -> impl Iterator<Item = &'static Row> {
+    ROWS.iter().chain(STEPPER_ROWS)
+}
 
 /// STM32F407 core clock, MHz.
 pub const CLOCK_MHZ: f64 = 168.0;
@@ -101,7 +107,7 @@ pub fn parse(output: &str) -> Result<Report> {
     if !self_checked {
         bail!("bench-m4 did not report its on-target self-check (VSQRT, DAC conversion)");
     }
-    for row in ROWS.iter().filter(|r| r.budget.is_some()) {
+    for row in all_rows().filter(|r| r.budget.is_some()) {
         if !rows.iter().any(|m| m.id == row.id) {
             bail!("bench-m4 did not report `{}`", row.id);
         }
@@ -117,7 +123,7 @@ pub fn parse(output: &str) -> Result<Report> {
 }
 
 fn measured(id: &str, instructions: f64) -> Measured {
-    let row = ROWS.iter().find(|r| r.id == id);
+    let row = all_rows().find(|r| r.id == id);
     let (what, unit) = match (row, plan_row(id)) {
         (Some(r), _) => (r.what.to_owned(), r.unit),
         (None, Some((what, unit))) => (what, unit),

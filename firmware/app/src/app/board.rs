@@ -10,6 +10,7 @@ use embedded_io_async::{Read, Write};
 
 use crate::galvo::{DacSample, DacStream, Half, Underrun};
 use crate::sequencer::{LaserSwitch, SettingsStore};
+use crate::stepper::{DriverSignals, StepperDrive};
 
 /// The command-line port: a host that may connect and disconnect (USB
 /// CDC-ACM on the target, the simulated terminal's byte pipes on the host).
@@ -91,6 +92,34 @@ impl DacStream for NoGalvoDac {
     }
 }
 
+/// The stepper outputs of a board that has none: no value of this type
+/// exists, so [`Parts::stepper`] is always `None` and no stepper task runs
+/// (`target stepper` is refused).
+#[derive(Debug)]
+pub enum NoStepper {}
+
+impl StepperDrive for NoStepper {
+    fn set_enabled(&mut self, _enabled: bool) {
+        match *self {}
+    }
+
+    fn set_signals(&mut self, _signals: DriverSignals) {
+        match *self {}
+    }
+
+    fn step(&mut self, _step: [bool; 2], _negative: [bool; 2]) {
+        match *self {}
+    }
+
+    async fn wait_ticks(&mut self, _ticks: u32) {
+        match *self {}
+    }
+
+    fn restart(&mut self) {
+        match *self {}
+    }
+}
+
 /// A board: the types of its parts, and the parts themselves
 /// ([`Board::into_parts`]), configured and with the laser off.
 pub trait Board {
@@ -106,6 +135,9 @@ pub trait Board {
     type Settings: SettingsStore;
     /// The galvo DAC stream ([`NoGalvoDac`] on a board without one).
     type GalvoDac: DacStream;
+    /// The stepper pan/tilt's STEP/DIR/ENABLE outputs and step timer
+    /// ([`NoStepper`] on a board without one).
+    type Stepper: StepperDrive;
     /// The status LEDs.
     type Indicators: Indicators;
     /// The stop button.
@@ -133,6 +165,9 @@ pub struct Parts<B: Board + ?Sized> {
     pub settings: B::Settings,
     /// The galvo DAC, when the board has one (else no galvo loop runs).
     pub galvo_dac: Option<B::GalvoDac>,
+    /// The stepper outputs, when the board has them (else no stepper task
+    /// runs).
+    pub stepper: Option<B::Stepper>,
     /// The status LEDs.
     pub indicators: B::Indicators,
     /// The stop button.

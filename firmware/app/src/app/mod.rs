@@ -6,7 +6,8 @@
 //!
 //! ```text
 //! console port ─▶ console ─CommandLink─▶ sequencer ─ServoLink─▶ servo bus ─▶ servo UART
-//!                      stop button ─┘     │  │  └─GalvoLink─▶ galvo loop ─▶ galvo DAC (if any)
+//!                      stop button ─┘     │  │  ├─GalvoLink─▶ galvo loop ─▶ galvo DAC (if any)
+//!                                         │  │  └─StepperLink─▶ stepper task ─▶ step timer ─▶ STEP/DIR (if any)
 //!                                         │  └─▶ laser pin (every laser behind the LaserGate)
 //!                                         └─StatusBoard─▶ indicators (LEDs), watchdog
 //! ```
@@ -16,7 +17,9 @@
 mod board;
 mod tasks;
 
-pub use self::board::{Board, Console, Indicators, Leds, NoGalvoDac, Parts, StopButton, Watchdog};
+pub use self::board::{
+    Board, Console, Indicators, Leds, NoGalvoDac, NoStepper, Parts, StopButton, Watchdog,
+};
 pub use self::tasks::{
     ConsoleTask, GalvoTask, HEARTBEAT_TICKS, INDICATOR_PERIOD, IndicatorTask, SequencerTask,
     ServoBusTask, StopButtonTask, WATCHDOG_CHECK_PERIOD, WATCHDOG_TIMEOUT_US, WatchdogTask,
@@ -28,6 +31,7 @@ use crate::galvo::GalvoLink;
 use crate::laser_gate::LaserGate;
 use crate::servo::task::ServoLink;
 use crate::status::StatusBoard;
+use crate::stepper::{StepPulseTask, StepperConfig, StepperLink, StepperTask};
 
 /// The channels and shared state between the tasks. The board owns them
 /// (`static`s on the target, leaked per run in the simulator) and lends
@@ -46,6 +50,9 @@ pub struct Links {
     pub status: &'static StatusBoard,
     /// The master laser gate (its close hook is the board's).
     pub gate: &'static LaserGate,
+    /// Sequencer ↔ stepper task ↔ step timer (no task serves it on a
+    /// board without stepper outputs).
+    pub stepper: &'static StepperLink,
 }
 
 /// Runs task bodies as tasks. Embassy tasks cannot be generic, so a board
@@ -62,6 +69,12 @@ pub trait Spawn<B: Board> {
     /// The galvo loop (only called when the board has a galvo DAC; a board
     /// with [`NoGalvoDac`] answers [`GalvoTask::unreachable`]).
     fn galvo(&mut self, task: GalvoTask<B::GalvoDac>);
+    /// The step timer, at high priority (only called when the board has
+    /// stepper outputs; a board with [`NoStepper`] answers
+    /// [`StepPulseTask::unreachable`]).
+    fn step_pulses(&mut self, task: StepPulseTask<B::Stepper>);
+    /// The stepper task (planning, segment prep), at low priority.
+    fn stepper(&mut self, task: StepperTask);
     /// The status LEDs.
     fn indicators(&mut self, task: IndicatorTask<B::Indicators>);
     /// The stop button.
@@ -72,8 +85,9 @@ pub trait Spawn<B: Board> {
 
 /// Builds the whole task set from `board` and `links` and spawns it
 /// through `spawner`, in dataflow order: console, servo bus, sequencer,
-/// galvo loop (when the board has a DAC), then the LEDs, the stop button
-/// and the watchdog.
+/// galvo loop (when the board has a DAC), step timer and stepper task
+/// (when it has stepper outputs), then the LEDs, the stop button and the
+/// watchdog.
 pub fn wire<B: Board>(board: B, links: Links, spawner: &mut impl Spawn<B>) {
     let parts = board.into_parts();
     spawner.console(ConsoleTask {
@@ -97,6 +111,16 @@ pub fn wire<B: Board>(board: B, links: Links, spawner: &mut impl Spawn<B>) {
             gate: links.gate,
         });
     }
+    if let Some(drive) = parts.stepper {
+        spawner.step_pulses(StepPulseTask {
+            drive,
+            link: links.stepper,
+        });
+        spawner.stepper(StepperTask {
+            link: links.stepper,
+            config: StepperConfig::default(),
+        });
+    }
     spawner.indicators(IndicatorTask {
         leds: parts.indicators,
         status: links.status,
@@ -104,6 +128,7 @@ pub fn wire<B: Board>(board: B, links: Links, spawner: &mut impl Spawn<B>) {
     spawner.stop_button(StopButtonTask {
         button: parts.stop_button,
         link: links.command,
+        stepper: links.stepper,
     });
     spawner.watchdog(WatchdogTask {
         dog: parts.watchdog,

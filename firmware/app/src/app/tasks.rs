@@ -15,9 +15,10 @@ use crate::command::CommandLink;
 use crate::galvo::{DacStream, GalvoConfig, GalvoLink, GalvoLoop, GalvoMemory};
 use crate::laser_gate::LaserGate;
 use crate::log;
-use crate::sequencer::{LaserSwitch, Sequencer, SettingsStore};
+use crate::sequencer::{ActuatorLinks, LaserSwitch, Sequencer, SettingsStore};
 use crate::servo::task::{ServoBus, ServoBusConfig, ServoLink};
 use crate::status::StatusBoard;
+use crate::stepper::StepperLink;
 
 /// Period of the status LEDs' update.
 pub const INDICATOR_PERIOD: Duration = Duration::from_millis(100);
@@ -79,9 +80,13 @@ impl<L: LaserSwitch, S: SettingsStore> SequencerTask<L, S> {
             galvo,
             status,
             gate,
+            stepper,
         } = self.links;
-        let mut sequencer =
-            Sequencer::new(command, servo, galvo, status, self.laser, gate, self.store).await;
+        let actuators = ActuatorLinks { galvo, stepper };
+        let mut sequencer = Sequencer::new(
+            command, servo, actuators, status, self.laser, gate, self.store,
+        )
+        .await;
         sequencer.run().await
     }
 }
@@ -169,18 +174,21 @@ impl<I: Indicators> IndicatorTask<I> {
     }
 }
 
-/// The stop button: stop the run, laser off (as the `stop` command).
+/// The stop button: stop the run, laser off (as the `stop` command), and
+/// the stepper's steps halted at once.
 pub struct StopButtonTask<B> {
     pub(super) button: B,
     pub(super) link: &'static CommandLink,
+    pub(super) stepper: &'static StepperLink,
 }
 
 impl<B: StopButton> StopButtonTask<B> {
-    /// Turns each press into a stop request.
+    /// Turns each press into a stop request (and a stepper halt).
     pub async fn run(mut self) -> ! {
         loop {
             self.button.pressed().await;
             log::info!("button: stop");
+            self.stepper.halt();
             self.link.stop_request.signal(());
         }
     }

@@ -68,6 +68,14 @@ impl DacStream for Part {
     async fn repeat_half(&mut self) {}
 }
 
+impl crate::stepper::StepperDrive for Part {
+    fn set_enabled(&mut self, _enabled: bool) {}
+    fn set_signals(&mut self, _timing: crate::stepper::DriverSignals) {}
+    fn step(&mut self, _step: [bool; 2], _negative: [bool; 2]) {}
+    async fn wait_ticks(&mut self, _ticks: u32) {}
+    fn restart(&mut self) {}
+}
+
 impl Indicators for Part {
     fn show(&mut self, _leds: Leds) {}
 }
@@ -81,7 +89,8 @@ impl Watchdog for Part {
     fn feed(&mut self) {}
 }
 
-/// A board whose parts all carry its number; with or without a galvo DAC.
+/// A board whose parts all carry its number; with or without a galvo DAC
+/// (and stepper outputs, which come with it here).
 struct TestBoard {
     id: u8,
     has_dac: bool,
@@ -94,6 +103,7 @@ impl Board for TestBoard {
     type Laser = Part;
     type Settings = Part;
     type GalvoDac = Part;
+    type Stepper = Part;
     type Indicators = Part;
     type StopButton = Part;
     type Watchdog = Part;
@@ -111,6 +121,7 @@ impl Board for TestBoard {
             laser: part,
             settings: part,
             galvo_dac: self.has_dac.then_some(part),
+            stepper: self.has_dac.then_some(part),
             indicators: part,
             stop_button: part,
             watchdog: part,
@@ -137,6 +148,13 @@ impl Spawn<TestBoard> for Spawned {
     fn galvo(&mut self, task: GalvoTask<Part>) {
         self.0.push(("galvo", task.dac));
     }
+    fn step_pulses(&mut self, task: crate::stepper::StepPulseTask<Part>) {
+        self.0.push(("step pulses", task.drive));
+    }
+    fn stepper(&mut self, task: crate::stepper::StepperTask) {
+        assert_eq!(task.config, crate::stepper::StepperConfig::default());
+        self.0.push(("stepper", Part(u8::MAX - 1)));
+    }
     fn indicators(&mut self, task: IndicatorTask<Part>) {
         self.0.push(("indicators", task.leds));
     }
@@ -153,6 +171,7 @@ static SERVO: ServoLink = ServoLink::new();
 static GALVO: GalvoLink = GalvoLink::new();
 static STATUS: StatusBoard = StatusBoard::new();
 static GATE: LaserGate = LaserGate::new();
+static STEPPER: crate::stepper::StepperLink = crate::stepper::StepperLink::new();
 
 fn links() -> Links {
     Links {
@@ -161,6 +180,7 @@ fn links() -> Links {
         galvo: &GALVO,
         status: &STATUS,
         gate: &GATE,
+        stepper: &STEPPER,
     }
 }
 
@@ -183,6 +203,8 @@ fn every_task_gets_its_part_once_in_dataflow_order() {
             ("servo bus", Part(u8::MAX)),
             ("sequencer", p),
             ("galvo", p),
+            ("step pulses", p),
+            ("stepper", Part(u8::MAX - 1)),
             ("indicators", p),
             ("stop button", p),
             ("watchdog", p),
@@ -191,7 +213,7 @@ fn every_task_gets_its_part_once_in_dataflow_order() {
 }
 
 #[test]
-fn a_board_without_a_galvo_dac_runs_no_galvo_loop() {
+fn a_board_without_a_galvo_dac_or_steppers_runs_no_galvo_or_stepper_task() {
     let names: Vec<_> = wired(TestBoard {
         id: 3,
         has_dac: false,

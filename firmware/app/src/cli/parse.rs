@@ -87,11 +87,12 @@ fn mode_command(name: &str, args: &mut Args<'_>) -> Result<Option<Command>, Comm
     let command = if is("target") {
         Command::Target(keyword(
             args,
-            "gimbal|galvo|both",
+            "gimbal|galvo|both|stepper",
             &[
                 ("gimbal", Actuator::Gimbal),
                 ("galvo", Actuator::Galvo),
                 ("both", Actuator::Both),
+                ("stepper", Actuator::Stepper),
             ],
         )?)
     } else if is("planner") {

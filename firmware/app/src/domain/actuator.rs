@@ -10,6 +10,8 @@ pub enum Actuator {
     Galvo,
     /// Both, visiting the same board points together.
     Both,
+    /// The stepper pan/tilt (STEP/DIR drivers, open loop).
+    Stepper,
 }
 
 impl Actuator {
@@ -19,17 +21,23 @@ impl Actuator {
             Actuator::Gimbal => "gimbal",
             Actuator::Galvo => "galvo",
             Actuator::Both => "both",
+            Actuator::Stepper => "stepper",
         }
     }
 
     /// Whether the gimbal takes part.
     pub fn uses_gimbal(self) -> bool {
-        self != Actuator::Galvo
+        matches!(self, Actuator::Gimbal | Actuator::Both)
     }
 
     /// Whether the galvo takes part.
     pub fn uses_galvo(self) -> bool {
-        self != Actuator::Gimbal
+        matches!(self, Actuator::Galvo | Actuator::Both)
+    }
+
+    /// Whether the stepper pan/tilt draws.
+    pub fn uses_stepper(self) -> bool {
+        self == Actuator::Stepper
     }
 }
 

@@ -18,6 +18,8 @@ pub(super) const CHECKS_PER_STEP: usize = 3;
 
 /// The reply to galvo commands when no galvo loop serves the link.
 const NO_GALVO: &str = "this build has no galvo output";
+/// The reply to `target stepper` when no stepper task serves the link.
+const NO_STEPPER: &str = "this build has no stepper output";
 
 impl Core {
     /// Runs `command` (`readings`: what the shell read from the links).
@@ -81,10 +83,15 @@ impl Core {
     }
 
     /// `target`, `planner` and `galvo status`: refused when no galvo loop
-    /// serves the link (except `target gimbal`).
+    /// serves the link (except `target gimbal`, and `target stepper`,
+    /// refused when no stepper task serves its link).
     fn galvo_command(&mut self, command: Command, readings: &Readings, out: &mut dyn ActionSink) {
         let gimbal = command == Command::Target(Actuator::Gimbal);
-        if !gimbal && self.inputs.galvo_room.is_none() {
+        if command == Command::Target(Actuator::Stepper) {
+            if !self.inputs.stepper_attached {
+                return self.error(out, NO_STEPPER);
+            }
+        } else if !gimbal && self.inputs.galvo_room.is_none() {
             return self.error(out, NO_GALVO);
         }
         match command {
@@ -156,6 +163,7 @@ impl Core {
                 if before.galvo != self.settings.galvo {
                     self.configure_galvo(out);
                 }
+                self.configure_stepper(out);
                 self.ok(out);
             }
             Err(reason) => {

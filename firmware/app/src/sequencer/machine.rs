@@ -30,6 +30,7 @@ use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{LoadedRecord, RecordError, Settings};
 use crate::status::{Activity, Snapshot};
+use crate::stepper::{StepperConfig, StepperEvent, StepperRequest};
 use crate::text::{ReplyText, reply_text};
 
 /// Something that happened, for the core to act on.
@@ -50,6 +51,8 @@ pub enum Event {
     Servo(ServoOutcome),
     /// The galvo loop's report.
     Galvo(GalvoEvent),
+    /// The stepper task's report.
+    Stepper(StepperEvent),
     /// The dwell deadline ([`Core::dwell_deadline`]) passed.
     DwellEnded,
     /// The housekeeping tick (liveness for the watchdog).
@@ -106,6 +109,9 @@ pub struct Inputs {
     /// The galvo loop's board plans jumps by bisection (`planner seed`;
     /// refused where it does not fit the target's time).
     pub galvo_bisection: bool,
+    /// A stepper task serves the stepper link (else `target stepper` is
+    /// refused).
+    pub stepper_attached: bool,
 }
 
 /// Something the core wants done, in order.
@@ -121,6 +127,10 @@ pub enum Action {
     ConfigureGalvo(GalvoConfig),
     /// Whether the laser mode lets the galvo light.
     AllowGalvoLaser(bool),
+    /// Send a request to the stepper task.
+    Stepper(StepperRequest),
+    /// New stepper parameters (the latest wins, applied at rest).
+    ConfigureStepper(StepperConfig),
     /// Close the master laser gate: dark at once, a new generation (what
     /// anyone computed before stays dark).
     CloseGate,
@@ -250,6 +260,7 @@ impl Core {
                 now,
                 galvo_room: None,
                 galvo_bisection: false,
+                stepper_attached: false,
             },
             gcode: super::gcode::Gcode::new(),
         }
@@ -268,6 +279,7 @@ impl Core {
             Event::StopRequest => self.stop("stop button", out),
             Event::Servo(outcome) => self.servo_outcome(outcome, out),
             Event::Galvo(event) => self.galvo_event(event, out),
+            Event::Stepper(event) => self.stepper_event(event, out),
             Event::DwellEnded => self.dwell_ended(out),
             Event::Tick => self.heartbeat = self.heartbeat.wrapping_add(1),
             Event::CheckStep => self.check_step(super::commands::CHECKS_PER_STEP, out),
@@ -347,6 +359,7 @@ impl Core {
         };
         self.geometry_changed();
         self.configure_galvo(out);
+        self.configure_stepper(out);
     }
 
     /// Rebuilds the geometry the run aims with after the settings or the
@@ -362,12 +375,13 @@ impl Core {
         // The galvo's laser is switched per sample by the galvo loop; this
         // is the gimbal's. Dark once the gate was closed by someone else
         // (a galvo underrun) until the run is stopped or restarted.
-        let wanted = self.actuator.uses_gimbal()
-            && (laser_wanted(
-                self.settings.laser_mode,
-                phase,
-                self.faults.gimbal_laser_blocked(yaw, pitch, phase),
-            ) || self.gcode_gimbal_lit())
+        // The stepper pan/tilt carries the gimbal's laser; no servo
+        // blocks it.
+        let servo_blocked =
+            !self.actuator.uses_stepper() && self.faults.gimbal_laser_blocked(yaw, pitch, phase);
+        let wanted = (self.actuator.uses_gimbal() || self.actuator.uses_stepper())
+            && (laser_wanted(self.settings.laser_mode, phase, servo_blocked)
+                || self.gcode_gimbal_lit())
             && !self.gate_lost;
         if wanted != self.laser_on {
             self.laser_on = wanted;

@@ -23,8 +23,9 @@ mod laser;
 mod machine;
 mod report;
 mod run;
+mod stepper;
 
-use embassy_futures::select::{Either, Either3, Either4, select, select3, select4};
+use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::galvo::config_from;
@@ -38,6 +39,7 @@ use crate::outbound::LineKind;
 use crate::servo::task::ServoLink;
 use crate::settings::Settings;
 use crate::status::StatusBoard;
+use crate::stepper::StepperLink;
 
 /// Where settings are saved (defined with the settings; named here too,
 /// as the sequencer's store).
@@ -66,6 +68,15 @@ pub struct Sequencer<'a, L: LaserSwitch, S: SettingsStore> {
     io: Io<'a, L, S>,
 }
 
+/// The links to the actuators other than the servo gimbal.
+#[derive(Clone, Copy)]
+pub struct ActuatorLinks<'a> {
+    /// The galvo loop's (served only on a board with a galvo DAC).
+    pub galvo: &'a GalvoLink,
+    /// The stepper task's (served only on a board with stepper outputs).
+    pub stepper: &'a StepperLink,
+}
+
 /// What the core's actions act on.
 struct Io<'a, L: LaserSwitch, S: SettingsStore> {
     link: &'a CommandLink,
@@ -73,6 +84,9 @@ struct Io<'a, L: LaserSwitch, S: SettingsStore> {
     /// The galvo link (whether a galvo loop serves it is its
     /// [`GalvoLink::attached`]).
     galvo: &'a GalvoLink,
+    /// The stepper link (whether a stepper task serves it is its
+    /// [`StepperLink::is_attached`]).
+    stepper: &'a StepperLink,
     status: &'a StatusBoard,
     laser: L,
     /// The master laser gate: closed at once by every stop, opened only
@@ -110,7 +124,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     pub async fn new(
         link: &'a CommandLink,
         servo: &'a ServoLink,
-        galvo: &'a GalvoLink,
+        actuators: ActuatorLinks<'a>,
         status: &'a StatusBoard,
         mut laser: L,
         gate: &'a LaserGate,
@@ -124,7 +138,8 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         let io = Io {
             link,
             servo,
-            galvo,
+            galvo: actuators.galvo,
+            stepper: actuators.stepper,
             status,
             laser,
             gate,
@@ -181,10 +196,11 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             command,
             io.servo.outcomes.receive(),
             timer,
-            select3(
+            select4(
                 Timer::at(housekeeping),
                 io.galvo.events.receive(),
                 io.link.realtime.receive(),
+                io.stepper.events.receive(),
             ),
         )
         .await;
@@ -199,9 +215,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             Either4::First(Either::Second(())) => Event::StopRequest,
             Either4::Second(outcome) => Event::Servo(outcome),
             Either4::Third(()) => Event::DwellEnded,
-            Either4::Fourth(Either3::First(())) => Event::Tick,
-            Either4::Fourth(Either3::Second(event)) => Event::Galvo(event),
-            Either4::Fourth(Either3::Third(request)) => Event::Realtime(request),
+            Either4::Fourth(Either4::First(())) => Event::Tick,
+            Either4::Fourth(Either4::Second(event)) => Event::Galvo(event),
+            Either4::Fourth(Either4::Third(request)) => Event::Realtime(request),
+            Either4::Fourth(Either4::Fourth(event)) => Event::Stepper(event),
         }
     }
 
@@ -217,6 +234,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 now: Instant::now(),
                 galvo_room: galvo.attached().then(|| galvo.requests.free_capacity()),
                 galvo_bisection: galvo.plans_bisection(),
+                stepper_attached: self.io.stepper.is_attached(),
             };
             self.core.on(inputs, event, &mut self.io);
             let follow_up = core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing);
@@ -304,6 +322,12 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
             }
             Action::ConfigureGalvo(config) => self.galvo.config.signal(config),
             Action::AllowGalvoLaser(allowed) => self.galvo.allow_laser(allowed),
+            Action::Stepper(request) => {
+                if self.stepper.requests.try_send(request).is_err() {
+                    log::warning!("stepper: request queue full");
+                }
+            }
+            Action::ConfigureStepper(config) => self.stepper.config.signal(config),
             Action::CloseGate => self.generation = self.gate.close(),
             Action::ShutGate => {
                 self.gate.shut();

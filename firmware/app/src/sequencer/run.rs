@@ -6,7 +6,7 @@ use embassy_time::{Duration, Instant};
 use super::faults;
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
-use crate::domain::{Aim, GridPattern, PathCursor, Pattern, Target};
+use crate::domain::{Aim, AimModel, GridPattern, PathCursor, Pattern, Target};
 use crate::log;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::status::Phase;
@@ -50,6 +50,15 @@ pub(super) enum RunKind {
         /// The interpolator at the current point of this pass (O(1) next).
         cursor: PathCursor,
     },
+    /// A path the stepper traces segment by segment: point 0 is the
+    /// stroke's start, point `k` its `k`-th segment's end (lines and arcs
+    /// exact, not the point-by-point interpolation).
+    Traced {
+        /// What runs.
+        pattern: Pattern,
+        /// A single pass.
+        once: bool,
+    },
     /// A path the galvo alone marks, one job per pass.
     Marked {
         /// What runs.
@@ -65,7 +74,9 @@ impl RunKind {
         match *self {
             RunKind::Goto(_) => None,
             RunKind::Grid { pattern, .. } => Some(Pattern::Grid(pattern)),
-            RunKind::Path { pattern, .. } | RunKind::Marked { pattern, .. } => Some(pattern),
+            RunKind::Path { pattern, .. }
+            | RunKind::Traced { pattern, .. }
+            | RunKind::Marked { pattern, .. } => Some(pattern),
         }
     }
 
@@ -75,6 +86,7 @@ impl RunKind {
             RunKind::Goto(_) => true,
             RunKind::Grid { once, .. }
             | RunKind::Path { once, .. }
+            | RunKind::Traced { once, .. }
             | RunKind::Marked { once, .. } => once,
         }
     }
@@ -133,8 +145,10 @@ impl Core {
         self.gcode_abort(out);
         out.act(Action::Note(LaserEvent::RunStarted));
         // Nothing of an earlier run may shine: a new gate generation, and
-        // the galvo drops its points and an underrun latch.
+        // the galvo drops its points and an underrun latch; the stepper
+        // comes to rest before the new run's first move.
         self.close_gate(out);
+        self.stop_stepper(out);
         self.run = None;
         match self.run_kind(start) {
             Some(kind) => {
@@ -159,6 +173,11 @@ impl Core {
         if let Pattern::Grid(pattern) = pattern {
             return Some(RunKind::Grid { pattern, once });
         }
+        // The stepper traces paths exactly; with `model seed` it keeps the
+        // seed's point-by-point method (for comparison), as the gimbal.
+        if self.actuator.uses_stepper() && self.model == AimModel::Exact {
+            return Self::traced(pattern, once);
+        }
         if self.actuator.uses_galvo() {
             return (!self.actuator.uses_gimbal()).then_some(RunKind::Marked { pattern, once });
         }
@@ -182,6 +201,7 @@ impl Core {
     pub(super) fn stop(&mut self, why: &'static str, out: &mut dyn ActionSink) {
         out.act(Action::Note(LaserEvent::Stopped { why }));
         self.close_gate(out);
+        self.stop_stepper(out);
         if let Some(run) = self.run.take() {
             log::info!("stop {} ({})", run.kind.name(), why);
         }
@@ -198,6 +218,7 @@ impl Core {
                 self.aimer.grid_target(&Pattern::Grid(pattern), run.index)
             }
             RunKind::Path { cursor, .. } => Some(cursor.target()),
+            RunKind::Traced { pattern, .. } => Self::traced_target(&pattern, run.index),
             RunKind::Marked { .. } => None,
         }
     }
@@ -220,9 +241,12 @@ impl Core {
         let closed = run.pass > 0 && self.last_aim.is_some_and(|(t, _)| t.point == target.point);
         let approach = holds || (run.index == 0 && !closed);
         let (gimbal, galvo) = (self.actuator.uses_gimbal(), self.actuator.uses_galvo());
+        let stepper = self.actuator.uses_stepper();
         let gimbal_started = !gimbal || self.begin_gimbal_move(target, out);
-        let galvo_started = gimbal_started && (!galvo || self.begin_galvo_point(target, out));
-        if !(gimbal_started && galvo_started) {
+        let stepper_started =
+            gimbal_started && (!stepper || self.begin_stepper_move(target, approach, out));
+        let galvo_started = stepper_started && (!galvo || self.begin_galvo_point(target, out));
+        if !(gimbal_started && stepper_started && galvo_started) {
             return;
         }
         if let Some(run) = self.run.as_mut() {
@@ -232,7 +256,7 @@ impl Core {
                 Phase::Moving
             };
             run.dwell_until = None;
-            run.gimbal_busy = gimbal;
+            run.gimbal_busy = gimbal || stepper;
             // A goto's galvo holds the point, laser on, until the next
             // command: nothing to wait for.
             run.galvo_busy = galvo && !holds;
@@ -332,6 +356,13 @@ impl Core {
         // Both servos answered and arrived: they are alive.
         self.faults
             .arrived(self.settings.yaw.id, self.settings.pitch.id);
+        self.start_dwell(seq, out);
+        log::info!("arrived (servo {} {})", tenths.0, tenths.1);
+    }
+
+    /// The pointing actuator (gimbal or stepper) arrived at move `seq`:
+    /// the dwell starts when it is the current move.
+    pub(super) fn start_dwell(&mut self, seq: u32, out: &mut dyn ActionSink) {
         let now = self.inputs.now;
         let dwell_ms = self.settings.dwell_ms;
         let Some(run) = self.run.as_mut().filter(|r| r.seq == seq) else {
@@ -345,7 +376,6 @@ impl Core {
             dwell_ms
         };
         run.dwell_until = Some(now.saturating_add(Duration::from_micros((dwell * 1000.0) as u64)));
-        log::info!("arrived (servo {} {})", tenths.0, tenths.1);
     }
 
     /// The dwell on the current point ended: next point, next pass, or done.
@@ -378,6 +408,7 @@ impl Core {
                 .grid_target(&Pattern::Grid(*pattern), run.index)
                 .is_some(),
             RunKind::Path { cursor, .. } => cursor.advance(),
+            RunKind::Traced { pattern, .. } => Self::traced_target(pattern, run.index).is_some(),
             RunKind::Marked { .. } => false,
         };
         if !more {

@@ -31,6 +31,7 @@ fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
         now: Instant::from_millis(ms),
         galvo_room: None,
         galvo_bisection: false,
+        stepper_attached: false,
     };
     let mut out = Vec::new();
     core.on(inputs, event, &mut out);

@@ -341,6 +341,7 @@ impl Harness {
                 now: self.now,
                 galvo_room: self.attached.then_some(self.galvo_room),
                 galvo_bisection: self.attached,
+                stepper_attached: false,
             };
             self.core.on(inputs, event, &mut actions);
             let mut follow = None;
@@ -411,7 +412,16 @@ impl Harness {
             Action::Note(super::LaserEvent::Stopped { .. }) => self.running = false,
             Action::Note(super::LaserEvent::RunStarted) => self.running = true,
             Action::Save | Action::Yield => *follow = Some(action.clone()),
+            Action::Stepper(crate::stepper::StepperRequest::MoveTo { .. }) => {
+                assert!(self.running, "stepper move while stopped");
+                assert!(
+                    self.core.actuator.uses_stepper(),
+                    "stepper move off the stepper"
+                );
+            }
             Action::ConfigureGalvo(_)
+            | Action::Stepper(_)
+            | Action::ConfigureStepper(_)
             | Action::AllowGalvoLaser(_)
             | Action::Note(_)
             | Action::Line(_) => {}

@@ -38,6 +38,7 @@ fn on_with(core: &mut Core, ms: u64, galvo: bool, event: Event) -> Vec<Action> {
         galvo_room: galvo.then_some(GALVO_REQUEST_DEPTH),
         // A host board: bisection allowed (refused on the M4: `planner_seed_*`).
         galvo_bisection: galvo,
+        stepper_attached: galvo,
     };
     let mut out = Vec::new();
     core.on(inputs, event, &mut out);
@@ -139,6 +140,7 @@ fn planner_seed_is_refused_where_the_board_cannot_afford_bisection() {
             now: Instant::from_millis(1),
             galvo_room: Some(GALVO_REQUEST_DEPTH),
             galvo_bisection: bisection,
+            stepper_attached: false,
         };
         let mut out = Vec::new();
         let readings = READINGS;

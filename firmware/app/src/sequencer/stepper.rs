@@ -1,0 +1,188 @@
+//! The core's side of the stepper pan/tilt (`target stepper`): each point
+//! of a run to the stepper task (grid and goto points straight in joint
+//! space, paths as their exact lines and arcs — or, with `model seed`, the
+//! seed's point-by-point interpolation joined by board lines), its
+//! arrivals back into the dwell, its refusals into an error and a stop,
+//! a stop into a deceleration at the limit (the laser dark at once:
+//! [`Core::stop`] closes the gate first). The stop button halts the steps
+//! at once through the link itself.
+
+use kinematics_core::frames::BoardPoint;
+use kinematics_core::gimbal::{Gimbal, GimbalModel};
+
+use super::machine::{Action, ActionSink, Core};
+use super::run::RunKind;
+use crate::domain::{Aim, Pattern, PointCm, Segment, Target, Unit};
+use crate::log;
+use crate::stepper::{MoveShape, StepperConfig, StepperEvent, StepperRequest};
+use crate::text::Fixed;
+
+impl Core {
+    /// The stepper parameters: the seed's pan/tilt ([`StepperConfig`]'s
+    /// defaults) on the board placed as the settings say (OQ, offsets,
+    /// pose), exact model, OL = 0.
+    pub(super) fn stepper_config(&self) -> StepperConfig {
+        let defaults = StepperConfig::default();
+        let mut geometry = self
+            .settings
+            .gimbal(crate::domain::AimModel::Exact)
+            .geometry;
+        geometry.ol_cm = defaults.gimbal.geometry.ol_cm;
+        StepperConfig {
+            gimbal: Gimbal {
+                model: GimbalModel::Exact,
+                geometry,
+            },
+            ..defaults
+        }
+    }
+
+    /// Sends the stepper task its parameters (applied at rest).
+    pub(super) fn configure_stepper(&self, out: &mut dyn ActionSink) {
+        out.act(Action::ConfigureStepper(self.stepper_config()));
+    }
+
+    /// Decelerates the stepper to rest (when it draws).
+    pub(super) fn stop_stepper(&self, out: &mut dyn ActionSink) {
+        if self.actuator.uses_stepper() {
+            out.act(Action::Stepper(StepperRequest::Stop));
+        }
+    }
+
+    /// Sends the current point to the stepper task: travel (`approach`,
+    /// grid and goto points) straight in joint space, a path's next point
+    /// along the board line.
+    pub(super) fn begin_stepper_move(
+        &mut self,
+        target: Target,
+        approach: bool,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        let Some(run) = self.run else { return false };
+        let shape = match (run.kind, approach) {
+            (RunKind::Traced { pattern, .. }, false) => Self::traced_shape(&pattern, run.index),
+            // The seed's point-by-point method: straight board lines between
+            // the interpolated points.
+            (RunKind::Path { .. }, false) => MoveShape::Line,
+            _ => MoveShape::Travel,
+        };
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let seq = self.next_seq;
+        let point = BoardPoint::new(target.point.x_cm, target.point.y_cm);
+        out.act(Action::Stepper(StepperRequest::MoveTo {
+            seq,
+            point,
+            shape,
+        }));
+        out.act(Action::Note(super::laser::LaserEvent::GimbalMoveSent));
+        log::info!(
+            "stepper target ({}, {}) cm ({})",
+            target.point.x_cm,
+            target.point.y_cm,
+            shape.name()
+        );
+        if let Some(run) = self.run.as_mut() {
+            run.seq = seq;
+        }
+        // What `status` and the recorders show: the target and its joint
+        // angles on the stepper (no servo: wire 0).
+        let joints = self.stepper_config().gimbal.ik(point).unwrap_or_default();
+        let aim = Aim {
+            yaw_deg: joints.yaw_deg,
+            pitch_deg: joints.pitch_deg,
+            yaw_wire: 0,
+            pitch_wire: 0,
+        };
+        self.last_aim = Some((target, aim));
+        true
+    }
+
+    /// How a traced run of `pattern` runs (`None`: a figure of more than
+    /// one stroke, which the stepper does not trace).
+    pub(super) fn traced(pattern: Pattern, once: bool) -> Option<RunKind> {
+        let Pattern::Path(figure) = pattern else {
+            return None;
+        };
+        let single = figure.stroke(1, Unit::BoardCm).is_none();
+        (single && figure.stroke(0, Unit::BoardCm).is_some())
+            .then_some(RunKind::Traced { pattern, once })
+    }
+
+    /// Point `index` of a traced pass: the stroke's start, then each
+    /// segment's end (`None` past the last).
+    pub(super) fn traced_target(pattern: &Pattern, index: usize) -> Option<Target> {
+        let Pattern::Path(figure) = pattern else {
+            return None;
+        };
+        let stroke = figure.stroke(0, Unit::BoardCm)?;
+        let [x, y] = match index.checked_sub(1) {
+            None => stroke.start,
+            Some(k) => match *stroke.segments.get(k)? {
+                Segment::Line { to } => to,
+                Segment::Arc { end, .. } => end,
+            },
+        };
+        Some(Target {
+            point: PointCm::new(x, y),
+            grid: None,
+        })
+    }
+
+    /// How the stepper gets to point `index` of a traced pass.
+    fn traced_shape(pattern: &Pattern, index: usize) -> MoveShape {
+        let Pattern::Path(figure) = pattern else {
+            return MoveShape::Travel;
+        };
+        let segment = index
+            .checked_sub(1)
+            .and_then(|k| figure.stroke(0, Unit::BoardCm)?.segments.get(k).copied());
+        match segment {
+            Some(Segment::Line { .. }) => MoveShape::Line,
+            Some(Segment::Arc {
+                centre: [x, y],
+                rotation,
+                ..
+            }) => MoveShape::Arc {
+                centre: BoardPoint::new(x, y),
+                rotation,
+            },
+            None => MoveShape::Travel,
+        }
+    }
+
+    /// The stepper task's report.
+    pub(super) fn stepper_event(&mut self, event: StepperEvent, out: &mut dyn ActionSink) {
+        match event {
+            StepperEvent::Arrived { seq, steps } => {
+                log::info!("stepper arrived at {} {} steps", steps[0], steps[1]);
+                self.start_dwell(seq, out);
+            }
+            StepperEvent::Refused { seq, why } => {
+                if self.run.is_none_or(|r| r.seq != seq) {
+                    return;
+                }
+                let name = self.run.map_or("goto", |r| r.kind.name());
+                let target = self.last_stepper_target();
+                self.notify(
+                    out,
+                    format_args!(
+                        "error: {name} stopped, laser off: point ({}, {}) cm refused by the stepper: {why:?}",
+                        Fixed::<2>(target.0),
+                        Fixed::<2>(target.1),
+                    ),
+                );
+                self.stop("stepper refused the point", out);
+            }
+            StepperEvent::Stopped { steps } => {
+                log::info!("stepper at rest at {} {} steps", steps[0], steps[1]);
+            }
+        }
+    }
+
+    /// The board point (cm) of the run's current point, for messages.
+    fn last_stepper_target(&self) -> (f64, f64) {
+        self.status()
+            .target
+            .map_or((0.0, 0.0), |(t, _)| (t.point.x_cm, t.point.y_cm))
+    }
+}

@@ -1,0 +1,266 @@
+//! What the sequencer, the stepper task and the step timer share: the
+//! request and event channels, and the prepared segments with the step
+//! generator (behind a critical section: the step timer takes one event at
+//! a time).
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::channel::Channel;
+use embassy_sync::signal::Signal;
+use kinematics_core::Rotation;
+use kinematics_core::frames::BoardPoint;
+use kinematics_core::stepper::{SegmentQueue, StepGenerator, StepTick};
+
+use super::{DriverSignals, StepperConfig};
+
+/// Prepared segments ahead of the step generator.
+pub const STEP_QUEUE_LEN: usize = 8;
+
+/// What the sequencer asks of the stepper task.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepperRequest {
+    /// Go to a board point (cm) the way `shape` says: board lines and
+    /// arcs from the previous target are cut into pieces (IK per piece
+    /// end) that keep the spot within
+    /// [`LINE_TOLERANCE_MM`](super::LINE_TOLERANCE_MM) of them.
+    MoveTo {
+        /// Request number.
+        seq: u32,
+        /// Board point, cm.
+        point: BoardPoint,
+        /// How to get there.
+        shape: MoveShape,
+    },
+    /// Decelerate to rest at the acceleration limit along the path, drop
+    /// the rest.
+    Stop,
+}
+
+/// How a move gets to its point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MoveShape {
+    /// Straight in joint space (travel: the spot's board path is curved).
+    Travel,
+    /// Along the straight board line from the previous target.
+    Line,
+    /// Along the board arc about `centre` (cm) from the previous target;
+    /// ending where it started is a full circle.
+    Arc {
+        /// Centre, cm.
+        centre: BoardPoint,
+        /// Direction.
+        rotation: Rotation,
+    },
+}
+
+impl MoveShape {
+    /// `travel`, `line` or `arc` (for logs).
+    pub fn name(&self) -> &'static str {
+        match self {
+            MoveShape::Travel => "travel",
+            MoveShape::Line => "line",
+            MoveShape::Arc { .. } => "arc",
+        }
+    }
+}
+
+/// Why a move was refused (nothing moved for it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StepperRefusal {
+    /// A joint angle beyond the soft limits.
+    SoftLimit,
+    /// No joint angles reach the point (behind, off the board).
+    Unreachable,
+    /// The parameters are unusable (rates, acceleration, timing).
+    BadConfig,
+    /// A line is still being cut (one move at a time).
+    Busy,
+}
+
+/// What the stepper task reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StepperEvent {
+    /// Move `seq` has stepped its last step; the axes are at rest at
+    /// `steps` (`[pan, tilt]`, microsteps).
+    Arrived {
+        /// Request number.
+        seq: u32,
+        /// Position, microsteps.
+        steps: [i32; 2],
+    },
+    /// Move `seq` was refused.
+    Refused {
+        /// Request number.
+        seq: u32,
+        /// Why.
+        why: StepperRefusal,
+    },
+    /// A stop or halt came to rest at `steps`.
+    Stopped {
+        /// Position, microsteps.
+        steps: [i32; 2],
+    },
+}
+
+/// The step timer's state: prepared segments and the generator.
+struct StepCore {
+    queue: SegmentQueue<STEP_QUEUE_LEN>,
+    generator: StepGenerator,
+}
+
+/// The links of the stepper pan/tilt.
+pub struct StepperLink {
+    /// Sequencer → stepper task.
+    pub requests: Channel<CriticalSectionRawMutex, StepperRequest, 4>,
+    /// Stepper task → sequencer.
+    pub events: Channel<CriticalSectionRawMutex, StepperEvent, 4>,
+    /// New parameters (the latest wins), applied at rest.
+    pub config: Signal<CriticalSectionRawMutex, StepperConfig>,
+    core: Mutex<CriticalSectionRawMutex, RefCell<StepCore>>,
+    /// Segments were prepared (wakes the step timer).
+    pub(super) ready: Signal<CriticalSectionRawMutex, ()>,
+    /// The step timer ran out of segments (wakes the stepper task).
+    pub(super) drained: Signal<CriticalSectionRawMutex, ()>,
+    /// Stop stepping now (stop button, fault): the step timer drops
+    /// everything prepared at its next event.
+    halt: AtomicBool,
+    /// Drivers energised (the stepper task decides, the step timer applies).
+    pub(super) enabled: AtomicBool,
+    /// A stepper task serves the link.
+    attached: AtomicBool,
+    /// STEP pulse width and DIR setup time, ns, ENABLE polarity (the
+    /// stepper task sets them, the step timer applies them when it
+    /// starts).
+    pulse_ns: AtomicU32,
+    dir_setup_ns: AtomicU32,
+    enable_active_high: AtomicBool,
+}
+
+impl Default for StepperLink {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl StepperLink {
+    /// Empty links (usable in a `static`).
+    pub const fn new() -> Self {
+        Self {
+            requests: Channel::new(),
+            events: Channel::new(),
+            config: Signal::new(),
+            core: Mutex::new(RefCell::new(StepCore {
+                queue: SegmentQueue::new(),
+                generator: StepGenerator::new(),
+            })),
+            ready: Signal::new(),
+            drained: Signal::new(),
+            halt: AtomicBool::new(false),
+            enabled: AtomicBool::new(false),
+            attached: AtomicBool::new(false),
+            pulse_ns: AtomicU32::new(0),
+            dir_setup_ns: AtomicU32::new(0),
+            enable_active_high: AtomicBool::new(false),
+        }
+    }
+
+    /// Whether a stepper task serves the link (else `target stepper` is
+    /// refused).
+    pub fn is_attached(&self) -> bool {
+        self.attached.load(Ordering::Relaxed)
+    }
+
+    pub(super) fn attach(&self) {
+        self.attached.store(true, Ordering::Relaxed);
+    }
+
+    pub(super) fn set_signals(&self, signals: DriverSignals) {
+        self.pulse_ns.store(signals.pulse_ns, Ordering::Relaxed);
+        self.dir_setup_ns
+            .store(signals.dir_setup_ns, Ordering::Relaxed);
+        self.enable_active_high
+            .store(signals.enable_active_high, Ordering::Relaxed);
+    }
+
+    pub(super) fn signals(&self) -> DriverSignals {
+        DriverSignals {
+            pulse_ns: self.pulse_ns.load(Ordering::Relaxed),
+            dir_setup_ns: self.dir_setup_ns.load(Ordering::Relaxed),
+            enable_active_high: self.enable_active_high.load(Ordering::Relaxed),
+        }
+    }
+
+    /// Halts the steps at once (stop button, faults): nothing prepared
+    /// runs any more; the stepper task forgets its plan and reports
+    /// [`StepperEvent::Stopped`].
+    pub fn halt(&self) {
+        self.halt.store(true, Ordering::Release);
+        self.ready.signal(());
+        self.drained.signal(());
+    }
+
+    /// Takes a pending halt (the stepper task's side): drops everything
+    /// prepared, under the step timer's lock, before clearing the flag, so
+    /// nothing prepared before the halt can still run.
+    pub(super) fn take_halt(&self) -> bool {
+        if !self.halting() {
+            return false;
+        }
+        self.core.lock(|core| {
+            let mut core = core.borrow_mut();
+            core.queue.clear();
+            core.generator.halt();
+        });
+        self.halt.store(false, Ordering::Release);
+        true
+    }
+
+    /// Whether a halt is pending.
+    pub(super) fn halting(&self) -> bool {
+        self.halt.load(Ordering::Acquire)
+    }
+
+    /// The step timer's work for one event: the next step of the prepared
+    /// segments (`None`: nothing prepared, or halted). Integer adds and
+    /// compares under a short critical section; no float, no division.
+    pub fn step_tick(&self) -> Option<StepTick> {
+        let halted = self.halting();
+        self.core.lock(|core| {
+            let mut core = core.borrow_mut();
+            if halted {
+                core.queue.clear();
+                core.generator.halt();
+                return None;
+            }
+            let StepCore { queue, generator } = &mut *core;
+            generator.tick(queue)
+        })
+    }
+
+    /// Runs `f` on the prepared segments (the stepper task fills them).
+    pub(super) fn with_queue<R>(
+        &self,
+        f: impl FnOnce(&mut SegmentQueue<STEP_QUEUE_LEN>) -> R,
+    ) -> R {
+        self.core.lock(|core| f(&mut core.borrow_mut().queue))
+    }
+
+    /// Whether every prepared step has run.
+    pub fn is_idle(&self) -> bool {
+        self.core.lock(|core| {
+            let core = core.borrow();
+            core.queue.is_empty() && !core.generator.is_running()
+        })
+    }
+
+    /// Position counted from the emitted steps, microsteps `[pan, tilt]`.
+    pub fn position_steps(&self) -> [i32; 2] {
+        self.core
+            .lock(|core| core.borrow().generator.position_steps())
+    }
+}

@@ -1,0 +1,175 @@
+//! The stepper pan/tilt (SPEC §4.4; seeds: stepper light-spot, grbl
+//! pan-tilt): two STEP/DIR axes — pan (yaw) and tilt (pitch) — and a
+//! shared ENABLE, driven in grbl's shape.
+//!
+//! ```text
+//! sequencer ─StepperRequest─▶ stepper task (low priority, f64):
+//!     board point → IK per piece end → planner → segment prep ─┐
+//!                                                               ▼ segment queue
+//! step timer (high priority, integers only): StepGenerator::tick ─▶ STEP/DIR pins
+//! ```
+//!
+//! The high-priority part ([`StepPulseTask`], one [`StepperLink::step_tick`]
+//! per step event) does no planning, no `f64` and no division: a lock, a
+//! ring pop and Bresenham adds. Everything else ([`StepperMotion`]) runs in
+//! the low-priority [`StepperTask`].
+
+mod link;
+mod motion;
+mod task;
+
+pub use self::link::{
+    MoveShape, STEP_QUEUE_LEN, StepperEvent, StepperLink, StepperRefusal, StepperRequest,
+};
+pub use self::motion::{LINE_TOLERANCE_MM, StepperMotion};
+pub use self::task::{StepPulseTask, StepperTask};
+
+use kinematics_core::gimbal::{Gimbal, GimbalGeometry, GimbalModel, JointAngles};
+use kinematics_core::servo::Direction;
+use kinematics_core::stepper::{SEED_FULL_STEP_DEG, SEED_MICROSTEPS, StepperAxis};
+
+/// Step-timer frequency, Hz (1 µs ticks: embassy-time's tick).
+pub const STEP_TIMER_HZ: u32 = 1_000_000;
+/// Length of a prepared segment, s (grbl's order of magnitude).
+pub const SEGMENT_S: f64 = 0.0015;
+
+/// How the driver inputs are signalled: STEP pulse width, DIR setup
+/// time, ENABLE polarity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DriverSignals {
+    /// STEP high time, ns.
+    pub pulse_ns: u32,
+    /// DIR stable before the rising STEP edge, ns.
+    pub dir_setup_ns: u32,
+    /// ENABLE is active high (else active low, as on TB6600-class
+    /// drivers' ENA− input).
+    pub enable_active_high: bool,
+}
+
+/// The board's stepper outputs and step timer.
+#[allow(async_fn_in_trait)]
+pub trait StepperDrive {
+    /// Energises (`true`) or releases the drivers (the board applies the
+    /// configured ENABLE polarity).
+    fn set_enabled(&mut self, enabled: bool);
+    /// The pulse timing and ENABLE polarity from now on.
+    fn set_signals(&mut self, signals: DriverSignals);
+    /// One step event: DIR to `negative` (high = negative) on both axes,
+    /// then — the DIR setup time later — a STEP pulse on each axis in
+    /// `step`.
+    fn step(&mut self, step: [bool; 2], negative: [bool; 2]);
+    /// Waits until `ticks` step-timer ticks after the previous event (the
+    /// schedule does not drift with the time the step took).
+    async fn wait_ticks(&mut self, ticks: u32);
+    /// The next event is scheduled from now (after the timer was idle).
+    fn restart(&mut self);
+}
+
+/// The stepper pan/tilt's parameters (from the settings).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepperConfig {
+    /// Motor full-step angle, degrees.
+    pub full_step_deg: f64,
+    /// Driver microsteps per full step.
+    pub microsteps: u16,
+    /// Step count sign vs joint angle, `[pan, tilt]`.
+    pub direction: [Direction; 2],
+    /// Joint angle at step position 0 (power-up), degrees `[pan, tilt]`.
+    pub zero_deg: [f64; 2],
+    /// Soft limits: lowest joint angle, degrees `[pan, tilt]`.
+    pub min_deg: [f64; 2],
+    /// Soft limits: highest joint angle, degrees `[pan, tilt]`.
+    pub max_deg: [f64; 2],
+    /// Highest joint speed of either axis, °/s.
+    pub max_speed_deg_s: f64,
+    /// Joint acceleration limit, °/s².
+    pub accel_deg_s2: f64,
+    /// grbl's junction deviation, degrees of joint travel.
+    pub junction_deviation_deg: f64,
+    /// STEP pulse width, DIR setup time, ENABLE polarity.
+    pub signals: DriverSignals,
+    /// Drivers released after this long at rest, ms (0: always held, the
+    /// default: a released pan/tilt may sag off the point it holds).
+    pub idle_release_ms: u32,
+    /// The pointing geometry: the exact model with the pan/tilt's OL.
+    pub gimbal: Gimbal,
+}
+
+impl Default for StepperConfig {
+    /// The seed's pan/tilt: 1.8° at 32 microsteps (0.05625° per step), OL
+    /// = 0, ±60° soft limits, 90 °/s, 900 °/s², junction deviation 0.01°,
+    /// 2.5 µs pulses, 5 µs DIR setup, ENABLE active low, always held.
+    fn default() -> Self {
+        Self {
+            full_step_deg: SEED_FULL_STEP_DEG,
+            microsteps: SEED_MICROSTEPS,
+            direction: [Direction::Normal; 2],
+            zero_deg: [0.0; 2],
+            min_deg: [-60.0; 2],
+            max_deg: [60.0; 2],
+            max_speed_deg_s: 90.0,
+            accel_deg_s2: 900.0,
+            junction_deviation_deg: 0.01,
+            signals: DriverSignals {
+                pulse_ns: 2_500,
+                dir_setup_ns: 5_000,
+                enable_active_high: false,
+            },
+            idle_release_ms: 0,
+            gimbal: Gimbal {
+                model: GimbalModel::Exact,
+                geometry: GimbalGeometry {
+                    ol_cm: 0.0,
+                    ..GimbalGeometry::default()
+                },
+            },
+        }
+    }
+}
+
+impl StepperConfig {
+    /// Degrees per microstep.
+    pub fn deg_per_step(&self) -> f64 {
+        self.full_step_deg / f64::from(self.microsteps.max(1))
+    }
+
+    /// The microstep mapping of axis `i` (0 pan, 1 tilt).
+    pub fn axis(&self, i: usize) -> StepperAxis {
+        StepperAxis {
+            deg_per_step: self.deg_per_step(),
+            direction: self.direction[i & 1],
+        }
+    }
+
+    /// Joint angles of step positions `[pan, tilt]`, degrees.
+    pub fn joints_of(&self, steps: [i32; 2]) -> Option<JointAngles> {
+        let angle = |i: usize| self.axis(i).steps_to_angle(steps[i]).ok();
+        Some(JointAngles {
+            yaw_deg: self.zero_deg[0] + angle(0)?,
+            pitch_deg: self.zero_deg[1] + angle(1)?,
+        })
+    }
+
+    /// Nearest step positions for joint angles `j`, inside the soft
+    /// limits.
+    ///
+    /// Errors: [`StepperRefusal::SoftLimit`], [`StepperRefusal::Unreachable`].
+    pub fn steps_of(&self, j: JointAngles) -> Result<[i32; 2], StepperRefusal> {
+        let joints = [j.yaw_deg, j.pitch_deg];
+        let mut steps = [0; 2];
+        for (i, (step, angle)) in steps.iter_mut().zip(joints).enumerate() {
+            if !(self.min_deg[i]..=self.max_deg[i]).contains(&angle) {
+                return Err(StepperRefusal::SoftLimit);
+            }
+            *step = self
+                .axis(i)
+                .angle_to_steps(angle - self.zero_deg[i])
+                .map_err(|_| StepperRefusal::Unreachable)?;
+        }
+        Ok(steps)
+    }
+}
+
+#[cfg(test)]
+mod tests;

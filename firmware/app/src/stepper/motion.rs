@@ -1,0 +1,392 @@
+//! The stepper task's low-priority work, pure: targets → joint angles →
+//! microstep moves → planner → segment prep. Board lines and arcs are cut
+//! into pieces whose ends go through the IK and whose insides are
+//! straight in steps, enough pieces (a power of two) that the spot stays
+//! within [`LINE_TOLERANCE_MM`] of the board curve.
+
+use kinematics_core::frames::BoardPoint;
+use kinematics_core::gimbal::JointAngles;
+use kinematics_core::stepper::{Planner, Segment, SegmentPrep, StepMove};
+
+use super::{MoveShape, SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
+use kinematics_core::Rotation;
+use kinematics_core::numeric::clamp;
+
+/// Largest distance of the pieces' joint-space insides from the board
+/// curve, mm (the steps' own rounding, ≤ half a step per axis, comes on
+/// top).
+pub const LINE_TOLERANCE_MM: f64 = 0.05;
+/// Most pieces one line is cut into.
+const MAX_PIECES: u32 = 4096;
+/// Look-ahead depth of the planner, blocks.
+const PLANNER_LEN: usize = 16;
+
+/// The board curve of a move being cut into pieces.
+#[derive(Debug, Clone, Copy)]
+enum Curve {
+    Line {
+        from: BoardPoint,
+        to: BoardPoint,
+    },
+    Arc {
+        centre: BoardPoint,
+        radius_cm: f64,
+        /// Angle of the start about the centre, rad.
+        start_rad: f64,
+        /// Signed angle swept (negative: clockwise), rad.
+        sweep_rad: f64,
+    },
+}
+
+impl Curve {
+    /// The curve from `from` to `to` as `shape` says (`None`: travel).
+    fn of(from: BoardPoint, to: BoardPoint, shape: MoveShape) -> Option<Self> {
+        match shape {
+            MoveShape::Travel => None,
+            MoveShape::Line => Some(Curve::Line { from, to }),
+            MoveShape::Arc { centre, rotation } => {
+                let angle = |p: BoardPoint| libm::atan2(p.y_cm - centre.y_cm, p.x_cm - centre.x_cm);
+                let (start_rad, end_rad) = (angle(from), angle(to));
+                let turn = 2.0 * core::f64::consts::PI;
+                let diff = libm::fmod(end_rad - start_rad, turn);
+                let mut ccw = if diff < 0.0 { diff + turn } else { diff };
+                // The same point: a full circle.
+                if ccw < 1e-12 {
+                    ccw = turn;
+                }
+                let sweep_rad = match rotation {
+                    Rotation::Ccw => ccw,
+                    Rotation::Cw => ccw - turn,
+                };
+                let sweep_rad = if sweep_rad == 0.0 { -turn } else { sweep_rad };
+                Some(Curve::Arc {
+                    centre,
+                    radius_cm: libm::hypot(from.x_cm - centre.x_cm, from.y_cm - centre.y_cm),
+                    start_rad,
+                    sweep_rad,
+                })
+            }
+        }
+    }
+
+    /// The point a fraction `t` (0..=1) along the curve.
+    fn at(&self, t: f64) -> BoardPoint {
+        match *self {
+            Curve::Line { from, to } => BoardPoint {
+                x_cm: from.x_cm + t * (to.x_cm - from.x_cm),
+                y_cm: from.y_cm + t * (to.y_cm - from.y_cm),
+            },
+            Curve::Arc {
+                centre,
+                radius_cm,
+                start_rad,
+                sweep_rad,
+            } => {
+                let (s, c) = libm::sincos(start_rad + t * sweep_rad);
+                BoardPoint {
+                    x_cm: centre.x_cm + radius_cm * c,
+                    y_cm: centre.y_cm + radius_cm * s,
+                }
+            }
+        }
+    }
+
+    /// Pieces to start from: arcs in pieces of at most 22.5° (so a
+    /// piece's midpoint tells its deviation; a full circle is not one
+    /// piece from its start to itself).
+    fn fewest_pieces(&self) -> u32 {
+        match *self {
+            Curve::Line { .. } => 1,
+            Curve::Arc { sweep_rad, .. } => {
+                let wanted = libm::ceil(sweep_rad.abs() / (core::f64::consts::PI / 8.0));
+                // ≤ 16 for |sweep| ≤ 2π: the cast is exact.
+                (wanted as u32).max(1).next_power_of_two()
+            }
+        }
+    }
+
+    /// Distance of `p` from the curve (near it), cm.
+    fn distance_cm(&self, p: BoardPoint) -> f64 {
+        match *self {
+            Curve::Line { from, to } => distance_to_segment_cm(p, from, to),
+            Curve::Arc {
+                centre, radius_cm, ..
+            } => (libm::hypot(p.x_cm - centre.x_cm, p.y_cm - centre.y_cm) - radius_cm).abs(),
+        }
+    }
+}
+
+/// A board curve being cut into pieces.
+#[derive(Debug, Clone, Copy)]
+struct PieceCut {
+    curve: Curve,
+    pieces: u32,
+    /// Next piece end to queue (1..=pieces).
+    next: u32,
+}
+
+impl PieceCut {
+    fn point(&self, k: u32) -> BoardPoint {
+        self.curve.at(f64::from(k) / f64::from(self.pieces))
+    }
+}
+
+/// Planner, segment prep and the move being cut.
+#[derive(Debug, Clone)]
+pub struct StepperMotion {
+    config: StepperConfig,
+    planner: Planner<PLANNER_LEN>,
+    prep: SegmentPrep,
+    /// Step position where the queued moves end, `[pan, tilt]`.
+    planned: [i32; 2],
+    /// Board point of the last target (`None` after a stop).
+    last_point: Option<BoardPoint>,
+    line: Option<PieceCut>,
+    /// The move in flight, reported when its last step has run.
+    pending: Option<u32>,
+}
+
+impl StepperMotion {
+    /// At rest at step position 0 with `config`.
+    ///
+    /// Errors: [`StepperRefusal::BadConfig`].
+    pub fn new(config: StepperConfig) -> Result<Self, StepperRefusal> {
+        let (planner, prep) = Self::pipeline(&config)?;
+        Ok(Self {
+            config,
+            planner,
+            prep,
+            planned: [0; 2],
+            last_point: None,
+            line: None,
+            pending: None,
+        })
+    }
+
+    fn pipeline(
+        config: &StepperConfig,
+    ) -> Result<(Planner<PLANNER_LEN>, SegmentPrep), StepperRefusal> {
+        let bad = StepperRefusal::BadConfig;
+        config.gimbal.validate().map_err(|_| bad)?;
+        let jd_steps = config.junction_deviation_deg / config.deg_per_step();
+        let planner = Planner::new(jd_steps).map_err(|_| bad)?;
+        let prep = SegmentPrep::new(STEP_TIMER_HZ, SEGMENT_S).map_err(|_| bad)?;
+        // The rates must pass the planner's checks.
+        kinematics_core::stepper::motion::validate_move(&Self::step_move(config, [1, 0]))
+            .map_err(|_| bad)?;
+        Ok((planner, prep))
+    }
+
+    fn step_move(config: &StepperConfig, steps: [i32; 2]) -> StepMove {
+        StepMove {
+            steps,
+            nominal_rate_steps_per_s: config.max_speed_deg_s / config.deg_per_step(),
+            accel_steps_per_s2: config.accel_deg_s2 / config.deg_per_step(),
+        }
+    }
+
+    /// The parameters in use.
+    pub fn config(&self) -> &StepperConfig {
+        &self.config
+    }
+
+    /// New parameters (at rest only: the position in steps is kept; a new
+    /// step angle or zero moves the joint angles it stands for).
+    ///
+    /// Errors: [`StepperRefusal::BadConfig`] (nothing changes).
+    pub fn configure(&mut self, config: StepperConfig) -> Result<(), StepperRefusal> {
+        let (planner, prep) = Self::pipeline(&config)?;
+        self.config = config;
+        self.planner = planner;
+        self.prep = prep;
+        self.last_point = None;
+        Ok(())
+    }
+
+    /// Whether nothing is left to plan or cut (the step timer may still be
+    /// running prepared segments).
+    pub fn is_planned_out(&self) -> bool {
+        self.line.is_none() && self.planner.is_empty() && !self.prep.is_busy()
+    }
+
+    /// Queues move `seq` to the board point `point` (cm), along the board
+    /// line or arc from the previous target when `shape` says so (and
+    /// there is one; else as travel).
+    ///
+    /// Errors: [`StepperRefusal`] (nothing queued; [`StepperRefusal::Busy`]
+    /// while a line is still being cut).
+    pub fn move_to(
+        &mut self,
+        seq: u32,
+        point: BoardPoint,
+        shape: MoveShape,
+    ) -> Result<(), StepperRefusal> {
+        if self.line.is_some() {
+            return Err(StepperRefusal::Busy);
+        }
+        let end = self.steps_at(point)?;
+        match self
+            .last_point
+            .and_then(|from| Curve::of(from, point, shape))
+        {
+            Some(curve) => {
+                let pieces = self.pieces_for(curve)?;
+                self.line = Some(PieceCut {
+                    curve,
+                    pieces,
+                    next: 1,
+                });
+            }
+            None => {
+                self.line = None;
+                self.push_to(end)?;
+            }
+        }
+        self.last_point = Some(point);
+        self.pending = Some(seq);
+        Ok(())
+    }
+
+    /// Step positions for a board point, inside the soft limits.
+    fn steps_at(&self, point: BoardPoint) -> Result<[i32; 2], StepperRefusal> {
+        let j = self.joints_at(point)?;
+        self.config.steps_of(j)
+    }
+
+    fn joints_at(&self, point: BoardPoint) -> Result<JointAngles, StepperRefusal> {
+        self.config
+            .gimbal
+            .ik(point)
+            .map_err(|_| StepperRefusal::Unreachable)
+    }
+
+    /// The fewest pieces (a power of two) whose joint-space midpoints lie
+    /// within [`LINE_TOLERANCE_MM`] of the curve; every piece end within
+    /// the soft limits.
+    fn pieces_for(&self, curve: Curve) -> Result<u32, StepperRefusal> {
+        let mut pieces = curve.fewest_pieces();
+        loop {
+            let cut = PieceCut {
+                curve,
+                pieces,
+                next: 1,
+            };
+            if self.max_deviation_mm(&cut)? <= LINE_TOLERANCE_MM || pieces >= MAX_PIECES {
+                return Ok(pieces);
+            }
+            pieces *= 2;
+        }
+    }
+
+    /// Largest distance of a piece's joint-space midpoint from the curve,
+    /// mm.
+    fn max_deviation_mm(&self, cut: &PieceCut) -> Result<f64, StepperRefusal> {
+        let mut worst = 0.0_f64;
+        let mut a = self.joints_at(cut.point(0))?;
+        for k in 1..=cut.pieces {
+            let b = self.joints_at(cut.point(k))?;
+            self.config.steps_of(b)?;
+            let mid = JointAngles {
+                yaw_deg: 0.5 * (a.yaw_deg + b.yaw_deg),
+                pitch_deg: 0.5 * (a.pitch_deg + b.pitch_deg),
+            };
+            let spot = self
+                .config
+                .gimbal
+                .fk(mid)
+                .map_err(|_| StepperRefusal::Unreachable)?;
+            worst = worst.max(10.0 * cut.curve.distance_cm(spot));
+            a = b;
+        }
+        Ok(worst)
+    }
+
+    /// Queues the move from the planned position to `end` (steps).
+    fn push_to(&mut self, end: [i32; 2]) -> Result<(), StepperRefusal> {
+        let delta = [
+            end[0].wrapping_sub(self.planned[0]),
+            end[1].wrapping_sub(self.planned[1]),
+        ];
+        self.planner
+            .push(&Self::step_move(&self.config, delta))
+            .map_err(|_| StepperRefusal::BadConfig)?;
+        self.planned = end;
+        Ok(())
+    }
+
+    /// Queues the line's next pieces while the planner has room.
+    fn feed_line(&mut self) {
+        while let Some(mut cut) = self.line {
+            if self.planner.len() >= PLANNER_LEN || cut.next > cut.pieces {
+                break;
+            }
+            // Checked in `pieces_for`: reachable and inside the limits.
+            let Ok(end) = self.steps_at(cut.point(cut.next)) else {
+                self.line = None;
+                break;
+            };
+            if self.push_to(end).is_err() {
+                self.line = None;
+                break;
+            }
+            cut.next += 1;
+            self.line = (cut.next <= cut.pieces).then_some(cut);
+        }
+    }
+
+    /// The next segment to prepare (`None`: nothing more for now).
+    pub fn next_segment(&mut self) -> Option<Segment> {
+        self.feed_line();
+        self.prep.next_segment(&mut self.planner)
+    }
+
+    /// Decelerates to rest at the limit along the path; what is left of
+    /// the move is dropped.
+    pub fn stop(&mut self) {
+        self.line = None;
+        self.pending = None;
+        self.prep.hold(&mut self.planner);
+    }
+
+    /// The steps were halted (or a stop came to rest) at `position`:
+    /// forget the plan, continue from there.
+    pub fn rest_at(&mut self, position: [i32; 2]) {
+        self.line = None;
+        self.pending = None;
+        self.planner.clear();
+        self.prep.reset();
+        self.planned = position;
+        self.last_point = None;
+    }
+
+    /// The move whose last step has run, once the step timer is idle
+    /// (`idle`) and nothing is left to plan.
+    pub fn take_arrived(&mut self, idle: bool) -> Option<u32> {
+        if idle && self.is_planned_out() {
+            self.pending.take()
+        } else {
+            None
+        }
+    }
+
+    /// Step position where the queued moves end.
+    pub fn planned_steps(&self) -> [i32; 2] {
+        self.planned
+    }
+}
+
+/// Distance from `p` to the segment `a`–`b`, cm.
+fn distance_to_segment_cm(p: BoardPoint, a: BoardPoint, b: BoardPoint) -> f64 {
+    let (dx, dy) = (b.x_cm - a.x_cm, b.y_cm - a.y_cm);
+    let len2 = dx * dx + dy * dy;
+    let t = if len2 > 0.0 {
+        clamp(
+            ((p.x_cm - a.x_cm) * dx + (p.y_cm - a.y_cm) * dy) / len2,
+            0.0,
+            1.0,
+        )
+    } else {
+        0.0
+    };
+    libm::hypot(p.x_cm - (a.x_cm + t * dx), p.y_cm - (a.y_cm + t * dy))
+}

@@ -1,0 +1,103 @@
+//! The simulated board's stepper outputs: every STEP/DIR/ENABLE edge goes
+//! to the driver models ([`PanTiltDrivers`]) with its time, the step timer
+//! is virtual time (1 µs ticks, deadlines that do not drift).
+
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use embassy_time::{Duration, Instant, Timer};
+use laser_app::stepper::{DriverSignals, STEP_TIMER_HZ, StepperDrive};
+
+use super::{PanTiltDrivers, StepEdge, StepPin};
+
+// The step timer's ticks are embassy-time's.
+const _: () = assert!(STEP_TIMER_HZ as u64 == embassy_time::TICK_HZ);
+
+/// The stepper outputs of the simulated board (implements
+/// [`StepperDrive`]).
+pub struct SimStepperDrive {
+    drivers: Rc<RefCell<PanTiltDrivers>>,
+    signals: DriverSignals,
+    next: Instant,
+    dir: [bool; 2],
+}
+
+impl SimStepperDrive {
+    /// Outputs into `drivers`.
+    pub fn new(drivers: Rc<RefCell<PanTiltDrivers>>) -> Self {
+        Self {
+            drivers,
+            signals: DriverSignals {
+                pulse_ns: 0,
+                dir_setup_ns: 0,
+                enable_active_high: false,
+            },
+            next: Instant::from_ticks(0),
+            dir: [false; 2],
+        }
+    }
+}
+
+fn now_ns() -> u64 {
+    crate::clock::now_us() * 1000
+}
+
+impl StepperDrive for SimStepperDrive {
+    /// Records the logical state (the ENABLE pin's level follows the
+    /// configured polarity).
+    fn set_enabled(&mut self, enabled: bool) {
+        crate::executor::simulator_work(|| {
+            self.drivers.borrow_mut().enable.push((now_ns(), enabled));
+        });
+    }
+
+    fn set_signals(&mut self, signals: DriverSignals) {
+        self.signals = signals;
+    }
+
+    /// The edges go to the driver models as simulator work (not charged
+    /// to the firmware task).
+    fn step(&mut self, step: [bool; 2], negative: [bool; 2]) {
+        crate::executor::simulator_work(|| self.record_step(step, negative));
+    }
+
+    async fn wait_ticks(&mut self, ticks: u32) {
+        self.next += Duration::from_ticks(u64::from(ticks));
+        Timer::at(self.next).await;
+    }
+
+    fn restart(&mut self) {
+        self.next = Instant::now();
+    }
+}
+
+impl SimStepperDrive {
+    fn record_step(&mut self, step: [bool; 2], negative: [bool; 2]) {
+        let t = now_ns();
+        let rise = t + u64::from(self.signals.dir_setup_ns);
+        let fall = rise + u64::from(self.signals.pulse_ns);
+        let mut drivers = self.drivers.borrow_mut();
+        for axis in 0..2u8 {
+            let i = usize::from(axis);
+            if negative[i] != self.dir[i] {
+                self.dir[i] = negative[i];
+                drivers.edge(StepEdge {
+                    t_ns: t,
+                    axis,
+                    pin: StepPin::Dir,
+                    high: negative[i],
+                });
+            }
+            if step[i] {
+                for (t_ns, high) in [(rise, true), (fall, false)] {
+                    drivers.edge(StepEdge {
+                        t_ns,
+                        axis,
+                        pin: StepPin::Step,
+                        high,
+                    });
+                }
+            }
+        }
+    }
+}
