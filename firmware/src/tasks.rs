@@ -18,7 +18,7 @@ use laser_app::app::{
 };
 use laser_app::galvo::GalvoMemory;
 
-use static_cell::ConstStaticCell;
+use static_cell::StaticCell;
 
 use crate::board::Stm32Board;
 use crate::galvo_dac::{self, Stm32GalvoDac};
@@ -55,11 +55,11 @@ async fn sequencer(task: SequencerTask<LaserPin, FlashSettings>) -> ! {
 /// The galvo loop (on the galvo executor): feeds the DAC stream.
 #[embassy_executor::task]
 async fn galvo(task: GalvoTask<Stm32GalvoDac>) {
-    // The loop's memory in a static, not in this task's future; built at
-    // compile time (`init_with` would build its 22 KB on this stack).
-    static MEMORY: ConstStaticCell<GalvoMemory<{ galvo_dac::HALF_LEN }>> =
-        ConstStaticCell::new(GalvoMemory::new());
-    task.run_in(MEMORY.take()).await
+    // The loop's memory in a static (.bss), not in this task's future;
+    // written in place (`init_with` would build its 22 KB on this stack,
+    // a const initialiser would put 22 KB of .data in flash).
+    static MEMORY: StaticCell<GalvoMemory<{ galvo_dac::HALF_LEN }>> = StaticCell::new();
+    task.run_in(GalvoMemory::init_in(MEMORY.uninit())).await
 }
 
 /// The stepper step timer: executes the prepared segments on PE9–PE13.

@@ -316,6 +316,30 @@ impl<const S: usize, const CAP: usize, const Q: usize> Integrator<S, CAP, Q> {
         at(&self.end_state, THETA)
     }
 
+    /// A placeholder of no model (all zero), to be [`reset`](Self::reset)
+    /// in place: lets a big owner be built without an integrator
+    /// temporary on the stack. Steps nothing useful until reset.
+    pub const IDLE: Self = Self {
+        a_minus_i: [[0.0; S]; S],
+        bd: [0.0; S],
+        ad64: [[0.0; S]; S],
+        bd64: [0.0; S],
+        z: [0.0; S],
+        comp: [0.0; S],
+        ring: [0.0; CAP],
+        read: 0,
+        queued: 0,
+        moves: [QueuedMove {
+            samples: 0,
+            target: [0.0; S],
+        }; Q],
+        move_read: 0,
+        move_count: 0,
+        k_in_move: 0,
+        end_state: [0.0; S],
+        rest_mask: [false; S],
+    };
+
     /// [`Self::new`] in place (nothing copied: the sample ring is a few KB):
     /// the model `disc`, at rest at `theta_rad`, queued moves dropped.
     /// Fails (changing nothing) for a non-finite `theta_rad`.

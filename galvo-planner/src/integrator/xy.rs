@@ -29,6 +29,12 @@ impl<const S: usize, const CAP: usize, const Q: usize> XyIntegrator<S, CAP, Q> {
         })
     }
 
+    /// Both axes [`Integrator::IDLE`]: reset before use.
+    pub const IDLE: Self = Self {
+        x: Integrator::IDLE,
+        y: Integrator::IDLE,
+    };
+
     /// [`Self::new`] in place (see [`Integrator::reset`]); fails, changing
     /// nothing, for a non-finite angle.
     pub fn reset(
