@@ -108,7 +108,7 @@ pub const M4_COST: CostModel = CostModel {
     // `loop.reconfigure`.
     rebuild: 4_560,
     // `loop.new`.
-    model_sampled: 462_560,
+    model_sampled: 371_080,
     cpi: 1.3,
     clock_hz: 168e6,
 };

@@ -200,6 +200,29 @@ impl<const HALF: usize> GalvoMemory<HALF> {
     }
 }
 
+impl<const HALF: usize> GalvoMemory<HALF> {
+    /// [`Self::new`] written into `slot` (a board's `static`, e.g.
+    /// `StaticCell::uninit()`) field by field: no 22 KB temporary on the
+    /// stack, no 22 KB initialiser in flash.
+    #[inline(never)]
+    pub fn init_in(slot: &mut core::mem::MaybeUninit<Self>) -> &mut Self {
+        let () = Self::HALF_OK;
+        let memory = slot.as_mut_ptr();
+        // SAFETY: `memory` comes from a `&mut MaybeUninit<Self>`, so it is
+        // valid and aligned for `Self`; both fields (the only ones) are
+        // written through raw pointers before the value is assumed
+        // initialised, and nothing reads them before.
+        unsafe {
+            core::ptr::addr_of_mut!((*memory).galvo).write(None);
+            let half = core::ptr::addr_of_mut!((*memory).half).cast::<DacSample>();
+            for i in 0..HALF {
+                half.add(i).write(DacSample::default());
+            }
+            slot.assume_init_mut()
+        }
+    }
+}
+
 impl<const HALF: usize> Default for GalvoMemory<HALF> {
     fn default() -> Self {
         Self::new()
@@ -232,26 +255,64 @@ impl GalvoLoop {
         Self::with_planning(config, planning)
     }
 
+    /// [`Self::for_dac`] into `slot` (replacing what it held), out of
+    /// line and in place: the loop (22 KB) is written into `slot`, its
+    /// integrator reset there, never built on the stack and moved. `Err`
+    /// leaves `slot` empty.
+    #[inline(never)]
+    pub fn start_in<D: DacStream>(
+        slot: &mut Option<Self>,
+        config: GalvoConfig,
+    ) -> Result<&mut Self, GalvoError> {
+        *slot = None;
+        let planning = prep::Planning::of::<D>();
+        planning.check(config.method)?;
+        let galvo = Self::placed(slot, config, planning)?;
+        let disc = galvo.disc;
+        let mirrors = galvo.mirrors.reset(&disc, &disc, galvo.active_end_rad);
+        if mirrors.is_err() {
+            *slot = None;
+            return Err(GalvoError::Planner);
+        }
+        slot.as_mut().ok_or(GalvoError::Planner)
+    }
+
     fn with_planning(config: GalvoConfig, planning: prep::Planning) -> Result<Self, GalvoError> {
+        let mut slot = None;
+        Self::placed(&mut slot, config, planning)?;
+        let galvo = slot.as_mut().ok_or(GalvoError::Planner)?;
+        let disc = galvo.disc;
+        galvo
+            .mirrors
+            .reset(&disc, &disc, galvo.active_end_rad)
+            .map_err(|_| GalvoError::Planner)?;
+        slot.ok_or(GalvoError::Planner)
+    }
+
+    /// The loop at the centre written into `slot`, its integrator
+    /// [`XyIntegrator::IDLE`] (the caller resets it to `disc`).
+    fn placed(
+        slot: &mut Option<Self>,
+        config: GalvoConfig,
+        planning: prep::Planning,
+    ) -> Result<&mut Self, GalvoError> {
         let angles_rad = [0.0, 0.0];
         let disc = config
             .mirrors
             .model()
             .and_then(|m| m.discretize(config.sample_period_s))
             .map_err(|_| GalvoError::Planner)?;
-        let mirrors =
-            XyIntegrator::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
         let [x_rad, y_rad] = angles_rad;
         let sample_map = SampleMap::new(&config.galvo).map_err(|_| GalvoError::Kinematics)?;
         let codes = sample_map
             .angles_to_codes(x_rad as f32, y_rad as f32)
             .ok_or(GalvoError::Kinematics)?;
         let ts = config.sample_period_s;
-        Ok(Self {
+        Ok(slot.insert(Self {
             sample_map,
             planning: config.galvo.cast(),
             disc,
-            mirrors,
+            mirrors: XyIntegrator::IDLE,
             steps: StepRing::new(),
             running: false,
             jump_codes: prep::JumpCodes::EMPTY,
@@ -273,7 +334,7 @@ impl GalvoLoop {
             off_delay_samples: samples_for(config.laser_off_delay_us, ts),
             jump_planning: planning,
             config,
-        })
+        }))
     }
 
     /// What the mirrors and laser are doing now.
@@ -415,6 +476,10 @@ impl GalvoLoop {
 
 impl GalvoLoop {
     /// Takes every request waiting in the link; refusals go back as events.
+    // Out of line (as the other per-half stages): the async run loop's
+    // frame, which nests on whatever stack the galvo interrupt
+    // interrupts, holds none of their temporaries.
+    #[inline(never)]
     fn take_requests(&mut self, link: &GalvoLink) {
         while let Ok(request) = link.requests.try_receive() {
             if let Some(event) = self.request(request) {

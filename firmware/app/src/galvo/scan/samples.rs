@@ -49,6 +49,7 @@ impl GalvoLoop {
     /// sample). A step that is not prepared yet holds the mirrors, laser
     /// off, until a later refill finds it prepared. `on_event` and the
     /// result as for [`Self::fill`].
+    #[inline(never)]
     pub fn refill(&mut self, out: &mut [DacSample], mut on_event: impl FnMut(GalvoEvent)) -> usize {
         self.fill_with(out, &mut on_event, false)
     }

@@ -569,3 +569,27 @@ fn a_board_that_cannot_afford_bisection_refuses_seed_parameters() {
     host.prep();
     assert_eq!(host.work.bisection_axes, 2);
 }
+
+#[test]
+fn memory_init_in_place_is_an_empty_dark_memory() {
+    let mut slot = core::mem::MaybeUninit::<GalvoMemory<64>>::uninit();
+    let memory = GalvoMemory::init_in(&mut slot);
+    assert!(memory.galvo.is_none());
+    assert!(
+        memory
+            .half
+            .iter()
+            .all(|s| *s == DacSample::default() && !s.laser)
+    );
+    // The loop started in place equals one built by value.
+    let galvo = GalvoLoop::start_in::<M4Dac>(&mut memory.galvo, GalvoConfig::default())
+        .expect("default loop");
+    let built = GalvoLoop::for_dac::<M4Dac>(GalvoConfig::default()).expect("default loop");
+    assert_eq!(galvo.phase(), built.phase());
+    assert_eq!(
+        galvo.mirrors.end_position_rad(),
+        built.mirrors.end_position_rad()
+    );
+    assert_eq!(galvo.mirrors.x.end_state(), built.mirrors.x.end_state());
+    assert_eq!(galvo.last, built.last);
+}
