@@ -3,8 +3,9 @@
 
 use galvo_planner::Error as PlannerError;
 
+use super::build::samples_for;
 use super::runs::queue_jump;
-use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase, samples_for};
+use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase};
 use crate::domain::Unit;
 use crate::galvo::{DacSample, GalvoEvent};
 

@@ -5,6 +5,7 @@ use std::vec::Vec;
 use galvo_planner::{JumpSync, Method, XyIntegrator, plan_xy_jump};
 use kinematics_core::{Galvo, MirrorAngles, PointMm};
 
+use super::build::samples_for;
 use super::*;
 use crate::domain::PointCm;
 use crate::galvo::GalvoRequest;
