@@ -316,6 +316,65 @@ impl<const S: usize, const CAP: usize, const Q: usize> Integrator<S, CAP, Q> {
         at(&self.end_state, THETA)
     }
 
+    /// A placeholder of no model (all zero), to be [`reset`](Self::reset)
+    /// in place: lets a big owner be built without an integrator
+    /// temporary on the stack. Steps nothing useful until reset.
+    pub const IDLE: Self = Self {
+        a_minus_i: [[0.0; S]; S],
+        bd: [0.0; S],
+        ad64: [[0.0; S]; S],
+        bd64: [0.0; S],
+        z: [0.0; S],
+        comp: [0.0; S],
+        ring: [0.0; CAP],
+        read: 0,
+        queued: 0,
+        moves: [QueuedMove {
+            samples: 0,
+            target: [0.0; S],
+        }; Q],
+        move_read: 0,
+        move_count: 0,
+        k_in_move: 0,
+        end_state: [0.0; S],
+        rest_mask: [false; S],
+    };
+
+    /// [`Self::new`] in place (nothing copied: the sample ring is a few KB):
+    /// the model `disc`, at rest at `theta_rad`, queued moves dropped.
+    /// Fails (changing nothing) for a non-finite `theta_rad`.
+    pub fn reset(&mut self, disc: &Discrete<S>, theta_rad: f64) -> Result<(), Error> {
+        let theta_rad = finite(theta_rad, "theta_rad")?;
+        let rest = disc.model().rest_state(theta_rad);
+        let ad = disc.ad();
+        for (i, row) in self.a_minus_i.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                let a = ad.get(i).map_or(0.0, |r| at(r, j));
+                *v = (if i == j { a - 1.0 } else { a }) as f32;
+            }
+        }
+        self.bd = to_f32(disc.bd());
+        self.ad64 = *ad;
+        self.bd64 = *disc.bd();
+        self.z = to_f32(&rest);
+        self.comp = [0.0; S];
+        self.ring.fill(0.0);
+        self.read = 0;
+        self.queued = 0;
+        for m in &mut self.moves {
+            *m = QueuedMove {
+                samples: 0,
+                target: rest,
+            };
+        }
+        self.move_read = 0;
+        self.move_count = 0;
+        self.k_in_move = 0;
+        self.end_state = rest;
+        self.rest_mask = *disc.model().position_states();
+        Ok(())
+    }
+
     /// Re-seats an idle integrator at rest at `theta_rad` (e.g. where a marked
     /// path, which drives the mirrors directly, left them), so the next jump
     /// is planned and queued from there. Fails with

@@ -11,6 +11,7 @@ mod qemu;
 mod scenario;
 mod sim;
 mod size_gcode;
+mod size_stack;
 mod toolchain;
 
 use std::process::ExitCode;

@@ -289,7 +289,8 @@ pub fn llvm_size_path() -> Result<PathBuf> {
 }
 
 /// `cargo xtask size`: builds the release image, prints text/data/bss and
-/// fails when it exceeds the flash or RAM budget.
+/// its largest stack frames, and fails when it exceeds the flash or RAM
+/// budget or a frame exceeds the frame budget.
 pub fn size() -> Result<()> {
     // Always (re)build: a stale ELF would report an old size.
     let elf = build_firmware()?;
@@ -319,7 +320,8 @@ pub fn size() -> Result<()> {
         100.0 * size.ram_bytes() as f64 / RAM_BUDGET_BYTES as f64
     );
     crate::size_gcode::report(&elf, &llvm_size)?;
-    check_budget(size)
+    check_budget(size)?;
+    crate::size_stack::report(&elf, &llvm_size)
 }
 
 /// Fails with a clear message when the image is over budget.

@@ -36,11 +36,11 @@ async fn sequencer(task: SequencerTask<LaserPin, RamSettings>) -> ! {
 #[embassy_executor::task]
 async fn galvo(task: GalvoTask<crate::galvo_dac::QemuDac>) {
     // The loop's memory in a static, not in this task's future (as on the
-    // STM32 board).
+    // STM32 board), built at compile time, not on this stack.
     static MEMORY: static_cell::StaticCell<
         laser_app::galvo::GalvoMemory<{ crate::galvo_dac::HALF_LEN }>,
     > = static_cell::StaticCell::new();
-    task.run_in(MEMORY.init_with(laser_app::galvo::GalvoMemory::new))
+    task.run_in(laser_app::galvo::GalvoMemory::init_in(MEMORY.uninit()))
         .await
 }
 

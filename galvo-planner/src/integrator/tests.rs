@@ -345,3 +345,49 @@ fn angles_ahead_equal_stepping_and_skipping_lands() {
         assert_eq!(skipped.step(), stepped.step());
     }
 }
+
+#[test]
+fn reset_in_place_equals_a_new_integrator() {
+    let slow = rigid(20e-6);
+    let fast = rigid(10e-6);
+    let from = [1.0 * DEG, -2.0 * DEG];
+    let to = [8.0 * DEG, 3.0 * DEG];
+    let plan = |d| {
+        plan_xy_jump(
+            d,
+            d,
+            from,
+            to,
+            Method::TimeOptimal,
+            JumpSync::Independent,
+            1024,
+        )
+    };
+    // A busy integrator of another model, reset mid-jump.
+    let mut reset: XyIntegrator<3, 1024> = XyIntegrator::new(&slow, &slow, [0.0, 0.0]).expect("xy");
+    let other = plan_xy_jump(
+        &slow,
+        &slow,
+        [0.0, 0.0],
+        to,
+        Method::TimeOptimal,
+        JumpSync::Independent,
+        1024,
+    )
+    .expect("jump");
+    reset.queue_jump(&other).expect("queue");
+    reset.step();
+    // A refused reset changes nothing.
+    assert!(reset.reset(&fast, &fast, [f64::NAN, 0.0]).is_err());
+    assert!(!reset.is_idle());
+    reset.reset(&fast, &fast, from).expect("reset");
+    assert!(reset.is_idle());
+    let mut fresh: XyIntegrator<3, 1024> = XyIntegrator::new(&fast, &fast, from).expect("xy");
+    let jump = plan(&fast).expect("jump");
+    reset.queue_jump(&jump).expect("queue");
+    fresh.queue_jump(&jump).expect("queue");
+    for _ in 0..jump.samples() + 3 {
+        assert_eq!(reset.step(), fresh.step());
+    }
+    assert_eq!(reset.x.end_state(), fresh.x.end_state());
+}

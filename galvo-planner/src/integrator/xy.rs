@@ -29,6 +29,27 @@ impl<const S: usize, const CAP: usize, const Q: usize> XyIntegrator<S, CAP, Q> {
         })
     }
 
+    /// Both axes [`Integrator::IDLE`]: reset before use.
+    pub const IDLE: Self = Self {
+        x: Integrator::IDLE,
+        y: Integrator::IDLE,
+    };
+
+    /// [`Self::new`] in place (see [`Integrator::reset`]); fails, changing
+    /// nothing, for a non-finite angle.
+    pub fn reset(
+        &mut self,
+        disc_x: &Discrete<S>,
+        disc_y: &Discrete<S>,
+        theta_rad: [f64; 2],
+    ) -> Result<(), Error> {
+        let [tx, ty] = theta_rad;
+        finite(tx, "theta_rad")?;
+        finite(ty, "theta_rad")?;
+        self.x.reset(disc_x, tx)?;
+        self.y.reset(disc_y, ty)
+    }
+
     /// Queues both axes of a jump, or neither.
     pub fn queue_jump(&mut self, jump: &XyJump<S>) -> Result<(), Error> {
         self.x.check_queue(&jump.x)?;

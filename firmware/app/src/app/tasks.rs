@@ -124,8 +124,8 @@ impl<D: DacStream> GalvoTask<D> {
             return;
         }
         let GalvoMemory { galvo, half } = memory;
-        let galvo = match GalvoLoop::for_dac::<D>(GalvoConfig::default()) {
-            Ok(built) => galvo.insert(built),
+        let galvo = match GalvoLoop::start_in::<D>(galvo, GalvoConfig::default()) {
+            Ok(galvo) => galvo,
             Err(e) => {
                 log::error!("galvo loop not started: {}", e);
                 return;

@@ -5,7 +5,7 @@ use core::fmt;
 use core::sync::atomic::Ordering;
 
 use galvo_planner::blocks::LoopIntegrator;
-use galvo_planner::{Discrete, Method, RigidParams, XyIntegrator};
+use galvo_planner::{Discrete, Method, RigidParams};
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
@@ -172,110 +172,7 @@ pub struct GalvoLoop {
     jump_planning: prep::Planning,
 }
 
-/// The galvo loop's memory: the loop (its prepared steps and jump
-/// integrator, about 22 KB) and the half buffer of `HALF` samples it
-/// computes into (at least the DAC's [`DacStream::half_len`]). A board
-/// keeps it in a `static` and hands it to
-/// [`GalvoTask::run_in`](crate::app::GalvoTask::run_in), so it is counted
-/// once and the task's future holds only a reference.
-pub struct GalvoMemory<const HALF: usize = MAX_HALF_LEN> {
-    pub(crate) galvo: Option<GalvoLoop>,
-    pub(crate) half: [DacSample; HALF],
-}
-
-impl<const HALF: usize> GalvoMemory<HALF> {
-    const HALF_OK: () = assert!(HALF > 0 && HALF <= MAX_HALF_LEN, "HALF in 1..=512");
-
-    /// No loop yet, a dark half buffer (usable in a `static`).
-    pub const fn new() -> Self {
-        let () = Self::HALF_OK;
-        Self {
-            galvo: None,
-            half: [DacSample {
-                x_code: 0,
-                y_code: 0,
-                laser: false,
-            }; HALF],
-        }
-    }
-}
-
-impl<const HALF: usize> Default for GalvoMemory<HALF> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-fn samples_for(us: u32, ts_s: f64) -> u32 {
-    // Whole samples, rounded up: a delay is never shorter than asked.
-    libm::ceil(f64::from(us) * 1e-6 / ts_s - 1e-9).max(0.0) as u32
-}
-
 impl GalvoLoop {
-    /// A loop holding the mirrors at the centre, laser off.
-    ///
-    /// Errors: [`GalvoError::Planner`] for an invalid mirror model or
-    /// sample period, [`GalvoError::Kinematics`] for invalid geometry.
-    ///
-    /// It plans jumps with every method, in `f64` where the method needs
-    /// it (a host); a board's loop is built by [`Self::for_dac`].
-    pub fn new(config: GalvoConfig) -> Result<Self, GalvoError> {
-        Self::with_planning(config, prep::Planning::HOST)
-    }
-
-    /// [`Self::new`] for the loop that feeds `D`, planning jumps as its
-    /// board can ([`DacStream::F64_PLANNING`]); also
-    /// [`GalvoError::SeedTooSlow`] for `planner seed` where it cannot.
-    pub fn for_dac<D: DacStream>(config: GalvoConfig) -> Result<Self, GalvoError> {
-        let planning = prep::Planning::of::<D>();
-        planning.check(config.method)?;
-        Self::with_planning(config, planning)
-    }
-
-    fn with_planning(config: GalvoConfig, planning: prep::Planning) -> Result<Self, GalvoError> {
-        let angles_rad = [0.0, 0.0];
-        let disc = config
-            .mirrors
-            .model()
-            .and_then(|m| m.discretize(config.sample_period_s))
-            .map_err(|_| GalvoError::Planner)?;
-        let mirrors =
-            XyIntegrator::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
-        let [x_rad, y_rad] = angles_rad;
-        let sample_map = SampleMap::new(&config.galvo).map_err(|_| GalvoError::Kinematics)?;
-        let codes = sample_map
-            .angles_to_codes(x_rad as f32, y_rad as f32)
-            .ok_or(GalvoError::Kinematics)?;
-        let ts = config.sample_period_s;
-        Ok(Self {
-            sample_map,
-            planning: config.galvo.cast(),
-            disc,
-            mirrors,
-            steps: StepRing::new(),
-            running: false,
-            jump_codes: prep::JumpCodes::EMPTY,
-            jump_cursor: None,
-            active_end_rad: angles_rad,
-            unprepared_samples: 0,
-            work: super::LoopWork::default(),
-            motion: Motion::default(),
-            queue: heapless::Deque::new(),
-            active: None,
-            last: DacSample {
-                x_code: codes.x.code,
-                y_code: codes.y.code,
-                laser: false,
-            },
-            faulted: false,
-            pending_config: None,
-            on_delay_samples: samples_for(config.laser_on_delay_us, ts),
-            off_delay_samples: samples_for(config.laser_off_delay_us, ts),
-            jump_planning: planning,
-            config,
-        })
-    }
-
     /// What the mirrors and laser are doing now.
     pub fn phase(&self) -> ScanPhase {
         // By reference: this runs several times per sample.
@@ -415,6 +312,10 @@ impl GalvoLoop {
 
 impl GalvoLoop {
     /// Takes every request waiting in the link; refusals go back as events.
+    // Out of line (as the other per-half stages): the async run loop's
+    // frame, which nests on whatever stack the galvo interrupt
+    // interrupts, holds none of their temporaries.
+    #[inline(never)]
     fn take_requests(&mut self, link: &GalvoLink) {
         while let Ok(request) = link.requests.try_receive() {
             if let Some(event) = self.request(request) {
@@ -466,7 +367,11 @@ impl Active {
     }
 }
 
+mod build;
 mod jobs;
+mod memory;
+
+pub use self::memory::GalvoMemory;
 mod mark;
 mod prep;
 mod runs;

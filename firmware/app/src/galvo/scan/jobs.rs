@@ -3,11 +3,11 @@
 
 use kinematics_core::PointMm;
 
-use galvo_planner::XyIntegrator;
 use kinematics_core::SampleMap;
 
+use super::build::samples_for;
 use super::mark::Motion;
-use super::{Active, GalvoConfig, GalvoError, GalvoLoop, Job, ScanPhase, samples_for};
+use super::{Active, GalvoConfig, GalvoError, GalvoLoop, Job, ScanPhase};
 use crate::domain::Unit;
 use crate::galvo::{DacSample, GalvoEvent, GalvoRequest};
 use crate::log;
@@ -97,6 +97,7 @@ impl GalvoLoop {
 
     /// Applies new parameters if no job is running; a refused
     /// configuration is reported and dropped.
+    #[inline(never)]
     pub(super) fn apply_pending_config(&mut self, at_half_boundary: bool) -> Option<GalvoEvent> {
         let config = self.pending_config?;
         if self.active.is_some()
@@ -123,6 +124,7 @@ impl GalvoLoop {
     /// matrix exponential, most of the cost on the M4) only when the
     /// mirrors or the sample rate changed; nothing else is rebuilt (the
     /// loop's buffers stay where they are, not copied).
+    #[inline(never)]
     fn reconfigure(&mut self, config: GalvoConfig) -> Result<(), GalvoError> {
         self.jump_planning.check(config.method)?;
         let angles_rad = self.mirrors.end_position_rad();
@@ -143,8 +145,10 @@ impl GalvoLoop {
                 .model()
                 .and_then(|m| m.discretize(config.sample_period_s))
                 .map_err(|_| GalvoError::Planner)?;
-            self.mirrors =
-                XyIntegrator::new(&disc, &disc, angles_rad).map_err(|_| GalvoError::Planner)?;
+            // In place: a new integrator would be built on the stack.
+            self.mirrors
+                .reset(&disc, &disc, angles_rad)
+                .map_err(|_| GalvoError::Planner)?;
             self.disc = disc;
             self.work.models_sampled += 1;
         }

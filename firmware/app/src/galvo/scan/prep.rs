@@ -173,6 +173,7 @@ impl GalvoLoop {
 
     /// [`Self::prep`], preparing at most `max_steps` steps (the run loop
     /// prepares one per half buffer, to stay within its window).
+    #[inline(never)]
     pub fn prep_up_to(&mut self, max_steps: usize) -> usize {
         let mut prepared = 0;
         while prepared < max_steps && self.steps.len() - self.started() < PREP_DEPTH {

@@ -3,8 +3,9 @@
 
 use galvo_planner::Error as PlannerError;
 
+use super::build::samples_for;
 use super::runs::queue_jump;
-use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase, samples_for};
+use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase};
 use crate::domain::Unit;
 use crate::galvo::{DacSample, GalvoEvent};
 
@@ -49,6 +50,7 @@ impl GalvoLoop {
     /// sample). A step that is not prepared yet holds the mirrors, laser
     /// off, until a later refill finds it prepared. `on_event` and the
     /// result as for [`Self::fill`].
+    #[inline(never)]
     pub fn refill(&mut self, out: &mut [DacSample], mut on_event: impl FnMut(GalvoEvent)) -> usize {
         self.fill_with(out, &mut on_event, false)
     }

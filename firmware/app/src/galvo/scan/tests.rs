@@ -5,6 +5,7 @@ use std::vec::Vec;
 use galvo_planner::{JumpSync, Method, XyIntegrator, plan_xy_jump};
 use kinematics_core::{Galvo, MirrorAngles, PointMm};
 
+use super::build::samples_for;
 use super::*;
 use crate::domain::PointCm;
 use crate::galvo::GalvoRequest;
@@ -568,4 +569,28 @@ fn a_board_that_cannot_afford_bisection_refuses_seed_parameters() {
     host.work = crate::galvo::LoopWork::default();
     host.prep();
     assert_eq!(host.work.bisection_axes, 2);
+}
+
+#[test]
+fn memory_init_in_place_is_an_empty_dark_memory() {
+    let mut slot = core::mem::MaybeUninit::<GalvoMemory<64>>::uninit();
+    let memory = GalvoMemory::init_in(&mut slot);
+    assert!(memory.galvo.is_none());
+    assert!(
+        memory
+            .half
+            .iter()
+            .all(|s| *s == DacSample::default() && !s.laser)
+    );
+    // The loop started in place equals one built by value.
+    let galvo = GalvoLoop::start_in::<M4Dac>(&mut memory.galvo, GalvoConfig::default())
+        .expect("default loop");
+    let built = GalvoLoop::for_dac::<M4Dac>(GalvoConfig::default()).expect("default loop");
+    assert_eq!(galvo.phase(), built.phase());
+    assert_eq!(
+        galvo.mirrors.end_position_rad(),
+        built.mirrors.end_position_rad()
+    );
+    assert_eq!(galvo.mirrors.x.end_state(), built.mirrors.x.end_state());
+    assert_eq!(galvo.last, built.last);
 }
