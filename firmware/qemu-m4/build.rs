@@ -12,11 +12,14 @@ fn main() {
         fs::copy(dir.join(file), out.join(file)).expect("copy the link script to OUT_DIR");
         println!("cargo:rerun-if-changed={file}");
     }
-    fs::write(
-        out.join("defmt.x"),
-        "/* qemu-m4 links no defmt: intentionally empty */\n",
-    )
-    .expect("write defmt.x to OUT_DIR");
+    // With `defmt-log` the defmt crate's own defmt.x is the one to find.
+    if env::var_os("CARGO_FEATURE_DEFMT_LOG").is_none() {
+        fs::write(
+            out.join("defmt.x"),
+            "/* qemu-m4 links no defmt: intentionally empty */\n",
+        )
+        .expect("write defmt.x to OUT_DIR");
+    }
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed=build.rs");
 }

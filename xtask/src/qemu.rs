@@ -9,8 +9,10 @@
 //! script's waits stay together in real time.
 
 mod board_log;
+mod defmt_log;
 mod machine;
 mod measure;
+mod pty;
 mod script;
 mod servo_bus;
 mod terminal;
@@ -20,6 +22,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::Receiver;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -27,7 +30,9 @@ use anyhow::{Context, Result, bail};
 use laser_sim::recorder::{Recording, SpotSample};
 
 pub use board_log::{BoardEvent, BoardLog};
+pub use defmt_log::check_channel as check_defmt_channel;
 pub use machine::{Machine, MachineOptions};
+pub use pty::check_console as check_pty_console;
 pub use script::{BoardStep, parse_board_script, split_at_resets};
 use script::{run_steps, wait_until_idle};
 pub use terminal::Terminal;
@@ -73,6 +78,11 @@ pub struct QemuArgs {
     /// Stop after this long, s (default 600; no limit with --interactive).
     #[arg(long)]
     max_time_s: Option<f64>,
+    /// The console on a raw pseudo-terminal for a serial program or a
+    /// G-code sender (its path is printed; with PATH also a symlink to it),
+    /// until Ctrl-C or --max-time-s.
+    #[arg(long, num_args = 0..=1, default_missing_value = "", conflicts_with_all = ["script", "interactive"])]
+    pty: Option<PathBuf>,
     /// Print the board's log channel on stderr.
     #[arg(long)]
     log: bool,
@@ -85,6 +95,11 @@ pub struct QemuArgs {
     /// works, and the galvo loop runs on the emulated M4.
     #[arg(long)]
     galvo_dac: bool,
+    /// laser-app's logs as defmt frames on UART3, decoded with
+    /// defmt-decoder against the image (printed with --log) instead of
+    /// the plain-text records.
+    #[arg(long)]
+    defmt_log: bool,
     /// Measure the board (image size, instructions per command and per
     /// second of holding, peak stack per task, the log channel's cost).
     #[arg(long, conflicts_with_all = ["script", "interactive", "scenarios"])]
@@ -124,7 +139,7 @@ fn script_text(args: &QemuArgs) -> Result<String> {
         Ok(text)
     };
     match &args.script {
-        _ if args.interactive => Ok(String::new()),
+        _ if args.interactive || args.pty.is_some() => Ok(String::new()),
         Some(path) if path.as_os_str() == "-" => read_stdin(),
         Some(path) => std::fs::read_to_string(path)
             .with_context(|| format!("cannot read script {}", path.display())),
@@ -194,6 +209,13 @@ pub enum Drive {
     Steps(Vec<BoardStep>),
     /// Lines typed on stdin until it ends.
     Interactive,
+    /// Bytes from the PTY bridge until `stop` is set.
+    Pty {
+        /// The host's bytes.
+        from_host: Receiver<Vec<u8>>,
+        /// Ends the run.
+        stop: Arc<AtomicBool>,
+    },
 }
 
 /// Runs `drive` on a fresh board from `elf`; `until_idle` then waits for
@@ -217,6 +239,11 @@ pub fn run_board(
                 let steps = parse_board_script(&line).unwrap_or_default();
                 run_steps(&mut machine, &steps, deadline)?;
             }
+            true
+        }
+        Drive::Pty { from_host, stop } => {
+            pty::forward_typed(&machine, from_host)?;
+            pty::wait_for_stop(&stop, deadline);
             true
         }
     };
@@ -265,27 +292,47 @@ pub fn run(args: QemuArgs) -> Result<ExitCode> {
     let max_time_s = match args.max_time_s {
         Some(s) if s.is_finite() && s > 0.0 => s,
         Some(_) => bail!("--max-time-s must be positive"),
-        None if args.interactive => 3.2e7,
+        None if args.interactive || args.pty.is_some() => 3.2e7,
         None => 600.0,
     };
-    let elf = if args.galvo_dac {
-        build_image_with(&["galvo-dac"], false)?
-    } else {
-        build_image()?
-    };
+    let mut features = Vec::new();
+    if args.galvo_dac {
+        features.push("galvo-dac");
+    }
+    if args.defmt_log {
+        features.push("defmt-log");
+    }
+    let elf = build_image_with(&features, args.defmt_log)?;
     if args.interactive {
         eprintln!("xtask qemu: type commands (help lists them); Ctrl-D ends the run");
     }
-    let drive = if args.interactive {
-        Drive::Interactive
-    } else {
-        Drive::Steps(steps)
-    };
-    let options = MachineOptions {
+    let mut options = MachineOptions {
         faults,
         slow_factor,
         echo: true,
         echo_log: args.log,
+        console_tee: None,
+    };
+    let mut open_pty = None;
+    let drive = if let Some(link) = &args.pty {
+        let link = (!link.as_os_str().is_empty()).then_some(link.as_path());
+        let (pty, bridge) = pty::open(link)?;
+        eprintln!(
+            "xtask qemu: console on {} (Ctrl-C ends the run)",
+            pty.path.display()
+        );
+        let stop = Arc::new(AtomicBool::new(false));
+        laser_sim::pty::stop_on_signals(stop.clone());
+        options.console_tee = Some(bridge.to_host.clone());
+        open_pty = Some(pty);
+        Drive::Pty {
+            from_host: bridge.from_host,
+            stop,
+        }
+    } else if args.interactive {
+        Drive::Interactive
+    } else {
+        Drive::Steps(steps)
     };
     let run = run_board(
         &elf,
@@ -295,6 +342,7 @@ pub fn run(args: QemuArgs) -> Result<ExitCode> {
         Duration::from_secs_f64(max_time_s),
         args.trace.is_some(),
     )?;
+    drop(open_pty);
     write_outputs(&args, &run)?;
     eprintln!(
         "xtask qemu: ended at t = {:.3} s; {} boots, {} servo frames, {} laser switches, {} error replies",

@@ -188,6 +188,7 @@ pub fn on_qemu(elf: &Path, scenario: &Scenario) -> Result<Outcome> {
         slow_factor,
         echo: false,
         echo_log: false,
+        console_tee: None,
     };
     let steps = parse_board_script(&scenario.script)?;
     let run = run_board(
@@ -232,6 +233,27 @@ pub fn run_on_qemu() -> Result<()> {
         if let Err(e) = verdict {
             failures.push(format!("{}: {e:#}", scenario.name));
         }
+    }
+    let started = std::time::Instant::now();
+    let verdict = crate::qemu::check_pty_console(&plain);
+    println!(
+        "the --pty console on QEMU: {} ({:.1} s)",
+        if verdict.is_ok() { "ok" } else { "FAILED" },
+        started.elapsed().as_secs_f64()
+    );
+    if let Err(e) = verdict {
+        failures.push(format!("--pty console: {e:#}"));
+    }
+    let started = std::time::Instant::now();
+    let verdict = crate::qemu::build_image_with(&["defmt-log"], true)
+        .and_then(|elf| crate::qemu::check_defmt_channel(&elf));
+    println!(
+        "the defmt log channel on QEMU: {} ({:.1} s)",
+        if verdict.is_ok() { "ok" } else { "FAILED" },
+        started.elapsed().as_secs_f64()
+    );
+    if let Err(e) = verdict {
+        failures.push(format!("defmt log channel: {e:#}"));
     }
     if !failures.is_empty() {
         bail!("scenarios failed:\n{}", failures.join("\n"));

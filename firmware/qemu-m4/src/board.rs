@@ -6,6 +6,7 @@
 //! | console               | UART0 0x4000_4000 (IRQ 0 rx, 1 tx)           |
 //! | servo bus (FashionStar)| UART1 0x4000_5000 (IRQ 2/3)                 |
 //! | log channel, stop button | UART2 0x4000_6000 (IRQ 4/5)               |
+//! | defmt logs (`defmt-log`) | UART3 0x4000_7000 (polled)                |
 //! | embassy-time          | APB timers 0/1 0x4000_0000/0x4000_1000 (IRQ 8/9) |
 //! | watchdog              | CMSDK watchdog 0x4000_8000 (NMI, then reset) |
 //! | laser pin, LEDs       | reported on the log channel                  |

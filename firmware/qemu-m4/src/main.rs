@@ -6,6 +6,8 @@
 #![no_main]
 
 mod board;
+#[cfg(feature = "defmt-log")]
+mod defmt_channel;
 mod executor;
 mod faults;
 #[cfg(feature = "galvo-dac")]
@@ -45,6 +47,8 @@ fn main() -> ! {
     stats::paint_stack();
     uart::Uart::start(&uart::UART2);
     log_channel::init();
+    #[cfg(feature = "defmt-log")]
+    defmt_channel::init();
     time_driver::init();
     log::info!(
         "{} {} (git {}) booting on QEMU mps2-an386",

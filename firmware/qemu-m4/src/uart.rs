@@ -158,6 +158,12 @@ impl UartState {
         self.with(|_, s| s.tx_waker.wake());
     }
 
+    /// Enables the transmitter only (no interrupts): for a polled output.
+    #[cfg(feature = "defmt-log")]
+    pub fn enable_tx(&self) {
+        self.regs.ctrl().set_bits(CTRL_TX_ENABLE);
+    }
+
     /// Writes `byte`, waiting (spinning) while the UART is full: for the
     /// log channel, which must work from any context.
     pub fn write_blocking(&self, byte: u8) {
@@ -170,6 +176,10 @@ impl UartState {
 pub static UART0: UartState = UartState::new(0x4000_4000, Irq::Uart0Rx, Irq::Uart0Tx);
 /// UART1: the FashionStar servo bus.
 pub static UART1: UartState = UartState::new(0x4000_5000, Irq::Uart1Rx, Irq::Uart1Tx);
+/// UART3: laser-app's defmt logs (feature `defmt-log`; out only, polled:
+/// its interrupts are never enabled, so the lines named here are unused).
+#[cfg(feature = "defmt-log")]
+pub static UART3: UartState = UartState::new(0x4000_7000, Irq::Uart2Rx, Irq::Uart2Tx);
 /// UART2: the log channel (out) and the stop button (in).
 pub static UART2: UartState = UartState::new(0x4000_6000, Irq::Uart2Rx, Irq::Uart2Tx);
 

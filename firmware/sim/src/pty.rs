@@ -110,8 +110,10 @@ const CHUNKS_IN_FLIGHT: usize = 4;
 
 /// The threads moving bytes between the PTY master and the simulator.
 pub struct PtyBridge {
-    from_host: Receiver<Vec<u8>>,
-    to_host: SyncSender<Vec<u8>>,
+    /// Bytes the host wrote (the reader thread stops reading while full).
+    pub from_host: Receiver<Vec<u8>>,
+    /// Bytes for the host (a send blocks while the host does not read).
+    pub to_host: SyncSender<Vec<u8>>,
 }
 
 impl PtyBridge {

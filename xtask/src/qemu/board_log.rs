@@ -74,6 +74,8 @@ pub struct BoardLog {
     pub leds: Vec<(u64, String)>,
     /// Log records: (board µs, `LEVEL message`).
     pub logs: Vec<(u64, String)>,
+    /// laser-app's defmt logs, decoded (`defmt-log` images, UART3).
+    pub defmt_lines: Vec<String>,
     /// The board's measurement reports (the text after `@stats`).
     pub stats: Vec<String>,
     /// Boots seen.

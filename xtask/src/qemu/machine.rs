@@ -1,4 +1,4 @@
-//! One run of the emulated board: QEMU started on the image with its three
+//! One run of the emulated board: QEMU started on the image with its four
 //! UARTs and its monitor on Unix sockets this process listens on, and the
 //! threads that serve them (console terminal, servo bus, log channel).
 
@@ -7,6 +7,7 @@ use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc::SyncSender;
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -16,6 +17,7 @@ use laser_sim::servo_model::SimServoBus;
 use laser_sim::servo_port::{BusFaults, FaultInjector};
 
 use super::board_log::{BoardLog, SharedLog, read_channel};
+use super::defmt_log::read_defmt;
 use super::servo_bus::{ServoSide, serve};
 use super::terminal::{SharedTerminal, Terminal, read_console};
 use crate::bench_m4::qemu::MACHINE_ARGS;
@@ -41,6 +43,8 @@ pub struct MachineOptions {
     pub echo: bool,
     /// Print the board's log records on stderr.
     pub echo_log: bool,
+    /// Also send the console's output here (the `--pty` bridge).
+    pub console_tee: Option<SyncSender<Vec<u8>>>,
 }
 
 /// A running emulated board.
@@ -109,6 +113,8 @@ fn spawn_qemu(elf: &Path, sockets: &[(&str, PathBuf)]) -> Result<Child> {
         .args([
             "-serial",
             "chardev:uart2",
+            "-serial",
+            "chardev:uart3",
             "-mon",
             "chardev=mon,mode=readline",
         ])
@@ -122,7 +128,7 @@ impl Machine {
     /// Starts QEMU on `elf` and waits for the board to boot.
     pub fn start(elf: &Path, options: &MachineOptions) -> Result<Self> {
         let dir = socket_dir()?;
-        let names = ["uart0", "uart1", "uart2", "mon"];
+        let names = ["uart0", "uart1", "uart2", "uart3", "mon"];
         let mut sockets = Vec::new();
         let mut listeners = Vec::new();
         for name in names {
@@ -143,8 +149,10 @@ impl Machine {
                 }
             }
         }
-        let [console, servo, log, monitor] = <[UnixStream; 4]>::try_from(streams)
-            .map_err(|_| anyhow::anyhow!("four sockets expected"))?;
+        let [console, servo, log, defmt, monitor] = <[UnixStream; 5]>::try_from(streams)
+            .map_err(|_| anyhow::anyhow!("five sockets expected"))?;
+        let elf_bytes =
+            std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
         let terminal: SharedTerminal = Arc::new((
             Mutex::new(Terminal {
                 echo: options.echo,
@@ -162,13 +170,20 @@ impl Machine {
         }));
         let mut threads = Vec::new();
         let (term, reader) = (terminal.clone(), console.try_clone()?);
-        threads.push(std::thread::spawn(move || read_console(reader, term, t0)));
+        let tee = options.console_tee.clone();
+        threads.push(std::thread::spawn(move || {
+            read_console(reader, term, t0, tee)
+        }));
         let side = servos.clone();
         threads.push(std::thread::spawn(move || serve(servo, side, t0)));
         let (shared_log, reader, echo_log) =
             (board_log.clone(), log.try_clone()?, options.echo_log);
         threads.push(std::thread::spawn(move || {
             read_channel(reader, shared_log, echo_log)
+        }));
+        let (shared_log, echo_log) = (board_log.clone(), options.echo_log);
+        threads.push(std::thread::spawn(move || {
+            read_defmt(defmt, elf_bytes, shared_log, echo_log)
         }));
         let machine = Self {
             child,
@@ -227,6 +242,15 @@ impl Machine {
         self.console
             .write_all(format!("{line}\r\n").as_bytes())
             .context("writing to the console socket")
+    }
+
+    /// A second handle on the console socket (bytes written to it are
+    /// typed on the board's console; a write blocks while QEMU holds input
+    /// back).
+    pub fn console_writer(&self) -> Result<UnixStream> {
+        self.console
+            .try_clone()
+            .context("cannot clone the console socket")
     }
 
     /// Waits until every line typed has its closing reply; `false` at

@@ -5,6 +5,7 @@
 
 use std::io::{ErrorKind, Read};
 use std::os::unix::net::UnixStream;
+use std::sync::mpsc::SyncSender;
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
@@ -71,8 +72,15 @@ impl Terminal {
 /// The terminal as the reader thread and the typist share it.
 pub type SharedTerminal = Arc<(Mutex<Terminal>, Condvar)>;
 
-/// Reads the console until QEMU closes it.
-pub fn read_console(mut stream: UnixStream, terminal: SharedTerminal, t0: Instant) {
+/// Reads the console until QEMU closes it; every chunk also goes to `tee`
+/// when given (the `--pty` bridge: a blocking send, so a host that does
+/// not read holds the board's output back instead of losing it).
+pub fn read_console(
+    mut stream: UnixStream,
+    terminal: SharedTerminal,
+    t0: Instant,
+    tee: Option<SyncSender<Vec<u8>>>,
+) {
     let _ = stream.set_read_timeout(Some(READ_POLL));
     let mut pending: Vec<u8> = Vec::new();
     let mut chunk = [0u8; 512];
@@ -90,6 +98,9 @@ pub fn read_console(mut stream: UnixStream, terminal: SharedTerminal, t0: Instan
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => continue,
             Err(_) => return,
         };
+        if let Some(tee) = &tee {
+            let _ = tee.send(chunk[..n].to_vec());
+        }
         pending.extend_from_slice(&chunk[..n]);
         let (lock, signal) = &*terminal;
         let Ok(mut term) = lock.lock() else { return };
