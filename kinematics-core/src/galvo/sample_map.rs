@@ -163,12 +163,8 @@ impl SampleMap {
         hold: [u16; 2],
     ) -> [u16; 2] {
         let mut last = hold;
-        for (out, [x_rad, y_rad]) in codes.iter_mut().zip(angles) {
-            let x = self.dac_x.offset_code + self.dac_x.codes_per_rad * x_rad;
-            let y = self.dac_y.offset_code + self.dac_y.codes_per_rad * y_rad;
-            if x.is_finite() && y.is_finite() {
-                last = [block_code(x), block_code(y)];
-            }
+        for (out, &[x_rad, y_rad]) in codes.iter_mut().zip(angles) {
+            last = self.angle_codes_or(x_rad, y_rad, last);
             *out = last;
         }
         last
@@ -185,15 +181,24 @@ impl SampleMap {
         hold: [u16; 2],
     ) -> [u16; 2] {
         let mut last = hold;
-        for ((out, x_rad), y_rad) in codes.iter_mut().zip(x).zip(y) {
-            let x = self.dac_x.offset_code + self.dac_x.codes_per_rad * x_rad;
-            let y = self.dac_y.offset_code + self.dac_y.codes_per_rad * y_rad;
-            if x.is_finite() && y.is_finite() {
-                last = [block_code(x), block_code(y)];
-            }
+        for ((out, &x_rad), &y_rad) in codes.iter_mut().zip(x).zip(y) {
+            last = self.angle_codes_or(x_rad, y_rad, last);
             *out = last;
         }
         last
+    }
+
+    /// The codes of mirror angles `θx`, `θy` (rad), or `last` when either
+    /// code is not finite (the blocks' per-sample step).
+    #[inline(always)]
+    fn angle_codes_or(&self, x_rad: f32, y_rad: f32, last: [u16; 2]) -> [u16; 2] {
+        let x = self.dac_x.offset_code + self.dac_x.codes_per_rad * x_rad;
+        let y = self.dac_y.offset_code + self.dac_y.codes_per_rad * y_rad;
+        if x.is_finite() && y.is_finite() {
+            [block_code(x), block_code(y)]
+        } else {
+            last
+        }
     }
 
     /// The codes `[x, y]` of a block of board points `[x, y]` (mm), as

@@ -11,7 +11,7 @@ use super::machine::{Action, ActionSink, Core};
 use crate::domain::{Figure, Target};
 use crate::galvo::GalvoRequest;
 use crate::grbl::{Block, PointMm};
-use crate::servo::task::{ServoOutcome, ServoRequest};
+use crate::servo::task::ServoOutcome;
 
 impl Core {
     /// Sends the current step to every actuator that draws.
@@ -110,22 +110,12 @@ impl Core {
             60_000.0 * from.distance_to(to) / f.max(1e-3)
         });
         let interval_ms = libm::fmax(f64::from(by_servo), by_feed).min(f64::from(u16::MAX)) as u16;
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
-        out.act(Action::Servo(ServoRequest::Move {
-            seq,
-            yaw_tenths: aim.yaw_wire,
-            pitch_tenths: aim.pitch_wire,
-            interval_ms,
-            ids: (self.settings.yaw.id, self.settings.pitch.id),
-            deadband_tenths: if corner {
-                CORNER_DEADBAND_TENTHS
-            } else {
-                (self.settings.deadband_deg * 10.0) as u16
-            },
-            ranges_tenths: super::faults::servo_ranges_tenths(&self.settings),
-        }));
-        out.act(Action::Note(LaserEvent::GimbalMoveSent));
+        let deadband_tenths = if corner {
+            CORNER_DEADBAND_TENTHS
+        } else {
+            (self.settings.deadband_deg * 10.0) as u16
+        };
+        let seq = self.send_gimbal_move(&aim, interval_ms, deadband_tenths, out);
         self.last_aim = Some((Target { point, grid: None }, aim));
         Some(seq)
     }

@@ -289,18 +289,8 @@ impl Core {
             }
         };
         let interval_ms = self.move_interval_ms(&aim);
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
-        out.act(Action::Servo(ServoRequest::Move {
-            seq,
-            yaw_tenths: aim.yaw_wire,
-            pitch_tenths: aim.pitch_wire,
-            interval_ms,
-            ids: (self.settings.yaw.id, self.settings.pitch.id),
-            deadband_tenths: (self.settings.deadband_deg * 10.0) as u16,
-            ranges_tenths: faults::servo_ranges_tenths(&self.settings),
-        }));
-        out.act(Action::Note(LaserEvent::GimbalMoveSent));
+        let deadband_tenths = (self.settings.deadband_deg * 10.0) as u16;
+        let seq = self.send_gimbal_move(&aim, interval_ms, deadband_tenths, out);
         log::info!(
             "target ({}, {}) cm -> servo {} {} (0.1 deg) over {} ms",
             target.point.x_cm,
@@ -314,6 +304,31 @@ impl Core {
         }
         self.last_aim = Some((target, aim));
         true
+    }
+
+    /// Sends the gimbal to `aim` over `interval_ms`, arrival within
+    /// `deadband_tenths` (0.1°), under a new sequence number (returned), and
+    /// notes the move for the laser logic.
+    pub(super) fn send_gimbal_move(
+        &mut self,
+        aim: &Aim,
+        interval_ms: u16,
+        deadband_tenths: u16,
+        out: &mut dyn ActionSink,
+    ) -> u32 {
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let seq = self.next_seq;
+        out.act(Action::Servo(ServoRequest::Move {
+            seq,
+            yaw_tenths: aim.yaw_wire,
+            pitch_tenths: aim.pitch_wire,
+            interval_ms,
+            ids: (self.settings.yaw.id, self.settings.pitch.id),
+            deadband_tenths,
+            ranges_tenths: faults::servo_ranges_tenths(&self.settings),
+        }));
+        out.act(Action::Note(LaserEvent::GimbalMoveSent));
+        seq
     }
 
     /// Travel time for a move at the configured speed, from the largest
