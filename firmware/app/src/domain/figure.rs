@@ -48,6 +48,71 @@ pub enum Figure {
         /// Side of the square, cm.
         size_cm: f64,
     },
+    /// One stroke of straight lines through up to
+    /// [`Polyline::MAX_SEGMENTS`] corners (the galvo marks consecutive
+    /// G-code feed moves as one: corners at the path planner's junction
+    /// speed, the laser on through them).
+    Stroke(Polyline),
+}
+
+/// Points of a [`Figure::Stroke`]: a start and up to
+/// [`Self::MAX_SEGMENTS`] line ends, board cm in `f32` (0.1 µm at the
+/// board's scale, and the figure no bigger than a circle's).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Polyline {
+    points: [[f32; 2]; STROKE_SEGMENTS + 1],
+    len: u8,
+}
+
+impl Polyline {
+    /// Most line segments one polyline holds (a stroke's segments, as
+    /// many as the galvo's path planner loads at once).
+    pub const MAX_SEGMENTS: usize = STROKE_SEGMENTS;
+
+    /// A polyline starting at `start`, no segment yet. `None` for a
+    /// non-finite point.
+    pub fn new(start: PointCm) -> Option<Self> {
+        let mut line = Self {
+            points: [[0.0; 2]; STROKE_SEGMENTS + 1],
+            len: 0,
+        };
+        line.set(0, start).then_some(line)
+    }
+
+    /// Adds a line to `to`; `false` (nothing added) when full or `to` is
+    /// not finite.
+    pub fn line_to(&mut self, to: PointCm) -> bool {
+        let next = usize::from(self.len) + 1;
+        if next > STROKE_SEGMENTS || !self.set(next, to) {
+            return false;
+        }
+        self.len += 1;
+        true
+    }
+
+    fn set(&mut self, index: usize, p: PointCm) -> bool {
+        let xy = [p.x_cm as f32, p.y_cm as f32];
+        match self.points.get_mut(index) {
+            Some(slot) if xy.iter().all(|v| v.is_finite()) => {
+                *slot = xy;
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// Line segments.
+    pub fn segments(&self) -> usize {
+        usize::from(self.len)
+    }
+
+    /// The start and every line end, cm.
+    pub fn points(&self) -> impl Iterator<Item = PointCm> + '_ {
+        let points = self.points.get(..=self.segments()).unwrap_or_default();
+        points
+            .iter()
+            .map(|&[x, y]| PointCm::new(f64::from(x), f64::from(y)))
+    }
 }
 
 /// A test pattern or path (SPEC §4.6).
@@ -80,8 +145,11 @@ pub enum Segment {
     },
 }
 
+/// Most segments of one stroke.
+const STROKE_SEGMENTS: usize = 4;
+
 /// Segments of one stroke.
-pub type Segments = heapless::Vec<Segment, 4>;
+pub type Segments = heapless::Vec<Segment, STROKE_SEGMENTS>;
 
 /// A stroke: drawn without a break from `start` through its segments, in
 /// the [`Unit`] it was built in.
@@ -128,6 +196,7 @@ impl Figure {
             Figure::Circle { .. } => "circle",
             Figure::Rect { .. } => "rect",
             Figure::Tuning { .. } => "tuning",
+            Figure::Stroke(_) => "stroke",
         }
     }
 
@@ -151,6 +220,11 @@ impl Figure {
                 rotation,
             )),
             (Figure::Rect { a, b }, 0) => Some(Stroke::rect(at(a), at(b))),
+            (Figure::Stroke(line), 0) => {
+                let mut points = line.points().map(at);
+                let start = points.next()?;
+                Some(Stroke::lines(start, points))
+            }
             (Figure::Tuning { centre, size_cm }, stroke) => {
                 let [cx, cy] = at(centre);
                 let h = unit.from_cm(size_cm) / 2.0;
@@ -188,6 +262,10 @@ impl Figure {
                 let (c, h) = (at(centre), (unit.from_cm(size_cm) / 2.0).abs());
                 ([c[0] - h, c[1] - h], [c[0] + h, c[1] + h])
             }
+            Figure::Stroke(line) => line.points().map(at).fold(
+                ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
+                |(lo, hi), [x, y]| ([lo[0].min(x), lo[1].min(y)], [hi[0].max(x), hi[1].max(y)]),
+            ),
         };
         [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]
     }
@@ -252,6 +330,13 @@ impl fmt::Display for Pattern {
             Figure::Tuning { centre, size_cm } => {
                 let (x, y) = cm(centre);
                 write!(f, "tuning {x} {y} {}", Shortest(size_cm))
+            }
+            Figure::Stroke(line) => {
+                f.write_str("stroke")?;
+                line.points().try_for_each(|p| {
+                    let (x, y) = cm(p);
+                    write!(f, " {x} {y}")
+                })
             }
         }
     }

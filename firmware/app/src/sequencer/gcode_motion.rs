@@ -303,7 +303,8 @@ impl Core {
             .is_some_and(|c| c.servo_seq.is_some() || c.until.is_some());
         motion.hold = if waiting { Hold::Stopping } else { Hold::Held };
         if galvo_in_flight {
-            self.stop_galvo(out);
+            // Closing the gate also darkens the samples the DAC holds.
+            self.close_gate(out);
         }
     }
 

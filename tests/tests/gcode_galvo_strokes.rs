@@ -1,0 +1,171 @@
+//! Consecutive lit G-code blocks on the galvo are marked as joined
+//! strokes (issue 12's galvo look-ahead): one jump and one pair of laser
+//! delays per stroke, corners at the path planner's junction speed, and
+//! the drawn path still on the toolpath.
+
+use kinematics_core::Galvo;
+use laser_sim::world::{SimOptions, SimReport};
+use system_tests::gcode_job::{Job, fit, rapids_dark};
+use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
+
+/// The galvo's tolerance (issue 12).
+const GALVO_TOLERANCE_MM: f64 = 0.2;
+/// Lines one galvo stroke joins (`Polyline::MAX_SEGMENTS`).
+const STROKE_SEGMENTS: usize = laser_app::domain::Polyline::MAX_SEGMENTS;
+
+/// A galvo job drawing `points` as lit G1s at F1200, then a G0 home.
+fn job_of(points: &[[f64; 2]]) -> Job {
+    let mut job = Job::default();
+    job.line("G21 G90");
+    job.line("M3");
+    job.polyline(points, 1200.0, 1000.0);
+    job.line("M5");
+    job.rapid([0.0, 0.0]);
+    job.line("M2");
+    job
+}
+
+fn square() -> Vec<[f64; 2]> {
+    vec![
+        [-10.0, -10.0],
+        [10.0, -10.0],
+        [10.0, 10.0],
+        [-10.0, 10.0],
+        [-10.0, -10.0],
+    ]
+}
+
+/// A circle of radius 10 mm as 36 G1 chords.
+fn circle_of_chords() -> Vec<[f64; 2]> {
+    (0..=36)
+        .map(|k| {
+            let a = core::f64::consts::TAU * f64::from(k) / 36.0;
+            [10.0 * a.cos(), 10.0 * a.sin()]
+        })
+        .collect()
+}
+
+fn run_galvo(job: &Job, extra: &[(usize, &str)]) -> SimReport {
+    let mut lines = job.lines.clone();
+    for &(at, line) in extra.iter().rev() {
+        lines.insert(at, line.into());
+    }
+    let mut text = String::from("target galvo\n");
+    for l in &lines {
+        text.push_str(l);
+        text.push('\n');
+    }
+    let report = run_with(&text, SimOptions::default());
+    let errors: Vec<String> = terminal_lines(&report)
+        .into_iter()
+        .filter(|l| l.starts_with("error") || l.starts_with("ALARM"))
+        .map(String::from)
+        .collect();
+    assert!(errors.is_empty(), "{errors:?}");
+    assert!(report.idle_at_end, "still running at the end");
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
+    report
+}
+
+/// Times (ns) the galvo laser turned on.
+fn laser_on_times_ns(report: &SimReport) -> Vec<u64> {
+    let mut lit = false;
+    let mut ons = Vec::new();
+    for (t, s) in report.dac.iter() {
+        if s.laser && !lit {
+            ons.push(t);
+        }
+        lit = s.laser;
+    }
+    ons
+}
+
+/// Lit positions and the spot's timeline, mm.
+fn galvo_spots(report: &SimReport) -> (Vec<[f64; 2]>, Vec<(u64, [f64; 2], bool)>) {
+    let galvo = Galvo::<f64>::default();
+    let timeline: Vec<(u64, [f64; 2], bool)> = report
+        .dac
+        .iter()
+        .filter_map(|(t, s)| {
+            let p = galvo.codes_to_board(s.x_code, s.y_code).ok()?;
+            Some((t, [p.x_mm, p.y_mm], s.laser))
+        })
+        .collect();
+    let lit = timeline.iter().filter(|s| s.2).map(|s| s.1).collect();
+    (lit, timeline)
+}
+
+/// Draws `points`: returns its strokes (laser on-transitions) and job
+/// time (s), after checking the lit path and the dark G0s.
+fn draw(label: &str, points: &[[f64; 2]]) -> (usize, f64) {
+    let job = job_of(points);
+    let report = run_galvo(&job, &[]);
+    let (lit, timeline) = galvo_spots(&report);
+    let fit = fit(&lit, &job.pieces);
+    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{label}: {fit:?}");
+    assert!(fit.worst_missed_mm <= 0.5, "{label}: {fit:?}");
+    let spans = rapids_dark(&timeline, &job.rapids, GALVO_TOLERANCE_MM)
+        .unwrap_or_else(|e| panic!("{label}: {e}"));
+    assert_eq!(spans.len(), job.rapids.len(), "{label}: {spans:?}");
+    assert!(
+        spans.iter().all(|s| s.lit == 0),
+        "{label}: lit G0 {spans:?}"
+    );
+    let strokes = laser_on_times_ns(&report).len();
+    let seconds = report.end_time_us as f64 / 1e6;
+    eprintln!(
+        "{label}: {} G1s, {strokes} strokes, worst off path {:.3} mm, job {seconds:.3} s",
+        points.len() - 1,
+        fit.worst_lit_mm
+    );
+    (strokes, seconds)
+}
+
+#[test]
+fn a_square_of_four_g1s_is_one_stroke_on_the_toolpath() {
+    let (strokes, _) = draw("square", &square());
+    assert_eq!(strokes, 1);
+}
+
+#[test]
+fn a_circle_of_36_g1s_is_marked_in_strokes_of_the_polyline_capacity() {
+    let (strokes, seconds) = draw("circle", &circle_of_chords());
+    // 36 lines, STROKE_SEGMENTS per stroke (one stroke per G1 before).
+    assert_eq!(strokes, 36usize.div_ceil(STROKE_SEGMENTS));
+    // The 2π·10 mm path at 20 mm/s alone takes 3.13 s; 36 separate
+    // strokes added a jump and both laser delays (≈ 1.3 ms) and a stop
+    // at every corner.
+    assert!(seconds < 3.6, "{seconds} s");
+}
+
+#[test]
+fn a_hold_mid_stroke_is_dark_and_resume_completes_the_square() {
+    let job = job_of(&square());
+    // The square's first G1 is line 4 (after G21, M3, G0); hold 1.5 s
+    // into its 4 s stroke, resume 0.5 s later.
+    let at = job.lines.len() - 3;
+    let report = run_galvo(
+        &job,
+        &[(at, "wait 1500"), (at, "!"), (at, "wait 500"), (at, "~")],
+    );
+    let hold_us = system_tests::sent_at(&report, "!");
+    let resume_us = system_tests::sent_at(&report, "~");
+    let ons = laser_on_times_ns(&report);
+    let lit_in_hold: Vec<u64> = system_tests::lit_sample_times_ns(&report)
+        .into_iter()
+        .filter(|&t| t > (hold_us + 1_000) * 1_000 && t < resume_us * 1_000)
+        .collect();
+    assert!(
+        lit_in_hold.is_empty(),
+        "{} lit samples in the hold {hold_us}..{resume_us} µs, from {:?} ns; on at {ons:?}",
+        lit_in_hold.len(),
+        lit_in_hold.first()
+    );
+    // Marked before the hold, then again from the stroke's start.
+    assert_eq!(ons.len(), 2, "{ons:?}");
+    assert!(ons[0] < hold_us * 1_000 && ons[1] > resume_us * 1_000);
+    let (lit, _) = galvo_spots(&report);
+    let fit = fit(&lit, &job.pieces);
+    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+}
