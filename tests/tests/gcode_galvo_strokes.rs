@@ -10,8 +10,8 @@ use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_li
 
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;
-/// Lines one galvo stroke joins (`Polyline::MAX_SEGMENTS`).
-const STROKE_SEGMENTS: usize = laser_app::domain::Polyline::MAX_SEGMENTS;
+/// Lines one galvo stroke joins (`StrokeCm::MAX_SEGMENTS`).
+const STROKE_SEGMENTS: usize = laser_app::domain::StrokeCm::MAX_SEGMENTS;
 
 /// A galvo job drawing `points` as lit G1s at F1200, then a G0 home.
 fn job_of(points: &[[f64; 2]]) -> Job {
@@ -168,4 +168,28 @@ fn a_hold_mid_stroke_is_dark_and_resume_completes_the_square() {
     let fit = fit(&lit, &job.pieces);
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
     assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+}
+
+#[test]
+fn the_laser_job_marks_runs_of_blocks_and_arcs_exactly() {
+    // Frame (4 G1s): 1 stroke; circles as two G2 half arcs or one full G3
+    // (two half-turn arcs): 1 stroke each; the "L" outline (6 G1s) and
+    // the "A" outline (8 G1s): 2 strokes each, its counter (3 G1s): 1; the
+    // raster's 30 dashes, separated by S0 moves: 30. Per block: 129.
+    let job = system_tests::gcode_job::laser_job(25.0);
+    let report = run_galvo(&job, &[]);
+    let (lit, timeline) = galvo_spots(&report);
+    let fit = fit(&lit, &job.pieces);
+    let strokes = laser_on_times_ns(&report).len();
+    eprintln!(
+        "laser job: {strokes} strokes, worst off path {:.3} mm, gap {:.3} mm, job {:.3} s",
+        fit.worst_lit_mm,
+        fit.worst_missed_mm,
+        report.end_time_us as f64 / 1e6
+    );
+    assert_eq!(strokes, 1 + 3 + 2 + 2 + 1 + 30);
+    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+    let spans = rapids_dark(&timeline, &job.rapids, GALVO_TOLERANCE_MM).expect("G0s found");
+    assert!(spans.iter().all(|s| s.lit == 0), "lit G0 {spans:?}");
 }

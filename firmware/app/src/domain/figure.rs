@@ -9,6 +9,7 @@ use core::fmt;
 
 pub use kinematics_core::{Pattern as GridPattern, Rotation};
 
+pub use self::stroke_cm::StrokeCm;
 use super::point::PointCm;
 use super::units::Unit;
 use crate::text::Shortest;
@@ -48,71 +49,10 @@ pub enum Figure {
         /// Side of the square, cm.
         size_cm: f64,
     },
-    /// One stroke of straight lines through up to
-    /// [`Polyline::MAX_SEGMENTS`] corners (the galvo marks consecutive
-    /// G-code feed moves as one: corners at the path planner's junction
-    /// speed, the laser on through them).
-    Stroke(Polyline),
-}
-
-/// Points of a [`Figure::Stroke`]: a start and up to
-/// [`Self::MAX_SEGMENTS`] line ends, board cm in `f32` (0.1 µm at the
-/// board's scale, and the figure no bigger than a circle's).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Polyline {
-    points: [[f32; 2]; STROKE_SEGMENTS + 1],
-    len: u8,
-}
-
-impl Polyline {
-    /// Most line segments one polyline holds (a stroke's segments, as
-    /// many as the galvo's path planner loads at once).
-    pub const MAX_SEGMENTS: usize = STROKE_SEGMENTS;
-
-    /// A polyline starting at `start`, no segment yet. `None` for a
-    /// non-finite point.
-    pub fn new(start: PointCm) -> Option<Self> {
-        let mut line = Self {
-            points: [[0.0; 2]; STROKE_SEGMENTS + 1],
-            len: 0,
-        };
-        line.set(0, start).then_some(line)
-    }
-
-    /// Adds a line to `to`; `false` (nothing added) when full or `to` is
-    /// not finite.
-    pub fn line_to(&mut self, to: PointCm) -> bool {
-        let next = usize::from(self.len) + 1;
-        if next > STROKE_SEGMENTS || !self.set(next, to) {
-            return false;
-        }
-        self.len += 1;
-        true
-    }
-
-    fn set(&mut self, index: usize, p: PointCm) -> bool {
-        let xy = [p.x_cm as f32, p.y_cm as f32];
-        match self.points.get_mut(index) {
-            Some(slot) if xy.iter().all(|v| v.is_finite()) => {
-                *slot = xy;
-                true
-            }
-            _ => false,
-        }
-    }
-
-    /// Line segments.
-    pub fn segments(&self) -> usize {
-        usize::from(self.len)
-    }
-
-    /// The start and every line end, cm.
-    pub fn points(&self) -> impl Iterator<Item = PointCm> + '_ {
-        let points = self.points.get(..=self.segments()).unwrap_or_default();
-        points
-            .iter()
-            .map(|&[x, y]| PointCm::new(f64::from(x), f64::from(y)))
-    }
+    /// One stroke of up to [`StrokeCm::MAX_SEGMENTS`] lines and arcs (the
+    /// galvo marks consecutive G-code feed moves as one: corners at the
+    /// path planner's junction speed, the laser on through them).
+    Stroke(StrokeCm),
 }
 
 /// A test pattern or path (SPEC §4.6).
@@ -144,6 +84,8 @@ pub enum Segment {
         rotation: Rotation,
     },
 }
+
+mod stroke_cm;
 
 /// Most segments of one stroke.
 const STROKE_SEGMENTS: usize = 4;
@@ -220,11 +162,7 @@ impl Figure {
                 rotation,
             )),
             (Figure::Rect { a, b }, 0) => Some(Stroke::rect(at(a), at(b))),
-            (Figure::Stroke(line), 0) => {
-                let mut points = line.points().map(at);
-                let start = points.next()?;
-                Some(Stroke::lines(start, points))
-            }
+            (Figure::Stroke(stroke), 0) => Some(stroke.in_unit(unit)),
             (Figure::Tuning { centre, size_cm }, stroke) => {
                 let [cx, cy] = at(centre);
                 let h = unit.from_cm(size_cm) / 2.0;
@@ -262,10 +200,7 @@ impl Figure {
                 let (c, h) = (at(centre), (unit.from_cm(size_cm) / 2.0).abs());
                 ([c[0] - h, c[1] - h], [c[0] + h, c[1] + h])
             }
-            Figure::Stroke(line) => line.points().map(at).fold(
-                ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
-                |(lo, hi), [x, y]| ([lo[0].min(x), lo[1].min(y)], [hi[0].max(x), hi[1].max(y)]),
-            ),
+            Figure::Stroke(stroke) => stroke.bounds(unit),
         };
         [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]
     }
@@ -331,12 +266,9 @@ impl fmt::Display for Pattern {
                 let (x, y) = cm(centre);
                 write!(f, "tuning {x} {y} {}", Shortest(size_cm))
             }
-            Figure::Stroke(line) => {
-                f.write_str("stroke")?;
-                line.points().try_for_each(|p| {
-                    let (x, y) = cm(p);
-                    write!(f, " {x} {y}")
-                })
+            Figure::Stroke(stroke) => {
+                let (x, y) = cm(stroke.start());
+                write!(f, "stroke {x} {y} ({} segments)", stroke.segments())
             }
         }
     }

@@ -4,10 +4,10 @@
 //! speed with the laser on through them, one laser-off delay — instead of
 //! one stroke per block.
 //!
-//! A stroke takes the steps left of the block in flight (a G1 is one
-//! step, a G2/G3 its chords within `$12`) and then whole lit G1/G2/G3
-//! blocks waiting at the front of the queue, up to
-//! [`Polyline::MAX_SEGMENTS`] lines. It is marked at the slowest of its
+//! A stroke takes the block in flight and then whole lit G1/G2/G3 blocks
+//! waiting at the front of the queue, up to [`StrokeCm::MAX_SEGMENTS`]
+//! segments: a G1 is a line, a G2/G3 an exact arc (two when it turns
+//! more than half a circle; no chords). It is marked at the slowest of its
 //! blocks' feeds (F × feed override, capped by `galvo.mark_speed_mm_s`).
 //! The galvo reports it done once; then its blocks leave the queue
 //! together (their slots free, a line waiting for room is answered) and
@@ -21,12 +21,9 @@
 
 use super::gcode_motion::{cm, point_at};
 use super::machine::{ActionSink, Core};
-use crate::domain::{Figure, Polyline};
+use crate::domain::{Figure, StrokeCm};
 use crate::galvo::GalvoRequest;
 use crate::grbl::{Block, PointMm};
-
-/// Most chords of an arc counted when joining it (more never fit).
-const MAX_ARC_CHORDS: u32 = 100_000;
 
 /// The stroke in flight on the galvo: what its "done" completes.
 #[derive(Debug, Clone, Copy, Default)]
@@ -91,49 +88,43 @@ impl Core {
         self.send_galvo(request, out).then_some(seq)
     }
 
-    /// The stroke from `from` through the steps left of the block in
+    /// The stroke from `from` through what is left of the block in
     /// flight and the lit blocks queued after it, its feed (the slowest,
     /// mm/min) and what it covers; `None` when the block in flight is not
     /// a feed move.
-    fn gcode_galvo_stroke(&self, from: PointMm) -> Option<(Polyline, f64, GalvoStroke)> {
+    fn gcode_galvo_stroke(&self, from: PointMm) -> Option<(StrokeCm, f64, GalvoStroke)> {
         let c = self.gcode.motion.current?;
         let mut feed = feed_of(&c.block)?;
-        let mut line = Polyline::new(cm(from))?;
+        let mut stroke = StrokeCm::new(cm(from))?;
         let mut record = GalvoStroke {
             seq: None,
-            last_index: c.index,
+            last_index: c.count,
             joined: 0,
         };
-        for k in c.index..=c.count {
-            if !line.line_to(cm(point_at(&c.block, k, c.count))) {
-                break;
+        if c.index > 1 || !push_block(&mut stroke, &c.block) {
+            // Part of the block was drawn already (or it does not fit):
+            // its steps from here, as lines.
+            for k in c.index..=c.count {
+                if !stroke.line_to(cm(point_at(&c.block, k, c.count))) {
+                    break;
+                }
+                record.last_index = k;
             }
-            record.last_index = k;
-        }
-        if record.last_index < c.count {
-            return Some((line, feed, record));
+            if record.last_index < c.count {
+                return Some((stroke, feed, record));
+            }
         }
         for block in self.gcode.motion.queue.iter() {
             let Some(block_feed) = feed_of(block).filter(|_| self.gcode_block_lit(block)) else {
                 break;
             };
-            let chords = match block {
-                Block::Arc { arc, .. } => {
-                    arc.segment_count(self.gcode.values.arc_tolerance_mm, MAX_ARC_CHORDS)
-                }
-                _ => 1,
-            };
-            let room = Polyline::MAX_SEGMENTS - line.segments();
-            if chords as usize > room {
+            if !push_block(&mut stroke, block) {
                 break;
-            }
-            for k in 1..=chords {
-                line.line_to(cm(point_at(block, k, chords)));
             }
             feed = feed.min(block_feed);
             record.joined += 1;
         }
-        Some((line, feed, record))
+        Some((stroke, feed, record))
     }
 
     /// Whether `block` is a feed move whose laser setting lights.
@@ -168,6 +159,25 @@ impl Core {
         if record.joined > 0 {
             self.grbl_take_owed(out);
         }
+    }
+}
+
+/// Adds feed move `block` (from where the stroke ends) to `stroke`: a
+/// line, or an arc as one or two arcs of at most a half turn; `false`
+/// (the stroke as it was) when it does not fit.
+fn push_block(stroke: &mut StrokeCm, block: &Block) -> bool {
+    match *block {
+        Block::Line { to, .. } => stroke.line_to(cm(to)),
+        Block::Arc { arc, .. } => {
+            let halves = libm::fabs(arc.sweep_rad) > core::f64::consts::PI;
+            if !halves {
+                return stroke.arc_to(cm(arc.to), arc.sweep_rad);
+            }
+            stroke.room() >= 2
+                && stroke.arc_to(cm(arc.point_at(0.5)), arc.sweep_rad / 2.0)
+                && stroke.arc_to(cm(arc.to), arc.sweep_rad / 2.0)
+        }
+        _ => false,
     }
 }
 
