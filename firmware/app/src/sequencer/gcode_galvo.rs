@@ -188,3 +188,6 @@ fn feed_of(block: &Block) -> Option<f64> {
         _ => None,
     }
 }
+
+#[cfg(test)]
+mod tests;

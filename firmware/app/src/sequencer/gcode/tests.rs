@@ -26,7 +26,7 @@ const READINGS: Readings = Readings {
     implausible_readings: 0,
 };
 
-fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
+pub(in crate::sequencer) fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
     let inputs = Inputs {
         now: Instant::from_millis(ms),
         galvo_room: Some(8),
@@ -38,7 +38,7 @@ fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
     out
 }
 
-fn line(core: &mut Core, ms: u64, text: &str) -> Vec<Action> {
+pub(in crate::sequencer) fn line(core: &mut Core, ms: u64, text: &str) -> Vec<Action> {
     let command = Command::Grbl(GrblLine::new(text).expect("short line"));
     on(
         core,
@@ -50,7 +50,7 @@ fn line(core: &mut Core, ms: u64, text: &str) -> Vec<Action> {
     )
 }
 
-fn closers(actions: &[Action]) -> usize {
+pub(in crate::sequencer) fn closers(actions: &[Action]) -> usize {
     actions
         .iter()
         .filter(|a| matches!(a, Action::Line(Line::Ok | Line::GrblError(_))))
@@ -94,7 +94,7 @@ fn realtime(core: &mut Core, ms: u64, command: Realtime) -> Vec<Action> {
     on(core, ms, Event::Realtime(request))
 }
 
-fn status(core: &mut Core, ms: u64) -> String {
+pub(in crate::sequencer) fn status(core: &mut Core, ms: u64) -> String {
     let out = realtime(core, ms, Realtime::StatusReport);
     texts(&out).pop().expect("a status report")
 }
