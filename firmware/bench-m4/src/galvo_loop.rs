@@ -1,9 +1,9 @@
-//! The galvo loop's half-buffer fills: holding, marking a line, marking a
-//! circle (r = 40 mm), jumping; `GalvoLoop::new`.
+//! The galvo loop's half-buffer fills: holding, marking a line, a circle
+//! (r = 40 mm) and a G-code stroke, jumping; `GalvoLoop::new`.
 
 use core::hint::black_box;
 
-use laser_app::domain::{Figure, PointCm, Rotation};
+use laser_app::domain::{Figure, PointCm, Rotation, StrokeCm};
 use laser_app::galvo::{
     DacSample, DacStream, GalvoConfig, GalvoError, GalvoLoop, GalvoRequest, Half, ScanPhase,
     Underrun,
@@ -190,9 +190,25 @@ fn reconfigure(
     galvo.fill(&mut half[..1], |_| {});
 }
 
-/// Marking a line and a circle (r = 40 mm), half by half.
+/// Four half-turn arcs from (-60, 0) mm to (60, 0) mm, alternately
+/// clockwise and counter-clockwise.
+fn g_code_stroke() -> Option<StrokeCm> {
+    let mut stroke = StrokeCm::new(PointCm::new(-6.0, 0.0))?;
+    for (k, x_cm) in [-3.0, 0.0, 3.0, 6.0].into_iter().enumerate() {
+        let turn = if k % 2 == 0 { -1.0 } else { 1.0 };
+        let sweep = turn * core::f64::consts::PI;
+        stroke.arc_to(PointCm::new(x_cm, 0.0), sweep).then_some(())?;
+    }
+    Some(stroke)
+}
+
+/// Marking a line, a circle (r = 40 mm), a G-code stroke of four arcs and
+/// the tuning figure, half by half.
 #[inline(always)]
 fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
+    let Some(stroke) = g_code_stroke() else {
+        return b.fail("loop.stroke", "the stroke was refused");
+    };
     // Marking: first go to the stroke start (not measured), so the job's
     // own jump is zero-length and its halves hold marking only.
     let jobs = [
@@ -214,6 +230,13 @@ fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
                 radius_cm: 4.0,
                 rotation: Rotation::Ccw,
             },
+        ),
+        (
+            "loop.stroke",
+            [-60.0f32, 0.0],
+            // A G-code stroke at its dearest: four half-turn arcs (an S of
+            // 15 mm radius), corners where they meet.
+            Figure::Stroke(stroke),
         ),
         (
             "loop.tuning",

@@ -243,4 +243,18 @@ mod tests {
             Segment::Line { to: [1.0, 0.0] }
         );
     }
+
+    #[test]
+    fn a_stroke_figure_stays_small_enough_to_copy_through_channels() {
+        extern crate std;
+        use crate::galvo::GalvoRequest;
+        let (stroke, figure, request) = (
+            core::mem::size_of::<StrokeCm>(),
+            core::mem::size_of::<super::super::Figure>(),
+            core::mem::size_of::<GalvoRequest>(),
+        );
+        std::eprintln!("StrokeCm {stroke} B, Figure {figure} B, GalvoRequest {request} B");
+        // A circle figure is 40 B: the stroke adds at most 24 B.
+        assert!(figure <= 64 && request <= 80, "{figure} B, {request} B");
+    }
 }
