@@ -146,27 +146,59 @@ impl StrokeCm {
         Stroke { start, segments }
     }
 
-    /// Lowest and highest `[x, y]` in `unit` the stroke can reach: its
-    /// points, and each arc's whole circle.
+    /// Lowest and highest `[x, y]` in `unit` the stroke reaches: its
+    /// points, and where an arc crosses the axis directions through its
+    /// centre.
     pub(super) fn bounds(&self, unit: Unit) -> ([f64; 2], [f64; 2]) {
         let stroke = self.in_unit(unit);
-        let mut lo = stroke.start;
-        let mut hi = stroke.start;
-        let mut grow = |[x, y]: [f64; 2], r: f64| {
-            lo = [lo[0].min(x - r), lo[1].min(y - r)];
-            hi = [hi[0].max(x + r), hi[1].max(y + r)];
-        };
+        let (mut lo, mut hi) = (stroke.start, stroke.start);
+        let mut from = stroke.start;
         for segment in &stroke.segments {
-            match *segment {
-                Segment::Line { to } => grow(to, 0.0),
-                Segment::Arc { end, centre, .. } => {
-                    let r = libm::hypot(end[0] - centre[0], end[1] - centre[1]);
-                    grow(end, 0.0);
-                    grow(centre, r);
+            let (end, arc) = match *segment {
+                Segment::Line { to } => (to, None),
+                Segment::Arc {
+                    end,
+                    centre,
+                    rotation,
+                } => (end, Some((centre, rotation))),
+            };
+            let mut grow = |[x, y]: [f64; 2]| {
+                lo = [lo[0].min(x), lo[1].min(y)];
+                hi = [hi[0].max(x), hi[1].max(y)];
+            };
+            grow(end);
+            if let Some((c, rotation)) = arc {
+                let (r, start) = polar(c, from);
+                let sweep = libm::fabs(polar_sweep(start, polar(c, end).1, rotation));
+                for k in 0..4 {
+                    let axis = f64::from(k) * core::f64::consts::FRAC_PI_2;
+                    if libm::fabs(polar_sweep(start, axis, rotation)) <= sweep {
+                        let (sin, cos) = libm::sincos(axis);
+                        grow([c[0] + r * cos, c[1] + r * sin]);
+                    }
                 }
             }
+            from = end;
         }
         (lo, hi)
+    }
+}
+
+/// Distance and direction (rad) of `p` from `c`.
+fn polar(c: [f64; 2], p: [f64; 2]) -> (f64, f64) {
+    let (dx, dy) = (p[0] - c[0], p[1] - c[1]);
+    (libm::hypot(dx, dy), libm::atan2(dy, dx))
+}
+
+/// Angle turned from direction `from` to `to` (rad) in `rotation`'s
+/// sense, in [0, 2π) (signed: negative clockwise).
+fn polar_sweep(from: f64, to: f64, rotation: Rotation) -> f64 {
+    let tau = core::f64::consts::TAU;
+    let ccw = libm::fmod(libm::fmod(to - from, tau) + tau, tau);
+    match rotation {
+        Rotation::Ccw => ccw,
+        Rotation::Cw if ccw == 0.0 => 0.0,
+        Rotation::Cw => ccw - tau,
     }
 }
 
