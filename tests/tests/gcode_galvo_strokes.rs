@@ -170,24 +170,44 @@ fn a_hold_mid_stroke_is_dark_and_resume_completes_the_square() {
     assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
 }
 
+/// Strokes of an arc block alone: its chords within grbl's default `$12`,
+/// `STROKE_SEGMENTS` a stroke.
+fn arc_strokes(from: [f64; 2], to: [f64; 2], centre: [f64; 2], clockwise: bool) -> usize {
+    use laser_app::grbl::block::{Arc, PointMm};
+    let tolerance = laser_app::grbl::settings_map::find(12)
+        .expect("$12")
+        .default;
+    let p = |[x_mm, y_mm]: [f64; 2]| PointMm { x_mm, y_mm };
+    let arc = Arc::new(p(from), p(to), p(centre), clockwise);
+    (arc.segment_count(tolerance, 100_000) as usize).div_ceil(STROKE_SEGMENTS)
+}
+
 #[test]
-fn the_laser_job_marks_runs_of_blocks_and_arcs_exactly() {
-    // Frame (4 G1s): 1 stroke; circles as two G2 half arcs or one full G3
-    // (two half-turn arcs): 1 stroke each; the "L" outline (6 G1s) and
-    // the "A" outline (8 G1s): 2 strokes each, its counter (3 G1s): 1; the
-    // raster's 30 dashes, separated by S0 moves: 30. Per block: 129.
+fn the_laser_job_marks_runs_of_lines_as_strokes() {
+    // Frame (4 G1s): 1 stroke; the "L" outline (6 G1s) and the "A"
+    // outline (8 G1s): 2 strokes each, its counter (3 G1s): 1; the
+    // raster's 30 dashes, separated by S0 moves: 30. Circles: each arc
+    // block's chords, 4 a stroke (circles r 6.25 and 3.75 mm as two G2
+    // halves, r 5 mm as one full G3).
     let job = system_tests::gcode_job::laser_job(25.0);
+    let half_arcs = |c: [f64; 2], r: f64| {
+        let (right, left) = ([c[0] + r, c[1]], [c[0] - r, c[1]]);
+        arc_strokes(right, left, c, true) + arc_strokes(left, right, c, true)
+    };
+    let circles = half_arcs([-15.0, 8.75], 6.25)
+        + arc_strokes([5.0, 8.75], [5.0, 8.75], [0.0, 8.75], false)
+        + half_arcs([15.0, 8.75], 3.75);
     let report = run_galvo(&job, &[]);
     let (lit, timeline) = galvo_spots(&report);
     let fit = fit(&lit, &job.pieces);
     let strokes = laser_on_times_ns(&report).len();
     eprintln!(
-        "laser job: {strokes} strokes, worst off path {:.3} mm, gap {:.3} mm, job {:.3} s",
+        "laser job: {strokes} strokes ({circles} on the circles), worst off path {:.3} mm, gap {:.3} mm, job {:.3} s",
         fit.worst_lit_mm,
         fit.worst_missed_mm,
         report.end_time_us as f64 / 1e6
     );
-    assert_eq!(strokes, 1 + 3 + 2 + 2 + 1 + 30);
+    assert_eq!(strokes, 1 + 2 + 2 + 1 + 30 + circles);
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
     assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
     let spans = rapids_dark(&timeline, &job.rapids, GALVO_TOLERANCE_MM).expect("G0s found");

@@ -190,19 +190,17 @@ fn reconfigure(
     galvo.fill(&mut half[..1], |_| {});
 }
 
-/// Four half-turn arcs from (-60, 0) mm to (60, 0) mm, alternately
-/// clockwise and counter-clockwise.
+/// A G-code stroke at its dearest: four lines (open, so its end needs
+/// its own IK), a zigzag from (-60, -20) mm to (60, 20) mm.
 fn g_code_stroke() -> Option<StrokeCm> {
-    let mut stroke = StrokeCm::new(PointCm::new(-6.0, 0.0))?;
-    for (k, x_cm) in [-3.0, 0.0, 3.0, 6.0].into_iter().enumerate() {
-        let turn = if k % 2 == 0 { -1.0 } else { 1.0 };
-        let sweep = turn * core::f64::consts::PI;
-        stroke.arc_to(PointCm::new(x_cm, 0.0), sweep).then_some(())?;
+    let mut stroke = StrokeCm::new(PointCm::new(-6.0, -2.0))?;
+    for (x_cm, y_cm) in [(-3.0, 2.0), (0.0, -2.0), (3.0, 2.0), (6.0, 2.0)] {
+        stroke.line_to(PointCm::new(x_cm, y_cm)).then_some(())?;
     }
     Some(stroke)
 }
 
-/// Marking a line, a circle (r = 40 mm), a G-code stroke of four arcs and
+/// Marking a line, a circle (r = 40 mm), a G-code stroke of four lines and
 /// the tuning figure, half by half.
 #[inline(always)]
 fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
@@ -233,9 +231,8 @@ fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
         ),
         (
             "loop.stroke",
-            [-60.0f32, 0.0],
-            // A G-code stroke at its dearest: four half-turn arcs (an S of
-            // 15 mm radius), corners where they meet.
+            [-60.0f32, -20.0],
+            // A G-code stroke of four lines.
             Figure::Stroke(stroke),
         ),
         (

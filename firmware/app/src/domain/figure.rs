@@ -49,9 +49,9 @@ pub enum Figure {
         /// Side of the square, cm.
         size_cm: f64,
     },
-    /// One stroke of up to [`StrokeCm::MAX_SEGMENTS`] lines and arcs (the
-    /// galvo marks consecutive G-code feed moves as one: corners at the
-    /// path planner's junction speed, the laser on through them).
+    /// One stroke of up to [`StrokeCm::MAX_SEGMENTS`] lines (the galvo
+    /// marks consecutive G-code feed moves as one: corners at the path
+    /// planner's junction speed, the laser on through them).
     Stroke(StrokeCm),
 }
 

@@ -4,10 +4,11 @@
 //! speed with the laser on through them, one laser-off delay — instead of
 //! one stroke per block.
 //!
-//! A stroke takes the block in flight and then whole lit G1/G2/G3 blocks
-//! waiting at the front of the queue, up to [`StrokeCm::MAX_SEGMENTS`]
-//! segments: a G1 is a line, a G2/G3 an exact arc (two when it turns
-//! more than half a circle; no chords). It is marked at the slowest of its
+//! A stroke takes what is left of the block in flight and then whole lit
+//! G1/G2/G3 blocks waiting at the front of the queue, up to
+//! [`StrokeCm::MAX_SEGMENTS`] lines: a G1 is a line, a G2/G3 its chords
+//! within `$12` (exact arcs cost the galvo's prep stage too much, see
+//! [`StrokeCm`]). It is marked at the slowest of its
 //! blocks' feeds (F × feed override, capped by `galvo.mark_speed_mm_s`).
 //! The galvo reports it done once; then its blocks leave the queue
 //! together (their slots free, a line waiting for room is answered) and
@@ -24,6 +25,9 @@ use super::machine::{ActionSink, Core};
 use crate::domain::{Figure, StrokeCm};
 use crate::galvo::GalvoRequest;
 use crate::grbl::{Block, PointMm};
+
+/// Most chords of an arc counted when joining it (more never fit).
+const MAX_ARC_CHORDS: u32 = 100_000;
 
 /// The stroke in flight on the galvo: what its "done" completes.
 #[derive(Debug, Clone, Copy, Default)]
@@ -101,9 +105,10 @@ impl Core {
             last_index: c.count,
             joined: 0,
         };
-        if c.index > 1 || !push_block(&mut stroke, &c.block) {
+        let tolerance = self.gcode.values.arc_tolerance_mm;
+        if c.index > 1 || !push_block(&mut stroke, &c.block, tolerance) {
             // Part of the block was drawn already (or it does not fit):
-            // its steps from here, as lines.
+            // its steps (an arc's chords) from here, up to the room.
             for k in c.index..=c.count {
                 if !stroke.line_to(cm(point_at(&c.block, k, c.count))) {
                     break;
@@ -118,7 +123,7 @@ impl Core {
             let Some(block_feed) = feed_of(block).filter(|_| self.gcode_block_lit(block)) else {
                 break;
             };
-            if !push_block(&mut stroke, block) {
+            if !push_block(&mut stroke, block, tolerance) {
                 break;
             }
             feed = feed.min(block_feed);
@@ -163,19 +168,15 @@ impl Core {
 }
 
 /// Adds feed move `block` (from where the stroke ends) to `stroke`: a
-/// line, or an arc as one or two arcs of at most a half turn; `false`
-/// (the stroke as it was) when it does not fit.
-fn push_block(stroke: &mut StrokeCm, block: &Block) -> bool {
+/// line, or an arc as its chords within `arc_tolerance_mm` (`$12`);
+/// `false` (the stroke as it was) when it does not fit.
+fn push_block(stroke: &mut StrokeCm, block: &Block, arc_tolerance_mm: f64) -> bool {
     match *block {
         Block::Line { to, .. } => stroke.line_to(cm(to)),
         Block::Arc { arc, .. } => {
-            let halves = libm::fabs(arc.sweep_rad) > core::f64::consts::PI;
-            if !halves {
-                return stroke.arc_to(cm(arc.to), arc.sweep_rad);
-            }
-            stroke.room() >= 2
-                && stroke.arc_to(cm(arc.point_at(0.5)), arc.sweep_rad / 2.0)
-                && stroke.arc_to(cm(arc.to), arc.sweep_rad / 2.0)
+            let chords = arc.segment_count(arc_tolerance_mm, MAX_ARC_CHORDS);
+            chords as usize <= stroke.room()
+                && (1..=chords).all(|k| stroke.line_to(cm(point_at(block, k, chords))))
         }
         _ => false,
     }
