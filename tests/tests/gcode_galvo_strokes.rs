@@ -3,10 +3,11 @@
 //! delays per stroke, corners at the path planner's junction speed, and
 //! the drawn path still on the toolpath.
 
-use kinematics_core::Galvo;
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Job, fit, rapids_dark};
-use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
+use system_tests::{
+    UNTIL_STEP_FIXES, assert_safe_allowing, galvo_lit_mm, galvo_spot_mm, run_with, terminal_lines,
+};
 
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;
@@ -80,27 +81,12 @@ fn laser_on_times_ns(report: &SimReport) -> Vec<u64> {
     ons
 }
 
-/// Lit positions and the spot's timeline, mm.
-fn galvo_spots(report: &SimReport) -> (Vec<[f64; 2]>, Vec<(u64, [f64; 2], bool)>) {
-    let galvo = Galvo::<f64>::default();
-    let timeline: Vec<(u64, [f64; 2], bool)> = report
-        .dac
-        .iter()
-        .filter_map(|(t, s)| {
-            let p = galvo.codes_to_board(s.x_code, s.y_code).ok()?;
-            Some((t, [p.x_mm, p.y_mm], s.laser))
-        })
-        .collect();
-    let lit = timeline.iter().filter(|s| s.2).map(|s| s.1).collect();
-    (lit, timeline)
-}
-
 /// Draws `points`: returns its strokes (laser on-transitions) and job
 /// time (s), after checking the lit path and the dark G0s.
 fn draw(label: &str, points: &[[f64; 2]]) -> (usize, f64) {
     let job = job_of(points);
     let report = run_galvo(&job, &[]);
-    let (lit, timeline) = galvo_spots(&report);
+    let (lit, timeline) = (galvo_lit_mm(&report), galvo_spot_mm(&report));
     let fit = fit(&lit, &job.pieces);
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{label}: {fit:?}");
     assert!(fit.worst_missed_mm <= 0.5, "{label}: {fit:?}");
@@ -164,7 +150,7 @@ fn a_hold_mid_stroke_is_dark_and_resume_completes_the_square() {
     // Marked before the hold, then again from the stroke's start.
     assert_eq!(ons.len(), 2, "{ons:?}");
     assert!(ons[0] < hold_us * 1_000 && ons[1] > resume_us * 1_000);
-    let (lit, _) = galvo_spots(&report);
+    let lit = galvo_lit_mm(&report);
     let fit = fit(&lit, &job.pieces);
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
     assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
@@ -198,7 +184,7 @@ fn the_laser_job_marks_runs_of_lines_as_strokes() {
         + arc_strokes([5.0, 8.75], [5.0, 8.75], [0.0, 8.75], false)
         + half_arcs([15.0, 8.75], 3.75);
     let report = run_galvo(&job, &[]);
-    let (lit, timeline) = galvo_spots(&report);
+    let (lit, timeline) = (galvo_lit_mm(&report), galvo_spot_mm(&report));
     let fit = fit(&lit, &job.pieces);
     let strokes = laser_on_times_ns(&report).len();
     eprintln!(

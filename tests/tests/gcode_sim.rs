@@ -1,10 +1,11 @@
 //! G-code through the simulated console: grbl's replies, the motion
 //! queue, and what the gimbal and the galvo draw for a realistic laser job.
 
-use kinematics_core::Galvo;
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Job, PathFit, SpotMm, fit, laser_job, rapids_dark};
-use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
+use system_tests::{
+    UNTIL_STEP_FIXES, assert_safe_allowing, galvo_lit_mm, galvo_spot_mm, run_with, terminal_lines,
+};
 
 /// Servo resolution, 0.1°, as a distance on the board at the gimbal's
 /// distance (OQ = 25 cm) and the job's far corner (~50 mm off centre):
@@ -32,35 +33,12 @@ fn gimbal_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
         .collect()
 }
 
-fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
-    let galvo = Galvo::<f64>::default();
-    report
-        .dac
-        .iter()
-        .filter(|(_, s)| s.laser)
-        .filter_map(|(_, s)| galvo.codes_to_board(s.x_code, s.y_code).ok())
-        .map(|p| [p.x_mm, p.y_mm])
-        .collect()
-}
-
 fn gimbal_spot_mm(report: &SimReport) -> Vec<SpotMm> {
     report
         .recording
         .spot
         .iter()
         .map(|s| (s.t_us, [s.x_cm * 10.0, s.y_cm * 10.0], s.laser))
-        .collect()
-}
-
-fn galvo_spot_mm(report: &SimReport) -> Vec<SpotMm> {
-    let galvo = Galvo::<f64>::default();
-    report
-        .dac
-        .iter()
-        .filter_map(|(t, s)| {
-            let p = galvo.codes_to_board(s.x_code, s.y_code).ok()?;
-            Some((t, [p.x_mm, p.y_mm], s.laser))
-        })
         .collect()
 }
 
