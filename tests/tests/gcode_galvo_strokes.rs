@@ -137,10 +137,7 @@ fn a_hold_mid_stroke_is_dark_and_resume_completes_the_square() {
     let hold_us = system_tests::sent_at(&report, "!");
     let resume_us = system_tests::sent_at(&report, "~");
     let ons = laser_on_times_ns(&report);
-    let lit_in_hold: Vec<u64> = system_tests::lit_sample_times_ns(&report)
-        .into_iter()
-        .filter(|&t| t > (hold_us + 1_000) * 1_000 && t < resume_us * 1_000)
-        .collect();
+    let lit_in_hold = system_tests::lit_between_ns(&report, "!", "~");
     assert!(
         lit_in_hold.is_empty(),
         "{} lit samples in the hold {hold_us}..{resume_us} µs, from {:?} ns; on at {ons:?}",

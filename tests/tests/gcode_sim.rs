@@ -269,12 +269,7 @@ fn feed_hold_on_the_galvo_is_dark_and_the_job_still_draws_its_toolpath() {
     lines.insert(43, "~".into());
     let report = run_with(&script("target galvo\n", &lines), SimOptions::default());
     assert_all_ok(&report, "galvo hold");
-    let hold_us = system_tests::sent_at(&report, "!");
-    let resume_us = system_tests::sent_at(&report, "~");
-    let lit_in_hold: Vec<u64> = system_tests::lit_sample_times_ns(&report)
-        .into_iter()
-        .filter(|&t| t > (hold_us + 1_000) * 1_000 && t < resume_us * 1_000)
-        .collect();
+    let lit_in_hold = system_tests::lit_between_ns(&report, "!", "~");
     assert!(
         lit_in_hold.is_empty(),
         "{} lit samples in the hold",
