@@ -43,6 +43,9 @@ pub(super) struct Gcode {
     pub(super) motion: Motion,
     /// Status reports sent (grbl adds `WCO:` / `Ov:` every few).
     pub(super) reports: u32,
+    /// Actual over programmed speed of the gimbal step in flight, 0..=1
+    /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
+    pub(super) step_speed_ratio: f32,
 }
 
 impl Gcode {
@@ -59,6 +62,7 @@ impl Gcode {
             },
             motion: Motion::new(),
             reports: 0,
+            step_speed_ratio: 0.0,
         }
     }
 }
@@ -299,4 +303,4 @@ impl Core {
 }
 
 #[cfg(test)]
-mod tests;
+pub(super) mod tests;
