@@ -262,6 +262,7 @@ impl Core {
 
     /// A realtime command from the console.
     pub(super) fn grbl_realtime(&mut self, request: RealtimeRequest, out: &mut dyn ActionSink) {
+        let before = self.gcode.overrides;
         let ov = &mut self.gcode.overrides;
         match request.command {
             Realtime::StatusReport => self.grbl_status(request.rx_free_bytes, out),
@@ -274,6 +275,7 @@ impl Core {
             Realtime::SpindleOverride(step) => ov.spindle = step.apply(ov.spindle, 10, 200),
             Realtime::SpindleStop | Realtime::Ignored(_) => {}
         }
+        self.grbl_report_changed_overrides(before);
     }
 
     /// 0x18: everything stops at once, laser dark; the parser's modes

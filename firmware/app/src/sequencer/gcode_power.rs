@@ -14,6 +14,7 @@
 use super::gcode_motion::Hold;
 use super::laser::LaserPower;
 use super::machine::Core;
+use crate::grbl::report::Overrides;
 use crate::grbl::{Block, Laser, SpindleMode};
 
 /// Actual over programmed speed of a gimbal step that takes `interval_ms`
@@ -66,6 +67,15 @@ impl Core {
             };
         }
         LaserPower::from_fraction(fraction)
+    }
+
+    /// After a realtime command: when it changed an override (`before`
+    /// the old values), the next status report carries `Ov:` (as grbl's
+    /// report counter reset).
+    pub(super) fn grbl_report_changed_overrides(&mut self, before: Overrides) {
+        if self.gcode.overrides != before {
+            self.gcode.reports = 1;
+        }
     }
 
     /// The power `FS:` reports, in S units: on the galvo the running S

@@ -76,8 +76,12 @@ fn power_overrides_change_the_lit_power_at_once_within_10_to_200_percent() {
         "{reports:?}"
     );
     assert!(
-        reports.iter().any(|r| r.contains("|Ov:100,100,200")),
-        "{reports:?}"
+        reports[0].contains("|Ov:100,100,200"),
+        "the next report: {reports:?}"
+    );
+    assert!(
+        !reports[1].contains("|Ov:"),
+        "then every tenth: {reports:?}"
     );
     // Down to the 10 % floor: S50.
     for k in 0..25 {
