@@ -72,7 +72,7 @@ pub struct Job {
     /// Each G0 as (from, to), mm: the laser must be dark on the way.
     pub rapids: Vec<Rapid>,
     /// Where the last motion line ends, mm (`None` before the first).
-    at: Option<[f64; 2]>,
+    pub(crate) at: Option<[f64; 2]>,
 }
 
 /// A G0 move on the board, mm.
@@ -103,6 +103,11 @@ impl Job {
 
     fn rapid(&mut self, p: [f64; 2]) {
         self.line(format!("G0 X{} Y{}", num(p[0]), num(p[1])));
+        self.record_rapid(p);
+    }
+
+    /// Records a G0 to `p` (the line is already in `lines`).
+    pub(crate) fn record_rapid(&mut self, p: [f64; 2]) {
         self.rapids.push(Rapid {
             from: self.at,
             to: p,
