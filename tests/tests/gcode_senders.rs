@@ -40,6 +40,11 @@ const GIMBAL_JOB: &str = "tests/senders/job/job-gimbal.nc";
 /// Servo resolution, 0.1°, on the board at the gimbal's distance (OQ =
 /// 25 cm) and the job's far corner (~50 mm off centre), as in gcode_sim.
 const GIMBAL_TOLERANCE_MM: f64 = 0.45;
+/// How far a toolpath point may be from the nearest lit gimbal position:
+/// a feed hold darkens the spot at once, the gimbal finishes its path
+/// step (`path.step_cm` = 2 mm) dark and `~` does not redraw it (measured
+/// 1.2–1.8 mm where the hold fell), plus the spot's sampling.
+const GIMBAL_GAP_MM: f64 = 2.2;
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;
 /// Feed hold this long after the job starts, resume this much later, s.
@@ -238,7 +243,18 @@ fn check_protocol(label: &str, summary: &Summary, report: &SimReport, job: &Job)
         .filter(|l| !received.any(|r| r == squeeze(l)))
         .take(3)
         .collect();
-    assert!(lost.is_empty(), "{label}: lines lost, first {lost:?}");
+    // grbl-streamer's preprocessor splits lines with several G words
+    // (`G0 G17 G40 G54 G94`): there, count what it wrote instead.
+    match summary.json["g_lines_written"].as_u64() {
+        Some(written) => {
+            let got = system_tests::terminal_lines(report)
+                .iter()
+                .filter(|l| l.starts_with("> G"))
+                .count() as u64;
+            assert_eq!(got, written, "{label}: lines lost");
+        }
+        None => assert!(lost.is_empty(), "{label}: lines lost, first {lost:?}"),
+    }
     eprintln!(
         "{label}: {} lines in {seconds:.1} s with a {HOLD_FOR_S} s hold ({:.1} lines/s, motion-bound)",
         job.lines.len(),
@@ -253,7 +269,7 @@ fn check_drawing(
     report: &SimReport,
     job: &Job,
     spot: &[SpotMm],
-    tol_mm: f64,
+    (tol_mm, missed_mm): (f64, f64),
     time_per_us: u64,
 ) {
     let fit = fit(&lit_mm(spot), &job.pieces);
@@ -262,7 +278,7 @@ fn check_drawing(
         job.pieces[fit.worst_piece]
     );
     assert!(fit.worst_lit_mm <= tol_mm, "{label}: {fit:?}");
-    assert!(fit.worst_missed_mm <= 3.0 * tol_mm, "{label}: {fit:?}");
+    assert!(fit.worst_missed_mm <= missed_mm, "{label}: {fit:?}");
     let spans = rapids_dark(spot, &job.rapids, tol_mm).unwrap_or_else(|e| panic!("{label}: {e}"));
     assert_eq!(spans.len(), job.rapids.len(), "{label}");
     for (k, span) in spans.iter().enumerate() {
@@ -291,6 +307,8 @@ fn check_drawing(
         holds[0].0 * time_per_us,
         holds[holds.len() - 1].0 * time_per_us,
     );
+    let held_at = spot.iter().find(|s| s.0 >= from).map(|s| s.1);
+    eprintln!("{label}: held at {held_at:?}");
     let lit_in_hold = spot
         .iter()
         .filter(|s| s.2 && s.0 >= from && s.0 <= to)
@@ -325,7 +343,14 @@ fn draws_on_the_gimbal(sender: &Sender) {
     let label = format!("{} (gimbal)", sender.label);
     check_protocol(&label, &summary, &report, &job);
     let spot = gimbal_spot_mm(&report);
-    check_drawing(&label, &report, &job, &spot, GIMBAL_TOLERANCE_MM, 1);
+    check_drawing(
+        &label,
+        &report,
+        &job,
+        &spot,
+        (GIMBAL_TOLERANCE_MM, GIMBAL_GAP_MM),
+        1,
+    );
 }
 
 fn draws_on_the_galvo(sender: &Sender) {
@@ -339,7 +364,14 @@ fn draws_on_the_galvo(sender: &Sender) {
     let label = format!("{} (galvo)", sender.label);
     check_protocol(&label, &summary, &report, &job);
     let spot = galvo_spot_mm(&report);
-    check_drawing(&label, &report, &job, &spot, GALVO_TOLERANCE_MM, 1_000);
+    check_drawing(
+        &label,
+        &report,
+        &job,
+        &spot,
+        (GALVO_TOLERANCE_MM, 0.5),
+        1_000,
+    );
 }
 
 #[test]
