@@ -332,70 +332,78 @@ fn load(job: &str) -> Job {
     Job::from_gcode(&text).unwrap_or_else(|e| panic!("{job}: {e}"))
 }
 
-fn draws_on_the_gimbal(sender: &Sender) {
-    let job = load(GIMBAL_JOB);
-    let (report, summary) = stream(
-        sender,
-        &[],
-        &Path::new(REPO).join(GIMBAL_JOB),
-        &[HOLD_AT_S, HOLD_FOR_S],
-    );
-    let label = format!("{} (gimbal)", sender.label);
-    check_protocol(&label, &summary, &report, &job);
-    let spot = gimbal_spot_mm(&report);
-    check_drawing(
-        &label,
-        &report,
-        &job,
-        &spot,
-        (GIMBAL_TOLERANCE_MM, GIMBAL_GAP_MM),
-        1,
-    );
+/// Where a job is drawn and how it is checked.
+struct Actuator {
+    name: &'static str,
+    /// The job file, relative to the repository.
+    job: &'static str,
+    /// Product commands typed before the sender connects.
+    prepare: &'static [&'static str],
+    /// The spot's timeline from the report.
+    spot: fn(&SimReport) -> Vec<SpotMm>,
+    /// Largest distance lit → toolpath and toolpath → lit, mm.
+    tolerance_mm: (f64, f64),
+    /// Units of the spot's time per µs.
+    time_per_us: u64,
 }
 
-fn draws_on_the_galvo(sender: &Sender) {
-    let job = load(GALVO_JOB);
-    let (report, summary) = stream(
-        sender,
-        &["target galvo"],
-        &Path::new(REPO).join(GALVO_JOB),
-        &[HOLD_AT_S, HOLD_FOR_S],
-    );
-    let label = format!("{} (galvo)", sender.label);
+const GIMBAL: Actuator = Actuator {
+    name: "gimbal",
+    job: GIMBAL_JOB,
+    prepare: &[],
+    spot: gimbal_spot_mm,
+    tolerance_mm: (GIMBAL_TOLERANCE_MM, GIMBAL_GAP_MM),
+    time_per_us: 1,
+};
+
+const GALVO: Actuator = Actuator {
+    name: "galvo",
+    job: GALVO_JOB,
+    prepare: &["target galvo"],
+    spot: galvo_spot_mm,
+    tolerance_mm: (GALVO_TOLERANCE_MM, 0.5),
+    time_per_us: 1_000,
+};
+
+fn draws(sender: &Sender, on: &Actuator) {
+    let job = load(on.job);
+    let file = Path::new(REPO).join(on.job);
+    let (report, summary) = stream(sender, on.prepare, &file, &[HOLD_AT_S, HOLD_FOR_S]);
+    let label = format!("{} ({})", sender.label, on.name);
     check_protocol(&label, &summary, &report, &job);
-    let spot = galvo_spot_mm(&report);
+    let spot = (on.spot)(&report);
     check_drawing(
         &label,
         &report,
         &job,
         &spot,
-        (GALVO_TOLERANCE_MM, 0.5),
-        1_000,
+        on.tolerance_mm,
+        on.time_per_us,
     );
 }
 
 #[test]
 #[ignore = "real time, installs PyPI packages: cargo xtask senders"]
 fn grbl_streamer_draws_the_cam_job_on_the_gimbal() {
-    draws_on_the_gimbal(&GRBL_STREAMER);
+    draws(&GRBL_STREAMER, &GIMBAL);
 }
 
 #[test]
 #[ignore = "real time, installs PyPI packages: cargo xtask senders"]
 fn pygrbl_streamer_draws_the_cam_job_on_the_galvo() {
-    draws_on_the_galvo(&PYGRBL_STREAMER);
+    draws(&PYGRBL_STREAMER, &GALVO);
 }
 
 #[test]
 #[ignore = "real time, installs npm packages: cargo xtask senders"]
 fn cncjs_draws_the_cam_job_on_the_galvo() {
-    draws_on_the_galvo(&CNCJS);
+    draws(&CNCJS, &GALVO);
 }
 
 #[test]
 #[ignore = "real time, installs npm packages: cargo xtask senders"]
 fn cncjs_draws_the_cam_job_on_the_gimbal() {
-    draws_on_the_gimbal(&CNCJS);
+    draws(&CNCJS, &GIMBAL);
 }
 
 #[test]
