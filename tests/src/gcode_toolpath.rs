@@ -131,3 +131,90 @@ pub fn galvo_spot_mm(report: &laser_sim::world::SimReport) -> Vec<crate::gcode_j
 pub fn lit_mm(samples: &[crate::gcode_job::SpotMm]) -> Vec<[f64; 2]> {
     samples.iter().filter(|s| s.2).map(|s| s.1).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ends(piece: &Piece) -> [[f64; 2]; 2] {
+        match *piece {
+            Piece::Line { a, b } => [a, b],
+            Piece::Circle { .. } => panic!("a circle"),
+        }
+    }
+
+    #[test]
+    fn lit_moves_need_the_laser_on_and_power_and_rapids_are_recorded() {
+        let text = "G21 G90 (set up)\nG0 X1 Y2 ; travel\nM4 S0\nG1 X3\nS500\nG1 Y4 F600\n\
+                    M5\nG1 X0\nG0 X-1 Y-1\nM3\nG91\nG1 X2 Y1 S10\nX1\nM2\n";
+        let job = Job::from_gcode(text).unwrap();
+        let lit: Vec<[[f64; 2]; 2]> = job.pieces.iter().map(ends).collect();
+        assert_eq!(
+            lit,
+            [
+                [[3.0, 2.0], [3.0, 4.0]],
+                [[-1.0, -1.0], [1.0, 0.0]],
+                [[1.0, 0.0], [2.0, 0.0]]
+            ]
+        );
+        let rapids: Vec<_> = job.rapids.iter().map(|r| (r.from, r.to)).collect();
+        assert_eq!(
+            rapids,
+            [(None, [1.0, 2.0]), (Some([0.0, 4.0]), [-1.0, -1.0])]
+        );
+        assert_eq!(job.lines.len(), 14);
+    }
+
+    #[test]
+    fn arcs_and_malformed_words_are_refused() {
+        let arc = Job::from_gcode("G0 X1\nG2 X2 Y0 I1 J0\n").unwrap_err();
+        assert!(arc.contains("line 2"), "{arc}");
+        assert!(Job::from_gcode("G1 X1..2\n").is_err());
+        assert!(Job::from_gcode("G1 X1 #5\n").is_err());
+    }
+
+    fn committed(name: &str) -> Job {
+        let path = format!("{}/senders/job/{name}", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("svg2gcode 3.3.7"), "{path}: not svg2gcode's");
+        Job::from_gcode(&text).unwrap()
+    }
+
+    fn extent(job: &Job) -> [f64; 4] {
+        let points = job.pieces.iter().flat_map(ends);
+        points.fold([f64::MAX, f64::MAX, f64::MIN, f64::MIN], |e, p| {
+            [
+                e[0].min(p[0]),
+                e[1].min(p[1]),
+                e[2].max(p[0]),
+                e[3].max(p[1]),
+            ]
+        })
+    }
+
+    /// The committed jobs: centred on the board's origin, inside the board
+    /// (`$130` × `$131` = 230 × 153 mm), the gimbal's the galvo's scaled 1.6,
+    /// with every part of the drawing (frame, circles, text, raster)
+    /// reached by its own G0.
+    #[test]
+    fn the_committed_cam_jobs_are_centred_on_the_board() {
+        let (galvo, gimbal) = (committed("job-galvo.nc"), committed("job-gimbal.nc"));
+        let near = |a: [f64; 4], b: [f64; 4]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-3);
+        assert!(
+            near(extent(&galvo), [-25.0, -17.5, 25.0, 17.5]),
+            "{:?}",
+            extent(&galvo)
+        );
+        assert!(
+            near(extent(&gimbal), [-40.0, -28.0, 40.0, 28.0]),
+            "{:?}",
+            extent(&gimbal)
+        );
+        assert_eq!(galvo.rapids.len(), gimbal.rapids.len());
+        // 1 frame + 3 circles + 3 glyph contours + 30 dashes.
+        assert_eq!(galvo.rapids.len(), 37);
+        // Curves flattened at svg2gcode's resolution: more on the larger.
+        assert!(galvo.pieces.len() > 200, "{}", galvo.pieces.len());
+        assert!(gimbal.pieces.len() > galvo.pieces.len());
+    }
+}

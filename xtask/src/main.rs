@@ -83,6 +83,7 @@ fn main() -> ExitCode {
                 "--ignored",
                 "--test-threads",
                 "1",
+                "--nocapture",
             ],
         )
         .map(|()| ExitCode::SUCCESS),
