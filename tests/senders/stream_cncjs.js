@@ -78,7 +78,10 @@ async function main() {
     env: { ...process.env, HOME: home },
     stdio: ['ignore', 'ignore', 'inherit'],
   });
-  const stopServer = () => server.kill('SIGTERM');
+  const stopServer = () => {
+    server.kill('SIGTERM');
+    fs.rmSync(home, { recursive: true, force: true });
+  };
   process.on('exit', stopServer);
   const socket = await connect(httpPort, secret);
   let workflow = 'idle';
