@@ -61,7 +61,7 @@ written = []
 def counting_write(data):
     if data == "?":
         summary["polls"] += 1
-    else:
+    elif data not in ("!", "~"):  # realtime bytes are not lines
         written.append(data)
     return original_write(data)
 
@@ -97,5 +97,5 @@ g.poll_stop()
 time.sleep(0.5)
 summary["completed"] = finished and last_state["state"] == "Idle"
 g.disconnect()
-summary["g_lines_written"] = sum(1 for w in written if w.startswith("G"))
+summary["written"] = [w.strip() for w in written]
 print(json.dumps(summary))
