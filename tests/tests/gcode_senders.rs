@@ -47,6 +47,10 @@ const GIMBAL_TOLERANCE_MM: f64 = 0.45;
 const GIMBAL_GAP_MM: f64 = 2.2;
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;
+/// Lit samples allowed on the galvo after the first `Hold` report, ms:
+/// three 128-sample DAC halves at 10 µs (two written ahead, one being
+/// computed when the hold arrives).
+const GALVO_HOLD_DARK_MS: f64 = 3.84;
 /// Feed hold this long after the job starts, resume this much later, s.
 const HOLD_AT_S: &str = "5";
 const HOLD_FOR_S: &str = "1.5";
@@ -264,16 +268,9 @@ fn check_protocol(label: &str, summary: &Summary, report: &SimReport, job: &Job)
     );
 }
 
-/// The spot followed the toolpath, was dark on every G0 and while the
-/// controller reported `Hold` (`time_per_us`: the timeline's unit).
-fn check_drawing(
-    label: &str,
-    report: &SimReport,
-    job: &Job,
-    spot: &[SpotMm],
-    (tol_mm, missed_mm): (f64, f64),
-    time_per_us: u64,
-) {
+/// The spot followed the toolpath and was dark on every G0.
+fn check_path(label: &str, job: &Job, spot: &[SpotMm], on: &Actuator) {
+    let (tol_mm, missed_mm) = on.tolerance_mm;
     let fit = fit(&lit_mm(spot), &job.pieces);
     eprintln!(
         "{label}: {fit:?}, worst piece {:?}",
@@ -292,7 +289,13 @@ fn check_drawing(
         spans.len()
     );
     assert!(dark_samples > 0, "{label}: no G0 sampled");
-    // The hold: from the first `Hold` report to the last one.
+}
+
+/// The feed hold: dark from `on.hold_dark_ms` after the first `Hold`
+/// report to the last-but-one (the last may be read after `~` was
+/// processed: the PTY records a line when it reads it), `Hold:0`
+/// reached, `Run` again after it.
+fn check_hold(label: &str, report: &SimReport, spot: &[SpotMm], on: &Actuator) {
     let holds: Vec<(u64, &str)> = report
         .transcript
         .lines
@@ -305,27 +308,26 @@ fn check_drawing(
         holds.iter().any(|(_, l)| l.starts_with("<Hold:0|")),
         "{label}: {holds:?}"
     );
-    let (from, to) = (
-        holds[0].0 * time_per_us,
-        holds[holds.len() - 1].0 * time_per_us,
-    );
-    let held_at = spot.iter().find(|s| s.0 >= from).map(|s| s.1);
-    eprintln!("{label}: held at {held_at:?}");
-    let lit_in_hold = spot
-        .iter()
-        .filter(|s| s.2 && s.0 >= from && s.0 <= to)
-        .count();
-    let in_hold = spot.iter().filter(|s| s.0 >= from && s.0 <= to).count();
+    let per_us = on.time_per_us;
+    let (from, to) = (holds[0].0 * per_us, holds[holds.len() - 2].0 * per_us);
+    let after_ms = |t: u64| (t - from) as f64 / 1e3 / per_us as f64;
+    let in_hold: Vec<&SpotMm> = spot.iter().filter(|s| s.0 >= from && s.0 <= to).collect();
+    let last_lit_ms = in_hold.iter().rev().find(|s| s.2).map(|s| after_ms(s.0));
     eprintln!(
-        "{label}: hold reported for {:.2} s, {in_hold} samples",
-        (to - from) as f64 / 1e6 / time_per_us as f64
+        "{label}: held at {:?} for {:.2} s ({} samples), last lit {last_lit_ms:?} ms after the first Hold report",
+        in_hold.first().map(|s| s.1),
+        after_ms(to) / 1e3,
+        in_hold.len()
     );
-    assert_eq!(lit_in_hold, 0, "{label}: lit during the hold");
+    assert!(
+        last_lit_ms.is_none_or(|ms| ms <= on.hold_dark_ms),
+        "{label}: lit {last_lit_ms:?} ms into the hold; reports {holds:?}"
+    );
     let resumed = report
         .transcript
         .lines
         .iter()
-        .any(|(t, l)| *t * time_per_us > to && l.starts_with("<Run"));
+        .any(|(t, l)| *t * per_us > to && l.starts_with("<Run"));
     assert!(resumed, "{label}: no Run after the hold");
 }
 
@@ -347,6 +349,9 @@ struct Actuator {
     tolerance_mm: (f64, f64),
     /// Units of the spot's time per µs.
     time_per_us: u64,
+    /// How long after the first `Hold` report the spot may still be
+    /// lit, ms.
+    hold_dark_ms: f64,
 }
 
 const GIMBAL: Actuator = Actuator {
@@ -356,6 +361,8 @@ const GIMBAL: Actuator = Actuator {
     spot: gimbal_spot_mm,
     tolerance_mm: (GIMBAL_TOLERANCE_MM, GIMBAL_GAP_MM),
     time_per_us: 1,
+    // The laser output switches when the hold is processed.
+    hold_dark_ms: 0.0,
 };
 
 const GALVO: Actuator = Actuator {
@@ -365,6 +372,11 @@ const GALVO: Actuator = Actuator {
     spot: galvo_spot_mm,
     tolerance_mm: (GALVO_TOLERANCE_MM, 0.5),
     time_per_us: 1_000,
+    // Measured, not the 1 ms a stop meets: the hold does not close the
+    // laser gate, so the DAC halves already written play out lit (up to
+    // 3.5 ms seen after the first `Hold:0` report, with cncjs, whose `?`
+    // can follow its `!` within milliseconds).
+    hold_dark_ms: GALVO_HOLD_DARK_MS,
 };
 
 fn draws(sender: &Sender, on: &Actuator) {
@@ -374,14 +386,8 @@ fn draws(sender: &Sender, on: &Actuator) {
     let label = format!("{} ({})", sender.label, on.name);
     check_protocol(&label, &summary, &report, &job);
     let spot = (on.spot)(&report);
-    check_drawing(
-        &label,
-        &report,
-        &job,
-        &spot,
-        on.tolerance_mm,
-        on.time_per_us,
-    );
+    check_path(&label, &job, &spot, on);
+    check_hold(&label, &report, &spot, on);
 }
 
 #[test]
