@@ -43,7 +43,7 @@ const GIMBAL_TOLERANCE_MM: f64 = 0.45;
 /// How far a toolpath point may be from the nearest lit gimbal position:
 /// a feed hold darkens the spot at once, the gimbal finishes its path
 /// step (`path.step_cm` = 2 mm) dark and `~` does not redraw it (measured
-/// 1.2–1.8 mm where the hold fell), plus the spot's sampling.
+/// 0.9–1.8 mm where the hold fell), plus the spot's sampling.
 const GIMBAL_GAP_MM: f64 = 2.2;
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;
