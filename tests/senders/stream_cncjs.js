@@ -4,11 +4,11 @@
 // signed with the configuration's secret), opens PORT with controller type
 // Grbl, loads the file (`gcode:load`) and starts it (`gcode:start`):
 // cncjs's own sender streams it, character counting, and polls `?` itself.
-// The driver adds `?` (`statusreport`) every 0.2 s, optionally holds the
-// feed (`feedhold`: `!`) HOLD_AT s after the start and resumes
-// (`cyclestart`: `~`) HOLD_FOR s later, and waits for the workflow to come
-// back to idle with the whole job sent and acknowledged. Prints a JSON
-// summary. Usage: stream_cncjs.js PORT FILE [HOLD_AT HOLD_FOR]
+// The driver adds `?` (`statusreport`) every 0.2 s (each once the one
+// before was answered), optionally holds the feed (`feedhold`: `!`)
+// HOLD_AT s after the start and resumes (`cyclestart`: `~`) HOLD_FOR s
+// later, and waits for the workflow to come back to idle with the whole
+// job sent and acknowledged. Prints a JSON summary. Usage: stream_cncjs.js PORT FILE [HOLD_AT HOLD_FOR]
 // (NODE_PATH: the node_modules cncjs is installed in).
 'use strict';
 const { spawn } = require('child_process');
@@ -99,9 +99,11 @@ async function main() {
     progress.total = status.total;
   });
   let booted = false;
+  let polled = false;
   socket.on('serialport:read', (line) => {
     if (line.startsWith('<')) {
       summary.statuses += 1;
+      polled = false;
     } else if (line.startsWith('error')) {
       summary.errors.push(line);
     } else if (line.startsWith('ALARM')) {
@@ -128,7 +130,17 @@ async function main() {
   await emit(socket, 'command', port, 'gcode:load', job, gcode);
   summary.statuses = 0;
   const start = Date.now();
+  // One `?` every 0.2 s, the next once the last was answered: cncjs
+  // echoes the status report that follows a client's `?` (one flag, not a
+  // count), so two `?` written together (timers bunched after a stall of
+  // the event loop) would show one answer.
+  summary.deferred = 0;
   const poller = setInterval(() => {
+    if (polled) {
+      summary.deferred += 1;
+      return;
+    }
+    polled = true;
     summary.polls += 1;
     socket.emit('command', port, 'statusreport');
   }, 200);
