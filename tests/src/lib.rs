@@ -3,6 +3,7 @@
 
 pub mod console;
 pub mod gcode_job;
+pub mod gcode_toolpath;
 mod random;
 pub mod spec_patterns;
 

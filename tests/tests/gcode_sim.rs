@@ -4,6 +4,7 @@
 use kinematics_core::Galvo;
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Job, PathFit, SpotMm, fit, laser_job, rapids_dark};
+use system_tests::gcode_toolpath::{galvo_spot_mm, gimbal_spot_mm};
 use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
 
 /// Servo resolution, 0.1°, as a distance on the board at the gimbal's
@@ -40,27 +41,6 @@ fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
         .filter(|(_, s)| s.laser)
         .filter_map(|(_, s)| galvo.codes_to_board(s.x_code, s.y_code).ok())
         .map(|p| [p.x_mm, p.y_mm])
-        .collect()
-}
-
-fn gimbal_spot_mm(report: &SimReport) -> Vec<SpotMm> {
-    report
-        .recording
-        .spot
-        .iter()
-        .map(|s| (s.t_us, [s.x_cm * 10.0, s.y_cm * 10.0], s.laser))
-        .collect()
-}
-
-fn galvo_spot_mm(report: &SimReport) -> Vec<SpotMm> {
-    let galvo = Galvo::<f64>::default();
-    report
-        .dac
-        .iter()
-        .filter_map(|(t, s)| {
-            let p = galvo.codes_to_board(s.x_code, s.y_code).ok()?;
-            Some((t, [p.x_mm, p.y_mm], s.laser))
-        })
         .collect()
 }
 
