@@ -10,6 +10,9 @@
 //! fixed number of decimals by integer arithmetic: for status lines.
 //! [`Interval`] prints a closed range `[min, max]` in the shortest form.
 //! [`ReplyText`] is one reply line, [`reply_text`] formats into one.
+//! [`decimal`] reads numbers back: decimal text to `f64`, correctly rounded.
+
+pub mod decimal;
 
 use core::fmt::{self, Write as _};
 
