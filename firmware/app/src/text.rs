@@ -47,24 +47,29 @@ pub struct Fixed<const DECIMALS: u32>(pub f64);
 
 impl<const DECIMALS: u32> fmt::Display for Fixed<DECIMALS> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let scale = 10u64.pow(DECIMALS);
-        let scaled = libm::round(libm::fabs(self.0) * scale as f64);
-        // Beyond 2^53 the decimals are meaningless: shortest form instead.
-        if !scaled.is_finite() || scaled >= 9.0e15 {
-            return Shortest(self.0).fmt(f);
-        }
-        let units = scaled as u64;
-        let sign = if self.0 < 0.0 && units != 0 { "-" } else { "" };
-        let (whole, fraction) = (units / scale, units % scale);
-        if DECIMALS == 0 {
-            write!(f, "{sign}{whole}")
-        } else {
-            write!(
-                f,
-                "{sign}{whole}.{fraction:0width$}",
-                width = DECIMALS as usize
-            )
-        }
+        write_fixed(self.0, DECIMALS, f)
+    }
+}
+
+/// [`Fixed`]'s text, one copy for every `DECIMALS`.
+fn write_fixed(value: f64, decimals: u32, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    let scale = 10u64.pow(decimals);
+    let scaled = libm::round(libm::fabs(value) * scale as f64);
+    // Beyond 2^53 the decimals are meaningless: shortest form instead.
+    if !scaled.is_finite() || scaled >= 9.0e15 {
+        return fmt::Display::fmt(&Shortest(value), f);
+    }
+    let units = scaled as u64;
+    let sign = if value < 0.0 && units != 0 { "-" } else { "" };
+    let (whole, fraction) = (units / scale, units % scale);
+    if decimals == 0 {
+        write!(f, "{sign}{whole}")
+    } else {
+        write!(
+            f,
+            "{sign}{whole}.{fraction:0width$}",
+            width = decimals as usize
+        )
     }
 }
 
