@@ -5,14 +5,17 @@
 //! and it uses nothing of the application.
 //!
 //! [`Shortest`] prints the shortest text that parses back to the same
-//! `f64` (Ryū, `ryu` crate with its small tables): for values users read
+//! `f64` (in Ryū's layout, by exact big-integer arithmetic: no tables):
+//! for values users read
 //! back and may paste again (`get`, `params`, ranges). [`Fixed`] prints a
 //! fixed number of decimals by integer arithmetic: for status lines.
 //! [`Interval`] prints a closed range `[min, max]` in the shortest form.
 //! [`ReplyText`] is one reply line, [`reply_text`] formats into one.
 //! [`decimal`] reads numbers back: decimal text to `f64`, correctly rounded.
 
+mod big;
 pub mod decimal;
+mod shortest;
 
 use core::fmt::{self, Write as _};
 
@@ -36,8 +39,7 @@ impl fmt::Display for Shortest {
         if v == libm::trunc(v) && v.abs() < 1e15 {
             return write!(f, "{}", v as i64);
         }
-        let mut buf = ryu::Buffer::new();
-        f.write_str(buf.format_finite(v))
+        shortest::write_finite(v, f)
     }
 }
 

@@ -9,6 +9,8 @@
 //! optional `.` (digits on at least one side), then an optional
 //! `e`/`E` `[+|-]` digits. `inf` and `nan` are not numbers here.
 
+use super::big::Big;
+
 /// Most significant digits (leading and trailing zeros not counted) read:
 /// more than any command line holds ([`crate::command::MAX_LINE_LEN`]).
 pub const MAX_SIGNIFICANT_DIGITS: usize = 128;
@@ -121,75 +123,6 @@ fn digits_to_f64(digits: &[u8], exp10: i32) -> Option<f64> {
         whole.mul_add(10, u32::from(d));
     }
     Some(exact_quotient_to_f64(whole, exp10))
-}
-
-/// Limbs of the big integers: 10^452 · 2^66 (the smallest value's divisor,
-/// shifted for a 66-bit quotient) has 1 568 bits.
-const LIMBS: usize = 52;
-
-/// An unsigned integer of `LIMBS` 32-bit limbs, least significant first.
-#[derive(Clone, Copy)]
-struct Big([u32; LIMBS]);
-
-impl Big {
-    const ZERO: Self = Self([0; LIMBS]);
-
-    fn mul_add(&mut self, factor: u32, addend: u32) {
-        let mut carry = u64::from(addend);
-        for limb in &mut self.0 {
-            let v = u64::from(*limb) * u64::from(factor) + carry;
-            *limb = v as u32;
-            carry = v >> 32;
-        }
-    }
-
-    fn bits(&self) -> i32 {
-        match self.0.iter().rposition(|l| *l != 0) {
-            Some(top) => (top as i32 + 1) * 32 - self.0[top].leading_zeros() as i32,
-            None => 0,
-        }
-    }
-
-    fn shl(&mut self, bits: u32) {
-        let (limbs, bits) = ((bits / 32) as usize, bits % 32);
-        for i in (0..LIMBS).rev() {
-            let hi = if i >= limbs { self.0[i - limbs] } else { 0 };
-            let lo = if i > limbs { self.0[i - limbs - 1] } else { 0 };
-            self.0[i] = if bits == 0 {
-                hi
-            } else {
-                (hi << bits) | (lo >> (32 - bits))
-            };
-        }
-    }
-
-    fn shr1(&mut self) {
-        for i in 0..LIMBS {
-            let next = if i + 1 < LIMBS { self.0[i + 1] } else { 0 };
-            self.0[i] = (self.0[i] >> 1) | (next << 31);
-        }
-    }
-
-    /// `self -= other` if `self >= other`; whether it did.
-    fn sub_if_ge(&mut self, other: &Self) -> bool {
-        for i in (0..LIMBS).rev() {
-            if self.0[i] != other.0[i] {
-                if self.0[i] < other.0[i] {
-                    return false;
-                }
-                break;
-            }
-        }
-        let mut borrow = 0u64;
-        for (a, b) in self.0.iter_mut().zip(other.0.iter()) {
-            let v = u64::from(*a)
-                .wrapping_sub(u64::from(*b))
-                .wrapping_sub(borrow);
-            *a = v as u32;
-            borrow = (v >> 63) & 1;
-        }
-        true
-    }
 }
 
 /// `whole × 10^exp10` rounded to the nearest `f64` (ties to even) by exact
