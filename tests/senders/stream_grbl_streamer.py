@@ -1,6 +1,8 @@
 """Streams a G-code file to a grbl controller with grbl-streamer (PyPI,
 the gerbil interface: character counting, `?` polled every 0.2 s);
-prints a JSON summary. Usage: stream_grbl_streamer.py PORT FILE."""
+optionally holds the feed (its hold(): `!`) HOLD_AT s after the start and
+resumes (its resume(): `~`) HOLD_FOR s later; prints a JSON summary.
+Usage: stream_grbl_streamer.py PORT FILE [HOLD_AT HOLD_FOR]."""
 import json
 import sys
 import threading
@@ -9,6 +11,7 @@ import time
 from grbl_streamer import GrblStreamer
 
 port, path = sys.argv[1], sys.argv[2]
+hold = (float(sys.argv[3]), float(sys.argv[4])) if len(sys.argv) > 4 else None
 summary = {"sender": "grbl-streamer", "errors": [], "alarms": [], "statuses": 0, "polls": 0}
 booted = threading.Event()
 done = threading.Event()
@@ -58,7 +61,7 @@ written = []
 def counting_write(data):
     if data == "?":
         summary["polls"] += 1
-    else:
+    elif data not in ("!", "~"):  # realtime bytes are not lines
         written.append(data)
     return original_write(data)
 
@@ -79,6 +82,11 @@ start = time.monotonic()
 with open(path) as f:
     g.write(f.read())
 g.job_run()
+if hold:
+    time.sleep(max(0.0, start + hold[0] - time.monotonic()))
+    g.hold()
+    time.sleep(hold[1])
+    g.resume()
 finished = done.wait(300)
 # The job is sent; wait for the motion to end.
 deadline = time.monotonic() + 300
@@ -89,5 +97,5 @@ g.poll_stop()
 time.sleep(0.5)
 summary["completed"] = finished and last_state["state"] == "Idle"
 g.disconnect()
-summary["g_lines_written"] = sum(1 for w in written if w.startswith("G"))
+summary["written"] = [w.strip() for w in written]
 print(json.dumps(summary))

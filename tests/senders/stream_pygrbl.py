@@ -1,6 +1,8 @@
 """Streams a G-code file to a grbl controller with pygrbl-streamer (PyPI,
 character counting against a 128-byte RX buffer) while polling `?` at
-5 Hz; prints a JSON summary. Usage: stream_pygrbl.py PORT FILE."""
+5 Hz, optionally holding the feed (its pause(): `!`) HOLD_AT s after the
+start and resuming (`~`) HOLD_FOR s later; prints a JSON summary.
+Usage: stream_pygrbl.py PORT FILE [HOLD_AT HOLD_FOR]."""
 import json
 import sys
 import threading
@@ -9,6 +11,7 @@ import time
 from pygrbl_streamer import GrblStreamer
 
 port, path = sys.argv[1], sys.argv[2]
+hold = (float(sys.argv[3]), float(sys.argv[4])) if len(sys.argv) > 4 else None
 summary = {"sender": "pygrbl-streamer", "errors": [], "alarms": [], "statuses": 0, "polls": 0}
 lock = threading.Lock()
 g = GrblStreamer(port=port, baudrate=115200, auto_unlock=False)
@@ -47,13 +50,27 @@ def poll():
         time.sleep(0.2)
 
 
+def hold_and_resume():
+    if stop.wait(hold[0]):
+        return
+    g.pause()
+    summary["held"] = g.state.name
+    time.sleep(hold[1])
+    g.resume()
+
+
 poller = threading.Thread(target=poll)
+holder = threading.Thread(target=hold_and_resume) if hold else None
 start = time.monotonic()
 poller.start()
+if holder:
+    holder.start()
 summary["completed"] = g.send_file(path, completion_timeout=300)
 summary["seconds"] = time.monotonic() - start
 stop.set()
 poller.join()
+if holder:
+    holder.join()
 time.sleep(0.5)  # the last poll's report
 g.disconnect()
 print(json.dumps(summary))

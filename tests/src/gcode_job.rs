@@ -72,7 +72,7 @@ pub struct Job {
     /// Each G0 as (from, to), mm: the laser must be dark on the way.
     pub rapids: Vec<Rapid>,
     /// Where the last motion line ends, mm (`None` before the first).
-    at: Option<[f64; 2]>,
+    pub(crate) at: Option<[f64; 2]>,
 }
 
 /// A G0 move on the board, mm.
@@ -105,6 +105,11 @@ impl Job {
     /// A G0 to `p`, mm.
     pub fn rapid(&mut self, p: [f64; 2]) {
         self.line(format!("G0 X{} Y{}", num(p[0]), num(p[1])));
+        self.record_rapid(p);
+    }
+
+    /// Records a G0 to `p` (the line is already in `lines`).
+    pub(crate) fn record_rapid(&mut self, p: [f64; 2]) {
         self.rapids.push(Rapid {
             from: self.at,
             to: p,
@@ -292,6 +297,8 @@ pub struct PathFit {
     pub lit: usize,
     /// The toolpath piece with the worst gap (index into the pieces).
     pub worst_piece: usize,
+    /// Where on the toolpath the worst gap is, mm.
+    pub worst_gap_at: [f64; 2],
 }
 
 /// Compares lit spot positions with `pieces`.
@@ -324,25 +331,20 @@ pub fn fit(lit: &[[f64; 2]], pieces: &[Piece]) -> PathFit {
         }
         best
     };
-    let (worst_piece, worst_missed_mm) = pieces
+    let (worst_piece, worst_gap_at, worst_missed_mm) = pieces
         .iter()
-        .map(|piece| {
-            piece
-                .points(0.5)
-                .into_iter()
-                .map(nearest)
-                .fold(0.0, f64::max)
-        })
         .enumerate()
-        .fold(
-            (0, 0.0),
-            |best, (k, d)| if d > best.1 { (k, d) } else { best },
-        );
+        .flat_map(|(k, piece)| piece.points(0.5).into_iter().map(move |q| (k, q)))
+        .map(|(k, q)| (k, q, nearest(q)))
+        .fold((0, [0.0; 2], 0.0), |best, next| {
+            if next.2 > best.2 { next } else { best }
+        });
     PathFit {
         worst_lit_mm,
         worst_missed_mm,
         lit: lit.len(),
         worst_piece,
+        worst_gap_at,
     }
 }
 

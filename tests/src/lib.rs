@@ -3,6 +3,7 @@
 
 pub mod console;
 pub mod gcode_job;
+pub mod gcode_toolpath;
 mod random;
 pub mod spec_patterns;
 
@@ -196,29 +197,6 @@ pub fn gimbal_dark_after(report: &SimReport, t_us: u64) -> u64 {
         .find(|&&(t, on)| t >= t_us && !on)
         .expect("the laser went off");
     off - t_us
-}
-
-/// The galvo spot's timeline: every DAC sample's board position (mm,
-/// through the default galvo's geometry) and laser bit.
-pub fn galvo_spot_mm(report: &SimReport) -> Vec<gcode_job::SpotMm> {
-    let galvo = kinematics_core::Galvo::<f64>::default();
-    report
-        .dac
-        .iter()
-        .filter_map(|(t, s)| {
-            let p = galvo.codes_to_board(s.x_code, s.y_code).ok()?;
-            Some((t, [p.x_mm, p.y_mm], s.laser))
-        })
-        .collect()
-}
-
-/// Board positions (mm) of the galvo's lit DAC samples.
-pub fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
-    galvo_spot_mm(report)
-        .into_iter()
-        .filter(|s| s.2)
-        .map(|s| s.1)
-        .collect()
 }
 
 /// Times (ns) of lit DAC samples from 1 ms after sending `from` (the

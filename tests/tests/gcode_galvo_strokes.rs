@@ -5,9 +5,13 @@
 
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Job, fit, rapids_dark};
-use system_tests::{
-    UNTIL_STEP_FIXES, assert_safe_allowing, galvo_lit_mm, galvo_spot_mm, run_with, terminal_lines,
-};
+use system_tests::gcode_toolpath::{galvo_spot_mm, lit_mm};
+use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
+
+/// Board positions (mm) of the galvo's lit DAC samples.
+fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
+    lit_mm(&galvo_spot_mm(report))
+}
 
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;

@@ -1,11 +1,11 @@
 //! G-code through the simulated console: grbl's replies, the motion
 //! queue, and what the gimbal and the galvo draw for a realistic laser job.
 
+use kinematics_core::Galvo;
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Job, PathFit, SpotMm, fit, laser_job, rapids_dark};
-use system_tests::{
-    UNTIL_STEP_FIXES, assert_safe_allowing, galvo_lit_mm, galvo_spot_mm, run_with, terminal_lines,
-};
+use system_tests::gcode_toolpath::{galvo_spot_mm, gimbal_spot_mm};
+use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
 
 /// Servo resolution, 0.1°, as a distance on the board at the gimbal's
 /// distance (OQ = 25 cm) and the job's far corner (~50 mm off centre):
@@ -33,12 +33,14 @@ fn gimbal_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
         .collect()
 }
 
-fn gimbal_spot_mm(report: &SimReport) -> Vec<SpotMm> {
+fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
+    let galvo = Galvo::<f64>::default();
     report
-        .recording
-        .spot
+        .dac
         .iter()
-        .map(|s| (s.t_us, [s.x_cm * 10.0, s.y_cm * 10.0], s.laser))
+        .filter(|(_, s)| s.laser)
+        .filter_map(|(_, s)| galvo.codes_to_board(s.x_code, s.y_code).ok())
+        .map(|p| [p.x_mm, p.y_mm])
         .collect()
 }
 
@@ -269,7 +271,12 @@ fn feed_hold_on_the_galvo_is_dark_and_the_job_still_draws_its_toolpath() {
     lines.insert(43, "~".into());
     let report = run_with(&script("target galvo\n", &lines), SimOptions::default());
     assert_all_ok(&report, "galvo hold");
-    let lit_in_hold = system_tests::lit_between_ns(&report, "!", "~");
+    let hold_us = system_tests::sent_at(&report, "!");
+    let resume_us = system_tests::sent_at(&report, "~");
+    let lit_in_hold: Vec<u64> = system_tests::lit_sample_times_ns(&report)
+        .into_iter()
+        .filter(|&t| t > (hold_us + 1_000) * 1_000 && t < resume_us * 1_000)
+        .collect();
     assert!(
         lit_in_hold.is_empty(),
         "{} lit samples in the hold",

@@ -51,8 +51,9 @@ enum Command {
     /// merge new inputs into tests/fuzz/corpus.
     Fuzz(fuzz::FuzzArgs),
     /// Real G-code senders (PyPI's grbl-streamer and pygrbl-streamer,
-    /// pip-installed into target/senders when missing) stream a laser job
-    /// to the simulator through its PTY console, in real time (~30 s).
+    /// npm's cncjs headless; installed into target/senders when missing)
+    /// stream a laser CAM job to the simulator through its PTY console,
+    /// in real time (~3 min).
     Senders,
 }
 
@@ -82,6 +83,7 @@ fn main() -> ExitCode {
                 "--ignored",
                 "--test-threads",
                 "1",
+                "--nocapture",
             ],
         )
         .map(|()| ExitCode::SUCCESS),

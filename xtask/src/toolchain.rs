@@ -99,6 +99,15 @@ fn package_args<'a>(packages: &[&'a str]) -> Vec<&'a str> {
     packages.iter().flat_map(|p| ["-p", *p]).collect()
 }
 
+/// `cargo clippy` for the firmware target in release, with `packages`
+/// (`-p` arguments; none: the manifest's own package), warnings as errors.
+fn target_clippy_args<'a>(packages: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["clippy", "--target", TARGET, "--release"];
+    args.extend_from_slice(packages);
+    args.extend(["--", "-D", "warnings"]);
+    args
+}
+
 /// `cargo xtask test`: the whole gate, in the order a reviewer would run it
 /// (ends on QEMU: `bench-m4`, the M4 budgets, then the shared scenarios on
 /// the emulated board, `firmware/qemu-m4`).
@@ -113,34 +122,13 @@ pub fn test() -> Result<()> {
     clippy_host.extend(["--", "-D", "warnings"]);
     run("cargo", &clippy_host)?;
 
-    let mut clippy_target = vec!["clippy", "--target", TARGET, "--release", "-p", "firmware"];
+    let mut clippy_target = vec!["-p", "firmware"];
     clippy_target.extend(package_args(&TARGET_LIBRARIES));
-    clippy_target.extend(["--", "-D", "warnings"]);
-    run("cargo", &clippy_target)?;
+    run("cargo", &target_clippy_args(&clippy_target))?;
     // bench-m4 is a workspace of its own (see its Cargo.toml).
-    crate::bench_m4::cargo(&[
-        "clippy",
-        "--target",
-        TARGET,
-        "--release",
-        "--",
-        "-D",
-        "warnings",
-    ])?;
-
+    crate::bench_m4::cargo(&target_clippy_args(&[]))?;
     // So is the QEMU board (firmware/qemu-m4/Cargo.toml).
-    crate::bench_m4::cargo_in(
-        crate::qemu::MANIFEST,
-        &[
-            "clippy",
-            "--target",
-            TARGET,
-            "--release",
-            "--",
-            "-D",
-            "warnings",
-        ],
-    )?;
+    crate::bench_m4::cargo_in(crate::qemu::MANIFEST, &target_clippy_args(&[]))?;
 
     // The libraries for the target.
     let mut build_libs = vec!["build", "--target", TARGET, "--release"];

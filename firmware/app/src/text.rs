@@ -5,11 +5,17 @@
 //! and it uses nothing of the application.
 //!
 //! [`Shortest`] prints the shortest text that parses back to the same
-//! `f64` (Ryū, `ryu` crate with its small tables): for values users read
+//! `f64` (in Ryū's layout, by exact big-integer arithmetic: no tables):
+//! for values users read
 //! back and may paste again (`get`, `params`, ranges). [`Fixed`] prints a
 //! fixed number of decimals by integer arithmetic: for status lines.
 //! [`Interval`] prints a closed range `[min, max]` in the shortest form.
 //! [`ReplyText`] is one reply line, [`reply_text`] formats into one.
+//! [`decimal`] reads numbers back: decimal text to `f64`, correctly rounded.
+
+mod big;
+pub mod decimal;
+mod shortest;
 
 use core::fmt::{self, Write as _};
 
@@ -33,8 +39,7 @@ impl fmt::Display for Shortest {
         if v == libm::trunc(v) && v.abs() < 1e15 {
             return write!(f, "{}", v as i64);
         }
-        let mut buf = ryu::Buffer::new();
-        f.write_str(buf.format_finite(v))
+        shortest::write_finite(v, f)
     }
 }
 
@@ -44,24 +49,29 @@ pub struct Fixed<const DECIMALS: u32>(pub f64);
 
 impl<const DECIMALS: u32> fmt::Display for Fixed<DECIMALS> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let scale = 10u64.pow(DECIMALS);
-        let scaled = libm::round(libm::fabs(self.0) * scale as f64);
-        // Beyond 2^53 the decimals are meaningless: shortest form instead.
-        if !scaled.is_finite() || scaled >= 9.0e15 {
-            return Shortest(self.0).fmt(f);
-        }
-        let units = scaled as u64;
-        let sign = if self.0 < 0.0 && units != 0 { "-" } else { "" };
-        let (whole, fraction) = (units / scale, units % scale);
-        if DECIMALS == 0 {
-            write!(f, "{sign}{whole}")
-        } else {
-            write!(
-                f,
-                "{sign}{whole}.{fraction:0width$}",
-                width = DECIMALS as usize
-            )
-        }
+        write_fixed(self.0, DECIMALS, f)
+    }
+}
+
+/// [`Fixed`]'s text, one copy for every `DECIMALS`.
+fn write_fixed(value: f64, decimals: u32, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    let scale = 10u64.pow(decimals);
+    let scaled = libm::round(libm::fabs(value) * scale as f64);
+    // Beyond 2^53 the decimals are meaningless: shortest form instead.
+    if !scaled.is_finite() || scaled >= 9.0e15 {
+        return fmt::Display::fmt(&Shortest(value), f);
+    }
+    let units = scaled as u64;
+    let sign = if value < 0.0 && units != 0 { "-" } else { "" };
+    let (whole, fraction) = (units / scale, units % scale);
+    if decimals == 0 {
+        write!(f, "{sign}{whole}")
+    } else {
+        write!(
+            f,
+            "{sign}{whole}.{fraction:0width$}",
+            width = decimals as usize
+        )
     }
 }
 

@@ -55,19 +55,12 @@ pub fn parse_number(
     min: f64,
     max: f64,
 ) -> Result<f64, CommandError> {
-    let value: f64 =
-        lexical_parse_float::FromLexical::from_lexical(text.as_bytes()).map_err(|_| {
-            CommandError::InvalidArgument {
-                expected: what,
-                got: word(text),
-            }
-        })?;
-    if !value.is_finite() {
-        return Err(CommandError::InvalidArgument {
+    let value = crate::text::decimal::parse_f64(text.as_bytes())
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| CommandError::InvalidArgument {
             expected: what,
             got: word(text),
-        });
-    }
+        })?;
     if !(min..=max).contains(&value) {
         return Err(CommandError::OutOfRange { what, min, max });
     }

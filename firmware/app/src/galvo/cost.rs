@@ -87,9 +87,9 @@ pub const M4_COST: CostModel = CostModel {
     held: 10,
     // `loop.jump.steady`.
     jump_copied: 32,
-    // `integrator.xy.step` + `galvo.sample_map.angles_to_codes` (199 + 99
-    // = 298), rounded up.
-    jump_stepped: 300,
+    // `integrator.xy.step` + `galvo.sample_map.angles_to_codes` (200 + 103
+    // = 303: kinematics-core built at opt-level "s"), rounded up.
+    jump_stepped: 305,
     // `loop.arc_r40.steady` (the dearer of line and arc).
     marked: 256,
     // `loop.jump.refill`, the whole half that starts a jump (its samples

@@ -7,8 +7,6 @@
 //! and ignored. Numbers are `[+|-]digits[.digits]`, no exponent, read by
 //! integer arithmetic (no `core` float parsing is linked into the firmware).
 
-use core::fmt::Write as _;
-
 use super::error::GrblError;
 
 /// Largest number of integer digits a value may have; more is
@@ -102,12 +100,9 @@ impl<'a> Words<'a> {
         if !any_digit {
             return Err(GrblError::BadNumberFormat);
         }
-        // `mantissa`e-`fraction_digits`, converted correctly rounded by the
-        // same decimal parser the command line uses (lexical-parse-float).
-        let mut text = heapless::String::<40>::new();
-        write!(text, "{mantissa}e-{fraction_digits}").map_err(|_| GrblError::BadNumberFormat)?;
-        let value: f64 = lexical_parse_float::FromLexical::from_lexical(text.as_bytes())
-            .map_err(|_| GrblError::BadNumberFormat)?;
+        // `mantissa`e-`fraction_digits`, correctly rounded by the same
+        // decimal conversion the command line uses.
+        let value = crate::text::decimal::scaled_to_f64(mantissa, -fraction_digits);
         Ok(if negative { -value } else { value })
     }
 }

@@ -15,9 +15,11 @@ pub(in crate::galvo::scan) struct StepRing {
 }
 
 impl StepRing {
-    pub(in crate::galvo::scan) const fn new() -> Self {
+    /// Empty. Each slot is set to `None` where it lies (its tag only), not
+    /// copied from a constant image of a few KB in flash per slot.
+    pub(in crate::galvo::scan) fn new() -> Self {
         Self {
-            slots: [const { None }; SLOTS],
+            slots: core::array::from_fn(|_| None),
             head: 0,
             len: 0,
         }

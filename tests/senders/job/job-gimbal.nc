@@ -1,0 +1,592 @@
+; WARNING: Cut is not within machine bounds of X[0,300], Y[0,400]
+
+;    svg2gcode 3.3.7 (2026-12-02 02:42:30)
+;    arguments: 
+;      laser_power: 850,
+;      movement_speed: 1000,
+;      pixel_size: 0.1,
+;      maximum_image_laser_power: 300,
+;      image_movement_speed: 1200,
+;      fan: False,
+;      rapid_move: 10,
+;      showimage: False,
+;      x_axis_maximum_travel: 300,
+;      y_axis_maximum_travel: 400,
+;      image_noise: 0,
+;      pass_depth: 0.0,
+;      laser_mode: dynamic,
+;      splitfile: False,
+;      pathcut: False,
+;      nofill: True,
+;      image_poweroffset: 0,
+;      image_overscan: 0,
+;      image_showoverscan: False,
+;      color_coded: 
+;    Boundingbox: (X-40.0,Y-28.0:X40.0,Y28.0)
+;    boundingbox center: (X0,Y0)
+;    GRBL 1.1, unit=mm, absolute coordinates
+
+; Machine settings:
+;    rapid movement,
+;    XY plane,
+;    cutter compensation off,
+;    coordinate system 1,
+;    move 'unit'/min
+G0 G17 G40 G54 G94
+
+G21
+G90
+; pass #1
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X-40 Y28
+; F1200 mm/min, power S300
+M4
+G1 X40 S300 F1200
+G1 Y-28
+G1 X-40
+G1 Y28
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X-14 Y14
+; F1200 mm/min, power S300
+M4
+G1 X-14.034496 Y13.170106
+G1 X-14.137745 Y12.345938
+G1 X-14.309035 Y11.533182
+G1 X-14.547184 Y10.737444
+G1 X-14.850550 Y9.964216
+G1 X-15.217038 Y9.218830
+G1 X-15.644122 Y8.506431
+G1 X-16.128854 Y7.831932
+G1 X-16.667890 Y7.199988
+G1 X-17.257511 Y6.614958
+G1 X-17.893650 Y6.080878
+G1 X-18.571917 Y5.601434
+G1 X-19.287633 Y5.179932
+G1 X-20.035860 Y4.819281
+G1 X-20.811437 Y4.521969
+G1 X-21.609012 Y4.290048
+G1 X-22.423082 Y4.125116
+G1 X-23.248032 Y4.028313
+G1 X-24.078170 Y4.000306
+G1 X-24.907769 Y4.041287
+G1 X-25.731105 Y4.150976
+G1 X-26.542497 Y4.328614
+G1 X-27.336349 Y4.572976
+G1 X-28.107183 Y4.882377
+G1 X-28.849680 Y5.254681
+G1 X-29.558719 Y5.687321
+G1 X-30.229408 Y6.177310
+G1 X-30.857119 Y6.721270
+G1 X-31.437523 Y7.315446
+G1 X-31.966613 Y7.955740
+G1 X-32.440741 Y8.637734
+G1 X-32.856635 Y9.356724
+G1 X-33.211426 Y10.107747
+G1 X-33.502666 Y10.885624
+G1 X-33.728346 Y11.684988
+G1 X-33.886909 Y12.500323
+G1 X-33.977261 Y13.326004
+G1 X-34 Y14
+G1 X-33.965504 Y14.829894
+G1 X-33.862255 Y15.654062
+G1 X-33.690965 Y16.466818
+G1 X-33.452816 Y17.262556
+G1 X-33.149450 Y18.035784
+G1 X-32.782962 Y18.781170
+G1 X-32.355878 Y19.493569
+G1 X-31.871146 Y20.168068
+G1 X-31.332110 Y20.800012
+G1 X-30.742489 Y21.385042
+G1 X-30.106350 Y21.919122
+G1 X-29.428083 Y22.398566
+G1 X-28.712367 Y22.820068
+G1 X-27.964140 Y23.180719
+G1 X-27.188563 Y23.478031
+G1 X-26.390988 Y23.709952
+G1 X-25.576918 Y23.874884
+G1 X-24.751968 Y23.971687
+G1 X-23.921830 Y23.999694
+G1 X-23.092231 Y23.958713
+G1 X-22.268895 Y23.849024
+G1 X-21.457503 Y23.671386
+G1 X-20.663651 Y23.427024
+G1 X-19.892817 Y23.117623
+G1 X-19.150320 Y22.745319
+G1 X-18.441281 Y22.312679
+G1 X-17.770592 Y21.822690
+G1 X-17.142881 Y21.278730
+G1 X-16.562477 Y20.684554
+G1 X-16.033387 Y20.044260
+G1 X-15.559259 Y19.362266
+G1 X-15.143365 Y18.643276
+G1 X-14.788574 Y17.892253
+G1 X-14.497334 Y17.114376
+G1 X-14.271654 Y16.315012
+G1 X-14.113091 Y15.499677
+G1 X-14.022739 Y14.673996
+G1 X-14 Y14
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X8
+; F1200 mm/min, power S300
+M4
+G1 X7.966612 Y13.269870
+G1 X7.866728 Y12.545835
+G1 X7.701180 Y11.833937
+G1 X7.471351 Y11.140119
+G1 X7.179159 Y10.470173
+G1 X6.827043 Y9.829690
+G1 X6.417942 Y9.224016
+G1 X5.955271 Y8.658207
+G1 X5.442891 Y8.136986
+G1 X4.885080 Y7.664703
+G1 X4.286494 Y7.245300
+G1 X3.652128 Y6.882278
+G1 X2.987279 Y6.578668
+G1 X2.297494 Y6.337003
+G1 X1.588533 Y6.159301
+G1 X0.866312 Y6.047044
+G1 X0.136860 Y6.001171
+G1 X-0.593734 Y6.022063
+G1 X-1.319372 Y6.109546
+G1 X-2.033998 Y6.262891
+G1 X-2.731646 Y6.480817
+G1 X-3.406493 Y6.761505
+G1 X-4.052906 Y7.102613
+G1 X-4.665490 Y7.501292
+G1 X-5.239131 Y7.954216
+G1 X-5.769042 Y8.457604
+G1 X-6.250798 Y9.007253
+G1 X-6.680380 Y9.598577
+G1 X-7.054201 Y10.226640
+G1 X-7.369141 Y10.886198
+G1 X-7.622571 Y11.571747
+G1 X-7.812376 Y12.277565
+G1 X-7.936971 Y12.997759
+G1 X-7.995317 Y13.726320
+G1 X-8 Y14
+G1 X-7.966612 Y14.730130
+G1 X-7.866728 Y15.454165
+G1 X-7.701180 Y16.166063
+G1 X-7.471351 Y16.859881
+G1 X-7.179159 Y17.529827
+G1 X-6.827043 Y18.170310
+G1 X-6.417942 Y18.775984
+G1 X-5.955271 Y19.341793
+G1 X-5.442891 Y19.863014
+G1 X-4.885080 Y20.335297
+G1 X-4.286494 Y20.754700
+G1 X-3.652128 Y21.117722
+G1 X-2.987279 Y21.421332
+G1 X-2.297494 Y21.662997
+G1 X-1.588533 Y21.840699
+G1 X-0.866312 Y21.952956
+G1 X-0.136860 Y21.998829
+G1 X0.593734 Y21.977937
+G1 X1.319372 Y21.890454
+G1 X2.033998 Y21.737109
+G1 X2.731646 Y21.519183
+G1 X3.406493 Y21.238495
+G1 X4.052906 Y20.897387
+G1 X4.665490 Y20.498708
+G1 X5.239131 Y20.045784
+G1 X5.769042 Y19.542396
+G1 X6.250798 Y18.992747
+G1 X6.680380 Y18.401423
+G1 X7.054201 Y17.773360
+G1 X7.369141 Y17.113802
+G1 X7.622571 Y16.428253
+G1 X7.812376 Y15.722435
+G1 X7.936971 Y15.002241
+G1 X7.995317 Y14.273680
+G1 X8 Y14
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X30
+; F1200 mm/min, power S300
+M4
+G1 X29.963350 Y13.337835
+G1 X29.853846 Y12.683760
+G1 X29.672827 Y12.045766
+G1 X29.422504 Y11.431645
+G1 X29.105936 Y10.848902
+G1 X28.726989 Y10.304655
+G1 X28.290294 Y9.805554
+G1 X27.801185 Y9.357695
+G1 X27.265637 Y8.966550
+G1 X26.690194 Y8.636899
+G1 X26.081885 Y8.372767
+G1 X25.448142 Y8.177382
+G1 X24.796708 Y8.053131
+G1 X24.135540 Y8.001531
+G1 X23.472717 Y8.023214
+G1 X22.816335 Y8.117914
+G1 X22.174414 Y8.284474
+G1 X21.554795 Y8.520860
+G1 X20.965050 Y8.824184
+G1 X20.412381 Y9.190739
+G1 X19.903542 Y9.616048
+G1 X19.444749 Y10.094915
+G1 X19.041606 Y10.621490
+G1 X18.699039 Y11.189340
+G1 X18.421233 Y11.791527
+G1 X18.211581 Y12.420694
+G1 X18.072646 Y13.069155
+G1 X18.006124 Y13.728989
+G1 X18 Y14
+G1 X18.036650 Y14.662165
+G1 X18.146154 Y15.316240
+G1 X18.327173 Y15.954234
+G1 X18.577496 Y16.568355
+G1 X18.894064 Y17.151098
+G1 X19.273011 Y17.695345
+G1 X19.709706 Y18.194446
+G1 X20.198815 Y18.642305
+G1 X20.734363 Y19.033450
+G1 X21.309806 Y19.363101
+G1 X21.918115 Y19.627233
+G1 X22.551858 Y19.822618
+G1 X23.203292 Y19.946869
+G1 X23.864460 Y19.998469
+G1 X24.527283 Y19.976786
+G1 X25.183665 Y19.882086
+G1 X25.825586 Y19.715526
+G1 X26.445205 Y19.479140
+G1 X27.034950 Y19.175816
+G1 X27.587619 Y18.809261
+G1 X28.096458 Y18.383952
+G1 X28.555251 Y17.905085
+G1 X28.958394 Y17.378510
+G1 X29.300961 Y16.810660
+G1 X29.578767 Y16.208473
+G1 X29.788419 Y15.579306
+G1 X29.927354 Y14.930845
+G1 X29.993876 Y14.271011
+G1 X30 Y14
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X-29.985265 Y-4
+; F1200 mm/min, power S300
+M4
+G1 X-25.859344
+G1 Y-16.881447
+G1 X-18.614869
+G1 Y-20
+G1 X-29.985265
+G1 Y-4
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X-6.290690 Y-17.085064
+; F1200 mm/min, power S300
+M4
+G1 X-12.742130
+G1 X-13.760214 Y-20
+G1 X-17.907569
+G1 X-11.981246 Y-4
+G1 X-7.062291
+G1 X-1.135968 Y-20
+G1 X-5.283322
+G1 X-6.290690 Y-17.085064
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X-11.713329 Y-14.116544
+; F1200 mm/min, power S300
+M4
+G1 X-7.330208
+G1 X-9.516410 Y-7.750837
+G1 X-11.713329 Y-14.116544
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X8 Y-22.400000
+; F1200 mm/min, power S300
+M4
+G1 X10.880000
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X12.800000
+; F1200 mm/min, power S300
+M4
+G1 X15.680000
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X17.600000
+; F1200 mm/min, power S300
+M4
+G1 X20.480000
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X22.400000
+; F1200 mm/min, power S300
+M4
+G1 X25.280000
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X27.200000
+; F1200 mm/min, power S300
+M4
+G1 X30.080000
+
+; default action: engrave path '', color '#000000'
+
+; delta: 0
+M5
+G0 X32
+; F1200 mm/min, power S300
+M4
+G1 X34.880000
+
+; default action: engrave path '', color '#303030'
+
+; delta: 0
+M5
+G0 X8 Y-19.200000
+; F1200 mm/min, power S244
+M4
+G1 X10.880000 S244
+
+; default action: engrave path '', color '#303030'
+
+; delta: 0
+M5
+G0 X12.800000
+; F1200 mm/min, power S244
+M4
+G1 X15.680000
+
+; default action: engrave path '', color '#303030'
+
+; delta: 0
+M5
+G0 X17.600000
+; F1200 mm/min, power S244
+M4
+G1 X20.480000
+
+; default action: engrave path '', color '#303030'
+
+; delta: 0
+M5
+G0 X22.400000
+; F1200 mm/min, power S244
+M4
+G1 X25.280000
+
+; default action: engrave path '', color '#303030'
+
+; delta: 0
+M5
+G0 X27.200000
+; F1200 mm/min, power S244
+M4
+G1 X30.080000
+
+; default action: engrave path '', color '#303030'
+
+; delta: 0
+M5
+G0 X32
+; F1200 mm/min, power S244
+M4
+G1 X34.880000
+
+; default action: engrave path '', color '#606060'
+
+; delta: 0
+M5
+G0 X8 Y-16
+; F1200 mm/min, power S187
+M4
+G1 X10.880000 S187
+
+; default action: engrave path '', color '#606060'
+
+; delta: 0
+M5
+G0 X12.800000
+; F1200 mm/min, power S187
+M4
+G1 X15.680000
+
+; default action: engrave path '', color '#606060'
+
+; delta: 0
+M5
+G0 X17.600000
+; F1200 mm/min, power S187
+M4
+G1 X20.480000
+
+; default action: engrave path '', color '#606060'
+
+; delta: 0
+M5
+G0 X22.400000
+; F1200 mm/min, power S187
+M4
+G1 X25.280000
+
+; default action: engrave path '', color '#606060'
+
+; delta: 0
+M5
+G0 X27.200000
+; F1200 mm/min, power S187
+M4
+G1 X30.080000
+
+; default action: engrave path '', color '#606060'
+
+; delta: 0
+M5
+G0 X32
+; F1200 mm/min, power S187
+M4
+G1 X34.880000
+
+; default action: engrave path '', color '#909090'
+
+; delta: 0
+M5
+G0 X8 Y-12.800000
+; F1200 mm/min, power S131
+M4
+G1 X10.880000 S131
+
+; default action: engrave path '', color '#909090'
+
+; delta: 0
+M5
+G0 X12.800000
+; F1200 mm/min, power S131
+M4
+G1 X15.680000
+
+; default action: engrave path '', color '#909090'
+
+; delta: 0
+M5
+G0 X17.600000
+; F1200 mm/min, power S131
+M4
+G1 X20.480000
+
+; default action: engrave path '', color '#909090'
+
+; delta: 0
+M5
+G0 X22.400000
+; F1200 mm/min, power S131
+M4
+G1 X25.280000
+
+; default action: engrave path '', color '#909090'
+
+; delta: 0
+M5
+G0 X27.200000
+; F1200 mm/min, power S131
+M4
+G1 X30.080000
+
+; default action: engrave path '', color '#909090'
+
+; delta: 0
+M5
+G0 X32
+; F1200 mm/min, power S131
+M4
+G1 X34.880000
+
+; default action: engrave path '', color '#b0b0b0'
+
+; delta: 0
+M5
+G0 X8 Y-9.600000
+; F1200 mm/min, power S94
+M4
+G1 X10.880000 S94
+
+; default action: engrave path '', color '#b0b0b0'
+
+; delta: 0
+M5
+G0 X12.800000
+; F1200 mm/min, power S94
+M4
+G1 X15.680000
+
+; default action: engrave path '', color '#b0b0b0'
+
+; delta: 0
+M5
+G0 X17.600000
+; F1200 mm/min, power S94
+M4
+G1 X20.480000
+
+; default action: engrave path '', color '#b0b0b0'
+
+; delta: 0
+M5
+G0 X22.400000
+; F1200 mm/min, power S94
+M4
+G1 X25.280000
+
+; default action: engrave path '', color '#b0b0b0'
+
+; delta: 0
+M5
+G0 X27.200000
+; F1200 mm/min, power S94
+M4
+G1 X30.080000
+
+; default action: engrave path '', color '#b0b0b0'
+
+; delta: 0
+M5
+G0 X32
+; F1200 mm/min, power S94
+M4
+G1 X34.880000
+M5
+M2
