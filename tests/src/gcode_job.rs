@@ -97,11 +97,13 @@ fn num(v: f64) -> String {
 }
 
 impl Job {
-    fn line(&mut self, text: impl Into<String>) {
+    /// Appends a line as it is.
+    pub fn line(&mut self, text: impl Into<String>) {
         self.lines.push(text.into());
     }
 
-    fn rapid(&mut self, p: [f64; 2]) {
+    /// A G0 to `p`, mm.
+    pub fn rapid(&mut self, p: [f64; 2]) {
         self.line(format!("G0 X{} Y{}", num(p[0]), num(p[1])));
         self.record_rapid(p);
     }
@@ -116,7 +118,7 @@ impl Job {
     }
 
     /// A lit polyline (first point reached by G0).
-    fn polyline(&mut self, points: &[[f64; 2]], feed: f64, power: f64) {
+    pub fn polyline(&mut self, points: &[[f64; 2]], feed: f64, power: f64) {
         self.rapid(points[0]);
         for (k, w) in points.windows(2).enumerate() {
             let f = if k == 0 {

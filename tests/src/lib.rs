@@ -198,3 +198,13 @@ pub fn gimbal_dark_after(report: &SimReport, t_us: u64) -> u64 {
         .expect("the laser went off");
     off - t_us
 }
+
+/// Times (ns) of lit DAC samples from 1 ms after sending `from` (the
+/// laser's 1 ms to go dark) until sending `to`: a hold's lit samples.
+pub fn lit_between_ns(report: &SimReport, from: &str, to: &str) -> Vec<u64> {
+    let (from_us, to_us) = (sent_at(report, from), sent_at(report, to));
+    lit_sample_times_ns(report)
+        .into_iter()
+        .filter(|&t| t > (from_us + 1_000) * 1_000 && t < to_us * 1_000)
+        .collect()
+}

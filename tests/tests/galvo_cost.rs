@@ -76,7 +76,8 @@ fn m4_cost_model_matches_the_bench_table() {
     );
     let marking = row(&table, "loop.arc_r40.steady")
         .max(row(&table, "loop.line.steady"))
-        .max(row(&table, "loop.tuning.steady"));
+        .max(row(&table, "loop.tuning.steady"))
+        .max(row(&table, "loop.stroke.steady"));
     fits("marked", m.marked, marking);
     fits(
         "step_started",
@@ -90,7 +91,8 @@ fn m4_cost_model_matches_the_bench_table() {
     );
     let stroke = row(&table, "loop.tuning.prep")
         .max(row(&table, "loop.arc_r40.prep"))
-        .max(row(&table, "loop.line.prep"));
+        .max(row(&table, "loop.line.prep"))
+        .max(row(&table, "loop.stroke.prep"));
     fits("stroke_prepared", m.stroke_prepared, stroke);
     fits("rebuild", m.rebuild, row(&table, "loop.reconfigure"));
     fits(

@@ -1,9 +1,9 @@
-//! The galvo loop's half-buffer fills: holding, marking a line, marking a
-//! circle (r = 40 mm), jumping; `GalvoLoop::new`.
+//! The galvo loop's half-buffer fills: holding, marking a line, a circle
+//! (r = 40 mm) and a G-code stroke, jumping; `GalvoLoop::new`.
 
 use core::hint::black_box;
 
-use laser_app::domain::{Figure, PointCm, Rotation};
+use laser_app::domain::{Figure, PointCm, Rotation, StrokeCm};
 use laser_app::galvo::{
     DacSample, DacStream, GalvoConfig, GalvoError, GalvoLoop, GalvoRequest, Half, ScanPhase,
     Underrun,
@@ -190,9 +190,23 @@ fn reconfigure(
     galvo.fill(&mut half[..1], |_| {});
 }
 
-/// Marking a line and a circle (r = 40 mm), half by half.
+/// A G-code stroke at its dearest: four lines (open, so its end needs
+/// its own IK), a zigzag from (-60, -20) mm to (60, 20) mm.
+fn g_code_stroke() -> Option<StrokeCm> {
+    let mut stroke = StrokeCm::new(PointCm::new(-6.0, -2.0))?;
+    for (x_cm, y_cm) in [(-3.0, 2.0), (0.0, -2.0), (3.0, 2.0), (6.0, 2.0)] {
+        stroke.line_to(PointCm::new(x_cm, y_cm)).then_some(())?;
+    }
+    Some(stroke)
+}
+
+/// Marking a line, a circle (r = 40 mm), a G-code stroke of four lines and
+/// the tuning figure, half by half.
 #[inline(always)]
 fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
+    let Some(stroke) = g_code_stroke() else {
+        return b.fail("loop.stroke", "the stroke was refused");
+    };
     // Marking: first go to the stroke start (not measured), so the job's
     // own jump is zero-length and its halves hold marking only.
     let jobs = [
@@ -214,6 +228,12 @@ fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
                 radius_cm: 4.0,
                 rotation: Rotation::Ccw,
             },
+        ),
+        (
+            "loop.stroke",
+            [-60.0f32, -20.0],
+            // A G-code stroke of four lines.
+            Figure::Stroke(stroke),
         ),
         (
             "loop.tuning",

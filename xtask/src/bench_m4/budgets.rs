@@ -117,6 +117,24 @@ pub const ROWS: &[Row] = &[
         budget: half_refill_budget(REFILL),
     },
     Row {
+        id: "loop.stroke.steady",
+        what: "loop, marking a G-code stroke of four lines (a zigzag, sharp corners)",
+        unit: "sample",
+        budget: Some((0.20 * SAMPLE_US, "20 % of the 10 µs sample", LOOP)),
+    },
+    Row {
+        id: "loop.stroke.refill",
+        what: "refill, G-code stroke of four lines, steps prepared (worst half)",
+        unit: "half",
+        budget: half_refill_budget(REFILL),
+    },
+    Row {
+        id: "loop.stroke.prep",
+        what: "prep: a G-code stroke step of four lines (jump + stroke setup + end IK)",
+        unit: "step",
+        budget: prep_budget(PREP),
+    },
+    Row {
         id: "loop.tuning.steady",
         what: "loop, marking the 80 mm tuning figure (square, circle, cross)",
         unit: "sample",

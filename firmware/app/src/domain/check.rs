@@ -123,6 +123,7 @@ pub(super) fn figure_probes(figure: &Figure) -> heapless::Vec<Probe, MAX_PROBES>
                 }
             }
         }
+        Figure::Stroke(stroke) => stroke.points().for_each(|p| push(p.x_cm, p.y_cm)),
         Figure::Tuning { .. } => {}
     }
     probes

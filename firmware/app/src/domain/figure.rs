@@ -9,6 +9,7 @@ use core::fmt;
 
 pub use kinematics_core::{Pattern as GridPattern, Rotation};
 
+pub use self::stroke_cm::StrokeCm;
 use super::point::PointCm;
 use super::units::Unit;
 use crate::text::Shortest;
@@ -48,6 +49,10 @@ pub enum Figure {
         /// Side of the square, cm.
         size_cm: f64,
     },
+    /// One stroke of up to [`StrokeCm::MAX_SEGMENTS`] lines (the galvo
+    /// marks consecutive G-code feed moves as one: corners at the path
+    /// planner's junction speed, the laser on through them).
+    Stroke(StrokeCm),
 }
 
 /// A test pattern or path (SPEC §4.6).
@@ -80,8 +85,13 @@ pub enum Segment {
     },
 }
 
+mod stroke_cm;
+
+/// Most segments of one stroke.
+const STROKE_SEGMENTS: usize = 4;
+
 /// Segments of one stroke.
-pub type Segments = heapless::Vec<Segment, 4>;
+pub type Segments = heapless::Vec<Segment, STROKE_SEGMENTS>;
 
 /// A stroke: drawn without a break from `start` through its segments, in
 /// the [`Unit`] it was built in.
@@ -128,6 +138,7 @@ impl Figure {
             Figure::Circle { .. } => "circle",
             Figure::Rect { .. } => "rect",
             Figure::Tuning { .. } => "tuning",
+            Figure::Stroke(_) => "stroke",
         }
     }
 
@@ -151,6 +162,7 @@ impl Figure {
                 rotation,
             )),
             (Figure::Rect { a, b }, 0) => Some(Stroke::rect(at(a), at(b))),
+            (Figure::Stroke(stroke), 0) => Some(stroke.in_unit(unit)),
             (Figure::Tuning { centre, size_cm }, stroke) => {
                 let [cx, cy] = at(centre);
                 let h = unit.from_cm(size_cm) / 2.0;
@@ -188,6 +200,7 @@ impl Figure {
                 let (c, h) = (at(centre), (unit.from_cm(size_cm) / 2.0).abs());
                 ([c[0] - h, c[1] - h], [c[0] + h, c[1] + h])
             }
+            Figure::Stroke(stroke) => stroke.bounds(unit),
         };
         [lo, [hi[0], lo[1]], hi, [lo[0], hi[1]]]
     }
@@ -252,6 +265,10 @@ impl fmt::Display for Pattern {
             Figure::Tuning { centre, size_cm } => {
                 let (x, y) = cm(centre);
                 write!(f, "tuning {x} {y} {}", Shortest(size_cm))
+            }
+            Figure::Stroke(stroke) => {
+                let (x, y) = cm(stroke.start());
+                write!(f, "stroke {x} {y} ({} segments)", stroke.segments())
             }
         }
     }

@@ -23,7 +23,7 @@ pub use actuator::{Actuator, AimModel};
 pub use aim::{Aim, Aimer, Target};
 pub use check::{MAX_PROBES, PatternCheck, check_pattern, check_target};
 pub use error::PatternError;
-pub use figure::{Figure, GridPattern, Pattern, Rotation, Segment, Segments, Stroke};
+pub use figure::{Figure, GridPattern, Pattern, Rotation, Segment, Segments, Stroke, StrokeCm};
 pub use path::{PathCursor, pass_points};
 pub use point::PointCm;
 pub use units::Unit;

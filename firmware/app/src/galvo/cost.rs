@@ -99,9 +99,10 @@ pub const M4_COST: CostModel = CostModel {
     step_started: 9_560,
     // `loop.jump.prep`.
     point_prepared: 66_320,
-    // `loop.tuning.prep` (68 760): the dearest stroke step, a jump and a
-    // stroke; rounded up.
-    stroke_prepared: 68_800,
+    // `loop.stroke.prep` (75 240): the dearest stroke step, a jump and a
+    // G-code stroke of four lines (its open end needs its own IK); one
+    // 40-instruction timer tick of margin, rounded up.
+    stroke_prepared: 75_300,
     // `plan.seed.0.1deg` (1.572 M), rounded up: the cheapest bisection
     // plan, a lower bound for any jump.
     bisection_axis: 1_580_000,

@@ -4,6 +4,7 @@
 //! sender expects (`ok` once a line's motion is queued, `error:N`,
 //! `ALARM:N`, status reports).
 
+use super::gcode_galvo::GalvoStroke;
 use super::gcode_motion::{Hold, Motion, PLANNER_BLOCKS};
 use super::gcode_settings::GrblValues;
 use super::machine::{Action, ActionSink, Core, Line};
@@ -43,6 +44,8 @@ pub(super) struct Gcode {
     pub(super) motion: Motion,
     /// Status reports sent (grbl adds `WCO:` / `Ov:` every few).
     pub(super) reports: u32,
+    /// The galvo stroke in flight (several blocks joined).
+    pub(super) galvo: GalvoStroke,
     /// Actual over programmed speed of the gimbal step in flight, 0..=1
     /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
     pub(super) step_speed_ratio: f32,
@@ -62,6 +65,7 @@ impl Gcode {
             },
             motion: Motion::new(),
             reports: 0,
+            galvo: GalvoStroke::default(),
             step_speed_ratio: 0.0,
         }
     }

@@ -8,7 +8,9 @@
 //! * galvo: a G0 or dark move is a jump ([`GalvoRequest::Point`] without
 //!   dwell), a lit feed move is marked as a line stroke
 //!   ([`GalvoRequest::Path`]) at F with the feed override, capped by
-//!   `galvo.mark_speed_mm_s`; arcs as chords within `$12`.
+//!   `galvo.mark_speed_mm_s`; arcs as chords within `$12`. On the galvo
+//!   alone, consecutive lit blocks are joined into one stroke
+//!   ([`super::gcode_galvo`]).
 //!
 //! Feed hold stops after the step in flight (the galvo at once, braking
 //! along its stroke), laser dark; `~` goes on from there.
@@ -303,7 +305,8 @@ impl Core {
             .is_some_and(|c| c.servo_seq.is_some() || c.until.is_some());
         motion.hold = if waiting { Hold::Stopping } else { Hold::Held };
         if galvo_in_flight {
-            self.stop_galvo(out);
+            // Closing the gate also darkens the samples the DAC holds.
+            self.close_gate(out);
         }
     }
 

@@ -8,8 +8,7 @@ use embassy_time::{Duration, Instant};
 use super::gcode_motion::{CORNER_DEADBAND_TENTHS, CORNER_SETTLE_MS, Hold, cm, point_at};
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
-use crate::domain::{Figure, Target};
-use crate::galvo::GalvoRequest;
+use crate::domain::Target;
 use crate::grbl::{Block, PointMm};
 use crate::servo::task::ServoOutcome;
 
@@ -48,30 +47,9 @@ impl Core {
             self.gcode.motion.gimbal_lit = lit && self.gcode.motion.arrived;
         }
         if self.actuator.uses_galvo() {
-            let galvo_lit = lit;
-            self.next_seq = self.next_seq.wrapping_add(1);
-            let seq = self.next_seq;
-            let request = if galvo_lit {
-                GalvoRequest::Path {
-                    seq,
-                    path: Figure::Line {
-                        from: cm(from),
-                        to: cm(to),
-                    },
-                    mark_speed_mm_s: feed.map(|f| (self.gcode_galvo_feed_mm_min(f) / 60.0) as f32),
-                }
-            } else {
-                let [x_mm, y_mm] = cm(to).galvo_mm();
-                GalvoRequest::Point {
-                    seq,
-                    x_mm,
-                    y_mm,
-                    dwell_us: 0,
-                }
-            };
-            if !self.send_galvo(request, out) {
+            let Some(seq) = self.gcode_galvo_send(from, to, feed, lit, out) else {
                 return;
-            }
+            };
             galvo_seq = Some(seq);
         }
         if let Some(c) = self.gcode.motion.current.as_mut() {
@@ -154,6 +132,7 @@ impl Core {
             return false;
         }
         c.galvo_seq = None;
+        self.gcode_galvo_stroke_done(seq, out);
         self.gcode_step_done(out);
         true
     }

@@ -15,6 +15,7 @@ mod commands;
 mod faults;
 mod galvo;
 mod gcode;
+mod gcode_galvo;
 mod gcode_motion;
 mod gcode_power;
 mod gcode_report;
