@@ -154,7 +154,7 @@ impl UniformSampler {
                 start,
                 end,
                 centre,
-                rotation,
+                rotation: _,
             } => {
                 start.check_finite()?;
                 end.check_finite()?;

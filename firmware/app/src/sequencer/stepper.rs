@@ -18,23 +18,20 @@ use crate::stepper::{MoveShape, StepperConfig, StepperEvent, StepperRequest};
 use crate::text::Fixed;
 
 impl Core {
-    /// The stepper parameters: the seed's pan/tilt ([`StepperConfig`]'s
-    /// defaults) on the board placed as the settings say (OQ, offsets,
-    /// pose), exact model, OL = 0.
+    /// The stepper parameters from the settings (`stepper.*`), on the
+    /// board placed as the settings say (OQ, offsets, pose), exact model,
+    /// OL = 0 (the pan/tilt's axes meet at the beam).
     pub(super) fn stepper_config(&self) -> StepperConfig {
-        let defaults = StepperConfig::default();
         let mut geometry = self
             .settings
             .gimbal(crate::domain::AimModel::Exact)
             .geometry;
-        geometry.ol_cm = defaults.gimbal.geometry.ol_cm;
-        StepperConfig {
-            gimbal: Gimbal {
-                model: GimbalModel::Exact,
-                geometry,
-            },
-            ..defaults
-        }
+        geometry.ol_cm = 0.0;
+        let gimbal = Gimbal {
+            model: GimbalModel::Exact,
+            geometry,
+        };
+        StepperConfig::from_settings(&self.settings.stepper, gimbal)
     }
 
     /// Sends the stepper task its parameters (applied at rest).
