@@ -259,7 +259,9 @@ impl Default for Settings {
 }
 
 impl Settings {
-    /// Current value of `param`.
+    /// Current value of `param`. (Not inlined: its copy of the settings
+    /// stays out of the sequencer task's frame.)
+    #[inline(never)]
     pub fn get(&self, param: &ParamSpec) -> f64 {
         let mut copy = *self;
         match param.slot {
@@ -275,7 +277,9 @@ impl Settings {
     }
 
     /// Sets `param` to `value` after checking range, integrality and the
-    /// cross-parameter rules; on error nothing changes.
+    /// cross-parameter rules; on error nothing changes. (Not inlined, as
+    /// [`Settings::get`].)
+    #[inline(never)]
     pub fn set(&mut self, param: &ParamSpec, value: f64) -> Result<(), SettingsError> {
         check_value(param, value)?;
         let mut next = *self;
