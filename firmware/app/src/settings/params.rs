@@ -26,6 +26,8 @@
 //! | 160–168 | stepper drive: step angle, microsteps, speed, acceleration, junction, pulse, DIR setup, ENABLE, idle release (`settings/stepper.rs`) |
 //! | 169–172 | stepper pan: dir, zero_deg, min_deg, max_deg  |
 //! | 173–176 | stepper tilt: the same                        |
+//! | 177–183 | stepper homing: seek, latch, pull-off speeds/distance; pan home_dir, home_deg; tilt the same |
+//! | 177–183 | stepper homing: seek, latch, pull-off; pan home_dir, home_deg; tilt the same |
 
 use super::spec::COEF_HELP;
 use super::spec::{ParamSpec, Precision, Slot, choice, count, err_coef, real};
@@ -38,7 +40,7 @@ pub const MIN_CODES_PER_RAD: f64 = 1_000.0;
 pub const MAX_CODES_PER_RAD: f64 = 120_000.0;
 
 /// The parameter table (also the order of `params` and of the saved record).
-pub static PARAMS: &[ParamSpec] = &joined::<54, 17, 71>(BASE, STEPPER_PARAMS);
+pub static PARAMS: &[ParamSpec] = &joined::<54, 24, 78>(BASE, STEPPER_PARAMS);
 
 /// Every parameter of `a` then every one of `b` (the table is built from
 /// pieces kept next to what they describe).

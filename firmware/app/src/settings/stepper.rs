@@ -1,17 +1,17 @@
-//! The stepper pan/tilt's parameters (ids 160–176, one run of the saved
+//! The stepper pan/tilt's parameters (ids 160–183, one run of the saved
 //! record): microstep mapping, per-axis direction, zero and soft limits,
-//! motion limits and the driver's signal timing.
+//! motion limits, the driver's signal timing and homing.
 //!
 //! # Record size (the decision)
 //!
 //! They are stored like every other parameter: f64 values in the id-keyed
 //! version-3 record, so nothing about the framing changes and a record
-//! saved before they existed (488 bytes) loads as it is, the 17 values at
-//! their defaults (`defaulted = 17`; the next `save` writes them). The
-//! record grows by one run head and 17 values to 628 bytes. A 128 KiB
-//! sector then holds ≈ 200 saves before an erase instead of ≈ 260
-//! (100 000 erase cycles × 2 sectors × 200 saves is still 40 million
-//! saves); packing them into f32 or a second map item would save ~70
+//! saved before they existed (488 bytes) loads as it is, the 24 values at
+//! their defaults (`defaulted = 24`; the next `save` writes them). The
+//! record grows by one run head and 24 values to 684 bytes. A 128 KiB
+//! sector then holds ≈ 190 saves before an erase instead of ≈ 260
+//! (100 000 erase cycles × 2 sectors × 190 saves is still 38 million
+//! saves); packing them into f32 or a second map item would save ~100
 //! bytes for a new framing version and its migration, not worth it. The
 //! power-cut tests scale the sectors to 2 KiB (1/64) so a sector still
 //! holds two records and the hand-over is cut too.
@@ -39,6 +39,11 @@ pub struct StepperAxisSettings {
     pub min_deg: f64,
     /// Soft limit: highest joint angle, deg.
     pub max_deg: f64,
+    /// Joint direction towards the homing switch: 1, −1, or 0 (no
+    /// switch), whole.
+    pub home_dir: f64,
+    /// Joint angle where the homing switch closes, deg.
+    pub home_deg: f64,
 }
 
 /// The stepper pan/tilt's parameters.
@@ -62,6 +67,12 @@ pub struct StepperSettings {
     pub enable_active_high: f64,
     /// Drivers released after this long at rest, ms (0: always held).
     pub idle_release_ms: f64,
+    /// Homing seek (and pull-off) speed, deg/s.
+    pub home_seek_deg_s: f64,
+    /// Homing latch speed, deg/s.
+    pub home_latch_deg_s: f64,
+    /// Homing back-off and pull-off distance, deg.
+    pub home_pulloff_deg: f64,
     /// Pan (yaw) axis.
     pub pan: StepperAxisSettings,
     /// Tilt (pitch) axis.
@@ -78,6 +89,8 @@ impl Default for StepperSettings {
             zero_deg: 0.0,
             min_deg: -60.0,
             max_deg: 60.0,
+            home_dir: 0.0,
+            home_deg: 0.0,
         };
         Self {
             full_step_deg: SEED_FULL_STEP_DEG,
@@ -89,6 +102,9 @@ impl Default for StepperSettings {
             dir_setup_us: 5.0,
             enable_active_high: 0.0,
             idle_release_ms: 0.0,
+            home_seek_deg_s: 20.0,
+            home_latch_deg_s: 2.0,
+            home_pulloff_deg: 2.0,
             pan: axis,
             tilt: axis,
         }
@@ -122,6 +138,14 @@ impl StepperSettings {
                 "stepper pulse + DIR setup do not fit the step period at max speed",
             ));
         }
+        for speed in [self.home_seek_deg_s, self.home_latch_deg_s] {
+            let rate = speed / self.deg_per_step();
+            if !(MIN_RATE_STEPS_PER_S..=MAX_STEP_RATE_STEPS_S).contains(&rate) {
+                return Err(SettingsError::Rejected(
+                    "stepper homing speeds must be 1..50000 steps/s at this step angle",
+                ));
+            }
+        }
         for axis in [&self.pan, &self.tilt] {
             if axis.min_deg >= axis.max_deg {
                 return Err(SettingsError::Rejected(
@@ -134,7 +158,7 @@ impl StepperSettings {
 }
 
 /// The stepper's rows of the parameter table (ids ascending).
-pub(super) const STEPPER_PARAMS: [ParamSpec; 17] = [
+pub(super) const STEPPER_PARAMS: [ParamSpec; 24] = [
     real!(
         160,
         "stepper.full_step_deg",
@@ -266,6 +290,62 @@ pub(super) const STEPPER_PARAMS: [ParamSpec; 17] = [
         90.0,
         "stepper tilt soft limit high, deg",
         |s| s.stepper.tilt.max_deg
+    ),
+    real!(
+        177,
+        "stepper.home_seek_deg_s",
+        0.01,
+        360.0,
+        "stepper homing seek speed, deg/s",
+        |s| s.stepper.home_seek_deg_s
+    ),
+    real!(
+        178,
+        "stepper.home_latch_deg_s",
+        0.01,
+        360.0,
+        "stepper homing latch speed, deg/s",
+        |s| s.stepper.home_latch_deg_s
+    ),
+    real!(
+        179,
+        "stepper.home_pulloff_deg",
+        0.01,
+        20.0,
+        "stepper homing back-off/pull-off, deg",
+        |s| s.stepper.home_pulloff_deg
+    ),
+    whole(
+        180,
+        "stepper.pan.home_dir",
+        -1.0,
+        1.0,
+        "stepper pan switch direction: 1, -1, 0 none",
+        |s| &mut s.stepper.pan.home_dir,
+    ),
+    real!(
+        181,
+        "stepper.pan.home_deg",
+        -180.0,
+        180.0,
+        "stepper pan joint angle at the switch, deg",
+        |s| s.stepper.pan.home_deg
+    ),
+    whole(
+        182,
+        "stepper.tilt.home_dir",
+        -1.0,
+        1.0,
+        "stepper tilt switch direction: 1, -1, 0 none",
+        |s| &mut s.stepper.tilt.home_dir,
+    ),
+    real!(
+        183,
+        "stepper.tilt.home_deg",
+        -90.0,
+        90.0,
+        "stepper tilt joint angle at the switch, deg",
+        |s| s.stepper.tilt.home_deg
     ),
 ];
 

@@ -14,12 +14,14 @@
 //! ring pop and Bresenham adds. Everything else ([`StepperMotion`]) runs in
 //! the low-priority [`StepperTask`].
 
+mod home;
 mod link;
 mod motion;
 mod task;
 
 pub use self::link::{
-    MoveShape, STEP_QUEUE_LEN, StepperEvent, StepperLink, StepperRefusal, StepperRequest,
+    HomingFailure, MoveShape, STEP_QUEUE_LEN, StepperEvent, StepperLink, StepperRefusal,
+    StepperRequest,
 };
 pub use self::motion::{LINE_TOLERANCE_MM, StepperMotion};
 pub use self::task::{StepPulseTask, StepperTask};
@@ -66,6 +68,26 @@ pub trait StepperDrive {
     async fn wait_ticks(&mut self, ticks: u32);
     /// The next event is scheduled from now (after the timer was idle).
     fn restart(&mut self);
+    /// Whether each axis's limit switch is pressed, `[pan, tilt]` (read
+    /// before every step event; inputs without a switch read released).
+    fn limits(&mut self) -> [bool; 2];
+}
+
+/// Homing: which axes have switches, where they are, how fast to find
+/// them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HomingConfig {
+    /// Joint direction towards each axis's switch (+1/−1), 0: no switch,
+    /// `[pan, tilt]`.
+    pub dir: [i8; 2],
+    /// Joint angle where each switch closes, degrees `[pan, tilt]`.
+    pub switch_deg: [f64; 2],
+    /// Seek and pull-off speed, °/s.
+    pub seek_deg_s: f64,
+    /// Latch (slow approach) speed, °/s.
+    pub latch_deg_s: f64,
+    /// Back-off and pull-off distance, degrees.
+    pub pulloff_deg: f64,
 }
 
 /// The stepper pan/tilt's parameters (from the settings).
@@ -94,6 +116,8 @@ pub struct StepperConfig {
     /// Drivers released after this long at rest, ms (0: always held, the
     /// default: a released pan/tilt may sag off the point it holds).
     pub idle_release_ms: u32,
+    /// Homing switches and speeds.
+    pub homing: HomingConfig,
     /// The pointing geometry: the exact model with the pan/tilt's OL.
     pub gimbal: Gimbal,
 }
@@ -138,6 +162,14 @@ impl StepperConfig {
                 enable_active_high: s.enable_active_high == 1.0,
             },
             idle_release_ms: s.idle_release_ms as u32,
+            homing: HomingConfig {
+                // Whole −1..=1 (checked).
+                dir: [s.pan.home_dir as i8, s.tilt.home_dir as i8],
+                switch_deg: [s.pan.home_deg, s.tilt.home_deg],
+                seek_deg_s: s.home_seek_deg_s,
+                latch_deg_s: s.home_latch_deg_s,
+                pulloff_deg: s.home_pulloff_deg,
+            },
             gimbal,
         }
     }

@@ -325,6 +325,23 @@ impl StepperMotion {
         }
     }
 
+    /// Queues a move by `delta` microsteps at `speed_deg_s` (homing).
+    ///
+    /// Errors: [`StepperRefusal::BadConfig`] (the rate is refused).
+    pub fn jog(&mut self, delta: [i32; 2], speed_deg_s: f64) -> Result<(), StepperRefusal> {
+        let mut mv = Self::step_move(&self.config, delta);
+        mv.nominal_rate_steps_per_s = speed_deg_s / self.config.deg_per_step();
+        self.planner
+            .push(&mv)
+            .map_err(|_| StepperRefusal::BadConfig)?;
+        self.planned = [
+            self.planned[0].wrapping_add(delta[0]),
+            self.planned[1].wrapping_add(delta[1]),
+        ];
+        self.last_point = None;
+        Ok(())
+    }
+
     /// Step position where the queued moves end.
     pub fn planned_steps(&self) -> [i32; 2] {
         self.planned
