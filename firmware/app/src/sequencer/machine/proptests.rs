@@ -77,6 +77,8 @@ enum Step {
         current: bool,
     },
     StepperStopped,
+    /// A limit switch halted the steps (1–3), homing ended (4) or failed.
+    StepperLimit(u8),
     Dwell,
     Tick {
         ms: u64,
@@ -118,6 +120,7 @@ fn command() -> impl Strategy<Value = Command> {
         3 => point().prop_map(Command::Goto),
         2 => (-4i8..5, -4i8..5).prop_map(|(xi, yi)| Command::Grid { xi, yi }),
         3 => Just(Command::Stop),
+        1 => Just(Command::Home),
         3 => actuator.prop_map(Command::Target),
         2 => mode.prop_map(Command::Laser),
         1 => any::<bool>().prop_map(|seed| Command::Model(if seed { AimModel::Seed } else { AimModel::Exact })),
@@ -155,6 +158,7 @@ fn step() -> impl Strategy<Value = Step> {
             .prop_map(|(current, steps)| Step::StepperArrived { current, steps }),
         1 => current.prop_map(|current| Step::StepperRefused { current }),
         1 => Just(Step::StepperStopped),
+        1 => (0u8..6).prop_map(Step::StepperLimit),
         6 => Just(Step::Dwell),
         3 => (0u64..2_000).prop_map(|ms| Step::Tick { ms }),
     ]
@@ -244,7 +248,10 @@ impl Harness {
         }
         let stepper_step = matches!(
             step,
-            Step::StepperArrived { .. } | Step::StepperRefused { .. } | Step::StepperStopped
+            Step::StepperArrived { .. }
+                | Step::StepperRefused { .. }
+                | Step::StepperStopped
+                | Step::StepperLimit(_)
         );
         if stepper_step && !self.stepper_attached {
             return Ok(());
@@ -315,6 +322,16 @@ impl Harness {
                     Event::Stepper(StepperEvent::Stopped { steps: [0; 2] }),
                     true,
                 )
+            }
+            Step::StepperLimit(kind) => {
+                self.step_owed = None;
+                let steps = [0; 2];
+                let event = match kind {
+                    1..=3 => StepperEvent::LimitHit { axes: kind, steps },
+                    4 => StepperEvent::Homed { steps },
+                    _ => StepperEvent::HomingFailed(crate::stepper::HomingFailure::Interrupted),
+                };
+                (Event::Stepper(event), true)
             }
             Step::GalvoDone { current } => {
                 let seq = Self::seq(current, &mut self.job_owed);

@@ -11,7 +11,7 @@ use crate::settings::*;
 
 /// Every parameter's id as it was given (ids never change): a parameter
 /// whose id is not this one, or a new parameter not listed here, fails.
-const STABLE_IDS: [(u16, &str); 71] = [
+const STABLE_IDS: [(u16, &str); 78] = [
     (10, "oq_cm"),
     (11, "ol_cm"),
     (20, "grid.pitch_cm"),
@@ -83,11 +83,18 @@ const STABLE_IDS: [(u16, &str); 71] = [
     (174, "stepper.tilt.zero_deg"),
     (175, "stepper.tilt.min_deg"),
     (176, "stepper.tilt.max_deg"),
+    (177, "stepper.home_seek_deg_s"),
+    (178, "stepper.home_latch_deg_s"),
+    (179, "stepper.home_pulloff_deg"),
+    (180, "stepper.pan.home_dir"),
+    (181, "stepper.pan.home_deg"),
+    (182, "stepper.tilt.home_dir"),
+    (183, "stepper.tilt.home_deg"),
 ];
 
 /// Parameters added after the version-2 records (the stepper's): such
 /// records leave them at their defaults.
-const STEPPER_PARAMS: usize = 17;
+const STEPPER_PARAMS: usize = 24;
 
 /// A version-2 record written by the firmware before ids (galvo build: 54
 /// values) with the values of [`fixture_settings`].
@@ -256,10 +263,10 @@ fn the_record_is_magic_version_count_id_value_entries_and_crc() {
     assert_eq!(values_in(&s.to_record()), values);
     assert!(MAX_RECORD_LEN >= RECORD_LEN && MAX_RECORD_LEN >= V2_GALVO.len());
     if has_galvo() {
-        // 15 runs of 71 values, 3 bytes of padding: ≈ 200 saves fill a
+        // 15 runs of 78 values, 3 bytes of padding: ≈ 190 saves fill a
         // 128 KiB sector (tests/tests/settings_sim.rs; the decision is in
         // settings/stepper.rs).
-        assert_eq!(RECORD_LEN, 8 + 15 * 3 + 71 * 8 + 3 + 4);
+        assert_eq!(RECORD_LEN, 8 + 15 * 3 + 78 * 8 + 3 + 4);
     }
 }
 

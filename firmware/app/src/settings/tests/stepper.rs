@@ -27,17 +27,24 @@ fn changed() -> StepperSettings {
         dir_setup_us: 2.5,
         enable_active_high: 1.0,
         idle_release_ms: 5000.0,
+        home_seek_deg_s: 30.0,
+        home_latch_deg_s: 1.5,
+        home_pulloff_deg: 3.0,
         pan: StepperAxisSettings {
             direction: -1,
             zero_deg: 1.25,
             min_deg: -90.0,
             max_deg: 80.0,
+            home_dir: 1.0,
+            home_deg: 95.0,
         },
         tilt: StepperAxisSettings {
             direction: -1,
             zero_deg: -2.5,
             min_deg: -45.0,
             max_deg: 70.0,
+            home_dir: -1.0,
+            home_deg: -50.0,
         },
     }
 }
@@ -86,6 +93,11 @@ fn out_of_range_and_inconsistent_stepper_values_are_refused_and_change_nothing()
         ("stepper.tilt.dir", 0.5),
         ("stepper.pan.zero_deg", 181.0),
         ("stepper.tilt.max_deg", 91.0),
+        ("stepper.pan.home_dir", 2.0),
+        ("stepper.tilt.home_dir", 0.5),
+        ("stepper.home_pulloff_deg", 0.0),
+        // 0.02 °/s at 0.05625°/step is 0.36 steps/s.
+        ("stepper.home_latch_deg_s", 0.02),
         // Rules between parameters: limits in order …
         ("stepper.pan.min_deg", 60.0),
         ("stepper.tilt.max_deg", -60.0),
