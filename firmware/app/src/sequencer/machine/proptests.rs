@@ -494,6 +494,7 @@ impl Harness {
             Action::ConfigureGalvo(_)
             | Action::ConfigureStepper(_)
             | Action::AllowGalvoLaser(_)
+            | Action::GimbalPower(_)
             | Action::Note(_)
             | Action::Line(_) => {}
         }
