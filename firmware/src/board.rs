@@ -14,6 +14,7 @@
 //! | stepper pan STEP / DIR  | PE9 / PE10 (STEP on a TIM1 channel pin, for a later one-pulse timer; the step timer runs on an interrupt executor, `tasks.rs`) |
 //! | stepper tilt STEP / DIR | PE11 / PE12 (likewise) |
 //! | stepper ENABLE (both)   | PE13 (polarity a parameter; released = the idle level) |
+//! | stepper limit switches  | PE7 pan, PE8 tilt (pull-up inputs, normally-open switch to GND: low = pressed) |
 //!
 //! Flash: the image in sectors 0–5 (≤ 256 KiB), the saved settings in
 //! sectors 10 and 11 (`settings_flash`, `memory.x`).
@@ -27,7 +28,7 @@
 use embassy_executor::Spawner;
 use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::flash::{self, Flash};
-use embassy_stm32::gpio::{Level, Output, Pull, Speed};
+use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::Priority;
 use embassy_stm32::peripherals::{PA2, PA3, PA11, PA12, USART2, USB_OTG_FS};
 use embassy_stm32::time::Hertz;
@@ -134,7 +135,7 @@ pub struct Stm32Board {
     pub settings: FlashSettings,
     /// Independent watchdog (not started).
     pub watchdog: IndependentDog,
-    /// Stepper pan/tilt driver inputs (PE9–PE13).
+    /// Stepper pan/tilt driver inputs (PE9–PE13), limit switches (PE7, PE8).
     pub stepper: GpioStepper,
 }
 
@@ -236,6 +237,7 @@ pub fn init(spawner: Spawner) -> Stm32Board {
             ],
             // Active-low ENABLE by default: high = released at reset.
             enable: Output::new(p.PE13, Level::High, Speed::Low),
+            limit: [Input::new(p.PE7, Pull::Up), Input::new(p.PE8, Pull::Up)],
             signals: laser_app::stepper::StepperConfig::default().signals,
             next: Instant::MIN,
         },

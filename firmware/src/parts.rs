@@ -4,7 +4,7 @@
 
 use embassy_stm32::Peri;
 use embassy_stm32::exti::ExtiInput;
-use embassy_stm32::gpio::Output;
+use embassy_stm32::gpio::{Input, Output};
 use embassy_stm32::mode::Async;
 use embassy_stm32::peripherals::{IWDG, USB_OTG_FS};
 use embassy_stm32::usb::Driver;
@@ -97,7 +97,8 @@ impl Watchdog for IndependentDog {
 }
 
 /// The stepper pan/tilt's driver inputs: STEP and DIR per axis (PE9/PE10
-/// pan, PE11/PE12 tilt) and the shared ENABLE (PE13). Pulses are timed by
+/// pan, PE11/PE12 tilt) and the shared ENABLE (PE13); the limit switch
+/// inputs (PE7 pan, PE8 tilt). Pulses are timed by
 /// busy-waiting on the cycle counter's clock (2.5 µs STEP, 5 µs DIR setup
 /// by default); the step schedule is embassy-time deadlines (1 µs ticks).
 pub struct GpioStepper {
@@ -107,6 +108,10 @@ pub struct GpioStepper {
     pub dir: [Output<'static>; 2],
     /// The drivers' shared ENABLE.
     pub enable: Output<'static>,
+    /// Limit switch inputs, `[pan, tilt]` (PE7, PE8): pulled up, a
+    /// normally-open switch to ground closes (low = pressed; no switch
+    /// reads open).
+    pub limit: [Input<'static>; 2],
     /// Current pulse timing and ENABLE polarity.
     pub signals: laser_app::stepper::DriverSignals,
     /// Deadline of the next step event.
@@ -156,5 +161,9 @@ impl laser_app::stepper::StepperDrive for GpioStepper {
 
     fn restart(&mut self) {
         self.next = Instant::now();
+    }
+
+    fn limits(&mut self) -> [bool; 2] {
+        [self.limit[0].is_low(), self.limit[1].is_low()]
     }
 }

@@ -12,12 +12,14 @@ use laser_app::settings::{RECORD_LEN, Settings};
 use laser_sim::flash::{PowerCut, SimFlash, Tear};
 use sequential_storage::map::MapConfig;
 
-/// The F407's 128 KiB sectors scaled by 1/128, so a handful of saves fills
-/// a sector and the sector hand-over is cut too.
-const SECTOR: usize = 1024;
+/// The F407's 128 KiB sectors scaled by 1/64, so a handful of saves fills
+/// a sector and the sector hand-over is cut too (a sector holds two
+/// records of 628 bytes; 1/128 held only one once the stepper parameters
+/// came).
+const SECTOR: usize = 2048;
 type Flash = SimFlash<SECTOR>;
 /// Sectors 10 and 11 (0x080C_0000, 0x080E_0000), scaled.
-const BASE: u32 = 0x000C_0000 / 128;
+const BASE: u32 = 0x000C_0000 / 64;
 
 fn store(flash: Flash) -> FlashSettingsStore<Flash> {
     FlashSettingsStore::new(

@@ -313,3 +313,41 @@ fn the_seeds_point_by_point_method_is_kept_for_comparison() {
     assert!(seed > 0.5 && seed < 2.0, "{seed}");
     assert!(exact <= LINE_TOLERANCE_MM + ONE_STEP_MM, "{exact}");
 }
+
+/// The stepper parameters are saved settings: set, saved, and after a
+/// reboot from the flash the run left they drive the steps (16 microsteps:
+/// half the steps; pan direction reversed: counted the other way).
+#[test]
+fn saved_stepper_parameters_survive_a_reset_and_drive_the_steps() {
+    let saved = run_with(
+        "set stepper.microsteps 16\nset stepper.pan.dir -1\nset stepper.accel_deg_s2 1200\nsave\n",
+        SimOptions::default(),
+    );
+    assert_eq!(system_tests::reply_to(&saved, "save").1, "ok");
+    let goto = "get stepper.microsteps\nget stepper.pan.dir\nget stepper.accel_deg_s2\ntarget stepper\ngoto 5 0\n";
+    let rebooted = run_with(
+        goto,
+        SimOptions {
+            settings_flash: Some(saved.settings_flash.clone()),
+            ..SimOptions::default()
+        },
+    );
+    assert!(rebooted.succeeded(false), "{:?}", rebooted.transcript);
+    let lines = system_tests::terminal_lines(&rebooted);
+    for want in [
+        "stepper.microsteps = 16  #",
+        "stepper.pan.dir = -1  #",
+        "stepper.accel_deg_s2 = 1200  #",
+    ] {
+        assert!(
+            lines.iter().any(|l| l.starts_with(want)),
+            "{want}: {lines:?}"
+        );
+    }
+    let defaults = run("goto 5 0\n");
+    let pan = |r: &SimReport| r.stepper.axes[0].counted_steps();
+    // |yaw| = atan(5/25) = 11.31°: 201 steps of 0.05625°, 101 of 0.1125°
+    // (x > 0 is a negative yaw).
+    assert_eq!(pan(&defaults), -201);
+    assert_eq!(pan(&rebooted), 101);
+}

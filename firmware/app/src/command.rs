@@ -30,6 +30,7 @@ pub static HELP_LINES: &[&str] = &[
     "pattern rect <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
     "pattern tuning [<cx_cm> <cy_cm> <size_cm>] [once]   (galvo)",
     "stop                         stop the pattern, laser off",
+    "home                         home the stepper on its switches",
     "goto <x_cm> <y_cm>           aim at a board point",
     "grid <xi> <yi>               aim at a grid point",
     "laser on|off|auto|dwell      laser mode",
@@ -53,6 +54,8 @@ pub enum Command {
     Help,
     /// Firmware version and build.
     Version,
+    /// Home the stepper pan/tilt on its limit switches.
+    Home,
     /// Uptime, build and current state.
     Status,
     /// Run a pattern, repeating until stopped unless `once`.
@@ -138,6 +141,7 @@ impl Command {
         match self {
             Command::Help => "help",
             Command::Version => "version",
+            Command::Home => "home",
             Command::Status => "status",
             Command::Pattern { .. } => "pattern",
             Command::Stop => "stop",

@@ -30,9 +30,9 @@ use heapless::Deque;
 use crate::text::{REPLY_LINE_LEN, ReplyText, reply_text};
 
 /// Size of the outbound queue, bytes (lines are stored with a 2-byte
-/// header). Holds the longest reply (`params`, about 3.2 KiB stored) with
+/// header). Holds the longest reply (`params`, about 5.5 KiB stored) with
 /// room to spare, so a host that reads gets every line.
-pub const OUTBOUND_BYTES: usize = 6 * 1024;
+pub const OUTBOUND_BYTES: usize = 10 * 1024;
 
 /// Stored size of the longest line (header + text), bytes.
 const LINE_ENTRY_MAX: usize = HEADER + REPLY_LINE_LEN;

@@ -30,9 +30,11 @@
 
 mod drive;
 mod pan_tilt;
+mod switch;
 
 pub use drive::SimStepperDrive;
 pub use pan_tilt::{PanTiltDrivers, StepEdge, StepPin, StepperGeometry};
+pub use switch::LimitSwitch;
 
 /// Timing a driver needs on its inputs, ns.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -33,7 +33,9 @@ use crate::script::Step;
 use crate::servo_model::SimServoBus;
 use crate::servo_port::{BusFaults, SimServoPort};
 use crate::spot::{RecordingLaser, SpotFn, gimbal_spot_cm, spot_sampler};
-use crate::stepper::{DriverTiming, MotorLimits, PanTiltDrivers, SimStepperDrive, StepperGeometry};
+use crate::stepper::{
+    DriverTiming, LimitSwitch, MotorLimits, PanTiltDrivers, SimStepperDrive, StepperGeometry,
+};
 use crate::usb_host::{Transcript, UsbHost, host_tasks};
 
 /// Samples per galvo DAC half buffer (1.28 ms at 100 kHz).
@@ -124,6 +126,9 @@ pub struct SimOptions {
     /// The true stepper pan/tilt geometry (the spot comes from its
     /// counted steps).
     pub stepper_geometry: StepperGeometry,
+    /// Limit switches on the stepper axes `[pan, tilt]` (none: inputs
+    /// read open).
+    pub stepper_switches: [Option<LimitSwitch>; 2],
     /// Serve the console on a pseudo-terminal instead of the script
     /// (real time; the run ends when its stop flag is set).
     #[cfg(unix)]
@@ -153,6 +158,7 @@ impl Default for SimOptions {
             stepper_timing: DriverTiming::default(),
             stepper_motor: MotorLimits::default(),
             stepper_geometry: StepperGeometry::default(),
+            stepper_switches: [None; 2],
             #[cfg(unix)]
             pty: None,
         }
@@ -309,9 +315,13 @@ impl World {
                 panel: self.panel.clone(),
             },
             watchdog: SimWatchdog(self.panel.clone()),
-            stepper: options
-                .stepper
-                .then(|| SimStepperDrive::new(self.stepper.clone())),
+            stepper: options.stepper.then(|| {
+                SimStepperDrive::new(
+                    self.stepper.clone(),
+                    options.stepper_geometry,
+                    options.stepper_switches,
+                )
+            }),
         }
     }
 

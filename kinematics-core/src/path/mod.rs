@@ -30,7 +30,7 @@ mod sampler;
 pub use circle::ArcSteps;
 pub use line::LineSteps;
 pub use rect::RectSteps;
-pub use sampler::{Segment, UniformSampler};
+pub use sampler::{Segment, Shape, UniformSampler};
 
 use crate::error::Error;
 use crate::numeric::finite;

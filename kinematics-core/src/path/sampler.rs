@@ -47,18 +47,80 @@ pub struct UniformSampler {
     k: u32,
 }
 
-#[derive(Debug, Clone, Copy)]
-enum Shape {
+/// A board line or arc evaluated by the fraction of its length: the one
+/// point-at-parameter shared by the gimbal's sampler and the stepper's
+/// piece cutting.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shape {
+    /// Straight line.
     Line {
+        /// Start, cm.
         from: BoardPoint,
+        /// End, cm.
+        to: BoardPoint,
     },
+    /// Circular arc.
     Arc {
+        /// Centre, cm.
         centre: BoardPoint,
+        /// Radius (centre to start), cm.
         radius_cm: f64,
+        /// Angle of the start about the centre, rad.
         start_rad: f64,
         /// Signed sweep, radians (negative clockwise).
         sweep_rad: f64,
     },
+}
+
+impl Shape {
+    /// The shape of `segment`; an arc whose end is its start (or within
+    /// 1e-12 rad of it, ahead in its direction) is a full circle.
+    pub fn of(segment: Segment) -> Self {
+        match segment {
+            Segment::Line { from, to } => Shape::Line { from, to },
+            Segment::Arc {
+                start,
+                end,
+                centre,
+                rotation,
+            } => {
+                let (ax, ay) = (start.x_cm - centre.x_cm, start.y_cm - centre.y_cm);
+                let start_rad = libm::atan2(ay, ax);
+                let a = rotation.sign()
+                    * (libm::atan2(end.y_cm - centre.y_cm, end.x_cm - centre.x_cm) - start_rad);
+                let a = a - TAU * libm::floor(a / TAU);
+                let sweep = if start == end || a < 1e-12 { TAU } else { a };
+                Shape::Arc {
+                    centre,
+                    radius_cm: libm::hypot(ax, ay),
+                    start_rad,
+                    sweep_rad: rotation.sign() * sweep,
+                }
+            }
+        }
+    }
+
+    /// The point a fraction `t` (0..=1) along the shape, cm.
+    pub fn point_at(&self, t: f64) -> BoardPoint {
+        match *self {
+            Shape::Line { from, to } => BoardPoint {
+                x_cm: from.x_cm + t * (to.x_cm - from.x_cm),
+                y_cm: from.y_cm + t * (to.y_cm - from.y_cm),
+            },
+            Shape::Arc {
+                centre,
+                radius_cm,
+                start_rad,
+                sweep_rad,
+            } => {
+                let (s, c) = libm::sincos(start_rad + t * sweep_rad);
+                BoardPoint {
+                    x_cm: centre.x_cm + radius_cm * c,
+                    y_cm: centre.y_cm + radius_cm * s,
+                }
+            }
+        }
+    }
 }
 
 impl UniformSampler {
@@ -82,7 +144,7 @@ impl UniformSampler {
                 to.check_finite()?;
                 let len = libm::hypot(to.x_cm - from.x_cm, to.y_cm - from.y_cm);
                 (
-                    Shape::Line { from },
+                    Shape::Line { from, to },
                     from,
                     to,
                     libm::ceil(len / max_step_cm),
@@ -92,26 +154,25 @@ impl UniformSampler {
                 start,
                 end,
                 centre,
-                rotation,
+                rotation: _,
             } => {
                 start.check_finite()?;
                 end.check_finite()?;
                 centre.check_finite()?;
-                let (ax, ay) = (start.x_cm - centre.x_cm, start.y_cm - centre.y_cm);
-                let (bx, by) = (end.x_cm - centre.x_cm, end.y_cm - centre.y_cm);
-                let (r, r_end) = (libm::hypot(ax, ay), libm::hypot(bx, by));
+                let shape = Shape::of(segment);
+                let (r, r_end) = (
+                    libm::hypot(start.x_cm - centre.x_cm, start.y_cm - centre.y_cm),
+                    libm::hypot(end.x_cm - centre.x_cm, end.y_cm - centre.y_cm),
+                );
                 if !r.is_finite() || !r_end.is_finite() {
                     return Err(Error::TooManySteps);
                 }
                 if (r_end - r).abs() > max_chord_error_cm {
                     return Err(Error::EndNotOnCircle);
                 }
-                let start_rad = libm::atan2(ay, ax);
-                let sweep = if start == end {
-                    TAU
-                } else {
-                    let a = rotation.sign() * (libm::atan2(by, bx) - start_rad);
-                    a - TAU * libm::floor(a / TAU)
+                let sweep = match shape {
+                    Shape::Arc { sweep_rad, .. } => sweep_rad.abs(),
+                    Shape::Line { .. } => 0.0,
                 };
                 // Largest angle whose chord stays within the tolerance, and
                 // whose arc is at most one step.
@@ -119,12 +180,6 @@ impl UniformSampler {
                 let by_chord = 2.0 * libm::acos(cos_half);
                 let by_step = max_step_cm / r;
                 let dphi = by_chord.min(by_step);
-                let shape = Shape::Arc {
-                    centre,
-                    radius_cm: r,
-                    start_rad,
-                    sweep_rad: rotation.sign() * sweep,
-                };
                 let n_f = if r == 0.0 || sweep == 0.0 {
                     0.0
                 } else {
@@ -158,25 +213,7 @@ impl UniformSampler {
         if k >= self.n {
             return self.end;
         }
-        let t = f64::from(k) / f64::from(self.n);
-        match self.shape {
-            Shape::Line { from } => BoardPoint {
-                x_cm: from.x_cm + t * (self.end.x_cm - from.x_cm),
-                y_cm: from.y_cm + t * (self.end.y_cm - from.y_cm),
-            },
-            Shape::Arc {
-                centre,
-                radius_cm,
-                start_rad,
-                sweep_rad,
-            } => {
-                let (s, c) = libm::sincos(start_rad + t * sweep_rad);
-                BoardPoint {
-                    x_cm: centre.x_cm + radius_cm * c,
-                    y_cm: centre.y_cm + radius_cm * s,
-                }
-            }
-        }
+        self.shape.point_at(f64::from(k) / f64::from(self.n))
     }
 }
 

@@ -51,6 +51,12 @@ impl StepGenerator {
         self.position
     }
 
+    /// Redefines the position, microsteps `[pan, tilt]` (homing sets
+    /// the zero; at rest).
+    pub fn set_position(&mut self, position: [i32; 2]) {
+        self.position = position;
+    }
+
     /// Whether a segment is being executed.
     pub fn is_running(&self) -> bool {
         self.segment.is_some()

@@ -118,6 +118,10 @@ impl StepperDrive for NoStepper {
     fn restart(&mut self) {
         match *self {}
     }
+
+    fn limits(&mut self) -> [bool; 2] {
+        match *self {}
+    }
 }
 
 /// A board: the types of its parts, and the parts themselves

@@ -74,6 +74,9 @@ impl crate::stepper::StepperDrive for Part {
     fn step(&mut self, _step: [bool; 2], _negative: [bool; 2]) {}
     async fn wait_ticks(&mut self, _ticks: u32) {}
     fn restart(&mut self) {}
+    fn limits(&mut self) -> [bool; 2] {
+        [false; 2]
+    }
 }
 
 impl Indicators for Part {

@@ -14,6 +14,8 @@ pub enum GrblError {
     InvalidStatement,
     /// 4: a negative value where only positive ones make sense (F, N, P, S, T, `$N=`).
     NegativeValue,
+    /// 5: `$H` without homing switches configured.
+    HomingDisabled,
     /// 8: a `$` command that needs the machine idle.
     NotIdle,
     /// 9: G-code refused during an alarm or jog.
@@ -72,6 +74,7 @@ impl GrblError {
             BadNumberFormat => 2,
             InvalidStatement => 3,
             NegativeValue => 4,
+            HomingDisabled => 5,
             NotIdle => 8,
             GcodeLock => 9,
             LineOverflow => 11,

@@ -48,6 +48,10 @@ impl Core {
                 self.stop("stop command", out);
                 self.ok(out);
             }
+            Command::Home => match self.start_homing(out) {
+                Ok(()) => self.ok(out),
+                Err(reason) => self.error(out, reason),
+            },
             Command::Pattern { pattern, once } => self.check(
                 pattern,
                 AfterCheck::Start(Start::Pattern { pattern, once }),

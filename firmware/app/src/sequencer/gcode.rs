@@ -220,6 +220,12 @@ impl Core {
         if !idle || self.gcode.mode == GrblMode::Check {
             return self.grbl_error(out, GrblError::NotIdle);
         }
+        if self.actuator.uses_stepper() {
+            return match self.start_homing(out) {
+                Ok(()) => self.ok(out),
+                Err(_) => self.grbl_error(out, GrblError::HomingDisabled),
+            };
+        }
         self.gcode.mode = GrblMode::Normal;
         let from = self.gcode.motion.position;
         self.gcode.parser.position = crate::grbl::PointMm::ZERO;

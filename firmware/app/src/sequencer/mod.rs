@@ -138,7 +138,6 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         let generation = gate.close();
         let mut record = [0u8; crate::settings::MAX_RECORD_LEN];
         let n = store.load(&mut record).await;
-        let loaded = Settings::load_record(record.get(..n).unwrap_or(&[]));
         let io = Io {
             link,
             servo,
@@ -154,12 +153,21 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             follow_up: FollowUp::Nothing,
             refused: false,
         };
+        Self::started(io, record.get(..n).unwrap_or(&[]))
+    }
+
+    /// The sequencer with the settings of `record` applied. Not inlined:
+    /// its copies of the settings (record, core, event) stay out of the
+    /// task's frame.
+    #[inline(never)]
+    fn started(io: Io<'a, L, S>, record: &[u8]) -> Self {
         let mut sequencer = Self {
             core: Core::new(Instant::now()),
             io,
         };
         // The galvo loop starts with the loaded parameters and laser mode
         // (loading asks for no follow-up: no reply, check or save).
+        let loaded = Settings::load_record(record);
         let _ = sequencer.dispatch(Event::SettingsLoaded(loaded));
         sequencer.io.status.publish(sequencer.core.status());
         sequencer

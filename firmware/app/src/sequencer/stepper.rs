@@ -14,27 +14,24 @@ use super::machine::{Action, ActionSink, Core};
 use super::run::RunKind;
 use crate::domain::{Aim, Pattern, PointCm, Segment, Target, Unit};
 use crate::log;
-use crate::stepper::{MoveShape, StepperConfig, StepperEvent, StepperRequest};
+use crate::stepper::{HomingFailure, MoveShape, StepperConfig, StepperEvent, StepperRequest};
 use crate::text::Fixed;
 
 impl Core {
-    /// The stepper parameters: the seed's pan/tilt ([`StepperConfig`]'s
-    /// defaults) on the board placed as the settings say (OQ, offsets,
-    /// pose), exact model, OL = 0.
+    /// The stepper parameters from the settings (`stepper.*`), on the
+    /// board placed as the settings say (OQ, offsets, pose), exact model,
+    /// OL = 0 (the pan/tilt's axes meet at the beam).
     pub(super) fn stepper_config(&self) -> StepperConfig {
-        let defaults = StepperConfig::default();
         let mut geometry = self
             .settings
             .gimbal(crate::domain::AimModel::Exact)
             .geometry;
-        geometry.ol_cm = defaults.gimbal.geometry.ol_cm;
-        StepperConfig {
-            gimbal: Gimbal {
-                model: GimbalModel::Exact,
-                geometry,
-            },
-            ..defaults
-        }
+        geometry.ol_cm = 0.0;
+        let gimbal = Gimbal {
+            model: GimbalModel::Exact,
+            geometry,
+        };
+        StepperConfig::from_settings(&self.settings.stepper, gimbal)
     }
 
     /// Sends the stepper task its parameters (applied at rest).
@@ -176,7 +173,61 @@ impl Core {
             StepperEvent::Stopped { steps } => {
                 log::info!("stepper at rest at {} {} steps", steps[0], steps[1]);
             }
+            StepperEvent::LimitHit { axes, steps } => {
+                log::warning!("stepper limit switch at {} {} steps", steps[0], steps[1]);
+                let which = ["", "pan", "tilt", "pan and tilt"][usize::from(axes & 3)];
+                self.notify(
+                    out,
+                    format_args!(
+                        "error: stepper limit switch {which} hit: steps halted, laser off"
+                    ),
+                );
+                self.stop("limit switch", out);
+            }
+            StepperEvent::Homed { steps } => {
+                let j = self.stepper_config().joints_of(steps).unwrap_or_default();
+                self.notify(
+                    out,
+                    format_args!(
+                        "homed: stepper at pan {} tilt {} deg",
+                        Fixed::<3>(j.yaw_deg),
+                        Fixed::<3>(j.pitch_deg)
+                    ),
+                );
+            }
+            StepperEvent::HomingFailed(why) => {
+                let text = match why {
+                    HomingFailure::NoSwitches => "no homing switches configured",
+                    HomingFailure::NotFound(0) => "pan switch not found within the travel",
+                    HomingFailure::NotFound(_) => "tilt switch not found within the travel",
+                    HomingFailure::StillPressed(_) => "switch still closed after backing off",
+                    HomingFailure::Interrupted => "stopped",
+                    HomingFailure::BadConfig => "parameters refused for the homing moves",
+                };
+                self.notify(out, format_args!("error: home failed: {text}; not homed"));
+            }
         }
+    }
+
+    /// `home` / `$H` on the stepper: any run stops (laser dark), then the
+    /// stepper task homes the axes with switches; `homed: …` or
+    /// `error: home failed: …` follows.
+    ///
+    /// Errors: not the stepper, or no switches (nothing changes; the
+    /// power-up position stays step 0).
+    pub(super) fn start_homing(&mut self, out: &mut dyn ActionSink) -> Result<(), &'static str> {
+        if !self.actuator.uses_stepper() {
+            return Err("home: only with target stepper");
+        }
+        let s = &self.settings.stepper;
+        if s.pan.home_dir == 0.0 && s.tilt.home_dir == 0.0 {
+            return Err(
+                "home: no homing switches configured (stepper.pan.home_dir and stepper.tilt.home_dir are 0); the position stays as at power-up",
+            );
+        }
+        self.stop("home", out);
+        out.act(Action::Stepper(StepperRequest::Home));
+        Ok(())
     }
 
     /// The board point (cm) of the run's current point, for messages.

@@ -21,6 +21,7 @@ mod legacy;
 mod params;
 mod record;
 mod spec;
+mod stepper;
 pub mod store;
 #[cfg(test)]
 mod tests;
@@ -32,6 +33,7 @@ pub use record::{
     claimed_record_len, crc32, intact_record_len,
 };
 pub use spec::{ParamLine, ParamSpec, Precision};
+pub use stepper::{MAX_STEP_RATE_STEPS_S, StepperAxisSettings, StepperSettings};
 
 use spec::{Slot, check_value};
 
@@ -217,6 +219,8 @@ pub struct Settings {
     pub err_dy: [f64; 6],
     /// The galvo scanner.
     pub galvo: GalvoSettings,
+    /// The stepper pan/tilt.
+    pub stepper: StepperSettings,
 }
 
 impl Default for Settings {
@@ -249,16 +253,19 @@ impl Default for Settings {
             err_dx: [0.0; 6],
             err_dy: [0.0; 6],
             galvo: GalvoSettings::default(),
+            stepper: StepperSettings::default(),
         }
     }
 }
 
 impl Settings {
-    /// Current value of `param`.
+    /// Current value of `param`. (Not inlined: its copy of the settings
+    /// stays out of the sequencer task's frame.)
+    #[inline(never)]
     pub fn get(&self, param: &ParamSpec) -> f64 {
         let mut copy = *self;
         match param.slot {
-            Slot::Real(place) => *place(&mut copy),
+            Slot::Real(place) | Slot::Whole(place) => *place(&mut copy),
             Slot::Count(place) => f64::from(*place(&mut copy)),
             Slot::Sign(place) => f64::from(*place(&mut copy)),
             Slot::Laser => self.laser_mode.code(),
@@ -270,7 +277,9 @@ impl Settings {
     }
 
     /// Sets `param` to `value` after checking range, integrality and the
-    /// cross-parameter rules; on error nothing changes.
+    /// cross-parameter rules; on error nothing changes. (Not inlined, as
+    /// [`Settings::get`].)
+    #[inline(never)]
     pub fn set(&mut self, param: &ParamSpec, value: f64) -> Result<(), SettingsError> {
         check_value(param, value)?;
         let mut next = *self;
@@ -283,7 +292,7 @@ impl Settings {
     /// Stores an already checked value.
     fn apply(&mut self, param: &ParamSpec, value: f64) {
         match param.slot {
-            Slot::Real(place) => *place(self) = value,
+            Slot::Real(place) | Slot::Whole(place) => *place(self) = value,
             Slot::Count(place) => *place(self) = value as u8,
             Slot::Sign(place) => *place(self) = if value < 0.0 { -1 } else { 1 },
             Slot::Laser => {
@@ -321,6 +330,6 @@ impl Settings {
         if self.yaw.id == self.pitch.id {
             return Err(SettingsError::Rejected("yaw.id and pitch.id must differ"));
         }
-        Ok(())
+        self.stepper.validate()
     }
 }

@@ -23,9 +23,15 @@
 //! | 130–139 | galvo jump planner (130)                      |
 //! | 140–149 | galvo laser delays (on 140, off 141)          |
 //! | 150–159 | galvo marking (speed 150, acceleration 151)   |
+//! | 160–168 | stepper drive: step angle, microsteps, speed, acceleration, junction, pulse, DIR setup, ENABLE, idle release (`settings/stepper.rs`) |
+//! | 169–172 | stepper pan: dir, zero_deg, min_deg, max_deg  |
+//! | 173–176 | stepper tilt: the same                        |
+//! | 177–183 | stepper homing: seek, latch, pull-off speeds/distance; pan home_dir, home_deg; tilt the same |
+//! | 177–183 | stepper homing: seek, latch, pull-off; pan home_dir, home_deg; tilt the same |
 
 use super::spec::COEF_HELP;
 use super::spec::{ParamSpec, Precision, Slot, choice, count, err_coef, real};
+use super::stepper::STEPPER_PARAMS;
 use kinematics_core::error_model::COEF_LIMITS;
 
 /// Smallest |galvo DAC scale|, codes/rad: 4096 codes over ±45° of mirror.
@@ -34,7 +40,27 @@ pub const MIN_CODES_PER_RAD: f64 = 1_000.0;
 pub const MAX_CODES_PER_RAD: f64 = 120_000.0;
 
 /// The parameter table (also the order of `params` and of the saved record).
-pub static PARAMS: &[ParamSpec] = &[
+pub static PARAMS: &[ParamSpec] = &joined::<54, 24, 78>(BASE, STEPPER_PARAMS);
+
+/// Every parameter of `a` then every one of `b` (the table is built from
+/// pieces kept next to what they describe).
+const fn joined<const A: usize, const B: usize, const N: usize>(
+    a: [ParamSpec; A],
+    b: [ParamSpec; B],
+) -> [ParamSpec; N] {
+    assert!(A + B == N && A > 0);
+    let mut out = [a[0]; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = if i < A { a[i] } else { b[i - A] };
+        i += 1;
+    }
+    out
+}
+
+/// Parameters 10–151: gimbal, grid, motion, servos, laser, error model,
+/// galvo.
+const BASE: [ParamSpec; 54] = [
     real!(
         10,
         "oq_cm",

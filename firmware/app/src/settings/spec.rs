@@ -12,6 +12,8 @@ use crate::text::{Interval, Shortest};
 #[derive(Clone, Copy)]
 pub(crate) enum Slot {
     Real(fn(&mut Settings) -> &mut f64),
+    /// A whole number stored as f64.
+    Whole(fn(&mut Settings) -> &mut f64),
     Count(fn(&mut Settings) -> &mut u8),
     Sign(fn(&mut Settings) -> &mut i8),
     Laser,
@@ -152,7 +154,9 @@ pub(crate) fn check_value(param: &ParamSpec, value: f64) -> Result<(), SettingsE
     let whole = (value as i64) as f64 == value;
     match param.slot {
         Slot::Real(_) => Ok(()),
-        Slot::Count(_) if !whole => Err(SettingsError::Rejected("value must be a whole number")),
+        Slot::Count(_) | Slot::Whole(_) if !whole => {
+            Err(SettingsError::Rejected("value must be a whole number"))
+        }
         Slot::Sign(_) if value != 1.0 && value != -1.0 => {
             Err(SettingsError::Rejected("direction must be 1 or -1"))
         }

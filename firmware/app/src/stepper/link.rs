@@ -4,7 +4,7 @@
 //! a time).
 
 use core::cell::RefCell;
-use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
@@ -37,6 +37,9 @@ pub enum StepperRequest {
     /// Decelerate to rest at the acceleration limit along the path, drop
     /// the rest.
     Stop,
+    /// Home the axes with switches: seek, back off, latch, set the zero,
+    /// pull off.
+    Home,
 }
 
 /// How a move gets to its point.
@@ -105,6 +108,50 @@ pub enum StepperEvent {
         /// Position, microsteps.
         steps: [i32; 2],
     },
+    /// A limit switch was pressed during a move: the steps halted at
+    /// once at `steps`.
+    LimitHit {
+        /// Switches pressed: bit 0 pan, bit 1 tilt.
+        axes: u8,
+        /// Position, microsteps.
+        steps: [i32; 2],
+    },
+    /// `Home` ended: zero set from the switches, at rest at `steps`.
+    Homed {
+        /// Position, microsteps.
+        steps: [i32; 2],
+    },
+    /// `Home` failed (the position is not homed).
+    HomingFailed(HomingFailure),
+}
+
+/// Why homing failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum HomingFailure {
+    /// No axis has a switch (`stepper.*.home_dir` 0).
+    NoSwitches,
+    /// The switch of axis 0 (pan) / 1 (tilt) never closed within the
+    /// travel.
+    NotFound(u8),
+    /// The switch stayed closed after backing off.
+    StillPressed(u8),
+    /// A stop or the stop button ended it.
+    Interrupted,
+    /// The parameters do not allow the homing moves.
+    BadConfig,
+}
+
+/// What a pressed limit switch does (the step timer checks before each
+/// step event).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum LimitMode {
+    /// Any pressed switch halts the steps: a fault.
+    Guard,
+    /// Homing seeks axis 0/1's switch: pressed, the steps halt (no fault).
+    Seek(u8),
+    /// Homing backs off a switch: not checked.
+    Ignore,
 }
 
 /// The step timer's state: prepared segments and the generator.
@@ -129,6 +176,14 @@ pub struct StepperLink {
     /// Stop stepping now (stop button, fault): the step timer drops
     /// everything prepared at its next event.
     halt: AtomicBool,
+    /// [`LimitMode`]: 0 guard, 1/2 seek pan/tilt, 3 ignore.
+    limit_mode: AtomicU8,
+    /// Switches pressed at the last step event (bit 0 pan, bit 1 tilt).
+    pressed: AtomicU8,
+    /// Switches that halted a move in guard mode (reported, then cleared).
+    tripped: AtomicU8,
+    /// The homing seek found its switch.
+    seek_hit: AtomicBool,
     /// Drivers energised (the stepper task decides, the step timer applies).
     pub(super) enabled: AtomicBool,
     /// A stepper task serves the link.
@@ -161,6 +216,10 @@ impl StepperLink {
             ready: Signal::new(),
             drained: Signal::new(),
             halt: AtomicBool::new(false),
+            limit_mode: AtomicU8::new(0),
+            pressed: AtomicU8::new(0),
+            tripped: AtomicU8::new(0),
+            seek_hit: AtomicBool::new(false),
             enabled: AtomicBool::new(false),
             attached: AtomicBool::new(false),
             pulse_ns: AtomicU32::new(0),
@@ -220,6 +279,67 @@ impl StepperLink {
         true
     }
 
+    /// The step timer's limit check before a step event, with the
+    /// switches `pressed` (`[pan, tilt]`): halts the steps when the mode
+    /// says so; `false` when it did.
+    pub fn limits_allow(&self, pressed: [bool; 2]) -> bool {
+        let mask = u8::from(pressed[0]) | (u8::from(pressed[1]) << 1);
+        self.pressed.store(mask, Ordering::Relaxed);
+        let stop = match self.limit_mode.load(Ordering::Relaxed) {
+            0 => {
+                self.tripped.fetch_or(mask, Ordering::Relaxed);
+                mask != 0
+            }
+            m @ 1..=2 => {
+                let hit = mask & m != 0;
+                self.seek_hit.fetch_or(hit, Ordering::Relaxed);
+                hit
+            }
+            _ => false,
+        };
+        if stop {
+            self.halt();
+        }
+        !stop
+    }
+
+    pub(super) fn set_limit_mode(&self, mode: LimitMode) {
+        let code = match mode {
+            LimitMode::Guard => 0,
+            LimitMode::Seek(axis) => 1 + (axis & 1),
+            LimitMode::Ignore => 3,
+        };
+        self.seek_hit.store(false, Ordering::Relaxed);
+        self.limit_mode.store(code, Ordering::Relaxed);
+    }
+
+    /// Whether axis `axis`'s switch was pressed at the last step event.
+    pub(super) fn is_pressed(&self, axis: usize) -> bool {
+        self.pressed.load(Ordering::Relaxed) & (1 << axis) != 0
+    }
+
+    /// Switches that halted a move (cleared).
+    pub(super) fn take_tripped(&self) -> u8 {
+        self.tripped.swap(0, Ordering::Relaxed)
+    }
+
+    /// Whether the homing seek found its switch (cleared).
+    pub(super) fn take_seek_hit(&self) -> bool {
+        self.seek_hit.swap(false, Ordering::Relaxed)
+    }
+
+    /// Redefines the position of axis `axis` (homing, at rest).
+    pub(super) fn set_position(&self, axis: usize, steps: i32) {
+        self.core.lock(|core| {
+            let mut core = core.borrow_mut();
+            let mut position = core.generator.position_steps();
+            if let Some(p) = position.get_mut(axis) {
+                *p = steps;
+            }
+            core.generator.set_position(position);
+        });
+    }
+
     /// Whether a halt is pending.
     pub(super) fn halting(&self) -> bool {
         self.halt.load(Ordering::Acquire)
@@ -248,6 +368,15 @@ impl StepperLink {
         f: impl FnOnce(&mut SegmentQueue<STEP_QUEUE_LEN>) -> R,
     ) -> R {
         self.core.lock(|core| f(&mut core.borrow_mut().queue))
+    }
+
+    /// Whether a step may come at the next event (prepared segments or
+    /// one being run).
+    pub fn has_steps(&self) -> bool {
+        self.core.lock(|core| {
+            let core = core.borrow();
+            !core.queue.is_empty() || core.generator.is_running()
+        })
     }
 
     /// Whether every prepared step has run.

@@ -14,19 +14,23 @@
 //! ring pop and Bresenham adds. Everything else ([`StepperMotion`]) runs in
 //! the low-priority [`StepperTask`].
 
+mod home;
 mod link;
 mod motion;
 mod task;
 
 pub use self::link::{
-    MoveShape, STEP_QUEUE_LEN, StepperEvent, StepperLink, StepperRefusal, StepperRequest,
+    HomingFailure, MoveShape, STEP_QUEUE_LEN, StepperEvent, StepperLink, StepperRefusal,
+    StepperRequest,
 };
 pub use self::motion::{LINE_TOLERANCE_MM, StepperMotion};
 pub use self::task::{StepPulseTask, StepperTask};
 
 use kinematics_core::gimbal::{Gimbal, GimbalGeometry, GimbalModel, JointAngles};
 use kinematics_core::servo::Direction;
-use kinematics_core::stepper::{SEED_FULL_STEP_DEG, SEED_MICROSTEPS, StepperAxis};
+use kinematics_core::stepper::StepperAxis;
+
+use crate::settings::StepperSettings;
 
 /// Step-timer frequency, Hz (1 µs ticks: embassy-time's tick).
 pub const STEP_TIMER_HZ: u32 = 1_000_000;
@@ -64,6 +68,26 @@ pub trait StepperDrive {
     async fn wait_ticks(&mut self, ticks: u32);
     /// The next event is scheduled from now (after the timer was idle).
     fn restart(&mut self);
+    /// Whether each axis's limit switch is pressed, `[pan, tilt]` (read
+    /// before every step event; inputs without a switch read released).
+    fn limits(&mut self) -> [bool; 2];
+}
+
+/// Homing: which axes have switches, where they are, how fast to find
+/// them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HomingConfig {
+    /// Joint direction towards each axis's switch (+1/−1), 0: no switch,
+    /// `[pan, tilt]`.
+    pub dir: [i8; 2],
+    /// Joint angle where each switch closes, degrees `[pan, tilt]`.
+    pub switch_deg: [f64; 2],
+    /// Seek and pull-off speed, °/s.
+    pub seek_deg_s: f64,
+    /// Latch (slow approach) speed, °/s.
+    pub latch_deg_s: f64,
+    /// Back-off and pull-off distance, degrees.
+    pub pulloff_deg: f64,
 }
 
 /// The stepper pan/tilt's parameters (from the settings).
@@ -92,43 +116,64 @@ pub struct StepperConfig {
     /// Drivers released after this long at rest, ms (0: always held, the
     /// default: a released pan/tilt may sag off the point it holds).
     pub idle_release_ms: u32,
+    /// Homing switches and speeds.
+    pub homing: HomingConfig,
     /// The pointing geometry: the exact model with the pan/tilt's OL.
     pub gimbal: Gimbal,
 }
 
 impl Default for StepperConfig {
-    /// The seed's pan/tilt: 1.8° at 32 microsteps (0.05625° per step), OL
-    /// = 0, ±60° soft limits, 90 °/s, 900 °/s², junction deviation 0.01°,
-    /// 2.5 µs pulses, 5 µs DIR setup, ENABLE active low, always held.
+    /// The seed's pan/tilt ([`StepperSettings`]' defaults: 1.8° at 32
+    /// microsteps, 0.05625° per step) with OL = 0 on the default board.
     fn default() -> Self {
-        Self {
-            full_step_deg: SEED_FULL_STEP_DEG,
-            microsteps: SEED_MICROSTEPS,
-            direction: [Direction::Normal; 2],
-            zero_deg: [0.0; 2],
-            min_deg: [-60.0; 2],
-            max_deg: [60.0; 2],
-            max_speed_deg_s: 90.0,
-            accel_deg_s2: 900.0,
-            junction_deviation_deg: 0.01,
-            signals: DriverSignals {
-                pulse_ns: 2_500,
-                dir_setup_ns: 5_000,
-                enable_active_high: false,
-            },
-            idle_release_ms: 0,
-            gimbal: Gimbal {
+        Self::from_settings(
+            &StepperSettings::default(),
+            Gimbal {
                 model: GimbalModel::Exact,
                 geometry: GimbalGeometry {
                     ol_cm: 0.0,
                     ..GimbalGeometry::default()
                 },
             },
-        }
+        )
     }
 }
 
 impl StepperConfig {
+    /// The parameters `s` (checked by the settings) with the pointing
+    /// geometry `gimbal`.
+    pub fn from_settings(s: &StepperSettings, gimbal: Gimbal) -> Self {
+        let direction = |sign: i8| Direction::from_sign(sign).unwrap_or_default();
+        // Checked ranges: whole 1..=256 microsteps, pulse and setup ≤ 100 µs.
+        let ns = |us: f64| libm::round(us * 1000.0) as u32;
+        Self {
+            full_step_deg: s.full_step_deg,
+            microsteps: s.microsteps as u16,
+            direction: [direction(s.pan.direction), direction(s.tilt.direction)],
+            zero_deg: [s.pan.zero_deg, s.tilt.zero_deg],
+            min_deg: [s.pan.min_deg, s.tilt.min_deg],
+            max_deg: [s.pan.max_deg, s.tilt.max_deg],
+            max_speed_deg_s: s.max_speed_deg_s,
+            accel_deg_s2: s.accel_deg_s2,
+            junction_deviation_deg: s.junction_deviation_deg,
+            signals: DriverSignals {
+                pulse_ns: ns(s.pulse_us),
+                dir_setup_ns: ns(s.dir_setup_us),
+                enable_active_high: s.enable_active_high == 1.0,
+            },
+            idle_release_ms: s.idle_release_ms as u32,
+            homing: HomingConfig {
+                // Whole −1..=1 (checked).
+                dir: [s.pan.home_dir as i8, s.tilt.home_dir as i8],
+                switch_deg: [s.pan.home_deg, s.tilt.home_deg],
+                seek_deg_s: s.home_seek_deg_s,
+                latch_deg_s: s.home_latch_deg_s,
+                pulloff_deg: s.home_pulloff_deg,
+            },
+            gimbal,
+        }
+    }
+
     /// Degrees per microstep.
     pub fn deg_per_step(&self) -> f64 {
         self.full_step_deg / f64::from(self.microsteps.max(1))

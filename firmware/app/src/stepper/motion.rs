@@ -6,10 +6,10 @@
 
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::JointAngles;
+use kinematics_core::path::{Segment as BoardSegment, Shape};
 use kinematics_core::stepper::{Planner, Segment, SegmentPrep, StepMove};
 
 use super::{MoveShape, SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
-use kinematics_core::Rotation;
 use kinematics_core::numeric::clamp;
 
 /// Largest distance of the pieces' joint-space insides from the board
@@ -21,83 +21,39 @@ const MAX_PIECES: u32 = 4096;
 /// Look-ahead depth of the planner, blocks.
 const PLANNER_LEN: usize = 16;
 
-/// The board curve of a move being cut into pieces.
+/// The board curve of a move being cut into pieces (kinematics-core's
+/// shape, the gimbal sampler's point-at-parameter).
 #[derive(Debug, Clone, Copy)]
-enum Curve {
-    Line {
-        from: BoardPoint,
-        to: BoardPoint,
-    },
-    Arc {
-        centre: BoardPoint,
-        radius_cm: f64,
-        /// Angle of the start about the centre, rad.
-        start_rad: f64,
-        /// Signed angle swept (negative: clockwise), rad.
-        sweep_rad: f64,
-    },
-}
+struct Curve(Shape);
 
 impl Curve {
     /// The curve from `from` to `to` as `shape` says (`None`: travel).
     fn of(from: BoardPoint, to: BoardPoint, shape: MoveShape) -> Option<Self> {
-        match shape {
-            MoveShape::Travel => None,
-            MoveShape::Line => Some(Curve::Line { from, to }),
-            MoveShape::Arc { centre, rotation } => {
-                let angle = |p: BoardPoint| libm::atan2(p.y_cm - centre.y_cm, p.x_cm - centre.x_cm);
-                let (start_rad, end_rad) = (angle(from), angle(to));
-                let turn = 2.0 * core::f64::consts::PI;
-                let diff = libm::fmod(end_rad - start_rad, turn);
-                let mut ccw = if diff < 0.0 { diff + turn } else { diff };
-                // The same point: a full circle.
-                if ccw < 1e-12 {
-                    ccw = turn;
-                }
-                let sweep_rad = match rotation {
-                    Rotation::Ccw => ccw,
-                    Rotation::Cw => ccw - turn,
-                };
-                let sweep_rad = if sweep_rad == 0.0 { -turn } else { sweep_rad };
-                Some(Curve::Arc {
-                    centre,
-                    radius_cm: libm::hypot(from.x_cm - centre.x_cm, from.y_cm - centre.y_cm),
-                    start_rad,
-                    sweep_rad,
-                })
-            }
-        }
+        let segment = match shape {
+            MoveShape::Travel => return None,
+            MoveShape::Line => BoardSegment::Line { from, to },
+            MoveShape::Arc { centre, rotation } => BoardSegment::Arc {
+                start: from,
+                end: to,
+                centre,
+                rotation,
+            },
+        };
+        Some(Curve(Shape::of(segment)))
     }
 
     /// The point a fraction `t` (0..=1) along the curve.
     fn at(&self, t: f64) -> BoardPoint {
-        match *self {
-            Curve::Line { from, to } => BoardPoint {
-                x_cm: from.x_cm + t * (to.x_cm - from.x_cm),
-                y_cm: from.y_cm + t * (to.y_cm - from.y_cm),
-            },
-            Curve::Arc {
-                centre,
-                radius_cm,
-                start_rad,
-                sweep_rad,
-            } => {
-                let (s, c) = libm::sincos(start_rad + t * sweep_rad);
-                BoardPoint {
-                    x_cm: centre.x_cm + radius_cm * c,
-                    y_cm: centre.y_cm + radius_cm * s,
-                }
-            }
-        }
+        self.0.point_at(t)
     }
 
     /// Pieces to start from: arcs in pieces of at most 22.5° (so a
     /// piece's midpoint tells its deviation; a full circle is not one
     /// piece from its start to itself).
     fn fewest_pieces(&self) -> u32 {
-        match *self {
-            Curve::Line { .. } => 1,
-            Curve::Arc { sweep_rad, .. } => {
+        match self.0 {
+            Shape::Line { .. } => 1,
+            Shape::Arc { sweep_rad, .. } => {
                 let wanted = libm::ceil(sweep_rad.abs() / (core::f64::consts::PI / 8.0));
                 // ≤ 16 for |sweep| ≤ 2π: the cast is exact.
                 (wanted as u32).max(1).next_power_of_two()
@@ -107,9 +63,9 @@ impl Curve {
 
     /// Distance of `p` from the curve (near it), cm.
     fn distance_cm(&self, p: BoardPoint) -> f64 {
-        match *self {
-            Curve::Line { from, to } => distance_to_segment_cm(p, from, to),
-            Curve::Arc {
+        match self.0 {
+            Shape::Line { from, to } => distance_to_segment_cm(p, from, to),
+            Shape::Arc {
                 centre, radius_cm, ..
             } => (libm::hypot(p.x_cm - centre.x_cm, p.y_cm - centre.y_cm) - radius_cm).abs(),
         }
@@ -367,6 +323,23 @@ impl StepperMotion {
         } else {
             None
         }
+    }
+
+    /// Queues a move by `delta` microsteps at `speed_deg_s` (homing).
+    ///
+    /// Errors: [`StepperRefusal::BadConfig`] (the rate is refused).
+    pub fn jog(&mut self, delta: [i32; 2], speed_deg_s: f64) -> Result<(), StepperRefusal> {
+        let mut mv = Self::step_move(&self.config, delta);
+        mv.nominal_rate_steps_per_s = speed_deg_s / self.config.deg_per_step();
+        self.planner
+            .push(&mv)
+            .map_err(|_| StepperRefusal::BadConfig)?;
+        self.planned = [
+            self.planned[0].wrapping_add(delta[0]),
+            self.planned[1].wrapping_add(delta[1]),
+        ];
+        self.last_point = None;
+        Ok(())
     }
 
     /// Step position where the queued moves end.

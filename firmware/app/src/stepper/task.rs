@@ -13,7 +13,7 @@ use super::{SEGMENT_S, StepperConfig, StepperDrive};
 use crate::log;
 
 /// How often the stepper task refills the segment queue while steps run.
-const REFILL_PERIOD: Duration = Duration::from_micros((SEGMENT_S * 0.5e6) as u64);
+pub(super) const REFILL_PERIOD: Duration = Duration::from_micros((SEGMENT_S * 0.5e6) as u64);
 
 /// The step timer: executes prepared segments, one step event per timer
 /// period. Runs at high priority (on the target an interrupt executor
@@ -43,6 +43,11 @@ impl<D: StepperDrive> StepPulseTask<D> {
                 self.drive.set_enabled(want);
                 enabled = want;
             }
+            // A pressed switch halts before the step (position unchanged);
+            // checked only when there is a step to take.
+            if self.link.has_steps() {
+                self.link.limits_allow(self.drive.limits());
+            }
             match self.link.step_tick() {
                 Some(tick) => {
                     self.drive.step(tick.step, tick.negative);
@@ -66,14 +71,14 @@ pub struct StepperTask {
 }
 
 /// The stepper task's state between wake-ups.
-struct Running {
-    motion: StepperMotion,
+pub(super) struct Running {
+    pub(super) motion: StepperMotion,
     /// A stop is decelerating.
-    stopping: bool,
+    pub(super) stopping: bool,
     /// Parameters to apply once at rest.
     pending_config: Option<StepperConfig>,
     /// A move that arrived during a stop: queued once at rest.
-    deferred: Option<StepperRequest>,
+    pub(super) deferred: Option<StepperRequest>,
     /// When the axes came to rest (for the ENABLE release).
     rest_since: Option<Instant>,
 }
@@ -126,15 +131,32 @@ impl Running {
     /// Halts, refills, reports arrivals and rests, releases ENABLE.
     async fn step(&mut self, link: &StepperLink) {
         if link.take_halt() {
-            self.motion.rest_at(link.position_steps());
+            let steps = link.position_steps();
+            self.motion.rest_at(steps);
             self.stopping = false;
+            self.deferred = None;
             log::info!("stepper: halted");
-            link.events
-                .send(StepperEvent::Stopped {
-                    steps: link.position_steps(),
-                })
-                .await;
+            let axes = link.take_tripped();
+            let event = if axes != 0 {
+                StepperEvent::LimitHit { axes, steps }
+            } else {
+                StepperEvent::Stopped { steps }
+            };
+            link.events.send(event).await;
         }
+        self.refill(link);
+        let idle = link.is_idle();
+        if let Some(seq) = self.motion.take_arrived(idle) {
+            let steps = link.position_steps();
+            link.events.send(StepperEvent::Arrived { seq, steps }).await;
+        }
+        if idle && self.motion.is_planned_out() {
+            self.at_rest(link).await;
+        }
+    }
+
+    /// Tops the step timer's queue up with prepared segments.
+    pub(super) fn refill(&mut self, link: &StepperLink) {
         let mut added = 0;
         while !link.with_queue(|q| q.is_full()) {
             let Some(segment) = self.motion.next_segment() else {
@@ -149,14 +171,6 @@ impl Running {
             self.rest_since = None;
             link.enabled.store(true, Ordering::Relaxed);
             link.ready.signal(());
-        }
-        let idle = link.is_idle();
-        if let Some(seq) = self.motion.take_arrived(idle) {
-            let steps = link.position_steps();
-            link.events.send(StepperEvent::Arrived { seq, steps }).await;
-        }
-        if idle && self.motion.is_planned_out() {
-            self.at_rest(link).await;
         }
     }
 
@@ -203,6 +217,13 @@ impl Running {
                 self.motion.stop();
                 self.deferred = None;
                 self.stopping = true;
+            }
+            StepperRequest::Home => {
+                let event = match self.home(link).await {
+                    Ok(steps) => StepperEvent::Homed { steps },
+                    Err(why) => StepperEvent::HomingFailed(why),
+                };
+                link.events.send(event).await;
             }
         }
     }

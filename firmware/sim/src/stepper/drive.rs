@@ -8,7 +8,7 @@ use std::rc::Rc;
 use embassy_time::{Duration, Instant, Timer};
 use laser_app::stepper::{DriverSignals, STEP_TIMER_HZ, StepperDrive};
 
-use super::{PanTiltDrivers, StepEdge, StepPin};
+use super::{LimitSwitch, PanTiltDrivers, StepEdge, StepPin, StepperGeometry};
 
 // The step timer's ticks are embassy-time's.
 const _: () = assert!(STEP_TIMER_HZ as u64 == embassy_time::TICK_HZ);
@@ -20,11 +20,20 @@ pub struct SimStepperDrive {
     signals: DriverSignals,
     next: Instant,
     dir: [bool; 2],
+    /// The true geometry (where the counted steps point).
+    geometry: StepperGeometry,
+    /// Each axis's limit switch, if it has one, and whether it is closed.
+    switches: [Option<(LimitSwitch, bool)>; 2],
 }
 
 impl SimStepperDrive {
-    /// Outputs into `drivers`.
-    pub fn new(drivers: Rc<RefCell<PanTiltDrivers>>) -> Self {
+    /// Outputs into `drivers`; `switches` (`[pan, tilt]`) close at joint
+    /// angles of the true `geometry`.
+    pub fn new(
+        drivers: Rc<RefCell<PanTiltDrivers>>,
+        geometry: StepperGeometry,
+        switches: [Option<LimitSwitch>; 2],
+    ) -> Self {
         Self {
             drivers,
             signals: DriverSignals {
@@ -34,6 +43,8 @@ impl SimStepperDrive {
             },
             next: Instant::from_ticks(0),
             dir: [false; 2],
+            geometry,
+            switches: switches.map(|s| s.map(|s| (s, false))),
         }
     }
 }
@@ -68,6 +79,22 @@ impl StepperDrive for SimStepperDrive {
 
     fn restart(&mut self) {
         self.next = Instant::now();
+    }
+
+    /// The switches at the joint angles of the counted steps.
+    fn limits(&mut self) -> [bool; 2] {
+        let steps = self.drivers.borrow().counted_steps();
+        let joints = self.geometry.joints(steps);
+        let mut pressed = [false; 2];
+        for (i, switch) in self.switches.iter_mut().enumerate() {
+            let (Some((s, closed)), Some(j)) = (switch.as_mut(), joints) else {
+                continue;
+            };
+            let angle = if i == 0 { j.yaw_deg } else { j.pitch_deg };
+            *closed = s.closed_at(angle, *closed);
+            pressed[i] = *closed;
+        }
+        pressed
     }
 }
 

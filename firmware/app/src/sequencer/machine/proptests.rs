@@ -1,6 +1,7 @@
 //! State-machine property test of the core: random sequences of commands
 //! (stop, goto, grid, patterns, target switches, set, save, …), servo
-//! outcomes (arrivals, faults, recoveries, current and stale), galvo
+//! outcomes (arrivals, faults, recoveries, current and stale), stepper
+//! events (arrivals, refusals, stops), galvo
 //! events (done, refused, underruns, a gate closed under the core's feet)
 //! and ticks with advancing time, fed through a model of the shell. After
 //! every event the invariants hold:
@@ -9,7 +10,7 @@
 //!   deliberate drawing run (and, after a fault, an arrival) lights it;
 //! * every command gets exactly one closing reply, other events none;
 //! * every stop reaches every actuator: the gate closes and the galvo
-//!   gets `Stop` after it, and no servo move or galvo job is sent until
+//!   gets `Stop` after it (the stepper too, when it draws), and no servo move or galvo job is sent until
 //!   a new run starts (the servo protocol has no stop request: the servos
 //!   finish their move, dark);
 //! * the status view agrees with the outputs and with itself.
@@ -31,6 +32,7 @@ use crate::galvo::{
 use crate::servo::task::{ServoFault, ServoOutcome, ServoRequest};
 use crate::settings::{JumpPlanner, LaserMode, PARAMS};
 use crate::status::Activity;
+use crate::stepper::{StepperEvent, StepperRefusal, StepperRequest};
 
 impl ActionSink for Vec<Action> {
     fn act(&mut self, action: Action) {
@@ -67,6 +69,16 @@ enum Step {
     GalvoConfigRefused,
     /// The galvo loop takes queued requests.
     GalvoTakes(usize),
+    StepperArrived {
+        current: bool,
+        steps: (i16, i16),
+    },
+    StepperRefused {
+        current: bool,
+    },
+    StepperStopped,
+    /// A limit switch halted the steps (1–3), homing ended (4) or failed.
+    StepperLimit(u8),
     Dwell,
     Tick {
         ms: u64,
@@ -95,8 +107,12 @@ fn pattern() -> impl Strategy<Value = Pattern> {
 }
 
 fn command() -> impl Strategy<Value = Command> {
-    let actuator =
-        proptest::sample::select(vec![Actuator::Gimbal, Actuator::Galvo, Actuator::Both]);
+    let actuator = proptest::sample::select(vec![
+        Actuator::Gimbal,
+        Actuator::Galvo,
+        Actuator::Both,
+        Actuator::Stepper,
+    ]);
     let mode = proptest::sample::select(vec![LaserMode::Auto, LaserMode::Dwell, LaserMode::Off]);
     let param = 0..PARAMS.len();
     prop_oneof![
@@ -104,6 +120,7 @@ fn command() -> impl Strategy<Value = Command> {
         3 => point().prop_map(Command::Goto),
         2 => (-4i8..5, -4i8..5).prop_map(|(xi, yi)| Command::Grid { xi, yi }),
         3 => Just(Command::Stop),
+        1 => Just(Command::Home),
         3 => actuator.prop_map(Command::Target),
         2 => mode.prop_map(Command::Laser),
         1 => any::<bool>().prop_map(|seed| Command::Model(if seed { AimModel::Seed } else { AimModel::Exact })),
@@ -137,6 +154,11 @@ fn step() -> impl Strategy<Value = Step> {
         1 => Just(Step::GalvoUnderrun),
         1 => Just(Step::GalvoConfigRefused),
         3 => (0..=GALVO_REQUEST_DEPTH).prop_map(Step::GalvoTakes),
+        4 => (current, (-900i16..900, -900i16..900))
+            .prop_map(|(current, steps)| Step::StepperArrived { current, steps }),
+        1 => current.prop_map(|current| Step::StepperRefused { current }),
+        1 => Just(Step::StepperStopped),
+        1 => (0u8..6).prop_map(Step::StepperLimit),
         6 => Just(Step::Dwell),
         3 => (0u64..2_000).prop_map(|ms| Step::Tick { ms }),
     ]
@@ -148,6 +170,8 @@ struct Harness {
     now: Instant,
     /// Whether a galvo loop serves the link.
     attached: bool,
+    /// Whether a stepper task serves its link.
+    stepper_attached: bool,
     /// Free slots in the galvo request queue.
     galvo_room: usize,
     /// The master gate: open, and closed by the galvo loop since the core
@@ -162,6 +186,8 @@ struct Harness {
     fault_since_arrival: bool,
     /// The last servo move, while its outcome is still owed.
     move_owed: Option<u32>,
+    /// The last stepper move, while its report is still owed.
+    step_owed: Option<u32>,
     /// The last galvo job, while its report is still owed.
     job_owed: Option<u32>,
     /// Underrun reports the galvo loop still owes.
@@ -169,11 +195,12 @@ struct Harness {
 }
 
 impl Harness {
-    fn new(attached: bool) -> Self {
+    fn new(attached: bool, stepper_attached: bool) -> Self {
         let mut harness = Self {
             core: Core::new(Instant::from_secs(1)),
             now: Instant::from_secs(1),
             attached,
+            stepper_attached,
             galvo_room: GALVO_REQUEST_DEPTH,
             gate_open: false,
             gate_stolen: false,
@@ -181,6 +208,7 @@ impl Harness {
             running: false,
             fault_since_arrival: false,
             move_owed: None,
+            step_owed: None,
             job_owed: None,
             underruns_owed: 0,
         };
@@ -218,6 +246,16 @@ impl Harness {
             // No galvo loop: nothing reports.
             return Ok(());
         }
+        let stepper_step = matches!(
+            step,
+            Step::StepperArrived { .. }
+                | Step::StepperRefused { .. }
+                | Step::StepperStopped
+                | Step::StepperLimit(_)
+        );
+        if stepper_step && !self.stepper_attached {
+            return Ok(());
+        }
         let Some((event, save_ok)) = self.event(step) else {
             return Ok(());
         };
@@ -230,8 +268,10 @@ impl Harness {
                     ..
                 }
         );
+        // A stop reaches the stepper when it drew before the event.
+        let stepper_drew = self.core.actuator.uses_stepper();
         let actions = self.dispatch(event, save_ok);
-        self.check(&actions, is_command, stops)
+        self.check(&actions, is_command, stops, stepper_drew)
     }
 
     /// The event of `step` and the store's answer to a save (`None`: the
@@ -255,7 +295,8 @@ impl Harness {
                 (Event::Servo(arrived), true)
             }
             Step::Fault { current, id } => {
-                self.fault_since_arrival = true;
+                // Servo faults do not concern the stepper.
+                self.fault_since_arrival |= self.core.actuator.uses_gimbal();
                 let seq = Self::seq(current, &mut self.move_owed);
                 let fault = ServoFault::NoResponse;
                 (Event::Servo(ServoOutcome::Fault { seq, id, fault }), true)
@@ -264,6 +305,33 @@ impl Harness {
             Step::Superseded => {
                 let seq = Self::seq(false, &mut self.move_owed);
                 (Event::Servo(ServoOutcome::Superseded { seq }), true)
+            }
+            Step::StepperArrived { current, steps } => {
+                let seq = Self::seq(current, &mut self.step_owed);
+                let steps = [i32::from(steps.0), i32::from(steps.1)];
+                (Event::Stepper(StepperEvent::Arrived { seq, steps }), true)
+            }
+            Step::StepperRefused { current } => {
+                let seq = Self::seq(current, &mut self.step_owed);
+                let why = StepperRefusal::SoftLimit;
+                (Event::Stepper(StepperEvent::Refused { seq, why }), true)
+            }
+            Step::StepperStopped => {
+                self.step_owed = None;
+                (
+                    Event::Stepper(StepperEvent::Stopped { steps: [0; 2] }),
+                    true,
+                )
+            }
+            Step::StepperLimit(kind) => {
+                self.step_owed = None;
+                let steps = [0; 2];
+                let event = match kind {
+                    1..=3 => StepperEvent::LimitHit { axes: kind, steps },
+                    4 => StepperEvent::Homed { steps },
+                    _ => StepperEvent::HomingFailed(crate::stepper::HomingFailure::Interrupted),
+                };
+                (Event::Stepper(event), true)
             }
             Step::GalvoDone { current } => {
                 let seq = Self::seq(current, &mut self.job_owed);
@@ -341,7 +409,7 @@ impl Harness {
                 now: self.now,
                 galvo_room: self.attached.then_some(self.galvo_room),
                 galvo_bisection: self.attached,
-                stepper_attached: false,
+                stepper_attached: self.stepper_attached,
             };
             self.core.on(inputs, event, &mut actions);
             let mut follow = None;
@@ -412,15 +480,18 @@ impl Harness {
             Action::Note(super::LaserEvent::Stopped { .. }) => self.running = false,
             Action::Note(super::LaserEvent::RunStarted) => self.running = true,
             Action::Save | Action::Yield => *follow = Some(action.clone()),
-            Action::Stepper(crate::stepper::StepperRequest::MoveTo { .. }) => {
+            Action::Stepper(StepperRequest::MoveTo { seq, point, .. }) => {
                 assert!(self.running, "stepper move while stopped");
+                assert!(self.stepper_attached, "stepper move without a stepper");
                 assert!(
                     self.core.actuator.uses_stepper(),
                     "stepper move off the stepper"
                 );
+                assert!(point.x_cm.is_finite() && point.y_cm.is_finite());
+                self.step_owed = Some(*seq);
             }
+            Action::Stepper(_) => self.step_owed = None,
             Action::ConfigureGalvo(_)
-            | Action::Stepper(_)
             | Action::ConfigureStepper(_)
             | Action::AllowGalvoLaser(_)
             | Action::GimbalPower(_)
@@ -435,6 +506,7 @@ impl Harness {
         actions: &[Action],
         is_command: bool,
         stops: bool,
+        stepper_drew: bool,
     ) -> Result<(), std::string::String> {
         let closers = actions
             .iter()
@@ -457,6 +529,12 @@ impl Harness {
             let galvo = rest.iter().any(|a| *a == Action::Galvo(GalvoRequest::Stop));
             if !(closes && galvo) {
                 return Err("a stop that does not close the gate and stop the galvo".into());
+            }
+            let stepper = rest
+                .iter()
+                .any(|a| *a == Action::Stepper(StepperRequest::Stop));
+            if stepper_drew && !stepper {
+                return Err("a stop that does not stop the stepper".into());
             }
         }
         if stops && (self.core.run.is_some() || self.lit || self.running) {
@@ -484,9 +562,9 @@ impl Harness {
                 Some("laser on while idle")
             } else if !self.running {
                 Some("laser on after a stop")
-            } else if self.fault_since_arrival {
+            } else if self.fault_since_arrival && self.core.actuator.uses_gimbal() {
                 Some("laser on after a fault, before an arrival")
-            } else if !self.core.actuator.uses_gimbal() {
+            } else if self.core.actuator == Actuator::Galvo {
                 Some("gimbal laser on while only the galvo draws")
             } else if mode == LaserMode::Off {
                 Some("laser on in laser off")
@@ -514,9 +592,10 @@ proptest! {
     #[test]
     fn random_event_sequences_keep_the_invariants(
         attached in any::<bool>(),
+        stepper_attached in any::<bool>(),
         steps in proptest::collection::vec(step(), 1..160),
     ) {
-        let mut harness = Harness::new(attached);
+        let mut harness = Harness::new(attached, stepper_attached);
         for (i, step) in steps.iter().enumerate() {
             if let Err(why) = harness.step(step) {
                 prop_assert!(false, "step {i} {step:?}: {why}");

@@ -2,6 +2,7 @@
 //! `record.rs`.
 
 mod record;
+mod stepper;
 
 use super::spec::survives_f32;
 use super::*;

@@ -11,7 +11,7 @@ use crate::settings::*;
 
 /// Every parameter's id as it was given (ids never change): a parameter
 /// whose id is not this one, or a new parameter not listed here, fails.
-const STABLE_IDS: [(u16, &str); 54] = [
+const STABLE_IDS: [(u16, &str); 78] = [
     (10, "oq_cm"),
     (11, "ol_cm"),
     (20, "grid.pitch_cm"),
@@ -66,7 +66,35 @@ const STABLE_IDS: [(u16, &str); 54] = [
     (141, "galvo.laser_off_delay_us"),
     (150, "galvo.mark_speed_mm_s"),
     (151, "galvo.mark_accel_mm_s2"),
+    (160, "stepper.full_step_deg"),
+    (161, "stepper.microsteps"),
+    (162, "stepper.max_speed_deg_s"),
+    (163, "stepper.accel_deg_s2"),
+    (164, "stepper.junction_deg"),
+    (165, "stepper.pulse_us"),
+    (166, "stepper.dir_setup_us"),
+    (167, "stepper.enable_high"),
+    (168, "stepper.idle_release_ms"),
+    (169, "stepper.pan.dir"),
+    (170, "stepper.pan.zero_deg"),
+    (171, "stepper.pan.min_deg"),
+    (172, "stepper.pan.max_deg"),
+    (173, "stepper.tilt.dir"),
+    (174, "stepper.tilt.zero_deg"),
+    (175, "stepper.tilt.min_deg"),
+    (176, "stepper.tilt.max_deg"),
+    (177, "stepper.home_seek_deg_s"),
+    (178, "stepper.home_latch_deg_s"),
+    (179, "stepper.home_pulloff_deg"),
+    (180, "stepper.pan.home_dir"),
+    (181, "stepper.pan.home_deg"),
+    (182, "stepper.tilt.home_dir"),
+    (183, "stepper.tilt.home_deg"),
 ];
+
+/// Parameters added after the version-2 records (the stepper's): such
+/// records leave them at their defaults.
+const STEPPER_PARAMS: usize = 24;
 
 /// A version-2 record written by the firmware before ids (galvo build: 54
 /// values) with the values of [`fixture_settings`].
@@ -235,9 +263,10 @@ fn the_record_is_magic_version_count_id_value_entries_and_crc() {
     assert_eq!(values_in(&s.to_record()), values);
     assert!(MAX_RECORD_LEN >= RECORD_LEN && MAX_RECORD_LEN >= V2_GALVO.len());
     if has_galvo() {
-        // 14 runs of 54 values, 2 bytes of padding: small enough that more
-        // than 250 saves fill a 128 KiB sector (tests/tests/settings_sim.rs).
-        assert_eq!(RECORD_LEN, 8 + 14 * 3 + 54 * 8 + 2 + 4);
+        // 15 runs of 78 values, 3 bytes of padding: ≈ 190 saves fill a
+        // 128 KiB sector (tests/tests/settings_sim.rs; the decision is in
+        // settings/stepper.rs).
+        assert_eq!(RECORD_LEN, 8 + 15 * 3 + 78 * 8 + 3 + 4);
     }
 }
 
@@ -266,7 +295,7 @@ fn positional_records_of_the_earlier_firmware_load_their_exact_values() {
     let written = fixture_settings();
     let galvo = Settings::load_record(V2_GALVO).unwrap();
     assert_eq!(galvo.layout, RecordLayout::Positional);
-    assert_eq!(galvo.defaulted, 0);
+    assert_eq!(galvo.defaulted, STEPPER_PARAMS);
     if has_galvo() {
         assert_eq!(galvo.settings, written);
         assert_eq!(galvo.unknown, 0);
@@ -402,9 +431,13 @@ fn a_record_is_exactly_its_length() {
     wrong[6..8].copy_from_slice(&((RECORD_LEN + 8) as u16).to_le_bytes());
     let wrong = with_crc(wrong);
     assert_eq!(Settings::from_record(&wrong), Err(RecordError::Corrupt));
-    // A run that claims more values than the record holds.
+    // The last run claims one more value than the record holds.
     let mut overrun = record[..RECORD_LEN - 4].to_vec();
-    overrun[10] += 1;
+    let mut head = 8;
+    while head + 3 + 8 * usize::from(overrun[head + 2]) + 4 <= overrun.len() {
+        head += 3 + 8 * usize::from(overrun[head + 2]);
+    }
+    overrun[head + 2] += 1;
     assert_eq!(
         Settings::from_record(&with_crc(overrun)),
         Err(RecordError::Corrupt)
