@@ -109,22 +109,22 @@ impl<const N: usize> Lookahead<N> {
         }
     }
 
-    /// Appends a straight block of `length` along the unit direction
-    /// `unit` and re-plans the queue.
+    /// Appends a block of `length` that starts along the unit direction
+    /// `unit_in` and ends along `unit_out` (the same for a straight block;
+    /// an arc's tangents) and re-plans the queue.
     ///
     /// Errors: [`LookaheadError::InvalidBlock`], [`LookaheadError::Full`].
     pub fn push(
         &mut self,
         length: f64,
-        unit: [f64; 2],
+        [unit_in, unit_out]: [[f64; 2]; 2],
         nominal_speed: f64,
         accel: f64,
     ) -> Result<(), LookaheadError> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
-        let norm = libm::hypot(unit[0], unit[1]);
-        if !(positive(length) && positive(nominal_speed) && positive(accel))
-            || !(libm::fabs(norm - 1.0) < 1e-6)
-        {
+        let is_unit = |u: [f64; 2]| libm::fabs(libm::hypot(u[0], u[1]) - 1.0) < 1e-6;
+        let valid = positive(length) && positive(nominal_speed) && positive(accel);
+        if !(valid && is_unit(unit_in) && is_unit(unit_out)) {
             return Err(LookaheadError::InvalidBlock);
         }
         if self.len == N {
@@ -132,11 +132,14 @@ impl<const N: usize> Lookahead<N> {
         }
         let prev = self.len.checked_sub(1).and_then(|i| self.block(i)).copied();
         let max_entry = match (prev, self.last_unit) {
-            (Some(prev), Some(last)) => {
-                junction_speed(last, unit, prev.accel.min(accel), self.junction_deviation)
-                    .min(prev.nominal_speed)
-                    .min(nominal_speed)
-            }
+            (Some(prev), Some(last)) => junction_speed(
+                last,
+                unit_in,
+                prev.accel.min(accel),
+                self.junction_deviation,
+            )
+            .min(prev.nominal_speed)
+            .min(nominal_speed),
             _ => 0.0,
         };
         let Some(slot) = self.blocks.get_mut((self.head + self.len) % N) else {
@@ -151,7 +154,7 @@ impl<const N: usize> Lookahead<N> {
             exit_speed: 0.0,
         };
         self.len += 1;
-        self.last_unit = Some(unit);
+        self.last_unit = Some(unit_out);
         self.replan();
         Ok(())
     }
@@ -168,6 +171,17 @@ impl<const N: usize> Lookahead<N> {
         self.len = 0;
         self.frozen_head_entry = None;
         self.last_unit = None;
+    }
+
+    /// Keeps only the first `n` queued blocks (the rest are cancelled); the
+    /// last one kept now ends at rest.
+    pub fn keep_head(&mut self, n: usize) {
+        self.len = self.len.min(n);
+        self.last_unit = None;
+        if self.len == 0 {
+            self.frozen_head_entry = None;
+        }
+        self.replan();
     }
 
     /// Takes the head block for execution, with its exit speed set. The
@@ -283,7 +297,13 @@ impl SpeedCursor {
             let cruise = b.nominal_speed * scale.max(0.0);
             let up = (self.speed + b.accel * dt_s).min(cruise);
             let down = (self.speed - b.accel * dt_s).max(0.0);
-            up.min(self.braking_speed(dt_s, left)).max(down)
+            let mut brake = self.braking_speed(dt_s, left);
+            if 0.5 * (self.speed + b.exit_speed) * dt_s >= left {
+                // The end is reached within this period anyway: at most
+                // at the exit speed.
+                brake = brake.max(b.exit_speed);
+            }
+            up.min(brake).max(down)
         };
         let step = 0.5 * (self.speed + next) * dt_s;
         self.speed = next;

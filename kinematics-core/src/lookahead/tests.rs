@@ -42,20 +42,23 @@ fn junction_speed_limits() {
 fn refuses_bad_blocks_and_overflow() {
     let mut p = Lookahead::<2>::new(0.01).unwrap();
     assert_eq!(
-        p.push(0.0, [1.0, 0.0], 10.0, A),
+        p.push(0.0, [[1.0, 0.0]; 2], 10.0, A),
         Err(LookaheadError::InvalidBlock)
     );
     assert_eq!(
-        p.push(1.0, [2.0, 0.0], 10.0, A),
+        p.push(1.0, [[2.0, 0.0]; 2], 10.0, A),
         Err(LookaheadError::InvalidBlock)
     );
     assert_eq!(
-        p.push(1.0, [1.0, 0.0], f64::NAN, A),
+        p.push(1.0, [[1.0, 0.0]; 2], f64::NAN, A),
         Err(LookaheadError::InvalidBlock)
     );
-    p.push(1.0, [1.0, 0.0], 10.0, A).unwrap();
-    p.push(1.0, [1.0, 0.0], 10.0, A).unwrap();
-    assert_eq!(p.push(1.0, [1.0, 0.0], 10.0, A), Err(LookaheadError::Full));
+    p.push(1.0, [[1.0, 0.0]; 2], 10.0, A).unwrap();
+    p.push(1.0, [[1.0, 0.0]; 2], 10.0, A).unwrap();
+    assert_eq!(
+        p.push(1.0, [[1.0, 0.0]; 2], 10.0, A),
+        Err(LookaheadError::Full)
+    );
     assert!(Lookahead::<2>::new(-1.0).is_err());
     assert!(Lookahead::<0>::new(0.0).is_err());
 }
@@ -64,14 +67,14 @@ fn refuses_bad_blocks_and_overflow() {
 fn collinear_blocks_cruise_through_and_a_break_stops() {
     let mut p = Lookahead::<8>::new(0.01).unwrap();
     for _ in 0..4 {
-        p.push(100.0, [1.0, 0.0], 50.0, A).unwrap();
+        p.push(100.0, [[1.0, 0.0]; 2], 50.0, A).unwrap();
     }
     assert_eq!(p.block(0).unwrap().entry_speed, 0.0);
     for i in 1..4 {
         assert_eq!(p.block(i).unwrap().entry_speed, 50.0);
     }
     p.break_junction();
-    p.push(100.0, [1.0, 0.0], 50.0, A).unwrap();
+    p.push(100.0, [[1.0, 0.0]; 2], 50.0, A).unwrap();
     assert_eq!(p.block(4).unwrap().entry_speed, 0.0);
 }
 
@@ -87,16 +90,15 @@ proptest! {
         let mut p = Lookahead::<6>::new(deviation).unwrap();
         let mut frozen: Option<f64> = None;
         for (length, angle, speed, accel, action) in moves {
-            if p.is_full() || action == 0 {
-                if let Some(b) = p.pop() {
-                    prop_assert_eq!(b.exit_speed, p.block(0).map_or(0.0, |n| n.entry_speed));
-                    frozen = p.block(0).map(|n| n.entry_speed);
-                }
+            let take = p.is_full() || action == 0;
+            if let Some(b) = take.then(|| p.pop()).flatten() {
+                prop_assert_eq!(b.exit_speed, p.block(0).map_or(0.0, |n| n.entry_speed));
+                frozen = p.block(0).map(|n| n.entry_speed);
             }
             if action == 1 {
                 p.break_junction();
             }
-            p.push(length, unit(angle), speed, accel).unwrap();
+            p.push(length, [unit(angle); 2], speed, accel).unwrap();
             if let (Some(f), Some(head)) = (frozen, p.block(0)) {
                 prop_assert!(head.entry_speed <= f + 1e-9);
             }
@@ -118,7 +120,7 @@ proptest! {
         let mut p = Lookahead::<64>::new(0.02).unwrap();
         let mut total = 0.0;
         for &(length, angle) in &moves {
-            p.push(length, unit(angle), speed, accel).unwrap();
+            p.push(length, [unit(angle); 2], speed, accel).unwrap();
             total += length;
         }
         let mut cursor = SpeedCursor::start(p.pop().unwrap());
@@ -148,7 +150,7 @@ proptest! {
 #[test]
 fn a_hold_brakes_at_the_limit_and_resumes_from_rest() {
     let mut p = Lookahead::<4>::new(0.01).unwrap();
-    p.push(1000.0, [1.0, 0.0], 100.0, A).unwrap();
+    p.push(1000.0, [[1.0, 0.0]; 2], 100.0, A).unwrap();
     let mut c = SpeedCursor::start(p.pop().unwrap());
     for _ in 0..50 {
         c.advance(0.02, 1.0, false);

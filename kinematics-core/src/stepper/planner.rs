@@ -126,7 +126,7 @@ impl<const N: usize> Planner<N> {
         self.plan
             .push(
                 f64::from(event_count),
-                unit,
+                [unit; 2],
                 mv.nominal_rate_steps_per_s,
                 mv.accel_steps_per_s2,
             )

@@ -16,6 +16,7 @@
 use embassy_time::{Duration, Instant};
 use heapless::Deque;
 
+use super::gcode_stream::{Stream, planned_length};
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
 use crate::domain::PointCm;
@@ -83,6 +84,8 @@ pub(super) struct Motion {
     pub(super) arrived: bool,
     /// The gimbal laser should be lit.
     pub(super) gimbal_lit: bool,
+    /// The gimbal's look-ahead plan and the block it follows.
+    pub(super) stream: Stream,
 }
 
 impl Motion {
@@ -96,6 +99,7 @@ impl Motion {
             started: false,
             arrived: false,
             gimbal_lit: false,
+            stream: Stream::new(),
         }
     }
 
@@ -116,13 +120,18 @@ impl Motion {
             return (0.0, 0.0);
         };
         let scale = |v: f64, percent: u8| v * f64::from(percent) / 100.0;
+        // The gimbal's speed on its planned profile, when it streams.
+        let feed = |f: f64| match self.stream.is_following() {
+            true => self.stream.speed_mm_s() * 60.0,
+            false => scale(f, ov.feed),
+        };
         match current.block {
             Block::Line {
                 feed_mm_min, laser, ..
             }
             | Block::Arc {
                 feed_mm_min, laser, ..
-            } => (scale(feed_mm_min, ov.feed), scale(laser.power, ov.spindle)),
+            } => (feed(feed_mm_min), scale(laser.power, ov.spindle)),
             Block::Jog { feed_mm_min, .. } => (feed_mm_min, 0.0),
             _ => (0.0, 0.0),
         }
@@ -136,6 +145,7 @@ impl Motion {
         self.started = false;
         self.arrived = false;
         self.gimbal_lit = false;
+        self.stream.clear();
         self.owed.take().is_some()
     }
 }
@@ -151,10 +161,14 @@ fn block_end(block: &Block) -> Option<PointMm> {
 
 /// Point `k` of `n` along a motion block.
 pub(super) fn point_at(block: &Block, k: u32, n: u32) -> PointMm {
-    let t = f64::from(k) / f64::from(n.max(1));
+    block_point(block, f64::from(k) / f64::from(n.max(1)))
+}
+
+/// The point a fraction `t` (0..=1) along a motion block.
+pub(super) fn block_point(block: &Block, t: f64) -> PointMm {
     match *block {
         Block::Rapid { from, to } | Block::Line { from, to, .. } | Block::Jog { from, to, .. } => {
-            if k >= n {
+            if t >= 1.0 {
                 return to;
             }
             PointMm {
@@ -256,6 +270,12 @@ impl Core {
                     }
                 }
                 _ => {
+                    if self.gcode_streams() && planned_length(&block).is_some() {
+                        self.gcode.motion.current = Some(self.new_current(block, 1));
+                        if self.stream_begin(&block, out) {
+                            continue;
+                        }
+                    }
                     let count = self.step_count(&block);
                     self.gcode.motion.current = Some(self.new_current(block, count));
                     self.gcode_send_step(out);
@@ -264,7 +284,7 @@ impl Core {
         }
     }
 
-    fn new_current(&self, block: Block, count: u32) -> Current {
+    pub(super) fn new_current(&self, block: Block, count: u32) -> Current {
         Current {
             block,
             index: 1,
@@ -331,6 +351,7 @@ impl Core {
         }
         let motion = &mut self.gcode.motion;
         motion.queue.clear();
+        motion.stream.keep_running_block();
         let Some(c) = motion.current.as_mut() else {
             return;
         };
