@@ -12,9 +12,8 @@ use system_tests::{run_with, sent_at, terminal_lines};
 /// Servo resolution on the board (see `gcode_sim.rs`), mm.
 const GIMBAL_TOLERANCE_MM: f64 = 0.45;
 /// The stepper's: its line cut (0.05 mm) + one microstep of spot travel
-/// at the board (≈ 0.25 mm at 25 cm), mm.
-#[allow(dead_code)]
-const STEPPER_TOLERANCE_MM: f64 = 0.31;
+/// at the board (≤ 0.3 mm at 25 cm, see `stepper_sim.rs`), mm.
+const STEPPER_TOLERANCE_MM: f64 = 0.35;
 /// Feed of the jobs, mm/min.
 const FEED_MM_MIN: f64 = 1200.0;
 
@@ -253,4 +252,75 @@ fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_gimbal() {
     let fit = fit(&lit_mm(&report), &pieces);
     assert!(fit.worst_lit_mm <= GIMBAL_TOLERANCE_MM, "{fit:?}");
     assert!(fit.worst_missed_mm <= 1.5, "{fit:?}");
+}
+
+/// The drivers saw clean pulses and no stall.
+fn assert_clean_drive(report: &SimReport) {
+    for axis in &report.stepper.axes {
+        assert_eq!(
+            axis.violations().total(),
+            0,
+            "{:?}\n{}",
+            axis.violations(),
+            report.stepper.report()
+        );
+        assert!(axis.stalls().is_empty(), "{}", report.stepper.report());
+        assert_eq!(axis.lost_steps(), 0, "{}", report.stepper.report());
+    }
+}
+
+#[test]
+fn the_circle_and_the_zigzag_run_continuously_on_the_stepper() {
+    for (name, (lines, pieces, length)) in [
+        ("circle", circle_job(200, 40.0)),
+        ("zig-zag", zigzag_job(40, 4.0, 5.0)),
+    ] {
+        // A dwell at the end lets the rotors settle before the run ends.
+        let lines: Vec<String> = lines.into_iter().chain(["G4 P0.2".into()]).collect();
+        let (report, job_s) = run_job("target stepper\n", &lines);
+        assert_all_ok(&report, name);
+        assert_clean_drive(&report);
+        let fit = fit(&lit_mm(&report), &pieces);
+        let at_feed_s = length / (FEED_MM_MIN / 60.0);
+        let lit_s = lit_span_s(&report);
+        eprintln!(
+            "stepper {name}: job {job_s:.2} s, lit {lit_s:.2} s, at feed {at_feed_s:.2} s; {fit:?}"
+        );
+        assert!(fit.worst_lit_mm <= STEPPER_TOLERANCE_MM, "{name}: {fit:?}");
+        assert!(fit.worst_missed_mm <= 1.0, "{name}: {fit:?}");
+        assert!(lit_s < at_feed_s * 1.1 + 0.3, "{name}: lit {lit_s:.2} s");
+        if name == "circle" {
+            let slowest = slowest_lit_speed(&report, 0.3);
+            eprintln!("stepper circle: slowest 200 ms stretch {slowest:.1} mm/s");
+            assert!(slowest > 0.8 * FEED_MM_MIN / 60.0, "{slowest}");
+        }
+    }
+}
+
+#[test]
+fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_stepper() {
+    let (mut lines, pieces) = circle_with_hold(60);
+    lines.push("G4 P0.2".into());
+    let (report, _) = run_job("target stepper\n", &lines);
+    assert_all_ok(&report, "stepper hold");
+    assert_clean_drive(&report);
+    let terminal = terminal_lines(&report);
+    let statuses: Vec<&&str> = terminal.iter().filter(|l| l.starts_with('<')).collect();
+    assert_eq!(statuses.len(), 4, "{terminal:?}");
+    assert!(statuses[0].starts_with("<Run|"), "{statuses:?}");
+    assert!(statuses[1].starts_with("<Hold:0|"), "{statuses:?}");
+    assert!(statuses[2].starts_with("<Hold:0|"), "{statuses:?}");
+    assert!(statuses[3].starts_with("<Run|"), "{statuses:?}");
+    let (hold_at, resume_at) = (sent_at(&report, "!"), sent_at(&report, "~"));
+    assert!(
+        !report
+            .recording
+            .spot
+            .iter()
+            .any(|s| s.laser && s.t_us > hold_at + 1_000 && s.t_us < resume_at),
+        "lit during the hold"
+    );
+    let fit = fit(&lit_mm(&report), &pieces);
+    assert!(fit.worst_lit_mm <= STEPPER_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 1.0, "{fit:?}");
 }

@@ -16,6 +16,7 @@
 use embassy_time::{Duration, Instant};
 use heapless::Deque;
 
+use super::gcode_stepper::StepperJob;
 use super::gcode_stream::{Stream, planned_length};
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
@@ -61,6 +62,9 @@ pub(super) struct Current {
     pub(super) servo_seq: Option<u32>,
     /// Galvo job in flight.
     pub(super) galvo_seq: Option<u32>,
+    /// Stepper move handed over, not yet taken (or, for the last block
+    /// before rest, not yet at rest).
+    pub(super) stepper_seq: Option<u32>,
     /// End of a dwell.
     pub(super) until: Option<Instant>,
     /// A jog cancel ends the block after the step in flight.
@@ -86,6 +90,8 @@ pub(super) struct Motion {
     pub(super) gimbal_lit: bool,
     /// The gimbal's look-ahead plan and the block it follows.
     pub(super) stream: Stream,
+    /// What the stepper has of the job.
+    pub(super) stepper: StepperJob,
 }
 
 impl Motion {
@@ -100,6 +106,7 @@ impl Motion {
             arrived: false,
             gimbal_lit: false,
             stream: Stream::new(),
+            stepper: StepperJob::default(),
         }
     }
 
@@ -146,6 +153,7 @@ impl Motion {
         self.arrived = false;
         self.gimbal_lit = false;
         self.stream.clear();
+        self.stepper.clear();
         self.owed.take().is_some()
     }
 }
@@ -203,6 +211,7 @@ impl Core {
             on_board
                 && (!self.actuator.uses_gimbal() || self.aimer.aim(p).is_ok())
                 && (!self.actuator.uses_galvo() || self.aimer.galvo_in_range(p))
+                && (!self.actuator.uses_stepper() || self.stepper_reaches(p))
         };
         match block {
             Block::Arc { .. } => (0..=16).all(|k| reachable(point_at(block, k, 16))),
@@ -292,6 +301,7 @@ impl Core {
             from: self.gcode.motion.position,
             servo_seq: None,
             galvo_seq: None,
+            stepper_seq: None,
             until: None,
             cancelled: false,
         }
@@ -307,10 +317,11 @@ impl Core {
     /// `!`: laser dark at once; the gimbal stops after the step in
     /// flight, the galvo brakes along its stroke.
     pub(super) fn grbl_hold(&mut self, out: &mut dyn ActionSink) {
-        let motion = &mut self.gcode.motion;
-        if motion.hold != Hold::None || motion.is_idle() {
+        let motion = &self.gcode.motion;
+        if motion.hold != Hold::None || motion.is_idle() || self.gcode_stepper_hold(out) {
             return;
         }
+        let motion = &mut self.gcode.motion;
         motion.gimbal_lit = false;
         let galvo_in_flight = motion.current.is_some_and(|c| c.galvo_seq.is_some());
         if let Some(c) = motion.current.as_mut() {

@@ -20,6 +20,9 @@ impl Core {
             // The gimbal follows its planned profile.
             return self.stream_tick(out);
         }
+        if self.actuator.uses_stepper() {
+            return self.gcode_stepper_send(out);
+        }
         let motion = &self.gcode.motion;
         let Some(current) = motion.current else {
             return;
@@ -211,7 +214,8 @@ impl Core {
     pub(super) fn gcode_step_done(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         let Some(mut c) = motion.current else { return };
-        if c.servo_seq.is_some() || c.galvo_seq.is_some() || c.until.is_some() {
+        let stepper = c.stepper_seq.is_some();
+        if c.servo_seq.is_some() || c.galvo_seq.is_some() || c.until.is_some() || stepper {
             return;
         }
         if c.count > 0 {

@@ -352,7 +352,7 @@ impl Core {
     }
 
     /// Whether `block` lights the laser (a lit G1/G2/G3).
-    fn lights(&self, block: &Block) -> bool {
+    pub(super) fn lights(&self, block: &Block) -> bool {
         match *block {
             Block::Line { laser, .. } | Block::Arc { laser, .. } => {
                 self.gcode_lit(laser.mode, laser.power)

@@ -19,6 +19,7 @@ mod gcode_motion;
 mod gcode_report;
 mod gcode_settings;
 mod gcode_step;
+mod gcode_stepper;
 mod gcode_stream;
 mod laser;
 mod machine;

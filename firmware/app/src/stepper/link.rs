@@ -33,6 +33,9 @@ pub enum StepperRequest {
         point: BoardPoint,
         /// How to get there.
         shape: MoveShape,
+        /// Spot speed along a line or arc on the board, mm/s (G-code's
+        /// feed; `None`: the axes' speed limit, as for travel).
+        feed_mm_s: Option<f64>,
     },
     /// Decelerate to rest at the acceleration limit along the path, drop
     /// the rest.
@@ -92,6 +95,12 @@ pub enum StepperEvent {
         seq: u32,
         /// Position, microsteps.
         steps: [i32; 2],
+    },
+    /// Move `seq` is being cut into the planner (a G-code sender's next
+    /// move may follow; it is joined at speed).
+    Taken {
+        /// Request number.
+        seq: u32,
     },
     /// Move `seq` was refused.
     Refused {
