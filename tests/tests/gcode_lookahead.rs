@@ -320,7 +320,20 @@ fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_stepper() {
             .any(|s| s.laser && s.t_us > hold_at + 1_000 && s.t_us < resume_at),
         "lit during the hold"
     );
+    // At rest well before the resume, and on from exactly there.
+    let spot = &report.recording.spot;
+    let at = |t: u64| {
+        let s = spot.iter().rev().find(|s| s.t_us <= t).expect("a sample");
+        [s.x_cm * 10.0, s.y_cm * 10.0]
+    };
+    let dist = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]);
+    let (a, b) = (at(hold_at + 400_000), at(resume_at));
+    assert!(dist(a, b) < 1e-9, "{a:?} {b:?}");
     let fit = fit(&lit_mm(&report), &pieces);
+    eprintln!("stepper hold: {fit:?}");
     assert!(fit.worst_lit_mm <= STEPPER_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 1.0, "{fit:?}");
+    // The stretch travelled dark between `!` and rest is the one gap:
+    // the stepper runs its prepared segments (8 × 1.5 ms, but at least
+    // one step each: ≈ 12 ms a step at 20 mm/s) before it brakes.
+    assert!(fit.worst_missed_mm <= 3.0, "{fit:?}");
 }
