@@ -399,15 +399,14 @@ impl StepperMotion {
     /// The next segment to prepare (`None`: nothing more for now).
     pub fn next_segment(&mut self) -> Option<Segment> {
         self.feed_line();
-        if self.line.is_none() && self.planner.len() < PLANNER_LEN {
-            if let Some((seq, queued)) = self.next.take() {
-                // Checked when it was queued; a refusal now drops it.
-                if self.start(queued).is_ok() {
-                    self.pending = Some(seq);
-                    self.started = Some(seq);
-                }
-                self.feed_line();
+        let room = self.line.is_none() && self.planner.len() < PLANNER_LEN;
+        if let Some((seq, queued)) = self.next.take_if(|_| room) {
+            // Checked when it was queued; a refusal now drops it.
+            if self.start(queued).is_ok() {
+                self.pending = Some(seq);
+                self.started = Some(seq);
             }
+            self.feed_line();
         }
         self.prep.next_segment(&mut self.planner)
     }
