@@ -18,6 +18,13 @@ use crate::text::{ReplyText, reply_text};
 /// grbl's RX buffer as `$I` advertises it, bytes.
 pub(super) const RX_BUFFER_BYTES: u16 = crate::grbl::RX_BUFFER_BYTES as u16;
 
+/// Overrides at power-up and after a reset: 100 %.
+const NO_OVERRIDES: Overrides = Overrides {
+    feed: 100,
+    rapid: 100,
+    spindle: 100,
+};
+
 /// Whether G-code runs, is only checked, or is locked by an alarm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum GrblMode {
@@ -52,11 +59,7 @@ impl Gcode {
             parser: ParserState::new(),
             mode: GrblMode::Normal,
             values: GrblValues::default(),
-            overrides: Overrides {
-                feed: 100,
-                rapid: 100,
-                spindle: 100,
-            },
+            overrides: NO_OVERRIDES,
             motion: Motion::new(),
             reports: 0,
         }
@@ -281,7 +284,7 @@ impl Core {
         self.stop("grbl soft reset", out);
         self.gcode.parser.soft_reset();
         self.grbl_sync_position();
-        self.gcode.overrides = Gcode::new().overrides;
+        self.gcode.overrides = NO_OVERRIDES;
         if self.gcode.mode == GrblMode::Check {
             self.gcode.mode = GrblMode::Normal;
         }

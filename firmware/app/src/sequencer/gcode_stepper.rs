@@ -96,6 +96,7 @@ fn short_of_end_on(from: BoardPoint, to: &Handed, p: BoardPoint) -> bool {
 
 impl Core {
     /// Hands the current block to the stepper (or waits for rest first).
+    #[inline(never)]
     pub(super) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
         let Some(current) = self.gcode.motion.current else {
             return;
@@ -230,6 +231,7 @@ impl Core {
     }
 
     /// The G-code side of a stepper report: `true` when it was the job's.
+    #[inline(never)]
     pub(super) fn gcode_stepper_event(
         &mut self,
         event: &StepperEvent,
@@ -323,9 +325,17 @@ impl Core {
 }
 
 impl StepperJob {
-    /// Forgets the job (a stop, a reset).
+    /// Forgets the job (a stop, a reset); in place (the ring is large
+    /// for the sequencer's stack).
     pub(super) fn clear(&mut self) {
-        *self = Self::default();
+        self.inflight = None;
+        self.handed.clear();
+        self.start = None;
+        self.resend = 0;
+        self.resend_seq = None;
+        self.lit = false;
+        self.waiting = false;
+        self.stopped_at = None;
     }
 }
 

@@ -56,9 +56,12 @@ impl Stream {
         }
     }
 
-    /// Forgets the plan (a stop, a reset, an alarm).
+    /// Forgets the plan (a stop, a reset, an alarm); in place (the plan
+    /// is large for the sequencer's stack).
     pub(super) fn clear(&mut self) {
-        *self = Self::new();
+        self.plan = None;
+        self.cursor = None;
+        self.last_lit = false;
     }
 
     /// Drops the planned blocks after the running one (a jog cancel).
@@ -106,6 +109,7 @@ impl Core {
 
     /// A block enters the motion queue: motion is planned, anything else
     /// (dwell, pause, end) makes the motion before it end at rest.
+    #[inline(never)]
     pub(super) fn stream_queue(&mut self, block: &Block) {
         if !self.gcode_streams() {
             return;
@@ -190,6 +194,7 @@ impl Core {
     /// from rest, or on from the block before at the junction speed.
     /// `false` when the planner has no plan for it (it then runs step by
     /// step).
+    #[inline(never)]
     pub(super) fn stream_begin(&mut self, block: &Block, out: &mut dyn ActionSink) -> bool {
         let Some(length) = planned_length(block) else {
             return false;
@@ -227,6 +232,7 @@ impl Core {
     /// One period of the block being followed: the next point of the
     /// profile to the servos, the next tick scheduled — or the block's end
     /// reached (the next block, or the final move), or a hold at rest.
+    #[inline(never)]
     pub(super) fn stream_tick(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         let (Some(current), Some(mut cursor)) = (motion.current, motion.stream.cursor) else {
