@@ -173,17 +173,6 @@ impl<const N: usize> Lookahead<N> {
         self.last_unit = None;
     }
 
-    /// Keeps only the first `n` queued blocks (the rest are cancelled); the
-    /// last one kept now ends at rest.
-    pub fn keep_head(&mut self, n: usize) {
-        self.len = self.len.min(n);
-        self.last_unit = None;
-        if self.len == 0 {
-            self.frozen_head_entry = None;
-        }
-        self.replan();
-    }
-
     /// Takes the head block for execution, with its exit speed set. The
     /// next block's entry speed is then fixed: later blocks can only raise
     /// the speeds of the blocks before them, so that entry stays feasible.

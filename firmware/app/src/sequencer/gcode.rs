@@ -135,7 +135,6 @@ impl Core {
         for block in motion.owed.take().into_iter().flatten() {
             // Room was checked above.
             let _ = self.gcode.motion.queue.push_back(block);
-            self.stream_queue(&block);
         }
         self.ok(out);
     }

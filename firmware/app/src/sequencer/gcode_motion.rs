@@ -362,7 +362,6 @@ impl Core {
         }
         let motion = &mut self.gcode.motion;
         motion.queue.clear();
-        motion.stream.keep_running_block();
         let Some(c) = motion.current.as_mut() else {
             return;
         };

@@ -87,11 +87,7 @@ impl Core {
         let v = &mut self.gcode.values;
         match number {
             10 if value <= 3.0 => v.report_mask = value as u8,
-            11 if value > 0.0 => {
-                v.junction_mm = value;
-                // The next burst plans with it.
-                self.gcode.motion.stream.clear();
-            }
+            11 if value > 0.0 => v.junction_mm = value,
             12 if value > 0.0 => v.arc_tolerance_mm = value,
             30 if value > v.s_min => v.s_max = value,
             31 if value < v.s_max => v.s_min = value,

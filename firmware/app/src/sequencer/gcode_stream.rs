@@ -1,8 +1,14 @@
-//! G-code on the gimbal through grbl's look-ahead planner: each motion
-//! block enters [`kinematics_core::lookahead::Lookahead`] in board mm as
-//! it is queued (cruise at F — G0 at the rate limit — capped by `$110` and
-//! the servo speed; acceleration `$120` capped by the servos'
-//! [`GIMBAL_ACCEL_DEG_S2`]; junctions by `$11`). The block running is
+//! G-code on the gimbal through grbl's look-ahead planner: every period
+//! the block running (what is left of it, entered at the speed it has)
+//! and the motion blocks queued behind it (up to [`PLAN_BLOCKS`], to the
+//! first that must start from rest) are planned by
+//! [`kinematics_core::lookahead::Lookahead`] in board mm (cruise at F —
+//! G0 at the rate limit — capped by `$110` and the servo speed;
+//! acceleration `$120` capped by the servos' [`GIMBAL_ACCEL_DEG_S2`];
+//! junctions by `$11`): the plan gives the running block's exit speed.
+//! Planned afresh each period, nothing of it stays in the sequencer's
+//! state (its stack copies of it are what the 14 KiB ceiling counts). The
+//! block running is
 //! followed at [`STREAM_PERIOD_MS`] by a [`SpeedCursor`]: every period
 //! one servo move to the next point of the planned profile, timed to the
 //! period (each move supersedes the one before, so the servos never stop
@@ -14,11 +20,9 @@
 //! point it stopped at; the feed override scales the cruise on the fly.
 
 use embassy_time::Duration;
-use kinematics_core::lookahead::{Lookahead, SpeedCursor};
+use kinematics_core::lookahead::{Lookahead, LookaheadBlock, SpeedCursor};
 
-use super::gcode_motion::{
-    CORNER_DEADBAND_TENTHS, Hold, PLANNER_BLOCKS, block_point, cm, point_at,
-};
+use super::gcode_motion::{CORNER_DEADBAND_TENTHS, Hold, block_point, cm, point_at};
 use super::machine::{ActionSink, Core};
 use crate::domain::Target;
 use crate::grbl::{Block, PointMm};
@@ -27,48 +31,33 @@ use crate::grbl::{Block, PointMm};
 pub(super) const STREAM_PERIOD_MS: u64 = 20;
 /// Joint acceleration the servos follow, °/s² (their speed within 0.1 s).
 pub(super) const GIMBAL_ACCEL_DEG_S2: f64 = 2000.0;
-/// Blocks the planner holds: the queue and the block running.
-const PLAN_BLOCKS: usize = PLANNER_BLOCKS + 1;
+/// Blocks planned each period: the block running and those behind it.
+const PLAN_BLOCKS: usize = 8;
 /// Shorter blocks are not planned (nothing to move).
 const MIN_LENGTH_MM: f64 = 1e-4;
 /// Shortest tick, ms (a block end just past the previous tick).
 const MIN_TICK_MS: f64 = 2.0;
 
-/// The planner and the block being followed.
+/// The block being followed.
 #[derive(Debug, Clone)]
 pub(super) struct Stream {
-    plan: Option<Lookahead<PLAN_BLOCKS>>,
     /// Following the running block (`None`: at rest, or its final move).
     cursor: Option<SpeedCursor>,
     /// Highest cruise of the running block (servo speed, `$110`), mm/s.
     cap_mm_s: f64,
-    /// The last block planned lights the laser.
-    last_lit: bool,
 }
 
 impl Stream {
     pub(super) const fn new() -> Self {
         Self {
-            plan: None,
             cursor: None,
             cap_mm_s: 0.0,
-            last_lit: false,
         }
     }
 
-    /// Forgets the plan (a stop, a reset, an alarm); in place (the plan
-    /// is large for the sequencer's stack).
+    /// Forgets the block followed (a stop, a reset, an alarm).
     pub(super) fn clear(&mut self) {
-        self.plan = None;
         self.cursor = None;
-        self.last_lit = false;
-    }
-
-    /// Drops the planned blocks after the running one (a jog cancel).
-    pub(super) fn keep_running_block(&mut self) {
-        if let Some(plan) = self.plan.as_mut() {
-            plan.keep_head(usize::from(self.cursor.is_some()));
-        }
     }
 
     /// Whether a block is being followed.
@@ -94,6 +83,16 @@ pub(super) fn planned_length(block: &Block) -> Option<f64> {
     (length.is_finite() && length > MIN_LENGTH_MM).then_some(length)
 }
 
+/// Unit directions at the start and at the end of a motion block of
+/// `length` mm.
+fn tangents(block: &Block, length: f64) -> [[f64; 2]; 2] {
+    let near = (MIN_LENGTH_MM / length).max(1e-3);
+    [
+        unit(point_at(block, 0, 1), block_point(block, near)),
+        unit(block_point(block, 1.0 - near), point_at(block, 1, 1)),
+    ]
+}
+
 /// Unit direction from `a` to `b`.
 fn unit(a: PointMm, b: PointMm) -> [f64; 2] {
     let d = a.distance_to(b).max(1e-12);
@@ -105,55 +104,6 @@ impl Core {
     /// gimbal alone).
     pub(super) fn gcode_streams(&self) -> bool {
         self.actuator.uses_gimbal() && !self.actuator.uses_galvo()
-    }
-
-    /// A block enters the motion queue: motion is planned, anything else
-    /// (dwell, pause, end) makes the motion before it end at rest.
-    #[inline(never)]
-    pub(super) fn stream_queue(&mut self, block: &Block) {
-        if !self.gcode_streams() {
-            return;
-        }
-        let junction_mm = self.gcode.values.junction_mm;
-        let stream = &mut self.gcode.motion.stream;
-        if stream.plan.is_none() {
-            stream.plan = Lookahead::new(junction_mm).ok();
-        }
-        let lit = self.lights(block);
-        let stream = &mut self.gcode.motion.stream;
-        let dark_before = !core::mem::replace(&mut stream.last_lit, lit);
-        let Some(length) = planned_length(block) else {
-            if let Some(plan) = self.gcode.motion.stream.plan.as_mut() {
-                plan.break_junction();
-            }
-            return;
-        };
-        if lit && dark_before {
-            // Lit only where the spot is: the dark travel before a lit
-            // block ends at rest, with an arrival (the servos trail the
-            // streamed points by up to a period).
-            if let Some(plan) = self.gcode.motion.stream.plan.as_mut() {
-                plan.break_junction();
-            }
-        }
-        let (cruise, accel) = self.stream_limits(block, length);
-        let near = (MIN_LENGTH_MM / length).max(1e-3);
-        let tangents = [
-            unit(point_at(block, 0, 1), block_point(block, near)),
-            unit(block_point(block, 1.0 - near), point_at(block, 1, 1)),
-        ];
-        let from_rest = !self.gcode.motion.arrived && !self.gcode.motion.stream.is_following();
-        if let Some(plan) = self.gcode.motion.stream.plan.as_mut() {
-            let first = plan.is_empty();
-            if plan.push(length, tangents, cruise, accel).is_err() {
-                plan.break_junction();
-            }
-            if from_rest && first {
-                // Dark until the gimbal has arrived once: the first block
-                // ends at rest, with an arrival.
-                plan.break_junction();
-            }
-        }
     }
 
     /// Cruise (mm/s) and acceleration (mm/s²) of `block` on the gimbal:
@@ -174,12 +124,12 @@ impl Core {
         (feed.min(cap).max(1e-3), accel.max(1e-3))
     }
 
-    /// The larger joint's travel per mm along `block` (four pieces), °/mm.
+    /// The larger joint's travel per mm along `block` (two pieces), °/mm.
     fn joint_deg_per_mm(&self, block: &Block, length: f64) -> f64 {
-        let aim = |k: u32| self.aimer.aim(cm(point_at(block, k, 4))).ok();
+        let aim = |k: u32| self.aimer.aim(cm(point_at(block, k, 2))).ok();
         let (mut yaw, mut pitch) = (0.0, 0.0);
         let mut prev = aim(0);
-        for k in 1..=4 {
+        for k in 1..=2 {
             let next = aim(k);
             if let (Some(a), Some(b)) = (prev, next) {
                 yaw += libm::fabs(b.yaw_deg - a.yaw_deg);
@@ -191,42 +141,84 @@ impl Core {
     }
 
     /// Starts following `block` (already popped from the motion queue):
-    /// from rest, or on from the block before at the junction speed.
-    /// `false` when the planner has no plan for it (it then runs step by
-    /// step).
+    /// from rest, or on from the block before at the speed reached.
+    /// `false` when it has nothing to move (it then runs step by step).
     #[inline(never)]
     pub(super) fn stream_begin(&mut self, block: &Block, out: &mut dyn ActionSink) -> bool {
         let Some(length) = planned_length(block) else {
             return false;
         };
+        let (cruise, accel) = self.stream_limits(block, length);
+        let planned = LookaheadBlock {
+            length,
+            nominal_speed: cruise,
+            accel,
+            ..LookaheadBlock::default()
+        };
         let stream = &mut self.gcode.motion.stream;
-        let Some(plan) = stream.plan.as_mut() else {
-            return false;
-        };
-        let Some(head) = plan.block(0).copied() else {
-            stream.cursor = None;
-            return false;
-        };
-        if libm::fabs(head.length - length) > 1e-6 {
-            // Out of step with the queue (a refused push): re-plan.
-            stream.plan = None;
-            stream.cursor = None;
-            return false;
-        }
         stream.cursor = Some(match stream.cursor {
             Some(mut c) => {
-                c.continue_into(head, 0.0);
+                c.continue_into(planned, 0.0);
                 c
             }
-            None => SpeedCursor::start(head),
+            None => SpeedCursor::start(planned),
         });
-        let cap = self.stream_limits(block, length).0;
-        self.gcode.motion.stream.cap_mm_s = cap;
+        stream.cap_mm_s = cruise;
         if let Some(c) = self.gcode.motion.current.as_mut() {
             c.index = 0;
         }
         self.stream_tick(out);
         true
+    }
+
+    /// The exit speed the plan allows the running block (what is left of
+    /// it from `cursor`): its junction with the next queued motion block
+    /// and what lies behind that, or 0 when the next must start from rest
+    /// (none queued, a dwell, pause or end, a dark → lit change, or the
+    /// gimbal has not arrived anywhere yet: dark until it has).
+    #[inline(never)]
+    fn stream_exit_speed(&self, current: &Block, cursor: &SpeedCursor) -> f64 {
+        let motion = &self.gcode.motion;
+        let Ok(mut plan) = Lookahead::<PLAN_BLOCKS>::new(self.gcode.values.junction_mm) else {
+            return 0.0;
+        };
+        let left = cursor.block.length - cursor.done;
+        let b = &cursor.block;
+        let end_tangent = tangents(current, b.length)[1];
+        if !motion.arrived
+            || plan
+                .push(
+                    left.max(MIN_LENGTH_MM),
+                    [end_tangent; 2],
+                    b.nominal_speed,
+                    b.accel,
+                )
+                .is_err()
+        {
+            return 0.0;
+        }
+        plan.limit_head_entry(cursor.speed);
+        let mut lit = self.lights(current);
+        for next in motion.queue.iter() {
+            let Some(length) = planned_length(next) else {
+                break;
+            };
+            let next_lit = self.lights(next);
+            if next_lit && !lit {
+                break;
+            }
+            lit = next_lit;
+            let (cruise, accel) = self.stream_limits(next, length);
+            if plan
+                .push(length, tangents(next, length), cruise, accel)
+                .is_err()
+            {
+                break;
+            }
+        }
+        plan.block(1)
+            .filter(|n| n.max_entry_speed > 0.0)
+            .map_or(0.0, |n| n.entry_speed)
     }
 
     /// One period of the block being followed: the next point of the
@@ -240,9 +232,9 @@ impl Core {
         };
         let braking = motion.hold != Hold::None || current.cancelled;
         // The exit: the next block's entry while it joins at speed.
-        let next = motion.stream.plan.as_ref().and_then(|p| p.block(1));
-        let joins = next.is_some_and(|b| b.max_entry_speed > 0.0);
-        cursor.block.exit_speed = next.filter(|_| joins).map_or(0.0, |b| b.entry_speed);
+        cursor.block.exit_speed = self.stream_exit_speed(&current.block, &cursor);
+        let joins = cursor.block.exit_speed > 0.0;
+        let motion = &self.gcode.motion;
         let ov = f64::from(self.gcode.overrides.feed) / 100.0;
         let scale = ov.min(motion.stream.cap_mm_s / cursor.block.nominal_speed.max(1e-9));
         let dt_ms = STREAM_PERIOD_MS as f64;
@@ -273,10 +265,6 @@ impl Core {
             // The last move of the burst waits for arrival and settles
             // (`gcode_servo_arrived`); what follows starts from rest.
             motion.stream.cursor = None;
-            if let Some(plan) = motion.stream.plan.as_mut() {
-                plan.pop();
-                plan.limit_head_entry(0.0);
-            }
             return;
         }
         c.until = Some(
@@ -292,10 +280,6 @@ impl Core {
         let motion = &mut self.gcode.motion;
         if let Some(c) = motion.current.take() {
             motion.position = point_at(&c.block, 1, 1);
-        }
-        // Its plan leaves (before the queue takes a line waiting for room).
-        if let Some(plan) = motion.stream.plan.as_mut() {
-            plan.pop();
         }
         let next = motion.queue.front().copied();
         match next.filter(|b| planned_length(b).is_some()) {
@@ -384,9 +368,6 @@ impl Core {
             self.grbl_sync_position();
             self.grbl_advance(out);
             return;
-        }
-        if let Some(plan) = motion.stream.plan.as_mut() {
-            plan.limit_head_entry(0.0);
         }
         motion.hold = Hold::Held;
     }
