@@ -132,6 +132,7 @@ impl Core {
     }
 
     /// The current block was handed over as move `seq`.
+    #[inline(never)]
     fn stepper_handed(&mut self, seq: u32, lit: bool) {
         let motion = &mut self.gcode.motion;
         if let Some(c) = motion.current.as_mut() {
@@ -143,6 +144,7 @@ impl Core {
 
     /// Sends the next move to send again after a hold (the last one is
     /// the current block's).
+    #[inline(never)]
     fn stepper_resend(&mut self, out: &mut dyn ActionSink) {
         let job = &mut self.gcode.motion.stepper;
         let total = job.handed.len();
@@ -169,6 +171,7 @@ impl Core {
 
     /// A hold came to rest at `at`: the moves from the one it stopped in
     /// on are kept for the resume (that one from `at`).
+    #[inline(never)]
     fn stepper_held_at(&mut self, at: BoardPoint) {
         let job = &mut self.gcode.motion.stepper;
         let mut from = job.start.unwrap_or(at);
@@ -188,6 +191,7 @@ impl Core {
 
     /// The spot speed of a feed move with the feed override, mm/s
     /// (`None`: G0, at the axes' limit).
+    #[inline(never)]
     fn stepper_feed(&self, block: &Block) -> Option<f64> {
         let feed_mm_min = match *block {
             Block::Line { feed_mm_min, .. }
@@ -199,6 +203,7 @@ impl Core {
     }
 
     /// One move request to the stepper; returns its number.
+    #[inline(never)]
     fn stepper_request(
         &mut self,
         point: BoardPoint,
@@ -220,6 +225,7 @@ impl Core {
 
     /// Whether the block after the current one joins it at speed: a
     /// motion with the same laser, no hold.
+    #[inline(never)]
     fn stepper_joins_next(&self) -> bool {
         let motion = &self.gcode.motion;
         let same_laser = |b: &Block| self.lights(b) == motion.stepper.lit;
@@ -294,6 +300,7 @@ impl Core {
     }
 
     /// The current block is done on the stepper's side.
+    #[inline(never)]
     fn gcode_stepper_done(&mut self, out: &mut dyn ActionSink) {
         if let Some(c) = self.gcode.motion.current.as_mut() {
             c.stepper_seq = None;
@@ -303,6 +310,7 @@ impl Core {
 
     /// `!` on the stepper: decelerate along the path, dark at once.
     /// `false` when nothing moves there.
+    #[inline(never)]
     pub(super) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
         let motion = &mut self.gcode.motion;
         if !self.actuator.uses_stepper() || motion.stepper.inflight.is_none() {
@@ -315,6 +323,7 @@ impl Core {
     }
 
     /// Whether the stepper reaches board point `p` within its soft limits.
+    #[inline(never)]
     pub(super) fn stepper_reaches(&self, p: PointCm) -> bool {
         let config = self.stepper_config();
         config
@@ -327,6 +336,7 @@ impl Core {
 impl StepperJob {
     /// Forgets the job (a stop, a reset); in place (the ring is large
     /// for the sequencer's stack).
+    #[inline(never)]
     pub(super) fn clear(&mut self) {
         self.inflight = None;
         self.handed.clear();
@@ -341,6 +351,7 @@ impl StepperJob {
 
 impl super::gcode_motion::Motion {
     /// Where the G-code spot is, board cm.
+    #[inline(never)]
     fn stepper_point(&self) -> BoardPoint {
         let p = cm(self.position);
         BoardPoint::new(p.x_cm, p.y_cm)

@@ -56,16 +56,19 @@ impl Stream {
     }
 
     /// Forgets the block followed (a stop, a reset, an alarm).
+    #[inline(never)]
     pub(super) fn clear(&mut self) {
         self.cursor = None;
     }
 
     /// Whether a block is being followed.
+    #[inline(never)]
     pub(super) fn is_following(&self) -> bool {
         self.cursor.is_some()
     }
 
     /// Speed now, mm/s (0 at rest).
+    #[inline(never)]
     pub(super) fn speed_mm_s(&self) -> f64 {
         self.cursor.map_or(0.0, |c| c.speed)
     }
@@ -102,6 +105,7 @@ fn unit(a: PointMm, b: PointMm) -> [f64; 2] {
 impl Core {
     /// Whether G-code on this actuator streams through the planner (the
     /// gimbal alone).
+    #[inline(never)]
     pub(super) fn gcode_streams(&self) -> bool {
         self.actuator.uses_gimbal() && !self.actuator.uses_galvo()
     }
@@ -110,6 +114,7 @@ impl Core {
     /// F (G0: the rate limit) within `$110` and the servo speed, `$120`
     /// within [`GIMBAL_ACCEL_DEG_S2`], through the joint degrees per mm
     /// along the block.
+    #[inline(never)]
     fn stream_limits(&self, block: &Block, length: f64) -> (f64, f64) {
         let s = &self.settings;
         let deg_per_mm = self.joint_deg_per_mm(block, length).max(1e-6);
@@ -125,6 +130,7 @@ impl Core {
     }
 
     /// The larger joint's travel per mm along `block` (two pieces), °/mm.
+    #[inline(never)]
     fn joint_deg_per_mm(&self, block: &Block, length: f64) -> f64 {
         let aim = |k: u32| self.aimer.aim(cm(point_at(block, k, 2))).ok();
         let (mut yaw, mut pitch) = (0.0, 0.0);
@@ -276,6 +282,7 @@ impl Core {
 
     /// The tick reached the end of a block that joins the next at speed:
     /// the next block (queued, planned) goes on from here, hold or not.
+    #[inline(never)]
     pub(super) fn stream_block_done(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         if let Some(c) = motion.current.take() {
@@ -302,6 +309,7 @@ impl Core {
     /// A servo move to `to` taking `tick_ms` (`last`: arrive within the
     /// servo resolution and report it); the laser lit as the block says.
     /// `false` when the point is out of reach (alarm raised).
+    #[inline(never)]
     fn stream_sample(
         &mut self,
         to: PointMm,
@@ -334,6 +342,7 @@ impl Core {
     }
 
     /// Whether the running block lights the laser (a lit G1/G2/G3).
+    #[inline(never)]
     fn gcode_block_lit(&self) -> bool {
         self.gcode
             .motion
@@ -342,6 +351,7 @@ impl Core {
     }
 
     /// Whether `block` lights the laser (a lit G1/G2/G3).
+    #[inline(never)]
     pub(super) fn lights(&self, block: &Block) -> bool {
         match *block {
             Block::Line { laser, .. } | Block::Arc { laser, .. } => {
@@ -353,6 +363,7 @@ impl Core {
 
     /// A hold came to rest (`~` goes on from here), or a jog cancel did
     /// (the jog ends here).
+    #[inline(never)]
     fn stream_rest(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         motion.gimbal_lit = false;
@@ -374,6 +385,7 @@ impl Core {
 
     /// The servo task confirmed streamed move `seq`: `true` when it was
     /// a point on the way (the block goes on at its own pace).
+    #[inline(never)]
     pub(super) fn stream_arrived(&mut self, seq: u32) -> bool {
         let motion = &mut self.gcode.motion;
         let on_the_way = motion.stream.is_following()
