@@ -9,7 +9,6 @@
 //! limit (laser dark at once); `~` goes on from the point it stopped at:
 //! the rest of the block it stopped in, then the queue.
 
-use heapless::Deque;
 use kinematics_core::Rotation;
 use kinematics_core::frames::BoardPoint;
 
@@ -20,38 +19,17 @@ use crate::domain::PointCm;
 use crate::grbl::{Block, PointMm};
 use crate::stepper::{MoveShape, StepperEvent, StepperRequest};
 
-/// Moves the stepper may hold at once: its planner's pieces, the piece
-/// being cut and the move waiting behind it.
-const HANDED: usize = 18;
-
-/// A move handed to the stepper: its end, shape and feed.
-#[derive(Debug, Clone, Copy)]
-struct Handed {
-    point: BoardPoint,
-    shape: MoveShape,
-    feed_mm_s: Option<f64>,
-}
-
 /// What the stepper has of the G-code job.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Copy, Default)]
 pub(super) struct StepperJob {
     /// The last move handed over and not yet at rest.
     inflight: Option<u32>,
-    /// The moves handed over since the stepper was last at rest (oldest
-    /// first; the oldest dropped beyond [`HANDED`]), and where the oldest
-    /// starts: a hold's rest point is on one of them.
-    handed: Deque<Handed, HANDED>,
-    start: Option<BoardPoint>,
-    /// Moves still to send again after a hold (the tail of `handed`), and
-    /// the request whose `Taken` sends the next.
-    resend: usize,
-    resend_seq: Option<u32>,
     /// The laser of the blocks handed over.
     lit: bool,
     /// The current block waits for rest before it is handed over.
     waiting: bool,
-    /// Where a hold came to rest (the resume starts there).
-    stopped_at: Option<BoardPoint>,
+    /// A hold came to rest: `~` asks the stepper to go on with its moves.
+    held: bool,
 }
 
 /// The stepper move of a motion block: end point (cm) and shape.
@@ -76,24 +54,6 @@ fn stepper_move(block: &Block) -> Option<(BoardPoint, MoveShape)> {
     })
 }
 
-/// Whether `p` lies on the move from `from` to `to` short of its end:
-/// within 0.05 mm of a line or an arc (a joint-space travel within 2 mm
-/// of its chord).
-fn short_of_end_on(from: BoardPoint, to: &Handed, p: BoardPoint) -> bool {
-    let d = |a: BoardPoint, b: BoardPoint| 10.0 * libm::hypot(a.x_cm - b.x_cm, a.y_cm - b.y_cm);
-    let (end, tol_mm) = match to.shape {
-        MoveShape::Travel => (to.point, 2.0),
-        _ => (to.point, 0.05),
-    };
-    if d(p, end) <= 0.05 {
-        return false;
-    }
-    match to.shape {
-        MoveShape::Arc { centre, .. } => libm::fabs(d(p, centre) - d(from, centre)) <= tol_mm,
-        _ => d(from, p) + d(p, end) - d(from, end) <= tol_mm,
-    }
-}
-
 impl Core {
     /// Hands the current block to the stepper (or waits for rest first).
     #[inline(never)]
@@ -103,90 +63,31 @@ impl Core {
         };
         let lit = self.lights(&current.block) && self.gcode.motion.hold == Hold::None;
         let job = &mut self.gcode.motion.stepper;
-        if job.inflight.is_some() && (lit != job.lit || job.stopped_at.is_some()) {
+        if job.inflight.is_some() && lit != job.lit {
             job.waiting = true;
             return;
         }
         job.waiting = false;
+        if core::mem::take(&mut job.held) {
+            // A resume: the stepper goes on with the moves it had, from
+            // where the hold stopped.
+            job.inflight = current.stepper_seq;
+            out.act(Action::Stepper(StepperRequest::Resume));
+            let motion = &mut self.gcode.motion;
+            motion.gimbal_lit = lit && motion.arrived;
+            return;
+        }
         let Some((point, shape)) = stepper_move(&current.block) else {
             return;
         };
         let feed_mm_s = self.stepper_feed(&current.block);
-        let job = &mut self.gcode.motion.stepper;
-        let handed = Handed {
-            point,
-            shape,
-            feed_mm_s,
-        };
-        if let Some(at) = job.stopped_at.take() {
-            // A resume: from where the hold stopped, along what it had.
-            self.stepper_request(at, MoveShape::Travel, None, out);
-            return self.stepper_resend(out);
-        }
-        if job.handed.is_full() {
-            job.start = job.handed.pop_front().map(|h| h.point);
-        }
-        let _ = job.handed.push_back(handed);
         let seq = self.stepper_request(point, shape, feed_mm_s, out);
-        self.stepper_handed(seq, lit);
-    }
-
-    /// The current block was handed over as move `seq`.
-    #[inline(never)]
-    fn stepper_handed(&mut self, seq: u32, lit: bool) {
         let motion = &mut self.gcode.motion;
         if let Some(c) = motion.current.as_mut() {
             c.stepper_seq = Some(seq);
         }
         motion.stepper.lit = lit;
-        motion.gimbal_lit = lit && motion.arrived && motion.hold == Hold::None;
-    }
-
-    /// Sends the next move to send again after a hold (the last one is
-    /// the current block's).
-    #[inline(never)]
-    fn stepper_resend(&mut self, out: &mut dyn ActionSink) {
-        let job = &mut self.gcode.motion.stepper;
-        let total = job.handed.len();
-        let Some(h) = job
-            .handed
-            .iter()
-            .nth(total - job.resend.min(total))
-            .copied()
-        else {
-            return;
-        };
-        job.resend -= 1;
-        let last = job.resend == 0;
-        let lit = job.lit;
-        let seq = self.stepper_request(h.point, h.shape, h.feed_mm_s, out);
-        self.gcode.motion.stepper.resend_seq = (!last).then_some(seq);
-        if last {
-            self.stepper_handed(seq, lit);
-        } else {
-            let motion = &mut self.gcode.motion;
-            motion.gimbal_lit = lit && motion.hold == Hold::None;
-        }
-    }
-
-    /// A hold came to rest at `at`: the moves from the one it stopped in
-    /// on are kept for the resume (that one from `at`).
-    #[inline(never)]
-    fn stepper_held_at(&mut self, at: BoardPoint) {
-        let job = &mut self.gcode.motion.stepper;
-        let mut from = job.start.unwrap_or(at);
-        let mut keep = job.handed.len();
-        for (i, h) in job.handed.iter().enumerate() {
-            if short_of_end_on(from, h, at) {
-                keep = job.handed.len() - i;
-                break;
-            }
-            from = h.point;
-        }
-        // Stopped past every move (at the last end): the last one again,
-        // an empty move from there.
-        job.resend = keep.max(1);
-        job.stopped_at = Some(at);
+        motion.gimbal_lit = lit && motion.arrived;
     }
 
     /// The spot speed of a feed move with the feed override, mm/s
@@ -248,19 +149,12 @@ impl Core {
         let joins = self.stepper_joins_next();
         let motion = &mut self.gcode.motion;
         match *event {
-            StepperEvent::Taken { seq } if motion.stepper.resend_seq == Some(seq) => {
-                motion.stepper.resend_seq = None;
-                self.stepper_resend(out);
-                true
-            }
             StepperEvent::Taken { seq } if ours(seq) && joins => {
                 self.gcode_stepper_done(out);
                 true
             }
             StepperEvent::Arrived { seq, .. } if motion.stepper.inflight == Some(seq) => {
                 motion.stepper.inflight = None;
-                motion.stepper.handed.clear();
-                motion.stepper.start = Some(motion.stepper_point());
                 motion.arrived = true;
                 if ours(seq) {
                     self.gcode_stepper_done(out);
@@ -282,15 +176,9 @@ impl Core {
                         y_mm: p.y_cm * 10.0,
                     };
                 }
-                let held = motion.hold == Hold::Stopping;
-                if held {
+                if motion.hold == Hold::Stopping {
                     motion.hold = Hold::Held;
-                    if let Some(c) = motion.current.as_mut() {
-                        c.stepper_seq = None;
-                    }
-                }
-                if let Some(p) = at.filter(|_| held) {
-                    self.stepper_held_at(p);
+                    motion.stepper.held = true;
                 }
                 self.grbl_sync_position();
                 false
@@ -318,7 +206,7 @@ impl Core {
         }
         motion.gimbal_lit = false;
         motion.hold = Hold::Stopping;
-        out.act(Action::Stepper(StepperRequest::Stop));
+        out.act(Action::Stepper(StepperRequest::Hold));
         true
     }
 
@@ -334,26 +222,9 @@ impl Core {
 }
 
 impl StepperJob {
-    /// Forgets the job (a stop, a reset); in place (the ring is large
-    /// for the sequencer's stack).
+    /// Forgets the job (a stop, a reset).
     #[inline(never)]
     pub(super) fn clear(&mut self) {
-        self.inflight = None;
-        self.handed.clear();
-        self.start = None;
-        self.resend = 0;
-        self.resend_seq = None;
-        self.lit = false;
-        self.waiting = false;
-        self.stopped_at = None;
-    }
-}
-
-impl super::gcode_motion::Motion {
-    /// Where the G-code spot is, board cm.
-    #[inline(never)]
-    fn stepper_point(&self) -> BoardPoint {
-        let p = cm(self.position);
-        BoardPoint::new(p.x_cm, p.y_cm)
+        *self = Self::default();
     }
 }

@@ -40,6 +40,11 @@ pub enum StepperRequest {
     /// Decelerate to rest at the acceleration limit along the path, drop
     /// the rest.
     Stop,
+    /// A G-code feed hold: as `Stop`, the moves since the last rest kept.
+    Hold,
+    /// After a hold came to rest: the kept moves again, from the rest
+    /// point (the rest of the one it stopped in first).
+    Resume,
 }
 
 /// How a move gets to its point.

@@ -4,6 +4,8 @@
 //! straight in steps, enough pieces (a power of two) that the spot stays
 //! within [`LINE_TOLERANCE_MM`] of the board curve.
 
+mod resume;
+
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::JointAngles;
 use kinematics_core::stepper::{Planner, Segment, SegmentPrep, StepMove};
@@ -152,6 +154,8 @@ pub struct StepperMotion {
     next: Option<(u32, Queued)>,
     /// A queued move started being cut (reported as taken).
     started: Option<u32>,
+    /// The moves since the last rest, for a hold's resume.
+    history: resume::History,
 }
 
 /// A move waiting behind the line being cut.
@@ -177,6 +181,7 @@ impl StepperMotion {
             pending: None,
             next: None,
             started: None,
+            history: resume::History::default(),
         })
     }
 
@@ -225,6 +230,7 @@ impl StepperMotion {
     pub fn is_planned_out(&self) -> bool {
         self.line.is_none()
             && self.next.is_none()
+            && self.history.is_done()
             && self.planner.is_empty()
             && !self.prep.is_busy()
     }
@@ -240,6 +246,19 @@ impl StepperMotion {
     /// Errors: [`StepperRefusal`] (nothing queued; [`StepperRefusal::Busy`]
     /// while a line is cut and a move already waits).
     pub fn move_to(
+        &mut self,
+        seq: u32,
+        point: BoardPoint,
+        shape: MoveShape,
+        feed_mm_s: Option<f64>,
+    ) -> Result<bool, StepperRefusal> {
+        let taken = self.queue(seq, point, shape, feed_mm_s)?;
+        self.history.push(seq, point, shape, feed_mm_s);
+        Ok(taken)
+    }
+
+    /// [`Self::move_to`] without remembering it.
+    fn queue(
         &mut self,
         seq: u32,
         point: BoardPoint,
@@ -408,12 +427,20 @@ impl StepperMotion {
             }
             self.feed_line();
         }
+        self.queue_again();
         self.prep.next_segment(&mut self.planner)
     }
 
     /// Decelerates to rest at the limit along the path; what is left of
     /// the move is dropped.
     pub fn stop(&mut self) {
+        self.hold();
+        self.history.rest(None);
+    }
+
+    /// A feed hold: as [`Self::stop`], but the moves since the last rest
+    /// are kept for [`Self::resume`].
+    pub fn hold(&mut self) {
         self.line = None;
         self.next = None;
         self.pending = None;
@@ -436,7 +463,11 @@ impl StepperMotion {
     /// (`idle`) and nothing is left to plan.
     pub fn take_arrived(&mut self, idle: bool) -> Option<u32> {
         if idle && self.is_planned_out() {
-            self.pending.take()
+            let seq = self.pending.take();
+            if seq.is_some() {
+                self.history.rest(self.last_point);
+            }
+            seq
         } else {
             None
         }

@@ -207,6 +207,16 @@ impl Running {
                 self.deferred = None;
                 self.stopping = true;
             }
+            StepperRequest::Hold => {
+                self.motion.hold();
+                self.deferred = None;
+                self.stopping = true;
+            }
+            StepperRequest::Resume => {
+                if let Err(e) = self.motion.resume(link.position_steps()) {
+                    log::warning!("stepper: resume refused: {:?}", e);
+                }
+            }
         }
     }
 
