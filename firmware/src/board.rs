@@ -8,7 +8,7 @@
 //! | USB OTG FS (CDC-ACM)| PA11 DM, PA12 DP  |
 //! | servo bus USART2    | PA2 TX, PA3 RX (interrupt-driven, no DMA) |
 //! | galvo DAC1 X / Y    | PA4 / PA5, dual channel, TIM8-triggered, DMA1 stream 5 ch 7 |
-//! | laser enable        | PB0 (active high); galvo laser stream DMA2 stream 1 ch 7 (TIM8_UP) |
+//! | laser enable / power | PB0 (active high): TIM3_CH3 PWM (AF2, 1 kHz) for a power level, GPIO when dark or full (`laser_pwm`); galvo laser stream DMA2 stream 1 ch 7 (TIM8_UP) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
 //! | stepper pan STEP / DIR  | PE9 / PE10 (STEP on a TIM1 channel pin, for a later one-pulse timer; the step timer runs on an interrupt executor, `tasks.rs`) |
@@ -41,9 +41,8 @@ use laser_app::laser_gate::{GateState, LaserGate};
 use static_cell::StaticCell;
 
 use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac, darken_laser_stream};
-use crate::parts::{
-    GpioStepper, IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton,
-};
+use crate::laser_pwm::{LaserPin, laser_dark};
+use crate::parts::{GpioStepper, IndependentDog, StatusLeds, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::{FlashSettings, settings_store};
 
 bind_interrupts!(struct Irqs {
@@ -104,13 +103,14 @@ pub const LASER_PIN_BIT: usize = 0;
 pub static LASER_GATE: LaserGate = LaserGate::with_hook(laser_gate_changed);
 
 /// The gate's hook: when it closes, every word of the galvo's laser
-/// stream is zeroed (none can set the pin again), then PB0 goes low
-/// straight through the GPIO's set/reset register (one atomic store, safe
-/// from any task or interrupt), whoever holds the pin.
+/// stream is zeroed (none can set the pin again), then PB0 goes low at
+/// once, PWM or not ([`laser_dark`]: TIM3_CH3 forced inactive, the pin's
+/// ODR bit cleared through BSRR, PB0 a GPIO output again), whoever holds
+/// the pin.
 pub fn laser_gate_changed(state: GateState) {
     if !state.open {
         darken_laser_stream();
-        pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
+        laser_dark();
     }
 }
 
@@ -171,10 +171,11 @@ impl Board for Stm32Board {
 pub fn init(spawner: Spawner) -> Stm32Board {
     let p = embassy_stm32::init(clock_config());
     // Laser off before anything else can run.
-    let laser = LaserPin {
-        pin: Output::new(p.PB0, Level::Low, Speed::Low),
-        gate: &LASER_GATE,
-    };
+    let laser = LaserPin::new(
+        Output::new(p.PB0, Level::Low, Speed::Low),
+        p.TIM3,
+        &LASER_GATE,
+    );
     defmt::info!(
         "{} {} (git {}) booting at {} MHz",
         laser_app::build_info::PRODUCT,

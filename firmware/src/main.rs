@@ -12,6 +12,7 @@
 
 mod board;
 mod galvo_dac;
+mod laser_pwm;
 mod panic;
 mod parts;
 mod settings_flash;

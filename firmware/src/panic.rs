@@ -1,6 +1,7 @@
 //! Panic and HardFault handlers: laser off first (the galvo's sample clock
-//! and laser stream stopped, then the pin low, straight through the
-//! registers, as nothing else can be trusted), then log and halt. The
+//! and laser stream stopped, the laser PWM channel forced low, then the
+//! pin low, straight through the registers, as nothing else can be
+//! trusted), then log and halt. The
 //! watchdog then resets the MCU; the laser stays off through reset.
 //!
 //! The image is linked with flip-link (`.cargo/config.toml`): the stack sits
@@ -37,9 +38,13 @@ static PANICKED: AtomicBool = AtomicBool::new(false);
 fn laser_off_now() {
     pac::TIM8.cr1().write(|_| {});
     pac::DMA2.st(1).cr().write(|_| {});
+    // The laser PWM's channel forced low (PB0 may be on AF2, TIM3_CH3).
+    // SAFETY: a plain store of a valid CCMR2 value to TIM3's register.
+    unsafe { core::ptr::write_volatile(TIM3_CCMR2 as *mut u32, CCMR2_FORCE_INACTIVE) };
     pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
 }
 use crate::board::LASER_PIN_BIT;
+use crate::laser_pwm::{CCMR2_FORCE_INACTIVE, TIM3_CCMR2};
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo<'_>) -> ! {
@@ -81,6 +86,10 @@ unsafe extern "C" fn HardFault() -> ! {
         "str r1, [r0]",
         "ldr r0, ={dma2_s1cr}",
         "str r1, [r0]",
+        // The laser PWM channel (TIM3_CH3) forced inactive.
+        "ldr r0, ={tim3_ccmr2}",
+        "ldr r1, ={force_inactive}",
+        "str r1, [r0]",
         "ldr r0, ={bsrr}",
         "ldr r1, ={reset_laser}",
         "str r1, [r0]",
@@ -89,6 +98,8 @@ unsafe extern "C" fn HardFault() -> ! {
         "b {log}",
         tim8_cr1 = const TIM8_CR1,
         dma2_s1cr = const DMA2_S1CR,
+        tim3_ccmr2 = const TIM3_CCMR2,
+        force_inactive = const CCMR2_FORCE_INACTIVE,
         bsrr = const GPIOB_BSRR,
         reset_laser = const 1u32 << (16 + LASER_PIN_BIT),
         top = sym _stack_start,

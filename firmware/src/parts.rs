@@ -12,8 +12,6 @@ use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_time::{Duration, Instant, Timer};
 use embassy_usb::class::cdc_acm::{BufferedReceiver, Sender};
 use laser_app::app::{Console, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog};
-use laser_app::laser_gate::LaserGate;
-use laser_app::sequencer::LaserSwitch;
 
 /// The USB driver type of this board.
 pub type UsbDriver = Driver<'static, USB_OTG_FS>;
@@ -33,32 +31,6 @@ impl Console for UsbConsole {
     async fn connected(&mut self) -> (&mut Self::Rx, &mut Self::Tx) {
         self.rx.wait_connection().await;
         (&mut self.rx, &mut self.tx)
-    }
-}
-
-/// The laser-enable GPIO (active high), ANDed with the master laser gate:
-/// it goes high only while the gate is open, and the gate's close hook
-/// ([`crate::board::laser_gate_changed`]) pulls it low at once from
-/// whatever context closed it.
-pub struct LaserPin {
-    /// PB0.
-    pub pin: Output<'static>,
-    /// The master gate.
-    pub gate: &'static LaserGate,
-}
-
-impl LaserSwitch for LaserPin {
-    fn set(&mut self, on: bool) {
-        if on && self.gate.is_open() {
-            self.pin.set_high();
-            // A close between the check and the write has already run
-            // its hook: look again so the pin cannot stay high.
-            if !self.gate.is_open() {
-                self.pin.set_low();
-            }
-        } else {
-            self.pin.set_low();
-        }
     }
 }
 

@@ -22,9 +22,8 @@ use static_cell::StaticCell;
 
 use crate::board::Stm32Board;
 use crate::galvo_dac::{self, Stm32GalvoDac};
-use crate::parts::{
-    GpioStepper, IndependentDog, LaserPin, StatusLeds, UsbConsole, UsbDriver, UserButton,
-};
+use crate::laser_pwm::LaserPin;
+use crate::parts::{GpioStepper, IndependentDog, StatusLeds, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::FlashSettings;
 use laser_app::stepper::{StepPulseTask, StepperTask};
 

@@ -184,7 +184,8 @@ fn spot_sampler(machine: &Machine, stop: Arc<AtomicBool>) -> JoinHandle<Vec<Spot
         let mut samples = Vec::new();
         while !stop.load(Ordering::Relaxed) {
             let t_us = t0.elapsed().as_micros() as u64;
-            let laser = log.0.lock().is_ok_and(|l| l.laser_lit());
+            let power = log.0.lock().map_or(0, |l| l.laser_level());
+            let laser = power > 0;
             if let Ok(side) = servos.lock() {
                 let yaw = side.bus.angle_deg(gimbal.yaw_id, t_us).unwrap_or(0.0);
                 let pitch = side.bus.angle_deg(gimbal.pitch_id, t_us).unwrap_or(0.0);
@@ -194,6 +195,7 @@ fn spot_sampler(machine: &Machine, stop: Arc<AtomicBool>) -> JoinHandle<Vec<Spot
                         x_cm,
                         y_cm,
                         laser,
+                        power,
                     });
                 }
             }

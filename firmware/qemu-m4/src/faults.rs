@@ -9,7 +9,7 @@ use crate::parts::drive_laser_pin;
 
 /// Laser off, log `what`, halt until the watchdog resets the board.
 fn laser_off_and_halt(what: core::fmt::Arguments<'_>) -> ! {
-    drive_laser_pin(false);
+    drive_laser_pin(laser_app::sequencer::LaserPower::OFF);
     log_channel::line(what);
     loop {
         cortex_m::asm::wfi();

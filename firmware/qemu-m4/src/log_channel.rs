@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! 1234567 INFO console: host connected     (laser-app's logs, `log` crate)
-//! 1234600 @laser 1                          (the laser pin switched)
+//! 1234600 @laser 1 300                      (the laser lit at 300 ‰; `@laser 0` dark)
 //! 1300000 @leds heartbeat=1 laser=1 fault=0 (the status LEDs changed)
 //! ```
 //!

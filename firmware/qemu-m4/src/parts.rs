@@ -3,25 +3,31 @@
 //! or LEDs: their state is reported on the log channel, stamped with the
 //! board's time, as an oscilloscope on those pins would see it.
 
-use core::sync::atomic::{AtomicBool, Ordering};
+use core::sync::atomic::{AtomicU16, Ordering};
 
 use embedded_io_async::Read;
 use laser_app::app::{Console, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog};
 use laser_app::laser_gate::{GateState, LaserGate};
-use laser_app::sequencer::{LaserEvent, LaserSwitch};
+use laser_app::sequencer::{LaserEvent, LaserPower, LaserSwitch};
 
 use crate::log_channel;
 use crate::mmio::Reg;
 use crate::uart::Uart;
 
-/// The emulated laser-enable pin (high: lit).
-static LASER_PIN: AtomicBool = AtomicBool::new(false);
+/// The emulated laser output's level, ‰ of full (0: dark).
+static LASER_LEVEL: AtomicU16 = AtomicU16::new(0);
 
-/// Drives the emulated laser pin, reporting each change on the log
-/// channel (`@laser 0|1`).
-pub fn drive_laser_pin(lit: bool) {
-    if LASER_PIN.swap(lit, Ordering::AcqRel) != lit {
-        log_channel::line(format_args!("@laser {}", u8::from(lit)));
+/// Drives the emulated laser output, reporting each change on the log
+/// channel: `@laser 0` dark, `@laser 1 <‰>` lit at that duty (as a PWM
+/// output's compare value would show).
+pub fn drive_laser_pin(power: LaserPower) {
+    let level = power.per_mille();
+    if LASER_LEVEL.swap(level, Ordering::AcqRel) != level {
+        if power.is_on() {
+            log_channel::line(format_args!("@laser 1 {level}"));
+        } else {
+            log_channel::line(format_args!("@laser 0"));
+        }
     }
 }
 
@@ -31,7 +37,7 @@ pub static LASER_GATE: LaserGate = LaserGate::with_hook(laser_gate_changed);
 /// The gate's hook: pin low when it closes, whoever holds the pin.
 fn laser_gate_changed(state: GateState) {
     if !state.open {
-        drive_laser_pin(false);
+        drive_laser_pin(LaserPower::OFF);
     }
 }
 
@@ -42,16 +48,16 @@ pub struct LaserPin {
 }
 
 impl LaserSwitch for LaserPin {
-    fn set(&mut self, on: bool) {
-        if on && self.gate.is_open() {
-            drive_laser_pin(true);
+    fn set(&mut self, power: LaserPower) {
+        if power.is_on() && self.gate.is_open() {
+            drive_laser_pin(power);
             // A close between the check and the write has already run its
-            // hook: look again so the pin cannot stay high.
+            // hook: look again so the output cannot stay lit.
             if !self.gate.is_open() {
-                drive_laser_pin(false);
+                drive_laser_pin(LaserPower::OFF);
             }
         } else {
-            drive_laser_pin(false);
+            drive_laser_pin(LaserPower::OFF);
         }
     }
 

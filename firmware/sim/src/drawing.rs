@@ -99,33 +99,37 @@ fn draw_grid(chart: &mut BoardChart<'_, '_>, grid: GridView) -> Result<()> {
     Ok(())
 }
 
-/// The spot's path split into runs of equal laser state, each run
-/// starting where the one before ended.
-fn laser_runs(recording: &Recording) -> Vec<(bool, Vec<(f64, f64)>)> {
-    let mut runs: Vec<(bool, Vec<(f64, f64)>)> = Vec::new();
+/// The spot's path split into runs of equal laser power (‰, 0 dark),
+/// each run starting where the one before ended.
+fn laser_runs(recording: &Recording) -> Vec<(u16, Vec<(f64, f64)>)> {
+    let mut runs: Vec<(u16, Vec<(f64, f64)>)> = Vec::new();
     for s in &recording.spot {
+        let power = if s.laser { s.power.max(1) } else { 0 };
         match runs.last_mut() {
-            Some((on, pts)) if *on == s.laser => pts.push((s.x_cm, s.y_cm)),
+            Some((p, pts)) if *p == power => pts.push((s.x_cm, s.y_cm)),
             _ => {
                 let mut pts = Vec::new();
                 if let Some(&p) = runs.last().and_then(|(_, prev)| prev.last()) {
                     pts.push(p);
                 }
                 pts.push((s.x_cm, s.y_cm));
-                runs.push((s.laser, pts));
+                runs.push((power, pts));
             }
         }
     }
     runs
 }
 
-/// The gimbal spot's path (red where its laser was on) and its dwells.
+/// The gimbal spot's path (red where its laser was on, the more opaque
+/// the higher its power) and its dwells.
 fn draw_gimbal_spot(chart: &mut BoardChart<'_, '_>, recording: &Recording) -> Result<()> {
     let mut labelled_on = false;
     let mut labelled_off = false;
-    for (on, pts) in laser_runs(recording) {
+    for (power, pts) in laser_runs(recording) {
+        let on = power > 0;
         let style = if on {
-            ShapeStyle::from(&RED).stroke_width(2)
+            let opacity = 0.2 + 0.8 * f64::from(power.min(1000)) / 1000.0;
+            ShapeStyle::from(&RED.mix(opacity)).stroke_width(2)
         } else {
             ShapeStyle::from(&BLUE.mix(0.25)).stroke_width(1)
         };
@@ -135,7 +139,7 @@ fn draw_gimbal_spot(chart: &mut BoardChart<'_, '_>, recording: &Recording) -> Re
         if on && !labelled_on {
             labelled_on = true;
             series
-                .label("gimbal spot, laser on")
+                .label("gimbal spot, laser on (opacity: power)")
                 .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
         } else if !on && !labelled_off {
             labelled_off = true;
@@ -202,6 +206,7 @@ mod tests {
                     x_cm: i as f64 * 0.2 - 5.0,
                     y_cm: 1.0,
                     laser: i > 10,
+                    power: if i > 10 { 300 + 20 * i as u16 } else { 0 },
                 })
                 .collect(),
             dwells: vec![DwellRecord {
@@ -225,6 +230,15 @@ mod tests {
             "grid points drawn"
         );
         assert!(svg.contains("<polyline"), "path drawn");
+        // Lit runs at different powers, drawn at different opacities.
+        let opacities: std::collections::BTreeSet<&str> = svg
+            .split("<polyline fill=\"none\" opacity=\"")
+            .skip(1)
+            .filter_map(|rest| rest.split('>').next())
+            .filter(|attributes| attributes.contains("stroke=\"#FF0000\""))
+            .filter_map(|attributes| attributes.split('"').next())
+            .collect();
+        assert!(opacities.len() >= 10, "{opacities:?}");
         assert!(svg.contains("board x (cm)"));
     }
 }

@@ -10,7 +10,7 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use laser_app::laser_gate::{GateState, LaserGate};
-use laser_app::sequencer::LaserSwitch;
+use laser_app::sequencer::{LaserPower, LaserSwitch};
 
 use crate::dac::DacRecording;
 use crate::recorder::{Recording, SpotSample};
@@ -21,10 +21,11 @@ pub type SpotAt = Box<dyn Fn(u64) -> Option<(f64, f64)>>;
 struct GimbalLaser {
     recording: Rc<RefCell<Recording>>,
     spot_at: SpotAt,
-    /// What the sequencer asked of the pin.
-    pin: bool,
-    /// What was last recorded (pin AND gate).
-    lit: bool,
+    /// What the sequencer asked of the output.
+    pin: LaserPower,
+    /// What was last recorded (the output's level, dark while the gate is
+    /// closed).
+    power: LaserPower,
 }
 
 #[derive(Default)]
@@ -69,41 +70,61 @@ fn gate_changed(state: GateState) {
 }
 
 impl Output {
-    /// Records the gimbal laser when pin AND gate changed: a laser event
-    /// and a spot sample (so a trace has a row at every change).
+    /// Records the gimbal laser when its effective level (pin, dark
+    /// while the gate is closed) changed: a power change, a laser event
+    /// when it switched on or off, and a spot sample (so a trace has a row
+    /// at every change).
     fn update_gimbal(&mut self) {
         let open = self.gate_open;
         let Some(g) = self.gimbal.as_mut() else {
             return;
         };
-        let lit = g.pin && open;
-        if lit == g.lit {
+        let power = if open { g.pin } else { LaserPower::OFF };
+        if power == g.power {
             return;
         }
-        g.lit = lit;
+        let was_lit = g.power.is_on();
+        g.power = power;
         let t_us = crate::clock::now_us();
         let mut rec = g.recording.borrow_mut();
-        if rec.laser_events.last().is_some_and(|(t, _)| *t == t_us) {
-            // Switched back within the same microsecond: no light, no
-            // event (a new run closing and reopening the gate).
-            rec.laser_events.pop();
-            if rec.spot.last().is_some_and(|s| s.t_us == t_us) {
-                rec.spot.pop();
+        record_power(&mut rec.laser_power, t_us, power.per_mille());
+        let lit = power.is_on();
+        if rec.spot.last().is_some_and(|s| s.t_us == t_us) {
+            // One row per microsecond: the last level of it.
+            rec.spot.pop();
+        }
+        if lit != was_lit {
+            if rec.laser_events.last().is_some_and(|(t, _)| *t == t_us) {
+                // Switched back within the same microsecond: no light, no
+                // event (a new run closing and reopening the gate).
+                rec.laser_events.pop();
+                if rec.laser_events.last().is_some_and(|e| e.1) == lit {
+                    return;
+                }
             }
-            if rec.laser_events.last().is_some_and(|e| e.1) == lit {
-                return;
-            }
+            rec.laser_events.push((t_us, lit));
         }
         let spot = (g.spot_at)(t_us);
-        rec.laser_events.push((t_us, lit));
         if let Some((x_cm, y_cm)) = spot {
             rec.spot.push(SpotSample {
                 t_us,
                 x_cm,
                 y_cm,
                 laser: lit,
+                power: power.per_mille(),
             });
         }
+    }
+}
+
+/// Appends a level change at `t_us` to `changes`, keeping one per
+/// microsecond (the last) and none that changes nothing.
+fn record_power(changes: &mut Vec<(u64, u16)>, t_us: u64, per_mille: u16) {
+    if changes.last().is_some_and(|(t, _)| *t == t_us) {
+        changes.pop();
+    }
+    if changes.last().map_or(0, |(_, p)| *p) != per_mille {
+        changes.push((t_us, per_mille));
     }
 }
 
@@ -120,8 +141,8 @@ impl GatedLaserPin {
             o.borrow_mut().gimbal = Some(GimbalLaser {
                 recording,
                 spot_at,
-                pin: false,
-                lit: false,
+                pin: LaserPower::OFF,
+                power: LaserPower::OFF,
             })
         });
         Self(())
@@ -129,11 +150,11 @@ impl GatedLaserPin {
 }
 
 impl LaserSwitch for GatedLaserPin {
-    fn set(&mut self, on: bool) {
+    fn set(&mut self, power: LaserPower) {
         OUTPUT.with(|o| {
             let mut o = o.borrow_mut();
             if let Some(g) = o.gimbal.as_mut() {
-                g.pin = on;
+                g.pin = power;
             }
             o.update_gimbal();
         });
@@ -142,5 +163,5 @@ impl LaserSwitch for GatedLaserPin {
 
 /// Whether the gimbal laser is lit now (pin AND gate).
 pub fn gimbal_lit() -> bool {
-    OUTPUT.with(|o| o.borrow().gimbal.as_ref().is_some_and(|g| g.lit))
+    OUTPUT.with(|o| o.borrow().gimbal.as_ref().is_some_and(|g| g.power.is_on()))
 }

@@ -15,6 +15,9 @@ pub struct SpotSample {
     pub y_cm: f64,
     /// Laser output at that time.
     pub laser: bool,
+    /// Laser power at that time, ‰ of full (0 dark; an on/off output
+    /// records 1000 when on).
+    pub power: u16,
 }
 
 /// The spot while the sequencer dwelt on a point.
@@ -125,6 +128,8 @@ pub struct Recording {
     pub dwells: Vec<DwellRecord>,
     /// Laser switching: (t µs, on).
     pub laser_events: Vec<(u64, bool)>,
+    /// Gimbal laser power changes: (t µs, duty ‰ of full; 0 dark).
+    pub laser_power: Vec<(u64, u16)>,
     /// Servo-bus frames.
     pub frames: Vec<FrameRecord>,
     /// Sequencer events that decide when a laser may be lit, in order.
@@ -155,20 +160,31 @@ impl Recording {
         out
     }
 
-    /// `--trace` format: CSV `t_ms,x_cm,y_cm,laser`.
+    /// `--trace` format: CSV `t_ms,x_cm,y_cm,laser,power` (power: duty
+    /// ‰ of full).
     pub fn trace_csv(&self) -> String {
-        let mut out = String::from("t_ms,x_cm,y_cm,laser\n");
+        let mut out = String::from("t_ms,x_cm,y_cm,laser,power\n");
         for s in &self.spot {
             let _ = writeln!(
                 out,
-                "{:.3},{:.4},{:.4},{}",
+                "{:.3},{:.4},{:.4},{},{}",
                 s.t_us as f64 / 1000.0,
                 s.x_cm,
                 s.y_cm,
-                u8::from(s.laser)
+                u8::from(s.laser),
+                s.power
             );
         }
         out
+    }
+
+    /// Gimbal laser power at time `t_us`, ‰ (0 before the first change).
+    pub fn power_at(&self, t_us: u64) -> u16 {
+        self.laser_power
+            .iter()
+            .take_while(|(t, _)| *t <= t_us)
+            .last()
+            .map_or(0, |(_, p)| *p)
     }
 
     /// Laser state at time `t_us` (off before the first event).

@@ -3,8 +3,10 @@
 //! with `@` direct the simulated host instead of being typed:
 //! `@stall-read <ms>` makes it stop reading the device's output for that
 //! long (the script goes on, so lines can be typed during the stall),
-//! `@type-ahead <line>` types a line without waiting for its reply, and
-//! `@button` presses the board's stop button.
+//! `@type-ahead <line>` types a line without waiting for its reply,
+//! `@realtime <byte>` sends one of grbl's realtime bytes (`?`, `!`, `~`
+//! or hex: `0x18`, `0x9b`, …; no line, no reply awaited) and `@button`
+//! presses the board's stop button.
 
 use anyhow::{Context, Result, bail};
 
@@ -23,6 +25,25 @@ pub enum Step {
     SendAhead(String),
     /// Press the board's stop button (stop, laser off, no reply).
     StopButton,
+    /// Send one grbl realtime byte (no line end, no reply awaited).
+    Realtime(u8),
+}
+
+/// The byte of `@realtime <byte>`: one of grbl's realtime commands, as
+/// `?`, `!`, `~` or hex `0xNN`.
+fn realtime_byte(word: Option<&str>, number: usize) -> Result<u8> {
+    let byte = match word {
+        Some("?") => b'?',
+        Some("!") => b'!',
+        Some("~") => b'~',
+        Some(hex) if hex.starts_with("0x") => u8::from_str_radix(&hex[2..], 16)
+            .with_context(|| format!("script line {number}: bad byte {hex:?}"))?,
+        _ => bail!("script line {number}: `@realtime` needs ?, !, ~ or 0xNN"),
+    };
+    if laser_app::grbl::realtime::Realtime::from_byte(byte).is_none() {
+        bail!("script line {number}: 0x{byte:02x} is not a realtime command");
+    }
+    Ok(byte)
 }
 
 /// A whole number of milliseconds: the only argument of `word`.
@@ -70,10 +91,11 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
                 steps.push(Step::SendAhead(typed.to_owned()));
             }
             Some("@button") if line == "@button" => steps.push(Step::StopButton),
+            Some("@realtime") => steps.push(Step::Realtime(realtime_byte(words.next(), number)?)),
             Some(directive) if directive.starts_with('@') => {
                 bail!(
                     "script line {number}: unknown directive {directive:?} \
-                     (@stall-read <ms>, @type-ahead <line>, @button)"
+                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button)"
                 );
             }
             _ => steps.push(Step::Send(line.to_owned())),
@@ -99,6 +121,22 @@ pattern grid-full serpentine once
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn realtime_bytes_parse_by_symbol_or_hex_and_others_are_refused() {
+        let steps = parse_script("@realtime ?\n@realtime 0x9B\n@realtime 0x18\n").unwrap();
+        assert_eq!(
+            steps,
+            vec![
+                Step::Realtime(b'?'),
+                Step::Realtime(0x9b),
+                Step::Realtime(0x18)
+            ]
+        );
+        assert!(parse_script("@realtime 0x41").is_err(), "A is not realtime");
+        assert!(parse_script("@realtime").is_err());
+        assert!(parse_script("@realtime 0xZZ").is_err());
+    }
 
     #[test]
     fn parses_commands_waits_and_skips_comments() {

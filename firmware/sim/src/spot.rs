@@ -7,7 +7,7 @@ use std::cell::RefCell;
 use std::rc::Rc;
 
 use embassy_time::Timer;
-use laser_app::sequencer::{LaserEvent, LaserSwitch};
+use laser_app::sequencer::{LaserEvent, LaserPower, LaserSwitch};
 use laser_app::status::{Phase, StatusBoard};
 
 use crate::laser::GatedLaserPin;
@@ -40,8 +40,8 @@ impl RecordingLaser {
 }
 
 impl LaserSwitch for RecordingLaser {
-    fn set(&mut self, on: bool) {
-        self.pin.set(on);
+    fn set(&mut self, power: LaserPower) {
+        self.pin.set(power);
         crate::executor::simulator_work(|| {
             let t = crate::clock::now_us();
             let mut rec = self.recording.borrow_mut();
@@ -127,6 +127,7 @@ pub async fn spot_sampler(
         {
             let mut rec = recording.borrow_mut();
             let laser = rec.laser_at(t_us);
+            let power = rec.power_at(t_us);
             rec.servos
                 .push(servo_sample(&bus.borrow(), gimbal, t_us, laser));
             if let Some((x_cm, y_cm)) = spot {
@@ -135,6 +136,7 @@ pub async fn spot_sampler(
                     x_cm,
                     y_cm,
                     laser,
+                    power,
                 });
             }
             let s = status.snapshot();

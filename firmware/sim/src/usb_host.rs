@@ -157,6 +157,10 @@ async fn run_step(host: &UsbHost, step: Step, button: Option<&ButtonContacts>) {
         }
         Step::SendAhead(line) => type_line(host, &line).await,
         Step::StallReadMs(ms) => host.stall_read(ms),
+        Step::Realtime(byte) => {
+            host.record(format!(">> 0x{byte:02x}"));
+            host.to_device.write_all(&[byte]).await;
+        }
     }
 }
 

@@ -383,11 +383,13 @@ impl World {
             && let Some((x_cm, y_cm)) = (self.spot)(end_time_us)
         {
             let laser = crate::laser::gimbal_lit();
+            let power = rec.power_at(end_time_us);
             rec.spot.push(SpotSample {
                 t_us: end_time_us,
                 x_cm,
                 y_cm,
                 laser,
+                power,
             });
         }
     }

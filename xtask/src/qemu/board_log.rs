@@ -24,8 +24,8 @@ pub enum BoardEvent {
 /// One parsed line of the log channel.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum LogLine {
-    /// `@laser 0|1`.
-    Laser(u64, bool),
+    /// `@laser 0` or `@laser 1 <‰>`: the laser output's level, ‰.
+    Laser(u64, u16),
     /// `@event …`.
     Event(u64, BoardEvent),
     /// `@leds …` (the text after `@leds`).
@@ -42,7 +42,13 @@ pub fn parse_line(line: &str) -> Option<LogLine> {
     let (t, rest) = line.trim_end().split_once(' ')?;
     let t: u64 = t.parse().ok()?;
     let parsed = if let Some(v) = rest.strip_prefix("@laser ") {
-        LogLine::Laser(t, v == "1")
+        let mut words = v.split(' ');
+        let level = match (words.next(), words.next()) {
+            (Some("1"), Some(level)) => level.parse().unwrap_or(1000),
+            (Some("1"), None) => 1000,
+            _ => 0,
+        };
+        LogLine::Laser(t, level)
     } else if let Some(e) = rest.strip_prefix("@event ") {
         let event = match e {
             "run-started" => BoardEvent::RunStarted,
@@ -68,6 +74,8 @@ pub fn parse_line(line: &str) -> Option<LogLine> {
 pub struct BoardLog {
     /// Laser pin switches: (board µs, lit).
     pub laser_events: Vec<(u64, bool)>,
+    /// Laser output levels as reported: (board µs, ‰; 0 dark).
+    pub laser_power: Vec<(u64, u16)>,
     /// Laser-deciding events: (board µs, event).
     pub events: Vec<(u64, BoardEvent)>,
     /// LED changes: (board µs, `heartbeat=… laser=… fault=…`).
@@ -116,7 +124,12 @@ impl BoardLog {
         let t = self.boot_offset_us + raw_t;
         self.last_us = self.last_us.max(t);
         match parsed {
-            LogLine::Laser(_, on) => self.laser_events.push((t, on)),
+            LogLine::Laser(_, level) => {
+                if self.laser_lit() != (level > 0) {
+                    self.laser_events.push((t, level > 0));
+                }
+                self.laser_power.push((t, level));
+            }
             LogLine::Event(_, e) => self.events.push((t, e)),
             LogLine::Leds(_, l) => self.leds.push((t, l)),
             LogLine::Stats(_, text) => self.stats.push(text),
@@ -127,6 +140,11 @@ impl BoardLog {
     /// The laser pin's state as last reported.
     pub fn laser_lit(&self) -> bool {
         self.laser_events.last().is_some_and(|(_, on)| *on)
+    }
+
+    /// The laser output's level as last reported, ‰.
+    pub fn laser_level(&self) -> u16 {
+        self.laser_power.last().map_or(0, |(_, level)| *level)
     }
 }
 
@@ -155,7 +173,9 @@ mod tests {
 
     #[test]
     fn lines_parse_into_reports_and_logs() {
-        assert_eq!(parse_line("12 @laser 1"), Some(LogLine::Laser(12, true)));
+        assert_eq!(parse_line("12 @laser 1 300"), Some(LogLine::Laser(12, 300)));
+        assert_eq!(parse_line("12 @laser 1"), Some(LogLine::Laser(12, 1000)));
+        assert_eq!(parse_line("12 @laser 0"), Some(LogLine::Laser(12, 0)));
         assert_eq!(
             parse_line("13 @event stopped servo fault"),
             Some(LogLine::Event(
@@ -180,10 +200,11 @@ mod tests {
         let mut log = BoardLog::default();
         for line in [
             "0 INFO laser-pointer booting on QEMU mps2-an386",
-            "500 @laser 1",
+            "500 @laser 1 1000",
+            "700 @laser 1 300",
             "900 @laser 0",
             "0 INFO laser-pointer booting on QEMU mps2-an386",
-            "100 @laser 1",
+            "100 @laser 1 1000",
         ] {
             log.push(line);
         }
@@ -194,5 +215,10 @@ mod tests {
             vec![(500, true), (900, false), (1000, true)]
         );
         assert!(log.laser_lit());
+        assert_eq!(
+            log.laser_power,
+            vec![(500, 1000), (700, 300), (900, 0), (1000, 1000)]
+        );
+        assert_eq!(log.laser_level(), 1000);
     }
 }

@@ -244,6 +244,14 @@ impl Machine {
             .context("writing to the console socket")
     }
 
+    /// Sends one grbl realtime byte on the console (no line, no reply
+    /// outstanding).
+    pub fn send_realtime(&mut self, byte: u8) -> Result<()> {
+        self.console
+            .write_all(&[byte])
+            .context("writing to the console socket")
+    }
+
     /// A second handle on the console socket (bytes written to it are
     /// typed on the board's console; a write blocks while QEMU holds input
     /// back).

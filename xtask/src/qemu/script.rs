@@ -76,6 +76,7 @@ pub fn run_step(machine: &mut Machine, step: &BoardStep, deadline: Instant) -> R
             }
         }
         BoardStep::Script(Step::StopButton) => machine.press_button()?,
+        BoardStep::Script(Step::Realtime(byte)) => machine.send_realtime(*byte)?,
     }
     Ok(true)
 }

@@ -42,7 +42,7 @@ impl Console for TestConsole {
 }
 
 impl LaserSwitch for Part {
-    fn set(&mut self, _on: bool) {}
+    fn set(&mut self, _power: crate::sequencer::LaserPower) {}
 }
 
 impl SettingsStore for Part {

@@ -50,6 +50,9 @@ pub(super) struct Gcode {
     pub(super) motion: Motion,
     /// Status reports sent (grbl adds `WCO:` / `Ov:` every few).
     pub(super) reports: u32,
+    /// Actual over programmed speed of the gimbal step in flight, 0..=1
+    /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
+    pub(super) step_speed_ratio: f32,
 }
 
 impl Gcode {
@@ -62,6 +65,7 @@ impl Gcode {
             overrides: NO_OVERRIDES,
             motion: Motion::new(),
             reports: 0,
+            step_speed_ratio: 0.0,
         }
     }
 }
@@ -261,6 +265,7 @@ impl Core {
 
     /// A realtime command from the console.
     pub(super) fn grbl_realtime(&mut self, request: RealtimeRequest, out: &mut dyn ActionSink) {
+        let before = self.gcode.overrides;
         let ov = &mut self.gcode.overrides;
         match request.command {
             Realtime::StatusReport => self.grbl_status(request.rx_free_bytes, out),
@@ -273,6 +278,7 @@ impl Core {
             Realtime::SpindleOverride(step) => ov.spindle = step.apply(ov.spindle, 10, 200),
             Realtime::SpindleStop | Realtime::Ignored(_) => {}
         }
+        self.grbl_report_changed_overrides(before);
     }
 
     /// 0x18: everything stops at once, laser dark; the parser's modes
@@ -302,4 +308,4 @@ impl Core {
 }
 
 #[cfg(test)]
-mod tests;
+pub(super) mod tests;

@@ -63,7 +63,8 @@ impl Core {
             _ if motion.is_idle() => MachineState::Idle,
             _ => MachineState::Run,
         };
-        let (mut feed, power) = motion.feed_and_power(&g.overrides);
+        let (mut feed, _) = motion.feed_and_power(&g.overrides);
+        let power = self.gcode_reported_power();
         if self.actuator.uses_galvo() {
             // The galvo marks at most at its marking speed.
             feed = feed.min(self.settings.galvo.mark_speed_mm_s * 60.0);

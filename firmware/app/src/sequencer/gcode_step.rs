@@ -117,6 +117,7 @@ impl Core {
             60_000.0 * from.distance_to(to) / f.max(1e-3)
         });
         let interval_ms = libm::fmax(f64::from(by_servo), by_feed).min(f64::from(u16::MAX)) as u16;
+        self.gcode.step_speed_ratio = super::gcode_power::speed_ratio(by_feed, interval_ms);
         let deadband_tenths = if corner {
             CORNER_DEADBAND_TENTHS
         } else {

@@ -4,10 +4,49 @@
 use crate::settings::LaserMode;
 use crate::status::Phase;
 
-/// The laser output (a GPIO on the target, a recorder in the simulator).
+/// Laser output power: the duty of the laser output, per mille of full
+/// power (0 dark, 1000 full). Outputs that can only switch (the galvo's
+/// per-sample laser words) treat every level above 0 as on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LaserPower(u16);
+
+impl LaserPower {
+    /// Dark.
+    pub const OFF: Self = Self(0);
+    /// Full power (duty 100 %).
+    pub const FULL: Self = Self(1000);
+
+    /// The level for `fraction` of full power (0..=1; clamped, NaN dark),
+    /// rounded to the nearest per mille.
+    pub fn from_fraction(fraction: f32) -> Self {
+        // `as` saturates and maps NaN to 0.
+        Self((fraction.clamp(0.0, 1.0) * 1000.0 + 0.5) as u16)
+    }
+
+    /// Duty, per mille of full power (0..=1000).
+    pub fn per_mille(self) -> u16 {
+        self.0
+    }
+
+    /// Whether the laser shines at all.
+    pub fn is_on(self) -> bool {
+        self.0 > 0
+    }
+
+    /// `full_scale` × this duty, rounded down: the compare value of a
+    /// PWM timer whose period is `full_scale` counts.
+    pub fn scaled(self, full_scale: u32) -> u32 {
+        full_scale * u32::from(self.0) / 1000
+    }
+}
+
+/// The laser output (a GPIO or PWM channel on the target, a recorder in
+/// the simulator).
 pub trait LaserSwitch {
-    /// Turns the laser on or off.
-    fn set(&mut self, on: bool);
+    /// Sets the laser's power ([`LaserPower::OFF`]: dark). An output that
+    /// can only switch turns on for every level above 0.
+    fn set(&mut self, power: LaserPower);
 
     /// Told when the sequencer processes an event that decides whether a
     /// laser may be lit ([`LaserEvent`]). Only for recorders: the
@@ -61,6 +100,18 @@ pub fn laser_wanted(mode: LaserMode, phase: Option<Phase>, faulted: bool) -> boo
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn power_levels_round_clamp_and_scale() {
+        assert_eq!(LaserPower::from_fraction(0.3).per_mille(), 300);
+        assert_eq!(LaserPower::from_fraction(0.0005), LaserPower(1));
+        assert_eq!(LaserPower::from_fraction(1.7), LaserPower::FULL);
+        assert_eq!(LaserPower::from_fraction(-0.2), LaserPower::OFF);
+        assert_eq!(LaserPower::from_fraction(f32::NAN), LaserPower::OFF);
+        assert!(!LaserPower::OFF.is_on() && LaserPower(1).is_on());
+        assert_eq!(LaserPower(300).scaled(42_000), 12_600);
+        assert_eq!(LaserPower::FULL.scaled(42_000), 42_000);
+    }
 
     #[test]
     fn laser_is_off_when_idle_or_faulted() {

@@ -140,6 +140,10 @@ pub enum Action {
     /// Switch the gimbal laser; on only through the master gate (when it
     /// refuses, the shell answers [`Event::GateLost`]).
     GimbalLaser(bool),
+    /// The power the gimbal laser runs at while lit (sent before the
+    /// [`Action::GimbalLaser`] that lights it, and whenever it changes
+    /// while lit).
+    GimbalPower(super::LaserPower),
     /// Tell the laser switch about an event that decides when a laser may
     /// be lit ([`super::LaserSwitch::note`]).
     Note(LaserEvent<'static>),
@@ -226,6 +230,8 @@ pub struct Core {
     pub(super) measured: Option<(i16, i16)>,
     /// Whether the gimbal laser is on.
     pub(super) laser_on: bool,
+    /// The power the gimbal laser runs at while on.
+    pub(super) laser_power: super::LaserPower,
     /// The gate was closed by someone else since the core last closed it.
     pub(super) gate_lost: bool,
     /// Housekeeping ticks (liveness).
@@ -253,6 +259,7 @@ impl Core {
             last_aim: None,
             measured: None,
             laser_on: false,
+            laser_power: super::LaserPower::FULL,
             gate_lost: false,
             heartbeat: 0,
             pending: None,
@@ -383,6 +390,14 @@ impl Core {
             && (laser_wanted(self.settings.laser_mode, phase, servo_blocked)
                 || self.gcode_gimbal_lit())
             && !self.gate_lost;
+        // Full power for the product's patterns; G-code's S, overrides
+        // and M4 speed scaling otherwise (dark at 0: M4 at rest).
+        let power = self.gcode_gimbal_power();
+        let wanted = wanted && power.is_on();
+        if wanted && power != self.laser_power {
+            self.laser_power = power;
+            out.act(Action::GimbalPower(power));
+        }
         if wanted != self.laser_on {
             self.laser_on = wanted;
             out.act(Action::GimbalLaser(wanted));

@@ -16,6 +16,7 @@ mod faults;
 mod galvo;
 mod gcode;
 mod gcode_motion;
+mod gcode_power;
 mod gcode_report;
 mod gcode_settings;
 mod gcode_step;
@@ -31,7 +32,7 @@ use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::galvo::config_from;
-pub use self::laser::{LaserEvent, LaserSwitch, laser_wanted};
+pub use self::laser::{LaserEvent, LaserPower, LaserSwitch, laser_wanted};
 pub use self::machine::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::CommandLink;
 use crate::galvo::{GalvoLink, GalvoRequest};
@@ -99,6 +100,8 @@ struct Io<'a, L: LaserSwitch, S: SettingsStore> {
     generation: u32,
     /// Whether the gimbal laser output is on.
     lit: bool,
+    /// The power the gimbal laser runs at while lit.
+    power: LaserPower,
     store: S,
     /// What the actions applied last ask to follow.
     follow_up: FollowUp,
@@ -132,7 +135,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         gate: &'a LaserGate,
         mut store: S,
     ) -> Self {
-        laser.set(false);
+        laser.set(LaserPower::OFF);
         let generation = gate.close();
         let mut record = [0u8; crate::settings::MAX_RECORD_LEN];
         let n = store.load(&mut record).await;
@@ -147,6 +150,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             gate,
             generation,
             lit: false,
+            power: LaserPower::FULL,
             store,
             follow_up: FollowUp::Nothing,
             refused: false,
@@ -297,9 +301,18 @@ impl<L: LaserSwitch, S: SettingsStore> Io<'_, L, S> {
         let lit = on && self.gate.open(self.generation);
         self.refused |= on && !lit;
         if lit != self.lit {
-            self.laser.set(lit);
+            self.laser
+                .set(if lit { self.power } else { LaserPower::OFF });
             self.lit = lit;
             log::info!("laser {}", if lit { "on" } else { "off" });
+        }
+    }
+
+    /// The gimbal laser's power while lit (applied at once when it is).
+    fn set_power(&mut self, power: LaserPower) {
+        self.power = power;
+        if self.lit {
+            self.laser.set(power);
         }
     }
 }
@@ -335,6 +348,7 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
                 self.gate.shut();
             }
             Action::GimbalLaser(on) => self.set_laser(on),
+            Action::GimbalPower(power) => self.set_power(power),
             Action::Note(event) => self.laser.note(event),
             Action::Line(line) => {
                 let outbound = &self.link.outbound;

@@ -5,7 +5,9 @@ use std::collections::VecDeque;
 use super::{Violation, ViolationKind};
 use crate::usb_host::Transcript;
 /// (c) Exactly one closing reply per line, in order; notices are whole
-/// `[…]` lines.
+/// `[…]` lines. grbl's realtime bytes (`>> 0xNN`, typed by `@realtime`)
+/// owe no reply, and what they answer (status reports `<…>`, `ALARM:N`,
+/// the `Grbl …` banner of a soft reset) may come between lines.
 pub(super) fn one_reply_per_line(transcript: &Transcript) -> Vec<Violation> {
     let mut found = Vec::new();
     let mut add = |t_us: u64, detail: String| {
@@ -29,6 +31,11 @@ pub(super) fn one_reply_per_line(transcript: &Transcript) -> Vec<Violation> {
             if !line.ends_with(']') {
                 add(t, format!("notice cut or glued to a reply: {line:?}"));
             }
+            continue;
+        }
+        let unsolicited =
+            line.starts_with('<') || line.starts_with("ALARM:") || line.starts_with("Grbl ");
+        if line.starts_with(">> ") || (unsolicited && pending.is_empty()) {
             continue;
         }
         let closing = line == "ok" || line.starts_with("error:");

@@ -82,6 +82,19 @@ fn one_closing_reply_per_line_and_whole_notices() {
         (1, "ok"),
     ]);
     assert_eq!(one_reply_per_line(&ahead), []);
+    // grbl realtime bytes owe no reply; their answers come between lines.
+    let realtime = transcript(&[
+        (0, "> G1 X20 F600 M3 S500"),
+        (0, "ok"),
+        (1, ">> 0x3f"),
+        (1, "<Run|MPos:1.000,0.000,0.000|FS:600,500>"),
+        (2, ">> 0x18"),
+        (2, "ALARM:3"),
+        (2, "Grbl 1.1h ['$' for help]"),
+        (3, "> $X"),
+        (3, "ok"),
+    ]);
+    assert_eq!(one_reply_per_line(&realtime), []);
     let cases: &[(&[(u64, &str)], &str)] = &[
         (
             &[(0, "> params"), (1, "oq_cm = 25")],
@@ -96,6 +109,7 @@ fn one_closing_reply_per_line_and_whole_notices() {
             "after the closing reply",
         ),
         (&[(0, "ok")], "before any command line"),
+        (&[(0, ">> 0x3f"), (0, "ok")], "before any command line"),
         // A reply glued onto a cut line: its closer is not a line.
         (
             &[

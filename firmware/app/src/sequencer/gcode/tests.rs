@@ -26,7 +26,7 @@ const READINGS: Readings = Readings {
     implausible_readings: 0,
 };
 
-fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
+pub(crate) fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
     let inputs = Inputs {
         now: Instant::from_millis(ms),
         galvo_room: Some(8),
@@ -38,7 +38,7 @@ fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {
     out
 }
 
-fn line(core: &mut Core, ms: u64, text: &str) -> Vec<Action> {
+pub(crate) fn line(core: &mut Core, ms: u64, text: &str) -> Vec<Action> {
     let command = Command::Grbl(GrblLine::new(text).expect("short line"));
     on(
         core,
@@ -50,14 +50,14 @@ fn line(core: &mut Core, ms: u64, text: &str) -> Vec<Action> {
     )
 }
 
-fn closers(actions: &[Action]) -> usize {
+pub(crate) fn closers(actions: &[Action]) -> usize {
     actions
         .iter()
         .filter(|a| matches!(a, Action::Line(Line::Ok | Line::GrblError(_))))
         .count()
 }
 
-fn texts(actions: &[Action]) -> Vec<String> {
+pub(crate) fn texts(actions: &[Action]) -> Vec<String> {
     actions
         .iter()
         .filter_map(|a| match a {
@@ -67,14 +67,14 @@ fn texts(actions: &[Action]) -> Vec<String> {
         .collect()
 }
 
-fn move_seq(actions: &[Action]) -> Option<u32> {
+pub(crate) fn move_seq(actions: &[Action]) -> Option<u32> {
     actions.iter().find_map(|a| match a {
         Action::Servo(ServoRequest::Move { seq, .. }) => Some(*seq),
         _ => None,
     })
 }
 
-fn arrive(core: &mut Core, ms: u64, seq: u32) -> Vec<Action> {
+pub(crate) fn arrive(core: &mut Core, ms: u64, seq: u32) -> Vec<Action> {
     on(
         core,
         ms,
@@ -86,7 +86,7 @@ fn arrive(core: &mut Core, ms: u64, seq: u32) -> Vec<Action> {
     )
 }
 
-fn realtime(core: &mut Core, ms: u64, command: Realtime) -> Vec<Action> {
+pub(crate) fn realtime(core: &mut Core, ms: u64, command: Realtime) -> Vec<Action> {
     let request = RealtimeRequest {
         command,
         rx_free_bytes: 100,
@@ -94,7 +94,7 @@ fn realtime(core: &mut Core, ms: u64, command: Realtime) -> Vec<Action> {
     on(core, ms, Event::Realtime(request))
 }
 
-fn status(core: &mut Core, ms: u64) -> String {
+pub(crate) fn status(core: &mut Core, ms: u64) -> String {
     let out = realtime(core, ms, Realtime::StatusReport);
     texts(&out).pop().expect("a status report")
 }

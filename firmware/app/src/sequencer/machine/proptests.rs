@@ -423,6 +423,7 @@ impl Harness {
             | Action::Stepper(_)
             | Action::ConfigureStepper(_)
             | Action::AllowGalvoLaser(_)
+            | Action::GimbalPower(_)
             | Action::Note(_)
             | Action::Line(_) => {}
         }
