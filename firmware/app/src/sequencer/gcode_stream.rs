@@ -331,6 +331,7 @@ impl Core {
         let seq = self.send_gimbal_move(&aim, interval_ms, deadband, out);
         self.last_aim = Some((Target { point, grid: None }, aim));
         let lit = self.gcode_block_lit();
+        self.gcode.step_speed_ratio = self.stream_speed_ratio();
         let motion = &mut self.gcode.motion;
         motion.position = to;
         motion.gimbal_lit = lit && motion.hold == Hold::None && motion.arrived;
@@ -339,6 +340,18 @@ impl Core {
             c.until = None;
         }
         true
+    }
+
+    /// The speed now over the programmed feed (with the override), for M4.
+    fn stream_speed_ratio(&self) -> f32 {
+        let programmed = match self.gcode.motion.current.map(|c| c.block) {
+            Some(Block::Line { feed_mm_min, .. } | Block::Arc { feed_mm_min, .. }) => {
+                feed_mm_min * f64::from(self.gcode.overrides.feed) / 6000.0
+            }
+            _ => return 0.0,
+        };
+        let ratio = self.gcode.motion.stream.speed_mm_s() / programmed.max(1e-9);
+        kinematics_core::numeric::clamp(ratio, 0.0, 1.0) as f32
     }
 
     /// Whether the running block lights the laser (a lit G1/G2/G3).

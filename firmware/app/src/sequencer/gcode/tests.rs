@@ -103,7 +103,11 @@ pub(crate) fn status(core: &mut Core, ms: u64) -> String {
 /// its deadline, each servo move confirmed 1 ms after it was sent, until
 /// `done` holds for what came out (or nothing is pending). Returns the
 /// time reached and everything that came out.
-fn pump(core: &mut Core, mut ms: u64, done: impl Fn(&[Action]) -> bool) -> (u64, Vec<Action>) {
+pub(in crate::sequencer) fn pump(
+    core: &mut Core,
+    mut ms: u64,
+    done: impl Fn(&[Action]) -> bool,
+) -> (u64, Vec<Action>) {
     let mut all = Vec::new();
     let mut pending: Option<u32> = None;
     for _ in 0..10_000 {
