@@ -29,6 +29,7 @@
 //! | [`frames`] | board ↔ global frames, board offsets and pose | [`BoardFrame`], [`BoardPose`], [`BoardPoint`], [`GlobalPoint`], [`PointMm`] |
 //! | [`gimbal`] | exact (default) and seed gimbal FK/IK, the calibrated chain | [`Gimbal`] (`ik`, `fk`, `ik_wire`, `fk_wire`), [`GimbalModel`], [`JointAngles`], [`gimbal::exact`], [`gimbal::seed`] |
 //! | [`servo`] | joint ↔ servo angle ↔ FashionStar wire value (0.1°) | [`ServoAxis`], [`Direction`], [`WireAngles`] |
+//! | [`lookahead`] | grbl's junction-deviation look-ahead planner, unit-agnostic | [`lookahead::Lookahead`], [`lookahead::SpeedCursor`] |
 //! | [`stepper`] | joint angle ↔ microsteps (0.05625°/step) | [`StepperAxis`] |
 //! | [`galvo`] | two-mirror FK/IK with pincushion, DAC mapping (`f32`/`f64`), the per-sample `f32` map | [`Galvo`], [`GalvoGeometry`], [`DacAxis`], [`MirrorAngles`], [`DacCodes`], [`SampleMap`] |
 //! | [`grid`] | grid geometry, index ↔ board point | [`Grid`], [`GridIndex`] |
@@ -59,6 +60,7 @@ pub mod frames;
 pub mod galvo;
 pub mod gimbal;
 pub mod grid;
+pub mod lookahead;
 pub mod numeric;
 pub mod path;
 pub mod pattern;

@@ -10,10 +10,13 @@
 //! steps), so no axis ever steps faster than the block's rate. The
 //! junction angle is taken between the moves' directions in step space.
 //!
-//! Planning uses `f64`; it runs in a low-priority task, never in the step
-//! path.
+//! The reverse/forward passes and the junction rule are the unit-agnostic
+//! [`crate::lookahead::Lookahead`] (the G-code gimbal plans through it in
+//! mm); this planner keeps the steps of each block beside it. Planning
+//! uses `f64`; it runs in a low-priority task, never in the step path.
 
 use super::motion::{MotionError, validate_move};
+use crate::lookahead::{Lookahead, LookaheadBlock, LookaheadError};
 
 /// One requested move: signed microsteps per axis (pan, tilt) and its
 /// limits.
@@ -51,15 +54,11 @@ pub struct PlannedBlock {
 /// Fixed-capacity look-ahead planner of up to `N` blocks.
 #[derive(Debug, Clone)]
 pub struct Planner<const N: usize> {
-    blocks: [PlannedBlock; N],
+    plan: Lookahead<N>,
+    /// Signed microsteps of each queued block, in the plan's ring order.
+    steps: [[i32; 2]; N],
+    /// Index in `steps` of the head block.
     head: usize,
-    len: usize,
-    junction_deviation_steps: f64,
-    /// Unit direction (step space) of the last queued block.
-    last_unit: [f64; 2],
-    /// Entry rate of the head block once its predecessor left the queue
-    /// (the segment prep is already executing towards it), steps/s.
-    frozen_head_entry: Option<f64>,
 }
 
 impl<const N: usize> Planner<N> {
@@ -72,44 +71,42 @@ impl<const N: usize> Planner<N> {
         if N == 0 {
             return Err(MotionError::ZeroCapacity);
         }
-        if !(junction_deviation_steps.is_finite() && junction_deviation_steps >= 0.0) {
-            return Err(MotionError::InvalidJunctionDeviation);
-        }
+        let plan = Lookahead::new(junction_deviation_steps)
+            .map_err(|_| MotionError::InvalidJunctionDeviation)?;
         Ok(Self {
-            blocks: [PlannedBlock::default(); N],
+            plan,
+            steps: [[0; 2]; N],
             head: 0,
-            len: 0,
-            junction_deviation_steps,
-            last_unit: [0.0; 2],
-            frozen_head_entry: None,
         })
     }
 
     /// Number of queued blocks.
     pub fn len(&self) -> usize {
-        self.len
+        self.plan.len()
     }
 
     /// Whether no block is queued.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.plan.is_empty()
     }
 
     /// The `i`-th queued block (0 = next to execute).
-    pub fn block(&self, i: usize) -> Option<&PlannedBlock> {
-        if i < self.len {
-            self.blocks.get((self.head + i) % N)
-        } else {
-            None
-        }
+    pub fn block(&self, i: usize) -> Option<PlannedBlock> {
+        let b = self.plan.block(i)?;
+        let steps = *self.steps.get((self.head + i) % N)?;
+        Some(Self::planned(steps, b))
     }
 
-    /// The `i`-th queued block, mutable.
-    fn block_mut(&mut self, i: usize) -> Option<&mut PlannedBlock> {
-        if i < self.len {
-            self.blocks.get_mut((self.head + i) % N)
-        } else {
-            None
+    fn planned(steps: [i32; 2], b: &LookaheadBlock) -> PlannedBlock {
+        PlannedBlock {
+            steps,
+            // Lengths are whole step-event counts (≤ 2³⁰): exact.
+            event_count: b.length as u32,
+            nominal_rate_steps_per_s: b.nominal_speed,
+            accel_steps_per_s2: b.accel,
+            max_entry_rate_steps_per_s: b.max_entry_speed,
+            entry_rate_steps_per_s: b.entry_speed,
+            exit_rate_steps_per_s: b.exit_speed,
         }
     }
 
@@ -123,113 +120,51 @@ impl<const N: usize> Planner<N> {
         if event_count == 0 {
             return Ok(());
         }
-        if self.len == N {
-            return Err(MotionError::QueueFull);
-        }
         let norm = libm::hypot(f64::from(mv.steps[0]), f64::from(mv.steps[1]));
         let unit = [f64::from(mv.steps[0]) / norm, f64::from(mv.steps[1]) / norm];
-        let max_entry = match self.len.checked_sub(1).and_then(|i| self.block(i)) {
-            None => 0.0,
-            Some(prev) => junction_rate_steps_per_s(
-                self.last_unit,
-                unit,
-                prev.accel_steps_per_s2.min(mv.accel_steps_per_s2),
-                self.junction_deviation_steps,
+        let slot = (self.head + self.plan.len()) % N;
+        self.plan
+            .push(
+                f64::from(event_count),
+                [unit; 2],
+                mv.nominal_rate_steps_per_s,
+                mv.accel_steps_per_s2,
             )
-            .min(prev.nominal_rate_steps_per_s)
-            .min(mv.nominal_rate_steps_per_s),
-        };
-        let Some(slot) = self.blocks.get_mut((self.head + self.len) % N) else {
-            return Err(MotionError::QueueFull);
-        };
-        *slot = PlannedBlock {
-            steps: mv.steps,
-            event_count,
-            nominal_rate_steps_per_s: mv.nominal_rate_steps_per_s,
-            accel_steps_per_s2: mv.accel_steps_per_s2,
-            max_entry_rate_steps_per_s: max_entry,
-            entry_rate_steps_per_s: 0.0,
-            exit_rate_steps_per_s: 0.0,
-        };
-        self.len += 1;
-        self.last_unit = unit;
-        self.replan();
+            .map_err(|e| match e {
+                LookaheadError::Full => MotionError::QueueFull,
+                _ => MotionError::InvalidRate,
+            })?;
+        if let Some(s) = self.steps.get_mut(slot) {
+            *s = mv.steps;
+        }
         Ok(())
     }
 
     /// Drops every queued block (after a hold or a halt); the next block
     /// starts from rest.
     pub fn clear(&mut self) {
-        self.len = 0;
-        self.frozen_head_entry = None;
+        self.plan.clear();
     }
 
     /// Takes the head block for execution, with its exit rate set. The
     /// next block's entry rate is then fixed: later blocks can only raise
     /// the speeds of the blocks before them, so that entry stays feasible.
     pub fn pop(&mut self) -> Option<PlannedBlock> {
-        let mut block = *self.block(0)?;
+        let steps = *self.steps.get(self.head)?;
+        let b = self.plan.pop()?;
         self.head = (self.head + 1) % N;
-        self.len -= 1;
-        block.exit_rate_steps_per_s = self.block(0).map_or(0.0, |b| b.entry_rate_steps_per_s);
-        self.frozen_head_entry = (self.len > 0).then_some(block.exit_rate_steps_per_s);
-        Some(block)
-    }
-
-    /// Reverse pass (every block can still stop by the end of the queue),
-    /// then forward pass (every entry is reachable from the one before).
-    fn replan(&mut self) {
-        let mut next_entry = 0.0_f64;
-        let frozen = self.frozen_head_entry;
-        for i in (0..self.len).rev() {
-            let Some(b) = self.block_mut(i) else { continue };
-            let reach = reachable(next_entry, b.accel_steps_per_s2, b.event_count);
-            b.entry_rate_steps_per_s = match (i, frozen) {
-                (0, Some(frozen)) => frozen,
-                _ => b.max_entry_rate_steps_per_s.min(reach),
-            };
-            next_entry = b.entry_rate_steps_per_s;
-        }
-        for i in 0..self.len.saturating_sub(1) {
-            let Some(&b) = self.block(i) else { continue };
-            let reach = reachable(
-                b.entry_rate_steps_per_s,
-                b.accel_steps_per_s2,
-                b.event_count,
-            );
-            if let Some(next) = self.block_mut(i + 1) {
-                next.entry_rate_steps_per_s = next.entry_rate_steps_per_s.min(reach);
-            }
-        }
+        Some(Self::planned(steps, &b))
     }
 }
 
-/// Rate reachable from `rate` (steps/s) over `events` steps at `accel`
-/// (steps/s²): √(v² + 2·a·d), steps/s.
-pub(crate) fn reachable(rate: f64, accel: f64, events: u32) -> f64 {
-    libm::sqrt(rate * rate + 2.0 * accel * f64::from(events))
-}
-
-/// grbl's junction-deviation limit between two unit directions: with θ
-/// the angle between the moves' directions and `cos θ = −u_in·u_out`,
-/// v² = a·δ·sin(θ/2) / (1 − sin(θ/2)). A reversal gives 0, a straight
-/// continuation `f64::INFINITY` (only the nominal rates limit it).
-///
-/// `accel_steps_per_s2` in steps/s², `deviation_steps` in steps; returns
-/// steps/s.
+/// grbl's junction-deviation limit between two unit directions in step
+/// space ([`crate::lookahead::junction_speed`]): `accel_steps_per_s2` in
+/// steps/s², `deviation_steps` in steps; returns steps/s.
 pub fn junction_rate_steps_per_s(
     u_in: [f64; 2],
     u_out: [f64; 2],
     accel_steps_per_s2: f64,
     deviation_steps: f64,
 ) -> f64 {
-    let cos_theta = -(u_in[0] * u_out[0] + u_in[1] * u_out[1]);
-    if cos_theta > 0.999_999 {
-        return 0.0;
-    }
-    if cos_theta < -0.999_999 {
-        return f64::INFINITY;
-    }
-    let sin_half = libm::sqrt(0.5 * (1.0 - cos_theta));
-    libm::sqrt(accel_steps_per_s2 * deviation_steps * sin_half / (1.0 - sin_half))
+    crate::lookahead::junction_speed(u_in, u_out, accel_steps_per_s2, deviation_steps)
 }

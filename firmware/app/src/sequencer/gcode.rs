@@ -19,6 +19,13 @@ use crate::text::{ReplyText, reply_text};
 /// grbl's RX buffer as `$I` advertises it, bytes.
 pub(super) const RX_BUFFER_BYTES: u16 = crate::grbl::RX_BUFFER_BYTES as u16;
 
+/// Overrides at power-up and after a reset: 100 %.
+const NO_OVERRIDES: Overrides = Overrides {
+    feed: 100,
+    rapid: 100,
+    spindle: 100,
+};
+
 /// Whether G-code runs, is only checked, or is locked by an alarm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum GrblMode {
@@ -58,11 +65,7 @@ impl Gcode {
             parser: ParserState::new(),
             mode: GrblMode::Normal,
             values: GrblValues::default(),
-            overrides: Overrides {
-                feed: 100,
-                rapid: 100,
-                spindle: 100,
-            },
+            overrides: NO_OVERRIDES,
             motion: Motion::new(),
             reports: 0,
             galvo: GalvoStroke::default(),
@@ -139,7 +142,7 @@ impl Core {
         }
         for block in motion.owed.take().into_iter().flatten() {
             // Room was checked above.
-            let _ = motion.queue.push_back(block);
+            let _ = self.gcode.motion.queue.push_back(block);
         }
         self.ok(out);
     }
@@ -296,7 +299,7 @@ impl Core {
         self.stop("grbl soft reset", out);
         self.gcode.parser.soft_reset();
         self.grbl_sync_position();
-        self.gcode.overrides = Gcode::new().overrides;
+        self.gcode.overrides = NO_OVERRIDES;
         if self.gcode.mode == GrblMode::Check {
             self.gcode.mode = GrblMode::Normal;
         }

@@ -120,7 +120,7 @@ impl Core {
             }
         }
         for block in self.gcode.motion.queue.iter() {
-            let Some(block_feed) = feed_of(block).filter(|_| self.gcode_block_lit(block)) else {
+            let Some(block_feed) = feed_of(block).filter(|_| self.lights(block)) else {
                 break;
             };
             if !push_block(&mut stroke, block, tolerance) {
@@ -130,16 +130,6 @@ impl Core {
             record.joined += 1;
         }
         Some((stroke, feed, record))
-    }
-
-    /// Whether `block` is a feed move whose laser setting lights.
-    fn gcode_block_lit(&self, block: &Block) -> bool {
-        match *block {
-            Block::Line { laser, .. } | Block::Arc { laser, .. } => {
-                self.gcode_lit(laser.mode, laser.power)
-            }
-            _ => false,
-        }
     }
 
     /// The galvo finished request `seq`: when it was the stroke in

@@ -18,6 +18,8 @@
 use embassy_time::{Duration, Instant};
 use heapless::Deque;
 
+use super::gcode_stepper::StepperJob;
+use super::gcode_stream::{Stream, planned_length};
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
 use crate::domain::PointCm;
@@ -62,6 +64,9 @@ pub(super) struct Current {
     pub(super) servo_seq: Option<u32>,
     /// Galvo job in flight.
     pub(super) galvo_seq: Option<u32>,
+    /// Stepper move handed over, not yet taken (or, for the last block
+    /// before rest, not yet at rest).
+    pub(super) stepper_seq: Option<u32>,
     /// End of a dwell.
     pub(super) until: Option<Instant>,
     /// A jog cancel ends the block after the step in flight.
@@ -85,6 +90,10 @@ pub(super) struct Motion {
     pub(super) arrived: bool,
     /// The gimbal laser should be lit.
     pub(super) gimbal_lit: bool,
+    /// The gimbal's look-ahead plan and the block it follows.
+    pub(super) stream: Stream,
+    /// What the stepper has of the job.
+    pub(super) stepper: StepperJob,
 }
 
 impl Motion {
@@ -98,6 +107,8 @@ impl Motion {
             started: false,
             arrived: false,
             gimbal_lit: false,
+            stream: Stream::new(),
+            stepper: StepperJob::default(),
         }
     }
 
@@ -118,13 +129,18 @@ impl Motion {
             return (0.0, 0.0);
         };
         let scale = |v: f64, percent: u8| v * f64::from(percent) / 100.0;
+        // The gimbal's speed on its planned profile, when it streams.
+        let feed = |f: f64| match self.stream.is_following() {
+            true => self.stream.speed_mm_s() * 60.0,
+            false => scale(f, ov.feed),
+        };
         match current.block {
             Block::Line {
                 feed_mm_min, laser, ..
             }
             | Block::Arc {
                 feed_mm_min, laser, ..
-            } => (scale(feed_mm_min, ov.feed), scale(laser.power, ov.spindle)),
+            } => (feed(feed_mm_min), scale(laser.power, ov.spindle)),
             Block::Jog { feed_mm_min, .. } => (feed_mm_min, 0.0),
             _ => (0.0, 0.0),
         }
@@ -138,6 +154,8 @@ impl Motion {
         self.started = false;
         self.arrived = false;
         self.gimbal_lit = false;
+        self.stream.clear();
+        self.stepper.clear();
         self.owed.take().is_some()
     }
 }
@@ -153,10 +171,14 @@ fn block_end(block: &Block) -> Option<PointMm> {
 
 /// Point `k` of `n` along a motion block.
 pub(super) fn point_at(block: &Block, k: u32, n: u32) -> PointMm {
-    let t = f64::from(k) / f64::from(n.max(1));
+    block_point(block, f64::from(k) / f64::from(n.max(1)))
+}
+
+/// The point a fraction `t` (0..=1) along a motion block.
+pub(super) fn block_point(block: &Block, t: f64) -> PointMm {
     match *block {
         Block::Rapid { from, to } | Block::Line { from, to, .. } | Block::Jog { from, to, .. } => {
-            if k >= n {
+            if t >= 1.0 {
                 return to;
             }
             PointMm {
@@ -191,6 +213,7 @@ impl Core {
             on_board
                 && (!self.actuator.uses_gimbal() || self.aimer.aim(p).is_ok())
                 && (!self.actuator.uses_galvo() || self.aimer.galvo_in_range(p))
+                && (!self.actuator.uses_stepper() || self.stepper_reaches(p))
         };
         match block {
             Block::Arc { .. } => (0..=16).all(|k| reachable(point_at(block, k, 16))),
@@ -258,6 +281,12 @@ impl Core {
                     }
                 }
                 _ => {
+                    if self.gcode_streams() && planned_length(&block).is_some() {
+                        self.gcode.motion.current = Some(self.new_current(block, 1));
+                        if self.stream_begin(&block, out) {
+                            continue;
+                        }
+                    }
                     let count = self.step_count(&block);
                     self.gcode.motion.current = Some(self.new_current(block, count));
                     self.gcode_send_step(out);
@@ -266,7 +295,7 @@ impl Core {
         }
     }
 
-    fn new_current(&self, block: Block, count: u32) -> Current {
+    pub(super) fn new_current(&self, block: Block, count: u32) -> Current {
         Current {
             block,
             index: 1,
@@ -274,6 +303,7 @@ impl Core {
             from: self.gcode.motion.position,
             servo_seq: None,
             galvo_seq: None,
+            stepper_seq: None,
             until: None,
             cancelled: false,
         }
@@ -289,10 +319,11 @@ impl Core {
     /// `!`: laser dark at once; the gimbal stops after the step in
     /// flight, the galvo brakes along its stroke.
     pub(super) fn grbl_hold(&mut self, out: &mut dyn ActionSink) {
-        let motion = &mut self.gcode.motion;
-        if motion.hold != Hold::None || motion.is_idle() {
+        let motion = &self.gcode.motion;
+        if motion.hold != Hold::None || motion.is_idle() || self.gcode_stepper_hold(out) {
             return;
         }
+        let motion = &mut self.gcode.motion;
         motion.gimbal_lit = false;
         let galvo_in_flight = motion.current.is_some_and(|c| c.galvo_seq.is_some());
         if let Some(c) = motion.current.as_mut() {

@@ -59,7 +59,9 @@ impl Core {
         let mut fraction = laser.fraction(v.s_min, v.s_max) as f32;
         if laser.mode == SpindleMode::Dynamic && v.laser_mode {
             let c = self.gcode.motion.current;
-            let moving = c.is_some_and(|c| c.until.is_none() && c.servo_seq.is_some());
+            // A streamed block moves while its cursor has speed.
+            let streaming = self.gcode.motion.stream.speed_mm_s() > 0.0;
+            let moving = streaming || c.is_some_and(|c| c.until.is_none() && c.servo_seq.is_some());
             fraction *= if moving {
                 self.gcode.step_speed_ratio
             } else {

@@ -15,6 +15,13 @@ use crate::servo::task::ServoOutcome;
 impl Core {
     /// Sends the current step to every actuator that draws.
     pub(super) fn gcode_send_step(&mut self, out: &mut dyn ActionSink) {
+        if self.gcode.motion.stream.is_following() {
+            // The gimbal follows its planned profile.
+            return self.stream_tick(out);
+        }
+        if self.actuator.uses_stepper() {
+            return self.gcode_stepper_send(out);
+        }
         let motion = &self.gcode.motion;
         let Some(current) = motion.current else {
             return;
@@ -102,6 +109,10 @@ impl Core {
     /// The servo task reports move `seq` arrived; `true` when it was the
     /// G-code step's.
     fn gcode_servo_arrived(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
+        if self.stream_arrived(seq) {
+            out.act(Action::Note(LaserEvent::GimbalArrived));
+            return true;
+        }
         let Some(c) = self.gcode.motion.current.as_mut() else {
             return false;
         };
@@ -145,6 +156,15 @@ impl Core {
         };
         if c.until.is_some_and(|until| until <= now) {
             c.until = None;
+            if self.gcode.motion.stream.is_following() {
+                // The streaming tick: the next point, or the next block.
+                c.servo_seq = None;
+                return if c.index > 0 {
+                    self.stream_block_done(out)
+                } else {
+                    self.stream_tick(out)
+                };
+            }
             self.gcode.motion.gimbal_lit = false;
             self.gcode_step_done(out);
         }
@@ -174,7 +194,8 @@ impl Core {
     pub(super) fn gcode_step_done(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         let Some(mut c) = motion.current else { return };
-        if c.servo_seq.is_some() || c.galvo_seq.is_some() || c.until.is_some() {
+        let stepper = c.stepper_seq.is_some();
+        if c.servo_seq.is_some() || c.galvo_seq.is_some() || c.until.is_some() || stepper {
             return;
         }
         if c.count > 0 {

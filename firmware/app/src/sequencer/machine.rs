@@ -246,6 +246,7 @@ pub struct Core {
 
 impl Core {
     /// Idle, default settings, gimbal, laser off; booted at `now`.
+    #[inline(never)]
     pub fn new(now: Instant) -> Self {
         Self {
             settings: Settings::default(),

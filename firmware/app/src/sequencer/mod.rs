@@ -21,6 +21,8 @@ mod gcode_power;
 mod gcode_report;
 mod gcode_settings;
 mod gcode_step;
+mod gcode_stepper;
+mod gcode_stream;
 mod laser;
 mod machine;
 mod report;
@@ -165,12 +167,19 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             core: Core::new(Instant::now()),
             io,
         };
+        sequencer.load(record);
+        sequencer.io.status.publish(sequencer.core.status());
+        sequencer
+    }
+
+    /// Applies the settings of `record`. Not inlined: the settings'
+    /// copies (record, event) stay out of the start-up frame.
+    #[inline(never)]
+    fn load(&mut self, record: &[u8]) {
         // The galvo loop starts with the loaded parameters and laser mode
         // (loading asks for no follow-up: no reply, check or save).
         let loaded = Settings::load_record(record);
-        let _ = sequencer.dispatch(Event::SettingsLoaded(loaded));
-        sequencer.io.status.publish(sequencer.core.status());
-        sequencer
+        let _ = self.dispatch(Event::SettingsLoaded(loaded));
     }
 
     /// Current settings.

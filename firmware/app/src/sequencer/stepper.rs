@@ -70,6 +70,7 @@ impl Core {
             seq,
             point,
             shape,
+            feed_mm_s: None,
         }));
         out.act(Action::Note(super::laser::LaserEvent::GimbalMoveSent));
         log::info!(
@@ -149,6 +150,9 @@ impl Core {
 
     /// The stepper task's report.
     pub(super) fn stepper_event(&mut self, event: StepperEvent, out: &mut dyn ActionSink) {
+        if self.gcode_stepper_event(&event, out) {
+            return;
+        }
         match event {
             StepperEvent::Arrived { seq, steps } => {
                 log::info!("stepper arrived at {} {} steps", steps[0], steps[1]);
@@ -170,6 +174,7 @@ impl Core {
                 );
                 self.stop("stepper refused the point", out);
             }
+            StepperEvent::Taken { .. } => {}
             StepperEvent::Stopped { steps } => {
                 log::info!("stepper at rest at {} {} steps", steps[0], steps[1]);
             }

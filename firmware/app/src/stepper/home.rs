@@ -132,8 +132,13 @@ impl Running {
                     let why = StepperRefusal::Busy;
                     link.events.send(StepperEvent::Refused { seq, why }).await;
                 }
-                Either3::Third(StepperRequest::Stop | StepperRequest::Home) => link.halt(),
-                Either3::First(()) | Either3::Second(()) => {}
+                // A feed hold while homing stops it, as a stop does.
+                Either3::Third(
+                    StepperRequest::Stop | StepperRequest::Home | StepperRequest::Hold,
+                ) => link.halt(),
+                Either3::Third(StepperRequest::Resume)
+                | Either3::First(())
+                | Either3::Second(()) => {}
             }
         }
     }

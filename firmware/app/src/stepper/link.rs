@@ -33,6 +33,9 @@ pub enum StepperRequest {
         point: BoardPoint,
         /// How to get there.
         shape: MoveShape,
+        /// Spot speed along a line or arc on the board, mm/s (G-code's
+        /// feed; `None`: the axes' speed limit, as for travel).
+        feed_mm_s: Option<f64>,
     },
     /// Decelerate to rest at the acceleration limit along the path, drop
     /// the rest.
@@ -40,6 +43,11 @@ pub enum StepperRequest {
     /// Home the axes with switches: seek, back off, latch, set the zero,
     /// pull off.
     Home,
+    /// A G-code feed hold: as `Stop`, the moves since the last rest kept.
+    Hold,
+    /// After a hold came to rest: the kept moves again, from the rest
+    /// point (the rest of the one it stopped in first).
+    Resume,
 }
 
 /// How a move gets to its point.
@@ -95,6 +103,12 @@ pub enum StepperEvent {
         seq: u32,
         /// Position, microsteps.
         steps: [i32; 2],
+    },
+    /// Move `seq` is being cut into the planner (a G-code sender's next
+    /// move may follow; it is joined at speed).
+    Taken {
+        /// Request number.
+        seq: u32,
     },
     /// Move `seq` was refused.
     Refused {

@@ -4,6 +4,8 @@
 //! straight in steps, enough pieces (a power of two) that the spot stays
 //! within [`LINE_TOLERANCE_MM`] of the board curve.
 
+mod resume;
+
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::JointAngles;
 use kinematics_core::path::{Segment as BoardSegment, Shape};
@@ -76,6 +78,8 @@ impl Curve {
 #[derive(Debug, Clone, Copy)]
 struct PieceCut {
     curve: Curve,
+    /// Spot speed along the curve, mm/s (`None`: the axes' limit).
+    feed_mm_s: Option<f64>,
     pieces: u32,
     /// Next piece end to queue (1..=pieces).
     next: u32,
@@ -100,6 +104,21 @@ pub struct StepperMotion {
     line: Option<PieceCut>,
     /// The move in flight, reported when its last step has run.
     pending: Option<u32>,
+    /// One move queued behind the line being cut (G-code blocks arrive
+    /// ahead of time), with its request number; it starts when the line
+    /// is cut, so the planner joins them at speed.
+    next: Option<(u32, Queued)>,
+    /// A queued move started being cut (reported as taken).
+    started: Option<u32>,
+    /// The moves since the last rest, for a hold's resume.
+    history: resume::History,
+}
+
+/// A move waiting behind the line being cut.
+#[derive(Debug, Clone, Copy)]
+enum Queued {
+    Cut(PieceCut),
+    Travel([i32; 2]),
 }
 
 impl StepperMotion {
@@ -116,6 +135,9 @@ impl StepperMotion {
             last_point: None,
             line: None,
             pending: None,
+            next: None,
+            started: None,
+            history: resume::History::default(),
         })
     }
 
@@ -162,45 +184,86 @@ impl StepperMotion {
     /// Whether nothing is left to plan or cut (the step timer may still be
     /// running prepared segments).
     pub fn is_planned_out(&self) -> bool {
-        self.line.is_none() && self.planner.is_empty() && !self.prep.is_busy()
+        self.line.is_none()
+            && self.next.is_none()
+            && self.history.is_done()
+            && self.planner.is_empty()
+            && !self.prep.is_busy()
     }
 
     /// Queues move `seq` to the board point `point` (cm), along the board
     /// line or arc from the previous target when `shape` says so (and
-    /// there is one; else as travel).
+    /// there is one; else as travel), at `feed_mm_s` along the board curve
+    /// (`None`: the axes' speed limit). While a line is still being cut, one
+    /// move waits behind it; `Ok(false)` says it waits (it is reported by
+    /// [`Self::take_started`] when its cutting starts), `Ok(true)` that it
+    /// was taken at once.
     ///
     /// Errors: [`StepperRefusal`] (nothing queued; [`StepperRefusal::Busy`]
-    /// while a line is still being cut).
+    /// while a line is cut and a move already waits).
     pub fn move_to(
         &mut self,
         seq: u32,
         point: BoardPoint,
         shape: MoveShape,
-    ) -> Result<(), StepperRefusal> {
-        if self.line.is_some() {
+        feed_mm_s: Option<f64>,
+    ) -> Result<bool, StepperRefusal> {
+        let taken = self.queue(seq, point, shape, feed_mm_s)?;
+        self.history.push(seq, point, shape, feed_mm_s);
+        Ok(taken)
+    }
+
+    /// [`Self::move_to`] without remembering it.
+    fn queue(
+        &mut self,
+        seq: u32,
+        point: BoardPoint,
+        shape: MoveShape,
+        feed_mm_s: Option<f64>,
+    ) -> Result<bool, StepperRefusal> {
+        if self.next.is_some() {
             return Err(StepperRefusal::Busy);
         }
         let end = self.steps_at(point)?;
-        match self
+        let queued = match self
             .last_point
             .and_then(|from| Curve::of(from, point, shape))
         {
-            Some(curve) => {
-                let pieces = self.pieces_for(curve)?;
-                self.line = Some(PieceCut {
-                    curve,
-                    pieces,
-                    next: 1,
-                });
+            Some(curve) => Queued::Cut(PieceCut {
+                curve,
+                feed_mm_s,
+                pieces: self.pieces_for(curve)?,
+                next: 1,
+            }),
+            None => Queued::Travel(end),
+        };
+        self.last_point = Some(point);
+        if self.line.is_some() {
+            self.next = Some((seq, queued));
+            return Ok(false);
+        }
+        self.start(queued)?;
+        self.pending = Some(seq);
+        Ok(true)
+    }
+
+    /// Starts cutting (or queues the travel of) a move.
+    fn start(&mut self, queued: Queued) -> Result<(), StepperRefusal> {
+        match queued {
+            Queued::Cut(cut) => {
+                self.line = Some(cut);
+                Ok(())
             }
-            None => {
+            Queued::Travel(end) => {
                 self.line = None;
-                self.push_to(end)?;
+                self.push_to(end, None)
             }
         }
-        self.last_point = Some(point);
-        self.pending = Some(seq);
-        Ok(())
+    }
+
+    /// The queued move whose cutting started since the last call.
+    pub fn take_started(&mut self) -> Option<u32> {
+        self.started.take()
     }
 
     /// Step positions for a board point, inside the soft limits.
@@ -224,6 +287,7 @@ impl StepperMotion {
         loop {
             let cut = PieceCut {
                 curve,
+                feed_mm_s: None,
                 pieces,
                 next: 1,
             };
@@ -257,14 +321,26 @@ impl StepperMotion {
         Ok(worst)
     }
 
-    /// Queues the move from the planned position to `end` (steps).
-    fn push_to(&mut self, end: [i32; 2]) -> Result<(), StepperRefusal> {
+    /// Queues the move from the planned position to `end` (steps), with
+    /// `feed` = (spot speed mm/s, piece length mm) when a feed applies.
+    fn push_to(&mut self, end: [i32; 2], feed: Option<(f64, f64)>) -> Result<(), StepperRefusal> {
         let delta = [
             end[0].wrapping_sub(self.planned[0]),
             end[1].wrapping_sub(self.planned[1]),
         ];
+        let mut mv = Self::step_move(&self.config, delta);
+        if let Some((speed_mm_s, length_mm)) = feed.filter(|f| f.1 > 0.0) {
+            // Step events per mm of the piece, at the feed.
+            let events = delta[0].unsigned_abs().max(delta[1].unsigned_abs());
+            let rate = speed_mm_s * f64::from(events) / length_mm;
+            mv.nominal_rate_steps_per_s = clamp(
+                rate,
+                kinematics_core::stepper::motion::MIN_RATE_STEPS_PER_S,
+                mv.nominal_rate_steps_per_s,
+            );
+        }
         self.planner
-            .push(&Self::step_move(&self.config, delta))
+            .push(&mv)
             .map_err(|_| StepperRefusal::BadConfig)?;
         self.planned = end;
         Ok(())
@@ -277,11 +353,16 @@ impl StepperMotion {
                 break;
             }
             // Checked in `pieces_for`: reachable and inside the limits.
-            let Ok(end) = self.steps_at(cut.point(cut.next)) else {
+            let (a, b) = (cut.point(cut.next - 1), cut.point(cut.next));
+            let Ok(end) = self.steps_at(b) else {
                 self.line = None;
                 break;
             };
-            if self.push_to(end).is_err() {
+            let length_mm = 10.0 * libm::hypot(b.x_cm - a.x_cm, b.y_cm - a.y_cm);
+            if self
+                .push_to(end, cut.feed_mm_s.map(|f| (f, length_mm)))
+                .is_err()
+            {
                 self.line = None;
                 break;
             }
@@ -293,13 +374,31 @@ impl StepperMotion {
     /// The next segment to prepare (`None`: nothing more for now).
     pub fn next_segment(&mut self) -> Option<Segment> {
         self.feed_line();
+        let room = self.line.is_none() && self.planner.len() < PLANNER_LEN;
+        if let Some((seq, queued)) = self.next.take_if(|_| room) {
+            // Checked when it was queued; a refusal now drops it.
+            if self.start(queued).is_ok() {
+                self.pending = Some(seq);
+                self.started = Some(seq);
+            }
+            self.feed_line();
+        }
+        self.queue_again();
         self.prep.next_segment(&mut self.planner)
     }
 
     /// Decelerates to rest at the limit along the path; what is left of
     /// the move is dropped.
     pub fn stop(&mut self) {
+        self.hold();
+        self.history.rest(None);
+    }
+
+    /// A feed hold: as [`Self::stop`], but the moves since the last rest
+    /// are kept for [`Self::resume`].
+    pub fn hold(&mut self) {
         self.line = None;
+        self.next = None;
         self.pending = None;
         self.prep.hold(&mut self.planner);
     }
@@ -308,6 +407,7 @@ impl StepperMotion {
     /// forget the plan, continue from there.
     pub fn rest_at(&mut self, position: [i32; 2]) {
         self.line = None;
+        self.next = None;
         self.pending = None;
         self.planner.clear();
         self.prep.reset();
@@ -319,7 +419,11 @@ impl StepperMotion {
     /// (`idle`) and nothing is left to plan.
     pub fn take_arrived(&mut self, idle: bool) -> Option<u32> {
         if idle && self.is_planned_out() {
-            self.pending.take()
+            let seq = self.pending.take();
+            if seq.is_some() {
+                self.history.rest(self.last_point);
+            }
+            seq
         } else {
             None
         }

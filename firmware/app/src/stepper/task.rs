@@ -145,6 +145,9 @@ impl Running {
             link.events.send(event).await;
         }
         self.refill(link);
+        if let Some(seq) = self.motion.take_started() {
+            link.events.send(StepperEvent::Taken { seq }).await;
+        }
         let idle = link.is_idle();
         if let Some(seq) = self.motion.take_arrived(idle) {
             let steps = link.position_steps();
@@ -225,16 +228,36 @@ impl Running {
                 };
                 link.events.send(event).await;
             }
+            StepperRequest::Hold => {
+                self.motion.hold();
+                self.deferred = None;
+                self.stopping = true;
+            }
+            StepperRequest::Resume => {
+                if let Err(e) = self.motion.resume(link.position_steps()) {
+                    log::warning!("stepper: resume refused: {:?}", e);
+                }
+            }
         }
     }
 
     async fn move_to(&mut self, request: StepperRequest, link: &StepperLink) {
-        let StepperRequest::MoveTo { seq, point, shape } = request else {
+        let StepperRequest::MoveTo {
+            seq,
+            point,
+            shape,
+            feed_mm_s,
+        } = request
+        else {
             return;
         };
-        if let Err(why) = self.motion.move_to(seq, point, shape) {
-            log::warning!("stepper: move {} refused: {:?}", seq, why);
-            link.events.send(StepperEvent::Refused { seq, why }).await;
+        match self.motion.move_to(seq, point, shape, feed_mm_s) {
+            Ok(true) => link.events.send(StepperEvent::Taken { seq }).await,
+            Ok(false) => {}
+            Err(why) => {
+                log::warning!("stepper: move {} refused: {:?}", seq, why);
+                link.events.send(StepperEvent::Refused { seq, why }).await;
+            }
         }
     }
 

@@ -66,7 +66,7 @@ fn move_to_a_point_ends_within_half_a_step() {
     let config = StepperConfig::default();
     let mut motion = StepperMotion::new(config).unwrap();
     let target = BoardPoint::new(6.0, -3.5);
-    motion.move_to(7, target, MoveShape::Travel).unwrap();
+    motion.move_to(7, target, MoveShape::Travel, None).unwrap();
     let positions = drain(&mut motion, link);
     let end = *positions.last().unwrap();
     let j = config.gimbal.ik(target).unwrap();
@@ -107,9 +107,9 @@ fn board_line_stays_on_the_line() {
     let config = StepperConfig::default();
     let mut motion = StepperMotion::new(config).unwrap();
     let (a, b) = (BoardPoint::new(-12.0, 10.0), BoardPoint::new(12.0, -8.0));
-    motion.move_to(1, a, MoveShape::Travel).unwrap();
+    motion.move_to(1, a, MoveShape::Travel, None).unwrap();
     drain(&mut motion, link);
-    motion.move_to(2, b, MoveShape::Line).unwrap();
+    motion.move_to(2, b, MoveShape::Line, None).unwrap();
     let positions = drain(&mut motion, link);
     assert!(positions.len() > 500);
     let (dx, dy) = (b.x_cm - a.x_cm, b.y_cm - a.y_cm);
@@ -134,7 +134,7 @@ fn refusals_change_nothing() {
     let mut motion = StepperMotion::new(StepperConfig::default()).unwrap();
     // 60° of pan at 25 cm is 43 cm: beyond the soft limit.
     assert_eq!(
-        motion.move_to(1, BoardPoint::new(50.0, 0.0), MoveShape::Travel),
+        motion.move_to(1, BoardPoint::new(50.0, 0.0), MoveShape::Travel, None),
         Err(StepperRefusal::SoftLimit)
     );
     assert!(motion.is_planned_out());
@@ -156,7 +156,7 @@ fn halt_drops_everything_prepared() {
     let link = link();
     let mut motion = StepperMotion::new(StepperConfig::default()).unwrap();
     motion
-        .move_to(1, BoardPoint::new(10.0, 0.0), MoveShape::Travel)
+        .move_to(1, BoardPoint::new(10.0, 0.0), MoveShape::Travel, None)
         .unwrap();
     for _ in 0..200 {
         while !link.with_queue(|q| q.is_full()) {
@@ -185,7 +185,7 @@ fn stop_decelerates_to_rest_short_of_the_target() {
     let config = StepperConfig::default();
     let mut motion = StepperMotion::new(config).unwrap();
     motion
-        .move_to(1, BoardPoint::new(14.0, 0.0), MoveShape::Travel)
+        .move_to(1, BoardPoint::new(14.0, 0.0), MoveShape::Travel, None)
         .unwrap();
     for _ in 0..400 {
         while !link.with_queue(|q| q.is_full()) {
@@ -216,13 +216,13 @@ fn board_circle_stays_on_the_circle() {
     let mut motion = StepperMotion::new(config).unwrap();
     let centre = BoardPoint::new(2.0, -1.0);
     let top = BoardPoint::new(2.0, 7.0);
-    motion.move_to(1, top, MoveShape::Travel).unwrap();
+    motion.move_to(1, top, MoveShape::Travel, None).unwrap();
     drain(&mut motion, link);
     let shape = MoveShape::Arc {
         centre,
         rotation: kinematics_core::Rotation::Cw,
     };
-    motion.move_to(2, top, shape).unwrap();
+    motion.move_to(2, top, shape, None).unwrap();
     let positions = drain(&mut motion, link);
     let mut angles = Vec::new();
     for steps in &positions {

@@ -99,49 +99,87 @@ pub(crate) fn status(core: &mut Core, ms: u64) -> String {
     texts(&out).pop().expect("a status report")
 }
 
+/// Runs the core's time on from `ms`: each streaming tick or settle at
+/// its deadline, each servo move confirmed 1 ms after it was sent, until
+/// `done` holds for what came out (or nothing is pending). Returns the
+/// time reached and everything that came out.
+pub(in crate::sequencer) fn pump(
+    core: &mut Core,
+    mut ms: u64,
+    done: impl Fn(&[Action]) -> bool,
+) -> (u64, Vec<Action>) {
+    let mut all = Vec::new();
+    let mut pending: Option<u32> = None;
+    for _ in 0..10_000 {
+        if done(&all) {
+            break;
+        }
+        let out = match (pending.take(), core.dwell_deadline()) {
+            (Some(seq), _) => {
+                ms += 1;
+                arrive(core, ms, seq)
+            }
+            (None, Some(deadline)) => {
+                ms = ms.max(deadline.as_micros().div_ceil(1000));
+                on(core, ms, Event::DwellEnded)
+            }
+            (None, None) => break,
+        };
+        pending = move_seq(&out);
+        all.extend(out);
+    }
+    (ms, all)
+}
+
 #[test]
 fn ok_waits_for_room_in_the_queue() {
     let mut core = Core::new(Instant::from_millis(0));
-    let mut first_move = None;
     // The first block starts at once; PLANNER_BLOCKS more fit the queue.
     for k in 0..=PLANNER_BLOCKS {
         let out = line(&mut core, 1, &std::format!("G0 X{} Y0", k % 2 + 1));
         assert_eq!(closers(&out), 1, "line {k} answered at once");
-        first_move = first_move.or(move_seq(&out));
+        assert_eq!(move_seq(&out).is_some(), k == 0, "line {k}");
     }
     let full = line(&mut core, 2, "G0 X5 Y5");
     assert_eq!(closers(&full), 0, "no room: the ok waits");
     assert!(status(&mut core, 3).starts_with("<Run|"));
-    // The first block ends: its successor starts, the waiting line fits.
-    let seq = first_move.expect("the first block moves");
-    let settled = arrive(&mut core, 50, seq);
-    assert_eq!(closers(&settled), 0, "settling at the block end");
-    let deadline = core.dwell_deadline().expect("settle time");
-    let next = on(&mut core, deadline.as_millis(), Event::DwellEnded);
-    assert_eq!(closers(&next), 1, "the waiting line's ok");
+    // The first block ends (a reversal follows: at rest, settled): its
+    // successor starts, the waiting line fits.
+    let (_, out) = pump(&mut core, 3, |out| closers(out) > 0);
+    assert_eq!(closers(&out), 1, "the waiting line's ok");
+    assert_eq!(core.gcode.motion.queue.len(), PLANNER_BLOCKS);
 }
 
 #[test]
-fn jog_cancel_stops_after_the_step_in_flight_and_the_parser_follows() {
+fn jog_cancel_brakes_on_the_path_and_the_parser_follows() {
     let mut core = Core::new(Instant::from_millis(0));
     let out = line(&mut core, 1, "$J=G91 X50 F600");
     assert_eq!(closers(&out), 1);
-    let seq = move_seq(&out).expect("jog step");
+    assert!(move_seq(&out).is_some(), "jog streams");
     assert!(status(&mut core, 2).starts_with("<Jog|"));
     assert_eq!(
         closers(&line(&mut core, 3, "G1 X1 F100")),
         1,
         "G-code refused while jogging"
     );
-    realtime(&mut core, 4, Realtime::JogCancel);
-    let after = arrive(&mut core, 20, seq);
-    assert_eq!(move_seq(&after), None, "no further step");
-    let report = status(&mut core, 21);
-    assert!(report.starts_with("<Idle|MPos:2.000,0.000"), "{report}");
+    // Cruising at 10 mm/s after 0.2 s.
+    let (ms, _) = pump(&mut core, 3, |out| out.len() > 40);
+    let before = core.gcode.motion.position.x_mm;
+    assert!(before > 1.0 && before < 3.0, "{before}");
+    realtime(&mut core, ms, Realtime::JogCancel);
+    pump(&mut core, ms, |_| false);
+    let report = status(&mut core, ms + 500);
+    assert!(report.starts_with("<Idle|MPos:"), "{report}");
+    // Braked within one period at 10 mm/s: 0.2 mm.
+    let stopped = core.gcode.motion.position.x_mm;
+    assert!(
+        stopped >= before && stopped <= before + 0.21,
+        "{before} {stopped}"
+    );
     // The parser continues from where the jog stopped.
-    let out = line(&mut core, 22, "$J=G91 X1 F600");
+    let out = line(&mut core, ms + 600, "$J=G91 X1 F600");
     assert!(move_seq(&out).is_some());
-    assert_eq!(core.gcode.parser.position.x_mm, 3.0);
+    assert!((core.gcode.parser.position.x_mm - stopped - 1.0).abs() < 1e-9);
 }
 
 #[test]
@@ -195,10 +233,8 @@ fn buffer_state_shows_with_report_mask_2() {
 fn laser_off_darkens_a_lit_gcode_step_at_once() {
     let mut core = Core::new(Instant::from_millis(0));
     let out = line(&mut core, 1, "G0 X1");
-    let seq = move_seq(&out).expect("rapid");
-    arrive(&mut core, 10, seq);
-    let deadline = core.dwell_deadline().expect("settle");
-    on(&mut core, deadline.as_millis(), Event::DwellEnded);
+    assert!(move_seq(&out).is_some(), "rapid");
+    pump(&mut core, 1, |_| false);
     let out = line(&mut core, 100, "G1 X20 F600 M3 S1000");
     assert!(out.contains(&Action::GimbalLaser(true)), "lit G1 step");
     let command = Command::Laser(crate::settings::LaserMode::Off);
@@ -257,4 +293,57 @@ fn the_galvo_marks_at_f_with_the_feed_override_capped_by_its_marking_speed() {
     assert_eq!(speed, Some(1000.0));
     let report = status(&mut core, 8);
     assert!(report.contains("|FS:60000,1000"), "{report}");
+}
+
+/// The speed (mm/s) and position (mm) the gimbal's cursor had at each
+/// step of `pump` until idle.
+fn follow(core: &mut Core, ms: u64) -> Vec<(f64, [f64; 2])> {
+    let mut trace = Vec::new();
+    let mut ms = ms;
+    let mut pending: Option<u32> = None;
+    for _ in 0..100_000 {
+        let out = match (pending.take(), core.dwell_deadline()) {
+            (Some(seq), _) => {
+                ms += 1;
+                arrive(core, ms, seq)
+            }
+            (None, Some(deadline)) => {
+                ms = ms.max(deadline.as_micros().div_ceil(1000));
+                on(core, ms, Event::DwellEnded)
+            }
+            (None, None) => break,
+        };
+        pending = move_seq(&out);
+        let p = core.gcode.motion.position;
+        trace.push((core.gcode.motion.stream.speed_mm_s(), [p.x_mm, p.y_mm]));
+    }
+    trace
+}
+
+#[test]
+fn the_gimbal_cruises_through_gentle_junctions_and_slows_at_sharp_ones() {
+    let mut core = Core::new(Instant::from_millis(0));
+    // 100 mm/s; a straight run cut in three, then a 90° corner.
+    // The first block (the G0) ends at rest: dark until the gimbal arrived.
+    for text in ["G0 X-5", "G1 X10 F6000", "G1 X20", "G1 X30", "G1 X30 Y10"] {
+        assert_eq!(closers(&line(&mut core, 1, text)), 1);
+    }
+    let trace = follow(&mut core, 1);
+    let speed_at = |x: f64, y: f64| {
+        trace
+            .iter()
+            .filter(|(_, p)| (p[0] - x).hypot(p[1] - y) < 1e-6)
+            .map(|(v, _)| *v)
+            .fold(f64::NAN, f64::max)
+    };
+    // Through X10 and X20 at the feed.
+    assert!((speed_at(10.0, 0.0) - 100.0).abs() < 1e-6, "{trace:?}");
+    assert!((speed_at(20.0, 0.0) - 100.0).abs() < 1e-6, "{trace:?}");
+    // The corner at X30: grbl's junction speed √(a·δ·s/(1−s)), s = sin 45°
+    // (a ≈ 8 800 mm/s², δ = 0.01 mm: ≈ 15 mm/s), far below the feed.
+    let corner = speed_at(30.0, 0.0);
+    assert!(corner > 5.0 && corner < 25.0, "{corner} {trace:?}");
+    let end = trace.last().expect("moved").1;
+    assert_eq!(end, [30.0, 10.0]);
+    assert!(core.gcode.motion.is_idle());
 }

@@ -8,9 +8,9 @@ use std::vec::Vec;
 
 use embassy_time::Instant;
 
-use super::super::gcode::tests::{arrive, closers, line, move_seq, on, realtime, status};
+use super::super::gcode::tests::{closers, line, move_seq, pump, realtime, status};
 use super::super::laser::LaserPower;
-use super::super::machine::{Action, Core, Event};
+use super::super::machine::{Action, Core};
 use crate::grbl::realtime::{OverrideStep, Realtime};
 
 /// The last power level `actions` set for the gimbal laser.
@@ -28,11 +28,9 @@ fn lit_core(settings: &[&str], gcode: &str) -> (Core, Vec<Action>) {
     for s in settings {
         assert_eq!(closers(&line(&mut core, 1, s)), 1, "{s}");
     }
-    let seq = move_seq(&line(&mut core, 2, "G0 X1")).expect("rapid");
-    arrive(&mut core, 10, seq);
-    let deadline = core.dwell_deadline().expect("settle");
-    on(&mut core, deadline.as_millis(), Event::DwellEnded);
-    let out = line(&mut core, 100, gcode);
+    assert!(move_seq(&line(&mut core, 2, "G0 X1")).is_some(), "rapid");
+    let (ms, _) = pump(&mut core, 2, |_| false);
+    let out = line(&mut core, ms + 100, gcode);
     (core, out)
 }
 
@@ -103,27 +101,21 @@ fn m4_scales_with_the_step_speed_and_is_dark_at_rest() {
         core.laser_on() && core.laser_power == LaserPower::FULL,
         "{m3:?}"
     );
-    let (mut core, m4) = lit_core(&[], "G1 X20 F60000 M4 S1000");
-    let slow = power(&m4).expect("lit");
+    let (mut core, first) = lit_core(&[], "G1 X20 F60000 M4 S1000");
+    // The gimbal accelerates from rest: lit from the first period moving.
+    let (_, more) = pump(&mut core, 200, |out| power(out).is_some());
+    let m4: Vec<Action> = first.into_iter().chain(more).collect();
+    let slow = power(&m4).unwrap_or_else(|| panic!("{m4:?}"));
     assert!(
         slow > 0 && slow < 1000,
         "M4 at a servo-limited step: {slow}"
     );
     assert!(m4.contains(&Action::GimbalLaser(true)));
-    // Drive the block to its end: at its last step's arrival the gimbal
-    // settles (speed 0), M4 goes dark there; M3 would stay lit.
-    let mut out = m4;
-    let mut ms = 200;
-    while let Some(seq) = move_seq(&out) {
-        out = arrive(&mut core, ms, seq);
-        ms += 50;
-    }
-    assert!(core.dwell_deadline().is_some(), "settling at the block end");
+    // Drive the block to its end: the gimbal brakes to rest there and
+    // settles (speed 0), M4 goes dark; M3 would stay lit.
+    let (ms, out) = pump(&mut core, 200, |_| false);
     assert!(out.contains(&Action::GimbalLaser(false)), "{out:?}");
-    assert!(
-        status(&mut core, ms).contains("|FS:"),
-        "report while settling"
-    );
+    assert!(status(&mut core, ms).contains("|FS:"), "report at rest");
     assert!(!core.laser_on());
 }
 

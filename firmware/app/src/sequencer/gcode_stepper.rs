@@ -1,0 +1,230 @@
+//! G-code on the stepper pan/tilt (`target stepper`): each block goes to
+//! the stepper task as a move along its board line or arc (G0 as joint
+//! travel), cut there within the stepper's line tolerance and planned by
+//! its look-ahead planner. A block is handed on as soon as the stepper
+//! has taken the one before ([`StepperEvent::Taken`]), so the planner
+//! joins them at speed; the block before a change of the laser (dark ↔
+//! lit), a dwell, a pause or the end waits for rest, so the laser switches
+//! where the spot is. A feed hold decelerates along the path at the
+//! limit (laser dark at once); `~` goes on from the point it stopped at:
+//! the rest of the block it stopped in, then the queue.
+
+use kinematics_core::Rotation;
+use kinematics_core::frames::BoardPoint;
+
+use super::gcode_motion::{Hold, cm};
+use super::gcode_stream::planned_length;
+use super::machine::{Action, ActionSink, Core};
+use crate::domain::PointCm;
+use crate::grbl::{Block, PointMm};
+use crate::stepper::{MoveShape, StepperEvent, StepperRequest};
+
+/// What the stepper has of the G-code job.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct StepperJob {
+    /// The last move handed over and not yet at rest.
+    inflight: Option<u32>,
+    /// The laser of the blocks handed over.
+    lit: bool,
+    /// The current block waits for rest before it is handed over.
+    waiting: bool,
+    /// A hold came to rest: `~` asks the stepper to go on with its moves.
+    held: bool,
+}
+
+/// The stepper move of a motion block: end point (cm) and shape.
+fn stepper_move(block: &Block) -> Option<(BoardPoint, MoveShape)> {
+    let board = |p: PointMm| {
+        let p = cm(p);
+        BoardPoint::new(p.x_cm, p.y_cm)
+    };
+    Some(match *block {
+        Block::Rapid { to, .. } => (board(to), MoveShape::Travel),
+        Block::Line { to, .. } | Block::Jog { to, .. } => (board(to), MoveShape::Line),
+        Block::Arc { arc, .. } => {
+            let rotation = if arc.sweep_rad < 0.0 {
+                Rotation::Cw
+            } else {
+                Rotation::Ccw
+            };
+            let centre = board(arc.centre);
+            (board(arc.to), MoveShape::Arc { centre, rotation })
+        }
+        _ => return None,
+    })
+}
+
+impl Core {
+    /// Hands the current block to the stepper (or waits for rest first).
+    #[inline(never)]
+    pub(super) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
+        let Some(current) = self.gcode.motion.current else {
+            return;
+        };
+        let lit = self.lights(&current.block) && self.gcode.motion.hold == Hold::None;
+        let job = &mut self.gcode.motion.stepper;
+        if job.inflight.is_some() && lit != job.lit {
+            job.waiting = true;
+            return;
+        }
+        job.waiting = false;
+        if core::mem::take(&mut job.held) {
+            // A resume: the stepper goes on with the moves it had, from
+            // where the hold stopped.
+            job.inflight = current.stepper_seq;
+            out.act(Action::Stepper(StepperRequest::Resume));
+            let motion = &mut self.gcode.motion;
+            motion.gimbal_lit = lit && motion.arrived;
+            return;
+        }
+        let Some((point, shape)) = stepper_move(&current.block) else {
+            return;
+        };
+        let feed_mm_s = self.stepper_feed(&current.block);
+        let seq = self.stepper_request(point, shape, feed_mm_s, out);
+        let motion = &mut self.gcode.motion;
+        if let Some(c) = motion.current.as_mut() {
+            c.stepper_seq = Some(seq);
+        }
+        motion.stepper.lit = lit;
+        motion.gimbal_lit = lit && motion.arrived;
+    }
+
+    /// The spot speed of a feed move with the feed override, mm/s
+    /// (`None`: G0, at the axes' limit).
+    #[inline(never)]
+    fn stepper_feed(&self, block: &Block) -> Option<f64> {
+        let feed_mm_min = match *block {
+            Block::Line { feed_mm_min, .. }
+            | Block::Arc { feed_mm_min, .. }
+            | Block::Jog { feed_mm_min, .. } => feed_mm_min,
+            _ => return None,
+        };
+        Some(feed_mm_min * f64::from(self.gcode.overrides.feed) / 6000.0)
+    }
+
+    /// One move request to the stepper; returns its number.
+    #[inline(never)]
+    fn stepper_request(
+        &mut self,
+        point: BoardPoint,
+        shape: MoveShape,
+        feed_mm_s: Option<f64>,
+        out: &mut dyn ActionSink,
+    ) -> u32 {
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let seq = self.next_seq;
+        out.act(Action::Stepper(StepperRequest::MoveTo {
+            seq,
+            point,
+            shape,
+            feed_mm_s,
+        }));
+        self.gcode.motion.stepper.inflight = Some(seq);
+        seq
+    }
+
+    /// Whether the block after the current one joins it at speed: a
+    /// motion with the same laser, no hold.
+    #[inline(never)]
+    fn stepper_joins_next(&self) -> bool {
+        let motion = &self.gcode.motion;
+        let same_laser = |b: &Block| self.lights(b) == motion.stepper.lit;
+        motion.hold == Hold::None
+            && motion
+                .queue
+                .front()
+                .is_some_and(|b| planned_length(b).is_some() && same_laser(b))
+    }
+
+    /// The G-code side of a stepper report: `true` when it was the job's.
+    #[inline(never)]
+    pub(super) fn gcode_stepper_event(
+        &mut self,
+        event: &StepperEvent,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        let current = self.gcode.motion.current;
+        let ours = |seq: u32| current.is_some_and(|c| c.stepper_seq == Some(seq));
+        let joins = self.stepper_joins_next();
+        let motion = &mut self.gcode.motion;
+        match *event {
+            StepperEvent::Taken { seq } if ours(seq) && joins => {
+                self.gcode_stepper_done(out);
+                true
+            }
+            StepperEvent::Arrived { seq, .. } if motion.stepper.inflight == Some(seq) => {
+                motion.stepper.inflight = None;
+                motion.arrived = true;
+                if ours(seq) {
+                    self.gcode_stepper_done(out);
+                } else if motion.stepper.waiting {
+                    self.gcode_stepper_send(out);
+                }
+                true
+            }
+            StepperEvent::Stopped { steps } => {
+                let config = self.stepper_config();
+                let at = config
+                    .joints_of(steps)
+                    .and_then(|j| config.gimbal.fk(j).ok());
+                let motion = &mut self.gcode.motion;
+                motion.stepper.inflight = None;
+                if let Some(p) = at {
+                    motion.position = PointMm {
+                        x_mm: p.x_cm * 10.0,
+                        y_mm: p.y_cm * 10.0,
+                    };
+                }
+                if motion.hold == Hold::Stopping {
+                    motion.hold = Hold::Held;
+                    motion.stepper.held = true;
+                }
+                self.grbl_sync_position();
+                false
+            }
+            _ => false,
+        }
+    }
+
+    /// The current block is done on the stepper's side.
+    #[inline(never)]
+    fn gcode_stepper_done(&mut self, out: &mut dyn ActionSink) {
+        if let Some(c) = self.gcode.motion.current.as_mut() {
+            c.stepper_seq = None;
+        }
+        self.gcode_step_done(out);
+    }
+
+    /// `!` on the stepper: decelerate along the path, dark at once.
+    /// `false` when nothing moves there.
+    #[inline(never)]
+    pub(super) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
+        let motion = &mut self.gcode.motion;
+        if !self.actuator.uses_stepper() || motion.stepper.inflight.is_none() {
+            return false;
+        }
+        motion.gimbal_lit = false;
+        motion.hold = Hold::Stopping;
+        out.act(Action::Stepper(StepperRequest::Hold));
+        true
+    }
+
+    /// Whether the stepper reaches board point `p` within its soft limits.
+    #[inline(never)]
+    pub(super) fn stepper_reaches(&self, p: PointCm) -> bool {
+        let config = self.stepper_config();
+        config
+            .gimbal
+            .ik(BoardPoint::new(p.x_cm, p.y_cm))
+            .is_ok_and(|j| config.steps_of(j).is_ok())
+    }
+}
+
+impl StepperJob {
+    /// Forgets the job (a stop, a reset).
+    #[inline(never)]
+    pub(super) fn clear(&mut self) {
+        *self = Self::default();
+    }
+}

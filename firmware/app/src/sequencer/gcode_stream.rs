@@ -1,0 +1,414 @@
+//! G-code on the gimbal through grbl's look-ahead planner: every period
+//! the block running (what is left of it, entered at the speed it has)
+//! and the motion blocks queued behind it (up to [`PLAN_BLOCKS`], to the
+//! first that must start from rest) are planned by
+//! [`kinematics_core::lookahead::Lookahead`] in board mm (cruise at F —
+//! G0 at the rate limit — capped by `$110` and the servo speed;
+//! acceleration `$120` capped by the servos' [`GIMBAL_ACCEL_DEG_S2`];
+//! junctions by `$11`): the plan gives the running block's exit speed.
+//! Planned afresh each period, nothing of it stays in the sequencer's
+//! state (its stack copies of it are what the 14 KiB ceiling counts). The
+//! block running is
+//! followed at [`STREAM_PERIOD_MS`] by a [`SpeedCursor`]: every period
+//! one servo move to the next point of the planned profile, timed to the
+//! period (each move supersedes the one before, so the servos never stop
+//! between points). A tick that reaches a block's end goes exactly to it
+//! (corners are not cut) and the next block goes on at the junction speed;
+//! only a block ending at rest (queue empty, dwell, pause, end, a
+//! reversal) waits for arrival within 0.1° and the settle. A feed hold
+//! brakes along the path at the limit (dark) and `~` goes on from the
+//! point it stopped at; the feed override scales the cruise on the fly.
+
+use embassy_time::Duration;
+use kinematics_core::lookahead::{Lookahead, LookaheadBlock, SpeedCursor};
+
+use super::gcode_motion::{CORNER_DEADBAND_TENTHS, Hold, block_point, cm, point_at};
+use super::machine::{ActionSink, Core};
+use crate::domain::Target;
+use crate::grbl::{Block, PointMm};
+
+/// The streaming period, ms (the servos' shortest move ramp).
+pub(super) const STREAM_PERIOD_MS: u64 = 20;
+/// Joint acceleration the servos follow, °/s² (their speed within 0.1 s).
+pub(super) const GIMBAL_ACCEL_DEG_S2: f64 = 2000.0;
+/// Blocks planned each period: the block running and those behind it.
+const PLAN_BLOCKS: usize = 8;
+/// Shorter blocks are not planned (nothing to move).
+const MIN_LENGTH_MM: f64 = 1e-4;
+/// Shortest tick, ms (a block end just past the previous tick).
+const MIN_TICK_MS: f64 = 2.0;
+
+/// The block being followed.
+#[derive(Debug, Clone)]
+pub(super) struct Stream {
+    /// Following the running block (`None`: at rest, or its final move).
+    cursor: Option<SpeedCursor>,
+    /// Highest cruise of the running block (servo speed, `$110`), mm/s.
+    cap_mm_s: f64,
+}
+
+impl Stream {
+    pub(super) const fn new() -> Self {
+        Self {
+            cursor: None,
+            cap_mm_s: 0.0,
+        }
+    }
+
+    /// Forgets the block followed (a stop, a reset, an alarm).
+    #[inline(never)]
+    pub(super) fn clear(&mut self) {
+        self.cursor = None;
+    }
+
+    /// Whether a block is being followed.
+    #[inline(never)]
+    pub(super) fn is_following(&self) -> bool {
+        self.cursor.is_some()
+    }
+
+    /// Speed now, mm/s (0 at rest).
+    #[inline(never)]
+    pub(super) fn speed_mm_s(&self) -> f64 {
+        self.cursor.map_or(0.0, |c| c.speed)
+    }
+}
+
+/// Length of a motion block, mm (`None`: not a motion, or nothing to move).
+pub(super) fn planned_length(block: &Block) -> Option<f64> {
+    let length = match *block {
+        Block::Rapid { from, to } | Block::Line { from, to, .. } | Block::Jog { from, to, .. } => {
+            from.distance_to(to)
+        }
+        Block::Arc { arc, .. } => arc.length_mm(),
+        _ => return None,
+    };
+    (length.is_finite() && length > MIN_LENGTH_MM).then_some(length)
+}
+
+/// Unit directions at the start and at the end of a motion block of
+/// `length` mm.
+fn tangents(block: &Block, length: f64) -> [[f64; 2]; 2] {
+    let near = (MIN_LENGTH_MM / length).max(1e-3);
+    [
+        unit(point_at(block, 0, 1), block_point(block, near)),
+        unit(block_point(block, 1.0 - near), point_at(block, 1, 1)),
+    ]
+}
+
+/// Unit direction from `a` to `b`.
+fn unit(a: PointMm, b: PointMm) -> [f64; 2] {
+    let d = a.distance_to(b).max(1e-12);
+    [(b.x_mm - a.x_mm) / d, (b.y_mm - a.y_mm) / d]
+}
+
+impl Core {
+    /// Whether G-code on this actuator streams through the planner (the
+    /// gimbal alone).
+    #[inline(never)]
+    pub(super) fn gcode_streams(&self) -> bool {
+        self.actuator.uses_gimbal() && !self.actuator.uses_galvo()
+    }
+
+    /// Cruise (mm/s) and acceleration (mm/s²) of `block` on the gimbal:
+    /// F (G0: the rate limit) within `$110` and the servo speed, `$120`
+    /// within [`GIMBAL_ACCEL_DEG_S2`], through the joint degrees per mm
+    /// along the block.
+    #[inline(never)]
+    fn stream_limits(&self, block: &Block, length: f64) -> (f64, f64) {
+        let s = &self.settings;
+        let deg_per_mm = self.joint_deg_per_mm(block, length).max(1e-6);
+        let cap = (s.servo_speed_deg_s / deg_per_mm).min(s.galvo.mark_speed_mm_s);
+        let feed = match *block {
+            Block::Line { feed_mm_min, .. }
+            | Block::Arc { feed_mm_min, .. }
+            | Block::Jog { feed_mm_min, .. } => feed_mm_min / 60.0,
+            _ => cap,
+        };
+        let accel = (GIMBAL_ACCEL_DEG_S2 / deg_per_mm).min(s.galvo.mark_accel_mm_s2);
+        (feed.min(cap).max(1e-3), accel.max(1e-3))
+    }
+
+    /// The larger joint's travel per mm along `block` (two pieces), °/mm.
+    #[inline(never)]
+    fn joint_deg_per_mm(&self, block: &Block, length: f64) -> f64 {
+        let aim = |k: u32| self.aimer.aim(cm(point_at(block, k, 2))).ok();
+        let (mut yaw, mut pitch) = (0.0, 0.0);
+        let mut prev = aim(0);
+        for k in 1..=2 {
+            let next = aim(k);
+            if let (Some(a), Some(b)) = (prev, next) {
+                yaw += libm::fabs(b.yaw_deg - a.yaw_deg);
+                pitch += libm::fabs(b.pitch_deg - a.pitch_deg);
+            }
+            prev = next;
+        }
+        libm::fmax(yaw, pitch) / length
+    }
+
+    /// Starts following `block` (already popped from the motion queue):
+    /// from rest, or on from the block before at the speed reached.
+    /// `false` when it has nothing to move (it then runs step by step).
+    #[inline(never)]
+    pub(super) fn stream_begin(&mut self, block: &Block, out: &mut dyn ActionSink) -> bool {
+        let Some(length) = planned_length(block) else {
+            return false;
+        };
+        let (cruise, accel) = self.stream_limits(block, length);
+        let planned = LookaheadBlock {
+            length,
+            nominal_speed: cruise,
+            accel,
+            ..LookaheadBlock::default()
+        };
+        let stream = &mut self.gcode.motion.stream;
+        stream.cursor = Some(match stream.cursor {
+            Some(mut c) => {
+                c.continue_into(planned, 0.0);
+                c
+            }
+            None => SpeedCursor::start(planned),
+        });
+        stream.cap_mm_s = cruise;
+        if let Some(c) = self.gcode.motion.current.as_mut() {
+            c.index = 0;
+        }
+        self.stream_tick(out);
+        true
+    }
+
+    /// The exit speed the plan allows the running block (what is left of
+    /// it from `cursor`): its junction with the next queued motion block
+    /// and what lies behind that, or 0 when the next must start from rest
+    /// (none queued, a dwell, pause or end, a dark → lit change, or the
+    /// gimbal has not arrived anywhere yet: dark until it has).
+    #[inline(never)]
+    fn stream_exit_speed(&self, current: &Block, cursor: &SpeedCursor) -> f64 {
+        let motion = &self.gcode.motion;
+        let Ok(mut plan) = Lookahead::<PLAN_BLOCKS>::new(self.gcode.values.junction_mm) else {
+            return 0.0;
+        };
+        let left = cursor.block.length - cursor.done;
+        let b = &cursor.block;
+        let end_tangent = tangents(current, b.length)[1];
+        if !motion.arrived
+            || plan
+                .push(
+                    left.max(MIN_LENGTH_MM),
+                    [end_tangent; 2],
+                    b.nominal_speed,
+                    b.accel,
+                )
+                .is_err()
+        {
+            return 0.0;
+        }
+        plan.limit_head_entry(cursor.speed);
+        let mut lit = self.lights(current);
+        for next in motion.queue.iter() {
+            let Some(length) = planned_length(next) else {
+                break;
+            };
+            let next_lit = self.lights(next);
+            if next_lit && !lit {
+                break;
+            }
+            lit = next_lit;
+            let (cruise, accel) = self.stream_limits(next, length);
+            if plan
+                .push(length, tangents(next, length), cruise, accel)
+                .is_err()
+            {
+                break;
+            }
+        }
+        plan.block(1)
+            .filter(|n| n.max_entry_speed > 0.0)
+            .map_or(0.0, |n| n.entry_speed)
+    }
+
+    /// One period of the block being followed: the next point of the
+    /// profile to the servos, the next tick scheduled — or the block's end
+    /// reached (the next block, or the final move), or a hold at rest.
+    #[inline(never)]
+    pub(super) fn stream_tick(&mut self, out: &mut dyn ActionSink) {
+        let motion = &mut self.gcode.motion;
+        let (Some(current), Some(mut cursor)) = (motion.current, motion.stream.cursor) else {
+            return;
+        };
+        let braking = motion.hold != Hold::None || current.cancelled;
+        // The exit: the next block's entry while it joins at speed.
+        cursor.block.exit_speed = self.stream_exit_speed(&current.block, &cursor);
+        let joins = cursor.block.exit_speed > 0.0;
+        let motion = &self.gcode.motion;
+        let ov = f64::from(self.gcode.overrides.feed) / 100.0;
+        let scale = ov.min(motion.stream.cap_mm_s / cursor.block.nominal_speed.max(1e-9));
+        let dt_ms = STREAM_PERIOD_MS as f64;
+        let left = cursor.block.length - cursor.done;
+        let over = cursor.advance(dt_ms / 1000.0, scale, braking);
+        // A tick that reaches the block's end stops there, early.
+        let tick_ms = over.map_or(dt_ms, |over| {
+            (dt_ms * left / (left + over).max(1e-12)).max(MIN_TICK_MS)
+        });
+        self.gcode.motion.stream.cursor = Some(cursor);
+        let to = block_point(&current.block, cursor.fraction());
+        let at_end = over.is_some();
+        let final_move = at_end && !joins;
+        if braking && cursor.is_at_rest() && !at_end {
+            // A hold (or a jog cancel) came to rest on the path.
+            self.stream_sample(to, tick_ms, false, out);
+            return self.stream_rest(out);
+        }
+        if !self.stream_sample(to, tick_ms, final_move, out) {
+            return;
+        }
+        let motion = &mut self.gcode.motion;
+        let Some(c) = motion.current.as_mut() else {
+            return;
+        };
+        c.index = u32::from(at_end);
+        if final_move {
+            // The last move of the burst waits for arrival and settles
+            // (`gcode_servo_arrived`); what follows starts from rest.
+            motion.stream.cursor = None;
+            return;
+        }
+        c.until = Some(
+            self.inputs
+                .now
+                .saturating_add(Duration::from_micros((tick_ms * 1000.0) as u64)),
+        );
+    }
+
+    /// The tick reached the end of a block that joins the next at speed:
+    /// the next block (queued, planned) goes on from here, hold or not.
+    #[inline(never)]
+    pub(super) fn stream_block_done(&mut self, out: &mut dyn ActionSink) {
+        let motion = &mut self.gcode.motion;
+        if let Some(c) = motion.current.take() {
+            motion.position = point_at(&c.block, 1, 1);
+        }
+        let next = motion.queue.front().copied();
+        match next.filter(|b| planned_length(b).is_some()) {
+            Some(block) => {
+                motion.queue.pop_front();
+                self.grbl_take_owed(out);
+                self.gcode.motion.current = Some(self.new_current(block, 1));
+                if !self.stream_begin(&block, out) {
+                    self.gcode.motion.current = None;
+                    self.grbl_advance(out);
+                }
+            }
+            None => {
+                self.gcode.motion.stream.cursor = None;
+                self.grbl_advance(out);
+            }
+        }
+    }
+
+    /// A servo move to `to` taking `tick_ms` (`last`: arrive within the
+    /// servo resolution and report it); the laser lit as the block says.
+    /// `false` when the point is out of reach (alarm raised).
+    #[inline(never)]
+    fn stream_sample(
+        &mut self,
+        to: PointMm,
+        tick_ms: f64,
+        last: bool,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        let point = cm(to);
+        let Ok(aim) = self.aimer.aim(point) else {
+            self.grbl_alarm(crate::grbl::Alarm::SoftLimit, out);
+            return false;
+        };
+        let deadband = if last {
+            CORNER_DEADBAND_TENTHS
+        } else {
+            (self.settings.deadband_deg * 10.0) as u16
+        };
+        let interval_ms = (libm::ceil(tick_ms) as u16).max(1);
+        let seq = self.send_gimbal_move(&aim, interval_ms, deadband, out);
+        self.last_aim = Some((Target { point, grid: None }, aim));
+        let lit = self.gcode_block_lit();
+        self.gcode.step_speed_ratio = self.stream_speed_ratio();
+        let motion = &mut self.gcode.motion;
+        motion.position = to;
+        motion.gimbal_lit = lit && motion.hold == Hold::None && motion.arrived;
+        if let Some(c) = motion.current.as_mut() {
+            c.servo_seq = Some(seq);
+            c.until = None;
+        }
+        true
+    }
+
+    /// The speed now over the programmed feed (with the override), for M4.
+    fn stream_speed_ratio(&self) -> f32 {
+        let programmed = match self.gcode.motion.current.map(|c| c.block) {
+            Some(Block::Line { feed_mm_min, .. } | Block::Arc { feed_mm_min, .. }) => {
+                feed_mm_min * f64::from(self.gcode.overrides.feed) / 6000.0
+            }
+            _ => return 0.0,
+        };
+        let ratio = self.gcode.motion.stream.speed_mm_s() / programmed.max(1e-9);
+        kinematics_core::numeric::clamp(ratio, 0.0, 1.0) as f32
+    }
+
+    /// Whether the running block lights the laser (a lit G1/G2/G3).
+    #[inline(never)]
+    fn gcode_block_lit(&self) -> bool {
+        self.gcode
+            .motion
+            .current
+            .is_some_and(|c| self.lights(&c.block))
+    }
+
+    /// Whether `block` lights the laser (a lit G1/G2/G3).
+    #[inline(never)]
+    pub(super) fn lights(&self, block: &Block) -> bool {
+        match *block {
+            Block::Line { laser, .. } | Block::Arc { laser, .. } => {
+                self.gcode_lit(laser.mode, laser.power)
+            }
+            _ => false,
+        }
+    }
+
+    /// A hold came to rest (`~` goes on from here), or a jog cancel did
+    /// (the jog ends here).
+    #[inline(never)]
+    fn stream_rest(&mut self, out: &mut dyn ActionSink) {
+        let motion = &mut self.gcode.motion;
+        motion.gimbal_lit = false;
+        let cancelled = motion.current.is_some_and(|c| c.cancelled);
+        if let Some(c) = motion.current.as_mut() {
+            // The sample's arrival is not waited for.
+            c.servo_seq = None;
+            c.until = None;
+        }
+        if cancelled {
+            motion.current = None;
+            motion.stream.clear();
+            self.grbl_sync_position();
+            self.grbl_advance(out);
+            return;
+        }
+        motion.hold = Hold::Held;
+    }
+
+    /// The servo task confirmed streamed move `seq`: `true` when it was
+    /// a point on the way (the block goes on at its own pace).
+    #[inline(never)]
+    pub(super) fn stream_arrived(&mut self, seq: u32) -> bool {
+        let motion = &mut self.gcode.motion;
+        let on_the_way = motion.stream.is_following()
+            && motion.current.is_some_and(|c| c.servo_seq == Some(seq));
+        if on_the_way {
+            motion.arrived = true;
+            if let Some(c) = motion.current.as_mut() {
+                c.servo_seq = None;
+            }
+        }
+        on_the_way
+    }
+}
