@@ -477,8 +477,8 @@ impl Harness {
                 self.gate_open |= lit;
                 self.lit = lit;
             }
-            Action::Note(super::LaserEvent::Stopped { .. }) => self.running = false,
-            Action::Note(super::LaserEvent::RunStarted) => self.running = true,
+            Action::Note(super::super::laser::LaserEvent::Stopped { .. }) => self.running = false,
+            Action::Note(super::super::laser::LaserEvent::RunStarted) => self.running = true,
             Action::Save | Action::Yield => *follow = Some(action.clone()),
             Action::Stepper(StepperRequest::MoveTo { seq, point, .. }) => {
                 assert!(self.running, "stepper move while stopped");
@@ -519,11 +519,12 @@ impl Harness {
             ));
         }
         // Every stop reaches every actuator.
-        for (i, _) in actions
-            .iter()
-            .enumerate()
-            .filter(|(_, a)| matches!(a, Action::Note(super::LaserEvent::Stopped { .. })))
-        {
+        for (i, _) in actions.iter().enumerate().filter(|(_, a)| {
+            matches!(
+                a,
+                Action::Note(super::super::laser::LaserEvent::Stopped { .. })
+            )
+        }) {
             let rest = &actions[i..];
             let closes = rest.contains(&Action::CloseGate);
             let galvo = rest.iter().any(|a| *a == Action::Galvo(GalvoRequest::Stop));
