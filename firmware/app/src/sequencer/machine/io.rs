@@ -32,7 +32,7 @@ pub enum Event {
     Galvo(GalvoEvent),
     /// The stepper task's report.
     Stepper(StepperEvent),
-    /// The dwell deadline ([`Core::dwell_deadline`]) passed.
+    /// The dwell deadline ([`Core::dwell_deadline`](super::Core::dwell_deadline)) passed.
     DwellEnded,
     /// The housekeeping tick (liveness for the watchdog).
     Tick,
@@ -124,11 +124,11 @@ pub enum Action {
     /// while lit).
     GimbalPower(super::super::LaserPower),
     /// Tell the laser switch about an event that decides when a laser may
-    /// be lit ([`super::LaserSwitch::note`]).
+    /// be lit ([`super::super::LaserSwitch::note`]).
     Note(LaserEvent<'static>),
     /// A line to the console.
     Line(Line),
-    /// Save the settings ([`Core::settings`]); answer with
+    /// Save the settings ([`Core::settings`](super::Core::settings)); answer with
     /// [`Event::Saved`].
     Save,
     /// Let the other tasks run, then send [`Event::CheckStep`].
