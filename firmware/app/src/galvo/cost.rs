@@ -102,7 +102,7 @@ pub const M4_COST: CostModel = CostModel {
     // `loop.stroke.prep` (75 240): the dearest stroke step, a jump and a
     // G-code stroke of four lines (its open end needs its own IK); one
     // 40-instruction timer tick of margin, rounded up.
-    stroke_prepared: 75_300,
+    stroke_prepared: 75_400,
     // `plan.seed.0.1deg` (1.572 M), rounded up: the cheapest bisection
     // plan, a lower bound for any jump.
     bisection_axis: 1_580_000,
