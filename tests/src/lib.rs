@@ -13,6 +13,30 @@ use laser_sim::safety::{Violation, ViolationKind, check, report_text};
 use laser_sim::script::parse_script;
 use laser_sim::world::{SimOptions, SimReport, run};
 
+/// Asserts that no console line of `report` is an error or an alarm,
+/// that the script ran to its end and that the machine ended idle.
+pub fn assert_all_ok(report: &SimReport, label: &str) {
+    let lines = terminal_lines(report);
+    let errors: Vec<&&str> = lines
+        .iter()
+        .filter(|l| l.starts_with("error") || l.starts_with("ALARM"))
+        .collect();
+    assert!(errors.is_empty(), "{label}: {errors:?}");
+    assert!(report.transcript.script_done, "{label}: script not done");
+    assert!(report.idle_at_end, "{label}: still running at the end");
+}
+
+/// A console script: `prefix` followed by each of `lines` on a line of
+/// its own.
+pub fn script(prefix: &str, lines: &[String]) -> String {
+    let mut s = String::from(prefix);
+    for l in lines {
+        s.push_str(l);
+        s.push('\n');
+    }
+    s
+}
+
 /// Runs `script` to idle in virtual time with default options.
 pub fn run_to_idle(script: &str) -> SimReport {
     run_with(script, SimOptions::default())

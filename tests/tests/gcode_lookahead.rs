@@ -7,7 +7,8 @@
 
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Piece, fit};
-use system_tests::{run_with, sent_at, terminal_lines};
+use system_tests::gcode_toolpath::{gimbal_spot_mm, lit_mm};
+use system_tests::{assert_all_ok, run_with, script, sent_at, terminal_lines};
 
 /// Servo resolution on the board (see `gcode_sim.rs`), mm.
 const GIMBAL_TOLERANCE_MM: f64 = 0.45;
@@ -17,13 +18,9 @@ const STEPPER_TOLERANCE_MM: f64 = 0.35;
 /// Feed of the jobs, mm/min.
 const FEED_MM_MIN: f64 = 1200.0;
 
-/// A closed polygon of `n` G1 segments approximating a circle of
-/// `radius_mm` about the origin, and its pieces.
-fn circle_job(n: usize, radius_mm: f64) -> (Vec<String>, Vec<Piece>, f64) {
-    let at = |k: usize| {
-        let a = std::f64::consts::TAU * k as f64 / n as f64;
-        [radius_mm * a.cos(), radius_mm * a.sin()]
-    };
+/// A lit polyline job: rapid to `at(0)`, then G1 through `at(1)` ..
+/// `at(n)` at the job's feed; its G-code lines, pieces and length (mm).
+fn polyline_job(n: usize, at: impl Fn(usize) -> [f64; 2]) -> (Vec<String>, Vec<Piece>, f64) {
     let mut lines = vec![
         "G21 G90".to_string(),
         format!("G0 X{:.3} Y{:.3}", at(0)[0], at(0)[1]),
@@ -40,55 +37,29 @@ fn circle_job(n: usize, radius_mm: f64) -> (Vec<String>, Vec<Piece>, f64) {
     }
     lines.push("M5".to_string());
     (lines, pieces, length)
+}
+
+/// A closed polygon of `n` G1 segments approximating a circle of
+/// `radius_mm` about the origin, and its pieces.
+fn circle_job(n: usize, radius_mm: f64) -> (Vec<String>, Vec<Piece>, f64) {
+    polyline_job(n, |k| {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        [radius_mm * a.cos(), radius_mm * a.sin()]
+    })
 }
 
 /// A zig-zag of `n` segments between y = ±`half_height_mm`, x advancing
 /// by `pitch_mm` (corners of ≈ 170°), and its pieces.
 fn zigzag_job(n: usize, pitch_mm: f64, half_height_mm: f64) -> (Vec<String>, Vec<Piece>, f64) {
     let x0 = -pitch_mm * n as f64 / 2.0;
-    let at = |k: usize| {
+    polyline_job(n, |k| {
         let y = if k.is_multiple_of(2) {
             -half_height_mm
         } else {
             half_height_mm
         };
         [x0 + pitch_mm * k as f64, y]
-    };
-    let mut lines = vec![
-        "G21 G90".to_string(),
-        format!("G0 X{:.3} Y{:.3}", at(0)[0], at(0)[1]),
-        "M3 S1000".to_string(),
-        format!("G1 F{FEED_MM_MIN}"),
-    ];
-    let mut pieces = Vec::new();
-    let mut length = 0.0;
-    for k in 1..=n {
-        let (a, b) = (at(k - 1), at(k));
-        lines.push(format!("G1 X{:.3} Y{:.3}", b[0], b[1]));
-        pieces.push(Piece::Line { a, b });
-        length += (b[0] - a[0]).hypot(b[1] - a[1]);
-    }
-    lines.push("M5".to_string());
-    (lines, pieces, length)
-}
-
-fn script(prefix: &str, lines: &[String]) -> String {
-    let mut s = String::from(prefix);
-    for l in lines {
-        s.push_str(l);
-        s.push('\n');
-    }
-    s
-}
-
-fn lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
-    report
-        .recording
-        .spot
-        .iter()
-        .filter(|s| s.laser)
-        .map(|s| [s.x_cm * 10.0, s.y_cm * 10.0])
-        .collect()
+    })
 }
 
 /// Simulated time from the first lit G1 to the end of the last lit
@@ -142,17 +113,6 @@ fn slowest_lit_speed(report: &SimReport, margin_s: f64) -> f64 {
     slowest
 }
 
-fn assert_all_ok(report: &SimReport, label: &str) {
-    let lines = terminal_lines(report);
-    let errors: Vec<&&str> = lines
-        .iter()
-        .filter(|l| l.starts_with("error") || l.starts_with("ALARM"))
-        .collect();
-    assert!(errors.is_empty(), "{label}: {errors:?}");
-    assert!(report.transcript.script_done, "{label}: script not done");
-    assert!(report.idle_at_end, "{label}: still running at the end");
-}
-
 /// Runs `lines` after `prefix`; returns the report and the job's time
 /// from its first line to idle, s.
 fn run_job(prefix: &str, lines: &[String]) -> (SimReport, f64) {
@@ -162,19 +122,27 @@ fn run_job(prefix: &str, lines: &[String]) -> (SimReport, f64) {
     (report, seconds)
 }
 
-#[test]
-fn a_200_segment_circle_runs_continuously_on_the_gimbal() {
-    let (lines, pieces, length) = circle_job(200, 40.0);
+/// Runs a polyline job (see [`polyline_job`]) on the gimbal: no error,
+/// every lit sample within the servo resolution of the path and the whole
+/// path drawn. Returns the report, the lit time and the time the path
+/// takes at the feed, s.
+fn run_on_gimbal(label: &str, job: (Vec<String>, Vec<Piece>, f64)) -> (SimReport, f64, f64) {
+    let (lines, pieces, length) = job;
     let (report, job_s) = run_job("", &lines);
-    assert_all_ok(&report, "gimbal circle");
-    let fit = fit(&lit_mm(&report), &pieces);
+    assert_all_ok(&report, label);
+    let fit = fit(&lit_mm(&gimbal_spot_mm(&report)), &pieces);
     let at_feed_s = length / (FEED_MM_MIN / 60.0);
     let lit_s = lit_span_s(&report);
-    eprintln!(
-        "gimbal circle: job {job_s:.2} s, lit {lit_s:.2} s, at feed {at_feed_s:.2} s, 200 blocks x 40 ms settle = 8 s; {fit:?}"
-    );
-    assert!(fit.worst_lit_mm <= GIMBAL_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 1.5, "{fit:?}");
+    eprintln!("{label}: job {job_s:.2} s, lit {lit_s:.2} s, at feed {at_feed_s:.2} s; {fit:?}");
+    assert!(fit.worst_lit_mm <= GIMBAL_TOLERANCE_MM, "{label}: {fit:?}");
+    assert!(fit.worst_missed_mm <= 1.5, "{label}: {fit:?}");
+    (report, lit_s, at_feed_s)
+}
+
+#[test]
+fn a_200_segment_circle_runs_continuously_on_the_gimbal() {
+    // A stop and settle at each of the 200 blocks would take 8 s more.
+    let (report, lit_s, at_feed_s) = run_on_gimbal("gimbal circle", circle_job(200, 40.0));
     // No stop at the gentle junctions: the lit part takes the time at
     // the feed (plus the start's and the end's ramps), far below one
     // settle per block.
@@ -188,17 +156,7 @@ fn a_200_segment_circle_runs_continuously_on_the_gimbal() {
 
 #[test]
 fn a_sharp_zigzag_keeps_its_corners_on_the_gimbal() {
-    let (lines, pieces, length) = zigzag_job(40, 4.0, 5.0);
-    let (report, job_s) = run_job("", &lines);
-    assert_all_ok(&report, "gimbal zig-zag");
-    let fit = fit(&lit_mm(&report), &pieces);
-    let at_feed_s = length / (FEED_MM_MIN / 60.0);
-    let lit_s = lit_span_s(&report);
-    eprintln!(
-        "gimbal zig-zag: job {job_s:.2} s, lit {lit_s:.2} s, at feed {at_feed_s:.2} s; {fit:?}"
-    );
-    assert!(fit.worst_lit_mm <= GIMBAL_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 1.5, "{fit:?}");
+    let (_, lit_s, at_feed_s) = run_on_gimbal("gimbal zig-zag", zigzag_job(40, 4.0, 5.0));
     assert!(lit_s < at_feed_s * 1.2 + 0.3, "lit {lit_s:.2} s");
 }
 
@@ -249,7 +207,7 @@ fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_gimbal() {
     assert!(dist(a, b) < 1.5, "{a:?} {b:?}");
     assert!(dist(b, c) < 0.05, "{b:?} {c:?}");
     // The whole circle drawn, nothing off it.
-    let fit = fit(&lit_mm(&report), &pieces);
+    let fit = fit(&lit_mm(&gimbal_spot_mm(&report)), &pieces);
     assert!(fit.worst_lit_mm <= GIMBAL_TOLERANCE_MM, "{fit:?}");
     assert!(fit.worst_missed_mm <= 1.5, "{fit:?}");
 }
@@ -280,7 +238,7 @@ fn the_circle_and_the_zigzag_run_continuously_on_the_stepper() {
         let (report, job_s) = run_job("target stepper\n", &lines);
         assert_all_ok(&report, name);
         assert_clean_drive(&report);
-        let fit = fit(&lit_mm(&report), &pieces);
+        let fit = fit(&lit_mm(&gimbal_spot_mm(&report)), &pieces);
         let at_feed_s = length / (FEED_MM_MIN / 60.0);
         let lit_s = lit_span_s(&report);
         eprintln!(
@@ -329,7 +287,7 @@ fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_stepper() {
     let dist = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]);
     let (a, b) = (at(hold_at + 400_000), at(resume_at));
     assert!(dist(a, b) < 1e-9, "{a:?} {b:?}");
-    let fit = fit(&lit_mm(&report), &pieces);
+    let fit = fit(&lit_mm(&gimbal_spot_mm(&report)), &pieces);
     eprintln!("stepper hold: {fit:?}");
     assert!(fit.worst_lit_mm <= STEPPER_TOLERANCE_MM, "{fit:?}");
     // The stretch travelled dark between `!` and rest is the one gap:

@@ -1,11 +1,12 @@
 //! G-code through the simulated console: grbl's replies, the motion
 //! queue, and what the gimbal and the galvo draw for a realistic laser job.
 
-use kinematics_core::Galvo;
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Job, PathFit, SpotMm, fit, laser_job, rapids_dark};
-use system_tests::gcode_toolpath::{galvo_spot_mm, gimbal_spot_mm};
-use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_lines};
+use system_tests::gcode_toolpath::{galvo_spot_mm, gimbal_spot_mm, lit_mm};
+use system_tests::{
+    UNTIL_STEP_FIXES, assert_all_ok, assert_safe_allowing, run_with, script, terminal_lines,
+};
 
 /// Servo resolution, 0.1°, as a distance on the board at the gimbal's
 /// distance (OQ = 25 cm) and the job's far corner (~50 mm off centre):
@@ -13,36 +14,6 @@ use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with, terminal_li
 const GIMBAL_TOLERANCE_MM: f64 = 0.45;
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;
-
-fn script(prefix: &str, lines: &[String]) -> String {
-    let mut s = String::from(prefix);
-    for l in lines {
-        s.push_str(l);
-        s.push('\n');
-    }
-    s
-}
-
-fn gimbal_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
-    report
-        .recording
-        .spot
-        .iter()
-        .filter(|s| s.laser)
-        .map(|s| [s.x_cm * 10.0, s.y_cm * 10.0])
-        .collect()
-}
-
-fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
-    let galvo = Galvo::<f64>::default();
-    report
-        .dac
-        .iter()
-        .filter(|(_, s)| s.laser)
-        .filter_map(|(_, s)| galvo.codes_to_board(s.x_code, s.y_code).ok())
-        .map(|p| [p.x_mm, p.y_mm])
-        .collect()
-}
 
 /// Every G0 of `job` was found on the spot's timeline, crossed with at
 /// least one sample, and not one of them lit.
@@ -61,17 +32,6 @@ fn assert_dark_on_every_rapid(samples: &[SpotMm], job: &Job, tol_mm: f64, label:
     );
 }
 
-fn assert_all_ok(report: &SimReport, label: &str) {
-    let lines = terminal_lines(report);
-    let errors: Vec<&&str> = lines
-        .iter()
-        .filter(|l| l.starts_with("error") || l.starts_with("ALARM"))
-        .collect();
-    assert!(errors.is_empty(), "{label}: {errors:?}");
-    assert!(report.transcript.script_done, "{label}: script not done");
-    assert!(report.idle_at_end, "{label}: still running at the end");
-}
-
 #[test]
 fn a_laser_job_draws_its_toolpath_on_the_gimbal() {
     let job = laser_job(40.0);
@@ -83,7 +43,7 @@ fn a_laser_job_draws_its_toolpath_on_the_gimbal() {
         worst_missed_mm,
         lit,
         ..
-    } = fit(&gimbal_lit_mm(&report), &job.pieces);
+    } = fit(&lit_mm(&gimbal_spot_mm(&report)), &job.pieces);
     eprintln!(
         "gimbal: {lit} lit samples, worst off path {worst_lit_mm:.3} mm, worst gap {worst_missed_mm:.3} mm, {:.1} s",
         report.end_time_us as f64 / 1e6
@@ -115,7 +75,7 @@ fn a_laser_job_draws_its_toolpath_on_the_galvo() {
         worst_missed_mm,
         lit,
         ..
-    } = fit(&galvo_lit_mm(&report), &job.pieces);
+    } = fit(&lit_mm(&galvo_spot_mm(&report)), &job.pieces);
     eprintln!(
         "galvo: {lit} lit samples, worst off path {worst_lit_mm:.3} mm, worst gap {worst_missed_mm:.3} mm, {:.1} s",
         report.end_time_us as f64 / 1e6
@@ -221,7 +181,7 @@ fn feed_hold_stops_dark_and_resume_finishes_the_job() {
     assert!(!lit_in_hold, "lit during the hold");
     // The whole line was drawn all the same, and nothing else.
     let fit = fit(
-        &gimbal_lit_mm(&report),
+        &lit_mm(&gimbal_spot_mm(&report)),
         &[system_tests::gcode_job::Piece::Line {
             a: [-30.0, 0.0],
             b: [30.0, 0.0],
@@ -287,7 +247,7 @@ fn feed_hold_on_the_galvo_is_dark_and_the_job_still_draws_its_toolpath() {
         .find(|l| l.starts_with('<'))
         .expect("a status report");
     assert!(status.starts_with("<Hold:0|"), "{status}");
-    let fit = fit(&galvo_lit_mm(&report), &job.pieces);
+    let fit = fit(&lit_mm(&galvo_spot_mm(&report)), &job.pieces);
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
     assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
 }
@@ -326,7 +286,7 @@ fn the_galvo_marks_at_the_programmed_feed() {
         let report = run_with(&text, SimOptions::default());
         assert_all_ok(&report, "galvo feed");
         let fit = fit(
-            &galvo_lit_mm(&report),
+            &lit_mm(&galvo_spot_mm(&report)),
             &[system_tests::gcode_job::Piece::Line {
                 a: [-20.0, 5.0],
                 b: [20.0, 5.0],

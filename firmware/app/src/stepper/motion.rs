@@ -4,11 +4,13 @@
 //! straight in steps, enough pieces (a power of two) that the spot stays
 //! within [`LINE_TOLERANCE_MM`] of the board curve.
 
+mod cut;
 mod resume;
+
+use cut::{Curve, PieceCut};
 
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::JointAngles;
-use kinematics_core::path::{Segment as BoardSegment, Shape};
 use kinematics_core::stepper::{Planner, Segment, SegmentPrep, StepMove};
 
 use super::{MoveShape, SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
@@ -22,74 +24,6 @@ pub const LINE_TOLERANCE_MM: f64 = 0.05;
 const MAX_PIECES: u32 = 4096;
 /// Look-ahead depth of the planner, blocks.
 const PLANNER_LEN: usize = 16;
-
-/// The board curve of a move being cut into pieces (kinematics-core's
-/// shape, the gimbal sampler's point-at-parameter).
-#[derive(Debug, Clone, Copy)]
-struct Curve(Shape);
-
-impl Curve {
-    /// The curve from `from` to `to` as `shape` says (`None`: travel).
-    fn of(from: BoardPoint, to: BoardPoint, shape: MoveShape) -> Option<Self> {
-        let segment = match shape {
-            MoveShape::Travel => return None,
-            MoveShape::Line => BoardSegment::Line { from, to },
-            MoveShape::Arc { centre, rotation } => BoardSegment::Arc {
-                start: from,
-                end: to,
-                centre,
-                rotation,
-            },
-        };
-        Some(Curve(Shape::of(segment)))
-    }
-
-    /// The point a fraction `t` (0..=1) along the curve.
-    fn at(&self, t: f64) -> BoardPoint {
-        self.0.point_at(t)
-    }
-
-    /// Pieces to start from: arcs in pieces of at most 22.5° (so a
-    /// piece's midpoint tells its deviation; a full circle is not one
-    /// piece from its start to itself).
-    fn fewest_pieces(&self) -> u32 {
-        match self.0 {
-            Shape::Line { .. } => 1,
-            Shape::Arc { sweep_rad, .. } => {
-                let wanted = libm::ceil(sweep_rad.abs() / (core::f64::consts::PI / 8.0));
-                // ≤ 16 for |sweep| ≤ 2π: the cast is exact.
-                (wanted as u32).max(1).next_power_of_two()
-            }
-        }
-    }
-
-    /// Distance of `p` from the curve (near it), cm.
-    fn distance_cm(&self, p: BoardPoint) -> f64 {
-        match self.0 {
-            Shape::Line { from, to } => distance_to_segment_cm(p, from, to),
-            Shape::Arc {
-                centre, radius_cm, ..
-            } => (libm::hypot(p.x_cm - centre.x_cm, p.y_cm - centre.y_cm) - radius_cm).abs(),
-        }
-    }
-}
-
-/// A board curve being cut into pieces.
-#[derive(Debug, Clone, Copy)]
-struct PieceCut {
-    curve: Curve,
-    /// Spot speed along the curve, mm/s (`None`: the axes' limit).
-    feed_mm_s: Option<f64>,
-    pieces: u32,
-    /// Next piece end to queue (1..=pieces).
-    next: u32,
-}
-
-impl PieceCut {
-    fn point(&self, k: u32) -> BoardPoint {
-        self.curve.at(f64::from(k) / f64::from(self.pieces))
-    }
-}
 
 /// Planner, segment prep and the move being cut.
 #[derive(Debug, Clone)]
@@ -279,48 +213,6 @@ impl StepperMotion {
             .map_err(|_| StepperRefusal::Unreachable)
     }
 
-    /// The fewest pieces (a power of two) whose joint-space midpoints lie
-    /// within [`LINE_TOLERANCE_MM`] of the curve; every piece end within
-    /// the soft limits.
-    fn pieces_for(&self, curve: Curve) -> Result<u32, StepperRefusal> {
-        let mut pieces = curve.fewest_pieces();
-        loop {
-            let cut = PieceCut {
-                curve,
-                feed_mm_s: None,
-                pieces,
-                next: 1,
-            };
-            if self.max_deviation_mm(&cut)? <= LINE_TOLERANCE_MM || pieces >= MAX_PIECES {
-                return Ok(pieces);
-            }
-            pieces *= 2;
-        }
-    }
-
-    /// Largest distance of a piece's joint-space midpoint from the curve,
-    /// mm.
-    fn max_deviation_mm(&self, cut: &PieceCut) -> Result<f64, StepperRefusal> {
-        let mut worst = 0.0_f64;
-        let mut a = self.joints_at(cut.point(0))?;
-        for k in 1..=cut.pieces {
-            let b = self.joints_at(cut.point(k))?;
-            self.config.steps_of(b)?;
-            let mid = JointAngles {
-                yaw_deg: 0.5 * (a.yaw_deg + b.yaw_deg),
-                pitch_deg: 0.5 * (a.pitch_deg + b.pitch_deg),
-            };
-            let spot = self
-                .config
-                .gimbal
-                .fk(mid)
-                .map_err(|_| StepperRefusal::Unreachable)?;
-            worst = worst.max(10.0 * cut.curve.distance_cm(spot));
-            a = b;
-        }
-        Ok(worst)
-    }
-
     /// Queues the move from the planned position to `end` (steps), with
     /// `feed` = (spot speed mm/s, piece length mm) when a feed applies.
     fn push_to(&mut self, end: [i32; 2], feed: Option<(f64, f64)>) -> Result<(), StepperRefusal> {
@@ -450,20 +342,4 @@ impl StepperMotion {
     pub fn planned_steps(&self) -> [i32; 2] {
         self.planned
     }
-}
-
-/// Distance from `p` to the segment `a`–`b`, cm.
-fn distance_to_segment_cm(p: BoardPoint, a: BoardPoint, b: BoardPoint) -> f64 {
-    let (dx, dy) = (b.x_cm - a.x_cm, b.y_cm - a.y_cm);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 {
-        clamp(
-            ((p.x_cm - a.x_cm) * dx + (p.y_cm - a.y_cm) * dy) / len2,
-            0.0,
-            1.0,
-        )
-    } else {
-        0.0
-    };
-    libm::hypot(p.x_cm - (a.x_cm + t * dx), p.y_cm - (a.y_cm + t * dy))
 }

@@ -99,6 +99,25 @@ pub(crate) fn status(core: &mut Core, ms: u64) -> String {
     texts(&out).pop().expect("a status report")
 }
 
+/// One step of [`pump`]: confirms the pending servo move 1 ms on, or
+/// ends the dwell/tick at its deadline; `None` when nothing is pending.
+/// Advances `ms` and notes the next pending move.
+fn pump_step(core: &mut Core, ms: &mut u64, pending: &mut Option<u32>) -> Option<Vec<Action>> {
+    let out = match (pending.take(), core.dwell_deadline()) {
+        (Some(seq), _) => {
+            *ms += 1;
+            arrive(core, *ms, seq)
+        }
+        (None, Some(deadline)) => {
+            *ms = (*ms).max(deadline.as_micros().div_ceil(1000));
+            on(core, *ms, Event::DwellEnded)
+        }
+        (None, None) => return None,
+    };
+    *pending = move_seq(&out);
+    Some(out)
+}
+
 /// Runs the core's time on from `ms`: each streaming tick or settle at
 /// its deadline, each servo move confirmed 1 ms after it was sent, until
 /// `done` holds for what came out (or nothing is pending). Returns the
@@ -114,18 +133,9 @@ pub(in crate::sequencer) fn pump(
         if done(&all) {
             break;
         }
-        let out = match (pending.take(), core.dwell_deadline()) {
-            (Some(seq), _) => {
-                ms += 1;
-                arrive(core, ms, seq)
-            }
-            (None, Some(deadline)) => {
-                ms = ms.max(deadline.as_micros().div_ceil(1000));
-                on(core, ms, Event::DwellEnded)
-            }
-            (None, None) => break,
+        let Some(out) = pump_step(core, &mut ms, &mut pending) else {
+            break;
         };
-        pending = move_seq(&out);
         all.extend(out);
     }
     (ms, all)
@@ -302,18 +312,9 @@ fn follow(core: &mut Core, ms: u64) -> Vec<(f64, [f64; 2])> {
     let mut ms = ms;
     let mut pending: Option<u32> = None;
     for _ in 0..100_000 {
-        let out = match (pending.take(), core.dwell_deadline()) {
-            (Some(seq), _) => {
-                ms += 1;
-                arrive(core, ms, seq)
-            }
-            (None, Some(deadline)) => {
-                ms = ms.max(deadline.as_micros().div_ceil(1000));
-                on(core, ms, Event::DwellEnded)
-            }
-            (None, None) => break,
-        };
-        pending = move_seq(&out);
+        if pump_step(core, &mut ms, &mut pending).is_none() {
+            break;
+        }
         let p = core.gcode.motion.position;
         trace.push((core.gcode.motion.stream.speed_mm_s(), [p.x_mm, p.y_mm]));
     }

@@ -306,33 +306,10 @@ impl Harness {
                 let seq = Self::seq(false, &mut self.move_owed);
                 (Event::Servo(ServoOutcome::Superseded { seq }), true)
             }
-            Step::StepperArrived { current, steps } => {
-                let seq = Self::seq(current, &mut self.step_owed);
-                let steps = [i32::from(steps.0), i32::from(steps.1)];
-                (Event::Stepper(StepperEvent::Arrived { seq, steps }), true)
-            }
-            Step::StepperRefused { current } => {
-                let seq = Self::seq(current, &mut self.step_owed);
-                let why = StepperRefusal::SoftLimit;
-                (Event::Stepper(StepperEvent::Refused { seq, why }), true)
-            }
-            Step::StepperStopped => {
-                self.step_owed = None;
-                (
-                    Event::Stepper(StepperEvent::Stopped { steps: [0; 2] }),
-                    true,
-                )
-            }
-            Step::StepperLimit(kind) => {
-                self.step_owed = None;
-                let steps = [0; 2];
-                let event = match kind {
-                    1..=3 => StepperEvent::LimitHit { axes: kind, steps },
-                    4 => StepperEvent::Homed { steps },
-                    _ => StepperEvent::HomingFailed(crate::stepper::HomingFailure::Interrupted),
-                };
-                (Event::Stepper(event), true)
-            }
+            Step::StepperArrived { .. }
+            | Step::StepperRefused { .. }
+            | Step::StepperStopped
+            | Step::StepperLimit(_) => (Event::Stepper(self.stepper_event(step)), true),
             Step::GalvoDone { current } => {
                 let seq = Self::seq(current, &mut self.job_owed);
                 (Event::Galvo(GalvoEvent::Done { seq }), true)
@@ -378,6 +355,36 @@ impl Harness {
             }
         };
         Some(event)
+    }
+
+    /// The stepper's report of a `Step::Stepper*` step.
+    fn stepper_event(&mut self, step: &Step) -> StepperEvent {
+        match *step {
+            Step::StepperArrived { current, steps } => {
+                let seq = Self::seq(current, &mut self.step_owed);
+                let steps = [i32::from(steps.0), i32::from(steps.1)];
+                StepperEvent::Arrived { seq, steps }
+            }
+            Step::StepperRefused { current } => {
+                let seq = Self::seq(current, &mut self.step_owed);
+                let why = StepperRefusal::SoftLimit;
+                StepperEvent::Refused { seq, why }
+            }
+            Step::StepperStopped => {
+                self.step_owed = None;
+                StepperEvent::Stopped { steps: [0; 2] }
+            }
+            Step::StepperLimit(kind) => {
+                self.step_owed = None;
+                let steps = [0; 2];
+                match kind {
+                    1..=3 => StepperEvent::LimitHit { axes: kind, steps },
+                    4 => StepperEvent::Homed { steps },
+                    _ => StepperEvent::HomingFailed(crate::stepper::HomingFailure::Interrupted),
+                }
+            }
+            _ => unreachable!("not a stepper step: {step:?}"),
+        }
     }
 
     /// The request number an outcome reports: the request still owed one
@@ -477,8 +484,8 @@ impl Harness {
                 self.gate_open |= lit;
                 self.lit = lit;
             }
-            Action::Note(super::LaserEvent::Stopped { .. }) => self.running = false,
-            Action::Note(super::LaserEvent::RunStarted) => self.running = true,
+            Action::Note(super::super::laser::LaserEvent::Stopped { .. }) => self.running = false,
+            Action::Note(super::super::laser::LaserEvent::RunStarted) => self.running = true,
             Action::Save | Action::Yield => *follow = Some(action.clone()),
             Action::Stepper(StepperRequest::MoveTo { seq, point, .. }) => {
                 assert!(self.running, "stepper move while stopped");
@@ -519,11 +526,12 @@ impl Harness {
             ));
         }
         // Every stop reaches every actuator.
-        for (i, _) in actions
-            .iter()
-            .enumerate()
-            .filter(|(_, a)| matches!(a, Action::Note(super::LaserEvent::Stopped { .. })))
-        {
+        for (i, _) in actions.iter().enumerate().filter(|(_, a)| {
+            matches!(
+                a,
+                Action::Note(super::super::laser::LaserEvent::Stopped { .. })
+            )
+        }) {
             let rest = &actions[i..];
             let closes = rest.contains(&Action::CloseGate);
             let galvo = rest.iter().any(|a| *a == Action::Galvo(GalvoRequest::Stop));
