@@ -173,21 +173,34 @@ fn circle_with_hold(at: usize) -> (Vec<String>, Vec<Piece>) {
     (lines, pieces)
 }
 
+/// The job's four `?` reports, checked to be Run, Hold:0, Hold:0, Run
+/// (asked before the hold, twice in it, after the resume).
+fn run_hold_hold_run_statuses(report: &SimReport) -> Vec<String> {
+    let terminal = terminal_lines(report);
+    let statuses: Vec<String> = terminal
+        .iter()
+        .filter(|l| l.starts_with('<'))
+        .map(|l| l.to_string())
+        .collect();
+    assert_eq!(statuses.len(), 4, "{terminal:?}");
+    for (status, state) in statuses
+        .iter()
+        .zip(["<Run|", "<Hold:0|", "<Hold:0|", "<Run|"])
+    {
+        assert!(status.starts_with(state), "{statuses:?}");
+    }
+    statuses
+}
+
 #[test]
 fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_gimbal() {
     let (lines, pieces) = circle_with_hold(60);
     let (report, _) = run_job("", &lines);
     assert_all_ok(&report, "gimbal hold");
-    let terminal = terminal_lines(&report);
-    let statuses: Vec<&&str> = terminal.iter().filter(|l| l.starts_with('<')).collect();
-    assert_eq!(statuses.len(), 4, "{terminal:?}");
-    assert!(statuses[0].starts_with("<Run|"), "{statuses:?}");
-    assert!(statuses[1].starts_with("<Hold:0|"), "{statuses:?}");
-    assert!(statuses[2].starts_with("<Hold:0|"), "{statuses:?}");
-    assert!(statuses[3].starts_with("<Run|"), "{statuses:?}");
+    let statuses = run_hold_hold_run_statuses(&report);
     // Held where it stopped: both reports in the hold at one position.
     let mpos = |s: &str| s.split('|').nth(1).map(str::to_string);
-    assert_eq!(mpos(statuses[1]), mpos(statuses[2]));
+    assert_eq!(mpos(&statuses[1]), mpos(&statuses[2]));
     let (hold_at, resume_at) = (sent_at(&report, "!"), sent_at(&report, "~"));
     let spot = &report.recording.spot;
     assert!(
@@ -262,13 +275,7 @@ fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_stepper() {
     let (report, _) = run_job("target stepper\n", &lines);
     assert_all_ok(&report, "stepper hold");
     assert_clean_drive(&report);
-    let terminal = terminal_lines(&report);
-    let statuses: Vec<&&str> = terminal.iter().filter(|l| l.starts_with('<')).collect();
-    assert_eq!(statuses.len(), 4, "{terminal:?}");
-    assert!(statuses[0].starts_with("<Run|"), "{statuses:?}");
-    assert!(statuses[1].starts_with("<Hold:0|"), "{statuses:?}");
-    assert!(statuses[2].starts_with("<Hold:0|"), "{statuses:?}");
-    assert!(statuses[3].starts_with("<Run|"), "{statuses:?}");
+    let statuses = run_hold_hold_run_statuses(&report);
     let (hold_at, resume_at) = (sent_at(&report, "!"), sent_at(&report, "~"));
     assert!(
         !report
