@@ -275,7 +275,7 @@ fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_stepper() {
     let (report, _) = run_job("target stepper\n", &lines);
     assert_all_ok(&report, "stepper hold");
     assert_clean_drive(&report);
-    let statuses = run_hold_hold_run_statuses(&report);
+    run_hold_hold_run_statuses(&report);
     let (hold_at, resume_at) = (sent_at(&report, "!"), sent_at(&report, "~"));
     assert!(
         !report

@@ -41,16 +41,18 @@ const GIMBAL_JOB: &str = "tests/senders/job/job-gimbal.nc";
 /// 25 cm) and the job's far corner (~50 mm off centre), as in gcode_sim.
 const GIMBAL_TOLERANCE_MM: f64 = 0.45;
 /// How far a toolpath point may be from the nearest lit gimbal position:
-/// a feed hold darkens the spot at once, the gimbal finishes its path
-/// step (`path.step_cm` = 2 mm) dark and `~` does not redraw it (measured
-/// 0.9–1.8 mm where the hold fell), plus the spot's sampling.
-const GIMBAL_GAP_MM: f64 = 2.2;
+/// the servo resolution, as for the lit path. A feed hold brakes along the
+/// path and `~` goes on from where it stopped, so the hold leaves no gap
+/// (before the look-ahead planner the gimbal finished its 2 mm path step
+/// dark and left a 0.9–1.8 mm gap; now 0.27 mm is measured).
+const GIMBAL_GAP_MM: f64 = GIMBAL_TOLERANCE_MM;
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;
 /// Lit samples allowed on the galvo after the first `Hold` report, ms:
-/// three 128-sample DAC halves at 10 µs (two written ahead, one being
-/// computed when the hold arrives).
-const GALVO_HOLD_DARK_MS: f64 = 3.84;
+/// SPEC §9's 1 ms (the hold closes the master laser gate, so the DAC
+/// halves already written play out dark; before that fix they stayed lit
+/// up to 3.5 ms).
+const GALVO_HOLD_DARK_MS: f64 = 1.0;
 /// Feed hold this long after the job starts, resume this much later, s.
 const HOLD_AT_S: &str = "5";
 const HOLD_FOR_S: &str = "1.5";
