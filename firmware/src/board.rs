@@ -239,7 +239,7 @@ pub fn init(spawner: Spawner) -> Stm32Board {
             enable: Output::new(p.PE13, Level::High, Speed::Low),
             limit: [Input::new(p.PE7, Pull::Up), Input::new(p.PE8, Pull::Up)],
             signals: laser_app::stepper::StepperConfig::default().signals,
-            next: Instant::MIN,
+            pace: laser_app::stepper::StepPace::new(),
         },
     }
 }

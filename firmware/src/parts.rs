@@ -114,8 +114,8 @@ pub struct GpioStepper {
     pub limit: [Input<'static>; 2],
     /// Current pulse timing and ENABLE polarity.
     pub signals: laser_app::stepper::DriverSignals,
-    /// Deadline of the next step event.
-    pub next: Instant,
+    /// The step timer's schedule.
+    pub pace: laser_app::stepper::StepPace,
 }
 
 /// CPU cycles for `ns` nanoseconds at SYSCLK (rounded up).
@@ -155,12 +155,11 @@ impl laser_app::stepper::StepperDrive for GpioStepper {
     }
 
     async fn wait_ticks(&mut self, ticks: u32) {
-        self.next += Duration::from_ticks(u64::from(ticks));
-        Timer::at(self.next).await;
+        self.pace.wait_ticks(ticks).await;
     }
 
     fn restart(&mut self) {
-        self.next = Instant::now();
+        self.pace.restart();
     }
 
     fn limits(&mut self) -> [bool; 2] {

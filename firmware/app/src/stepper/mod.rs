@@ -17,6 +17,7 @@
 mod home;
 mod link;
 mod motion;
+mod pace;
 mod task;
 
 pub use self::link::{
@@ -24,6 +25,7 @@ pub use self::link::{
     StepperRequest,
 };
 pub use self::motion::{LINE_TOLERANCE_MM, StepperMotion};
+pub use self::pace::StepPace;
 pub use self::task::{StepPulseTask, StepperTask};
 
 use kinematics_core::gimbal::{Gimbal, GimbalGeometry, GimbalModel, JointAngles};

@@ -5,8 +5,7 @@
 use std::cell::RefCell;
 use std::rc::Rc;
 
-use embassy_time::{Duration, Instant, Timer};
-use laser_app::stepper::{DriverSignals, STEP_TIMER_HZ, StepperDrive};
+use laser_app::stepper::{DriverSignals, STEP_TIMER_HZ, StepPace, StepperDrive};
 
 use super::{LimitSwitch, PanTiltDrivers, StepEdge, StepPin, StepperGeometry};
 
@@ -18,7 +17,7 @@ const _: () = assert!(STEP_TIMER_HZ as u64 == embassy_time::TICK_HZ);
 pub struct SimStepperDrive {
     drivers: Rc<RefCell<PanTiltDrivers>>,
     signals: DriverSignals,
-    next: Instant,
+    pace: StepPace,
     dir: [bool; 2],
     /// The true geometry (where the counted steps point).
     geometry: StepperGeometry,
@@ -41,7 +40,7 @@ impl SimStepperDrive {
                 dir_setup_ns: 0,
                 enable_active_high: false,
             },
-            next: Instant::from_ticks(0),
+            pace: StepPace::new(),
             dir: [false; 2],
             geometry,
             switches: switches.map(|s| s.map(|s| (s, false))),
@@ -73,12 +72,11 @@ impl StepperDrive for SimStepperDrive {
     }
 
     async fn wait_ticks(&mut self, ticks: u32) {
-        self.next += Duration::from_ticks(u64::from(ticks));
-        Timer::at(self.next).await;
+        self.pace.wait_ticks(ticks).await;
     }
 
     fn restart(&mut self) {
-        self.next = Instant::now();
+        self.pace.restart();
     }
 
     /// The switches at the joint angles of the counted steps.
