@@ -73,6 +73,14 @@ pub struct Overrides {
     pub spindle: u8,
 }
 
+impl Overrides {
+    /// `programmed_mm_min` (a block's F, mm/min) with the feed override
+    /// applied, mm/min.
+    pub fn feed_mm_min(&self, programmed_mm_min: f64) -> f64 {
+        programmed_mm_min * f64::from(self.feed) / 100.0
+    }
+}
+
 /// Everything a status report can show.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Status {

@@ -70,7 +70,7 @@ impl Core {
     /// override applied, capped by the galvo's marking speed
     /// (`galvo.mark_speed_mm_s`), mm/min.
     pub(super) fn gcode_galvo_feed_mm_min(&self, feed_mm_min: f64) -> f64 {
-        let feed = feed_mm_min * f64::from(self.gcode.overrides.feed) / 100.0;
+        let feed = self.gcode.overrides.feed_mm_min(feed_mm_min);
         feed.min(self.settings.galvo.mark_speed_mm_s * 60.0)
     }
 
@@ -91,7 +91,7 @@ impl Core {
         };
         let by_servo = self.move_interval_ms(&aim);
         let by_feed = feed.map_or(0.0, |f| {
-            let f = f * f64::from(self.gcode.overrides.feed) / 100.0;
+            let f = self.gcode.overrides.feed_mm_min(f);
             60_000.0 * from.distance_to(to) / f.max(1e-3)
         });
         let interval_ms = libm::fmax(f64::from(by_servo), by_feed).min(f64::from(u16::MAX)) as u16;

@@ -100,7 +100,7 @@ impl Core {
             | Block::Jog { feed_mm_min, .. } => feed_mm_min,
             _ => return None,
         };
-        Some(feed_mm_min * f64::from(self.gcode.overrides.feed) / 6000.0)
+        Some(self.gcode.overrides.feed_mm_min(feed_mm_min) / 60.0)
     }
 
     /// One move request to the stepper; returns its number.

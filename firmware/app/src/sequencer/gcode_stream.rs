@@ -236,7 +236,7 @@ impl Core {
     fn stream_speed_ratio(&self) -> f32 {
         let programmed = match self.gcode.motion.current.map(|c| c.block) {
             Some(Block::Line { feed_mm_min, .. } | Block::Arc { feed_mm_min, .. }) => {
-                feed_mm_min * f64::from(self.gcode.overrides.feed) / 6000.0
+                self.gcode.overrides.feed_mm_min(feed_mm_min) / 60.0
             }
             _ => return 0.0,
         };
