@@ -193,7 +193,7 @@ impl Core {
             let sent = record.ahead.iter().flatten().count();
             // One request slot stays free (for the stroke after).
             let room = self.inputs.galvo_room.is_some_and(|room| room > 1);
-            let Some(slot) = record.ahead.get(sent).filter(|_| room) else {
+            if !room || sent >= AHEAD {
                 return;
             };
             let last = record.ahead.iter().flatten().last();
