@@ -147,3 +147,6 @@ impl GalvoLoop {
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

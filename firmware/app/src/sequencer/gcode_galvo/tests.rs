@@ -11,7 +11,7 @@ use embassy_time::Instant;
 use super::super::gcode::tests::{closers, line, on, status};
 use super::super::gcode_motion::PLANNER_BLOCKS;
 use super::super::machine::{Action, Core, Event};
-use crate::domain::{Actuator, Figure, StrokeCm};
+use crate::domain::{Actuator, Figure};
 use crate::galvo::{GalvoEvent, GalvoRequest};
 
 /// The galvo requests in `actions`: (seq, stroke segments or `None` for
