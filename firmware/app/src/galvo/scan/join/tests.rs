@@ -42,13 +42,16 @@ fn run_halves(
     let mut events: Vec<(usize, GalvoEvent)> = Vec::new();
     let mut half = [DacSample::default(); 128];
     for k in 0..2_000 {
-        if events.iter().any(|(_, e)| *e == GalvoEvent::Done { seq: until }) {
+        if events
+            .iter()
+            .any(|(_, e)| *e == GalvoEvent::Done { seq: until })
+        {
             break;
         }
         later.retain(|(after, delay, request)| {
-            let due = events.iter().any(|(at, e)| {
-                *e == GalvoEvent::Done { seq: *after } && at + *delay as usize <= k
-            });
+            let due = events
+                .iter()
+                .any(|(at, e)| *e == GalvoEvent::Done { seq: *after } && at + *delay as usize <= k);
             if due {
                 assert_eq!(galvo.request(*request), None);
             }
@@ -149,7 +152,11 @@ fn stop_mid_contour_drops_the_joined_pieces_and_brakes_dark() {
         galvo.refill(&mut half, |e| events.push(e));
     }
     assert!(half.iter().all(|s| s.laser), "marking");
-    assert!((0.0..20.0).contains(&x_mm(&half[127])), "{}", x_mm(&half[127]));
+    assert!(
+        (0.0..20.0).contains(&x_mm(&half[127])),
+        "{}",
+        x_mm(&half[127])
+    );
     assert_eq!(galvo.request(GalvoRequest::Stop), None);
     galvo.prep_up_to(1);
     galvo.refill(&mut half, |e| events.push(e));
