@@ -8,6 +8,10 @@
 //! step may take, and 331 instructions per sample across its arc
 //! junctions, over the 2 µs budget), so G-code arcs reach the galvo as
 //! chords within `$12`, as before.
+//!
+//! A contour longer than four lines travels as several: the first, then
+//! pieces marked [`StrokeCm::continuing`] it, which the galvo joins to
+//! the stroke it is marking.
 
 use super::super::point::PointCm;
 use super::super::units::Unit;

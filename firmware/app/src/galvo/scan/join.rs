@@ -131,7 +131,10 @@ impl GalvoLoop {
 
     /// After marking samples: when the sampler has reached the joined
     /// continuation's blocks (`left` blocks remain in the planner), the
-    /// running job is done and the continuation runs on as the job.
+    /// running job is done and the continuation runs on as the job. Out
+    /// of line: it runs once per marking run, kept out of the refill's
+    /// per-sample code.
+    #[inline(never)]
     pub(super) fn reach_joined(&mut self, left: usize, on_event: &mut impl FnMut(GalvoEvent)) {
         let Some(joining) = self.joining else {
             return;
