@@ -268,3 +268,32 @@ fn the_laser_job_marks_each_contour_as_one_stroke() {
     let spans = rapids_dark(&timeline, &job.rapids, GALVO_TOLERANCE_MM).expect("G0s found");
     assert!(spans.iter().all(|s| s.lit == 0), "lit G0 {spans:?}");
 }
+
+#[test]
+fn the_svg2gcode_job_marks_each_contour_as_one_stroke() {
+    // The senders' CAM job (svg2gcode 3.3.7): 37 contours, each after
+    // its own G0 (frame, three circles, three glyph contours, 30
+    // dashes), 387 lit G1s; sent as a plain script (no sender).
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/senders/job/job-galvo.nc");
+    let text = std::fs::read_to_string(path).expect("the job file");
+    let mut job = Job::from_gcode(&text).expect("the job's toolpath");
+    job.lines
+        .retain(|l| !l.trim().is_empty() && !l.trim_start().starts_with(';'));
+    let report = run_galvo(&job, &[]);
+    let (lit, timeline) = (galvo_lit_mm(&report), galvo_spot_mm(&report));
+    let fit = fit(&lit, &job.pieces);
+    let strokes = laser_on_times_ns(&report).len();
+    eprintln!(
+        "svg2gcode job: {} lit G1s, {strokes} strokes, worst off path {:.3} mm, gap {:.3} mm, job {:.3} s",
+        job.pieces.len(),
+        fit.worst_lit_mm,
+        fit.worst_missed_mm,
+        report.end_time_us as f64 / 1e6
+    );
+    assert_eq!(job.rapids.len(), 37);
+    assert_eq!(strokes, job.rapids.len(), "one stroke per contour");
+    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+    let spans = rapids_dark(&timeline, &job.rapids, GALVO_TOLERANCE_MM).expect("G0s found");
+    assert!(spans.iter().all(|s| s.lit == 0), "lit G0 {spans:?}");
+}
