@@ -223,6 +223,16 @@ impl Core {
         }
     }
 
+    /// After a piece's `done`: a piece sent ahead that the next step did
+    /// not take over (cannot happen) is dropped from the galvo, which
+    /// brakes dark, rather than left to be marked behind the sequencer's
+    /// back.
+    pub(super) fn gcode_galvo_drop_unadopted(&mut self, out: &mut dyn ActionSink) {
+        if self.gcode.galvo.adopt.take().is_some() {
+            self.stop_galvo(out);
+        }
+    }
+
     /// Whether `seq` is a piece sent ahead of the stroke in flight.
     pub(super) fn gcode_galvo_ahead_is(&self, seq: u32) -> bool {
         let g = &self.gcode.galvo;

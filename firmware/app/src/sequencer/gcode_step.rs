@@ -148,6 +148,7 @@ impl Core {
         c.galvo_seq = None;
         self.gcode_galvo_stroke_done(seq, out);
         self.gcode_step_done(out);
+        self.gcode_galvo_drop_unadopted(out);
         true
     }
 
