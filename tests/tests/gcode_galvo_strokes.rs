@@ -73,6 +73,14 @@ fn run_galvo(job: &Job, extra: &[(usize, &str)]) -> SimReport {
     report
 }
 
+/// The lit samples lie on `job`'s toolpath (within the galvo's
+/// tolerance) and cover it (gaps within 0.5 mm).
+fn assert_on_toolpath(report: &SimReport, job: &Job) {
+    let fit = fit(&galvo_lit_mm(report), &job.pieces);
+    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+}
+
 /// Times (ns) the galvo laser turned on.
 fn laser_on_times_ns(report: &SimReport) -> Vec<u64> {
     let mut lit = false;
@@ -89,8 +97,13 @@ fn laser_on_times_ns(report: &SimReport) -> Vec<u64> {
 /// Draws `points`: returns its strokes (laser on-transitions) and job
 /// time (s), after checking the lit path and the dark G0s.
 fn draw(label: &str, points: &[[f64; 2]]) -> (usize, f64) {
-    let job = job_of(points);
-    let report = run_galvo(&job, &[]);
+    draw_job(label, &job_of(points))
+}
+
+/// Draws `job` on the galvo: returns its strokes (laser on-transitions)
+/// and job time (s), after checking the lit path and the dark G0s.
+fn draw_job(label: &str, job: &Job) -> (usize, f64) {
+    let report = run_galvo(job, &[]);
     let (lit, timeline) = (galvo_lit_mm(&report), galvo_spot_mm(&report));
     let fit = fit(&lit, &job.pieces);
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{label}: {fit:?}");
@@ -105,9 +118,10 @@ fn draw(label: &str, points: &[[f64; 2]]) -> (usize, f64) {
     let strokes = laser_on_times_ns(&report).len();
     let seconds = report.end_time_us as f64 / 1e6;
     eprintln!(
-        "{label}: {} G1s, {strokes} strokes, worst off path {:.3} mm, job {seconds:.3} s",
-        points.len() - 1,
-        fit.worst_lit_mm
+        "{label}: {} lit pieces, {strokes} strokes, worst off path {:.3} mm, gap {:.3} mm, job {seconds:.3} s",
+        job.pieces.len(),
+        fit.worst_lit_mm,
+        fit.worst_missed_mm,
     );
     (strokes, seconds)
 }
@@ -152,10 +166,7 @@ fn a_hold_mid_stroke_is_dark_and_resume_completes_the_square() {
     // Marked before the hold, then again from the stroke's start.
     assert_eq!(ons.len(), 2, "{ons:?}");
     assert!(ons[0] < hold_us * 1_000 && ons[1] > resume_us * 1_000);
-    let lit = galvo_lit_mm(&report);
-    let fit = fit(&lit, &job.pieces);
-    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+    assert_on_toolpath(&report, &job);
 }
 
 /// Index of the `n`-th (from 1) line of `job` starting with `prefix`.
@@ -184,10 +195,7 @@ fn a_hold_mid_contour_is_dark_within_a_millisecond_and_resume_completes_it() {
     let ons = laser_on_times_ns(&report);
     // Marked up to the hold, then from the step in flight again.
     assert_eq!(ons.len(), 2, "{ons:?}");
-    let lit = galvo_lit_mm(&report);
-    let fit = fit(&lit, &job.pieces);
-    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+    assert_on_toolpath(&report, &job);
 }
 
 #[test]
@@ -238,10 +246,7 @@ fn a_sender_pausing_mid_contour_ends_the_stroke_dark_and_goes_on() {
         .filter(|(t, _)| *t > ons[0] && *t < ons[1])
         .any(|(_, s)| !s.laser);
     assert!(dark_before, "dark between the two strokes");
-    let lit = galvo_lit_mm(&report);
-    let fit = fit(&lit, &job.pieces);
-    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+    assert_on_toolpath(&report, &job);
 }
 
 #[test]
@@ -252,21 +257,8 @@ fn the_laser_job_marks_each_contour_as_one_stroke() {
     // its chords within $12), and the raster's 30 dashes (separated by S0
     // moves).
     let job = system_tests::gcode_job::laser_job(25.0);
-    let report = run_galvo(&job, &[]);
-    let (lit, timeline) = (galvo_lit_mm(&report), galvo_spot_mm(&report));
-    let fit = fit(&lit, &job.pieces);
-    let strokes = laser_on_times_ns(&report).len();
-    eprintln!(
-        "laser job: {strokes} strokes, worst off path {:.3} mm, gap {:.3} mm, job {:.3} s",
-        fit.worst_lit_mm,
-        fit.worst_missed_mm,
-        report.end_time_us as f64 / 1e6
-    );
+    let (strokes, _) = draw_job("laser job", &job);
     assert_eq!(strokes, 1 + 1 + 1 + 1 + 3 + 30);
-    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
-    let spans = rapids_dark(&timeline, &job.rapids, GALVO_TOLERANCE_MM).expect("G0s found");
-    assert!(spans.iter().all(|s| s.lit == 0), "lit G0 {spans:?}");
 }
 
 #[test]
@@ -279,21 +271,7 @@ fn the_svg2gcode_job_marks_each_contour_as_one_stroke() {
     let mut job = Job::from_gcode(&text).expect("the job's toolpath");
     job.lines
         .retain(|l| !l.trim().is_empty() && !l.trim_start().starts_with(';'));
-    let report = run_galvo(&job, &[]);
-    let (lit, timeline) = (galvo_lit_mm(&report), galvo_spot_mm(&report));
-    let fit = fit(&lit, &job.pieces);
-    let strokes = laser_on_times_ns(&report).len();
-    eprintln!(
-        "svg2gcode job: {} lit G1s, {strokes} strokes, worst off path {:.3} mm, gap {:.3} mm, job {:.3} s",
-        job.pieces.len(),
-        fit.worst_lit_mm,
-        fit.worst_missed_mm,
-        report.end_time_us as f64 / 1e6
-    );
+    let (strokes, _) = draw_job("svg2gcode job", &job);
     assert_eq!(job.rapids.len(), 37);
     assert_eq!(strokes, job.rapids.len(), "one stroke per contour");
-    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
-    let spans = rapids_dark(&timeline, &job.rapids, GALVO_TOLERANCE_MM).expect("G0s found");
-    assert!(spans.iter().all(|s| s.lit == 0), "lit G0 {spans:?}");
 }
