@@ -318,7 +318,10 @@ fn joining(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
     }
     match joined {
         Some(ticks) if dones == 2 => b.report("loop.join.prep", ticks, 1),
-        _ => b.fail("loop.join.prep", ("joined, done", (joined.is_some(), dones))),
+        _ => b.fail(
+            "loop.join.prep",
+            ("joined, done", (joined.is_some(), dones)),
+        ),
     }
 }
 
