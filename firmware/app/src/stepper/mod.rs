@@ -17,6 +17,7 @@
 mod home;
 mod link;
 mod motion;
+mod one_pulse;
 mod pace;
 mod task;
 
@@ -25,6 +26,7 @@ pub use self::link::{
     StepperRequest,
 };
 pub use self::motion::{LINE_TOLERANCE_MM, StepperMotion};
+pub use self::one_pulse::{CCMR1_IDLE, OnePulse, OnePulseTiming};
 pub use self::pace::StepPace;
 pub use self::task::{StepPulseTask, StepperTask};
 
