@@ -43,7 +43,7 @@ use static_cell::StaticCell;
 
 use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac, darken_laser_stream};
 use crate::laser_pwm::{LaserPin, laser_dark};
-use crate::parts::{GpioStepper, IndependentDog, StatusLeds, UsbConsole, UsbDriver, UserButton};
+use crate::parts::{IndependentDog, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::{FlashSettings, settings_store};
 
 bind_interrupts!(struct Irqs {
@@ -136,7 +136,7 @@ pub struct Stm32Board {
     /// Independent watchdog (not started).
     pub watchdog: IndependentDog,
     /// Stepper pan/tilt driver inputs (PE9–PE13), limit switches (PE7, PE8).
-    pub stepper: GpioStepper,
+    pub stepper: TimerStepper,
 }
 
 impl Board for Stm32Board {
@@ -146,7 +146,7 @@ impl Board for Stm32Board {
     type Laser = LaserPin;
     type Settings = FlashSettings;
     type GalvoDac = Stm32GalvoDac;
-    type Stepper = GpioStepper;
+    type Stepper = TimerStepper;
     type Indicators = StatusLeds;
     type StopButton = UserButton;
     type Watchdog = IndependentDog;
@@ -226,21 +226,17 @@ pub fn init(spawner: Spawner) -> Stm32Board {
         },
         settings: settings_store(Flash::new(p.FLASH, Irqs)),
         watchdog: IndependentDog::new(p.IWDG),
-        stepper: GpioStepper {
-            step: [
-                Output::new(p.PE9, Level::Low, Speed::VeryHigh),
-                Output::new(p.PE11, Level::Low, Speed::VeryHigh),
-            ],
-            dir: [
+        stepper: TimerStepper::new(
+            p.TIM1,
+            (p.PE9, p.PE11),
+            [
                 Output::new(p.PE10, Level::Low, Speed::VeryHigh),
                 Output::new(p.PE12, Level::Low, Speed::VeryHigh),
             ],
             // Active-low ENABLE by default: high = released at reset.
-            enable: Output::new(p.PE13, Level::High, Speed::Low),
-            limit: [Input::new(p.PE7, Pull::Up), Input::new(p.PE8, Pull::Up)],
-            signals: laser_app::stepper::StepperConfig::default().signals,
-            pace: laser_app::stepper::StepPace::new(),
-        },
+            Output::new(p.PE13, Level::High, Speed::Low),
+            [Input::new(p.PE7, Pull::Up), Input::new(p.PE8, Pull::Up)],
+        ),
     }
 }
 

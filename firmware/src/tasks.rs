@@ -23,7 +23,7 @@ use static_cell::StaticCell;
 use crate::board::Stm32Board;
 use crate::galvo_dac::{self, Stm32GalvoDac};
 use crate::laser_pwm::LaserPin;
-use crate::parts::{GpioStepper, IndependentDog, StatusLeds, UsbConsole, UsbDriver, UserButton};
+use crate::parts::{IndependentDog, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::FlashSettings;
 use laser_app::stepper::{StepPulseTask, StepperTask};
 
@@ -64,7 +64,7 @@ async fn galvo(task: GalvoTask<Stm32GalvoDac>) {
 /// The stepper step timer: executes the prepared segments on PE9–PE13.
 /// Runs on [`STEP_EXECUTOR`], above the galvo executor and thread mode.
 #[embassy_executor::task]
-async fn step_pulses(task: StepPulseTask<GpioStepper>) -> ! {
+async fn step_pulses(task: StepPulseTask<TimerStepper>) -> ! {
     task.run().await
 }
 
@@ -135,7 +135,7 @@ impl Spawn<Stm32Board> for TaskSpawner {
         self.galvo.spawn(defmt::unwrap!(galvo(task)));
     }
 
-    fn step_pulses(&mut self, task: StepPulseTask<GpioStepper>) {
+    fn step_pulses(&mut self, task: StepPulseTask<TimerStepper>) {
         interrupt::CAN2_RX1.set_priority(STEP_PRIORITY);
         let spawner = STEP_EXECUTOR.start(interrupt::CAN2_RX1);
         spawner.spawn(defmt::unwrap!(step_pulses(task)));
