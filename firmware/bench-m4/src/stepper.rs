@@ -2,14 +2,19 @@
 //! event (Bresenham on two axes, integers only) and per segment (loading
 //! the next prepared segment), as the step timer runs it inside its
 //! critical section (the lock itself, `cpsid`/`cpsie` around it on the
-//! target, is a few instructions more). Segment prep (f64, low priority)
-//! is reported for scale.
+//! target, is a few instructions more); the same per event with the
+//! one-pulse timer's values chosen as the STM32 board's step does (DIR
+//! change, [`OnePulseTiming::event`]; the board's five timer register
+//! stores are not in it: QEMU's board has no TIM1). Segment prep (f64, low
+//! priority) is reported for scale.
 
 use core::hint::black_box;
 
 use kinematics_core::stepper::{
     Planner, Segment, SegmentPrep, SegmentQueue, StepBlock, StepGenerator, StepMove,
 };
+
+use laser_app::stepper::{DriverSignals, OnePulseTiming};
 
 use crate::harness::{Bench, window};
 
@@ -37,6 +42,7 @@ fn segment(events: u32, starts_block: bool) -> Segment {
 /// Per step event and per segment, and the prep for scale.
 pub fn stepper(b: &mut Bench) {
     per_event(b);
+    per_event_one_pulse(b);
     per_segment(b);
     prep(b);
 }
@@ -57,6 +63,37 @@ fn per_event(b: &mut Bench) {
         }
     });
     b.report("stepper.step_tick.event", ticks, events);
+}
+
+/// As [`per_event`], plus what the STM32 board's step computes for its
+/// one-pulse timer: whether a DIR pin changed, and the event's compare,
+/// reload and channel modes (TIM1 at 168 MHz, the default 2.5 µs pulse
+/// and 5 µs DIR setup).
+#[inline(always)]
+fn per_event_one_pulse(b: &mut Bench) {
+    let mut queue: SegmentQueue<QUEUE> = SegmentQueue::new();
+    let mut generator = StepGenerator::new();
+    for k in 0..QUEUE {
+        let _ = queue.push(segment(EVENTS_PER_SEGMENT, k == 0));
+    }
+    let signals = DriverSignals {
+        pulse_ns: 2_500,
+        dir_setup_ns: 5_000,
+        enable_active_high: false,
+    };
+    let timing = black_box(OnePulseTiming::new(168_000_000, signals));
+    let mut dir = [false; 2];
+    let events = EVENTS_PER_SEGMENT * QUEUE as u32;
+    let ticks = window(|| {
+        for _ in 0..events {
+            if let Some(tick) = generator.tick(black_box(&mut queue)) {
+                let dir_changed = tick.negative != dir;
+                dir = tick.negative;
+                black_box(timing.event(tick.step, dir_changed));
+            }
+        }
+    });
+    b.report("stepper.step_tick.event_one_pulse", ticks, events);
 }
 
 /// One-event segments: every event loads a segment (the worst case).
