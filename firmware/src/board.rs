@@ -11,8 +11,8 @@
 //! | laser enable / power | PB0 (active high): TIM3_CH3 PWM (AF2, 1 kHz) for a power level, GPIO when dark or full (`laser_pwm`); galvo laser stream DMA2 stream 1 ch 7 (TIM8_UP) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
-//! | stepper pan STEP / DIR  | PE9 / PE10 (STEP on a TIM1 channel pin, for a later one-pulse timer; the step timer runs on an interrupt executor, `tasks.rs`) |
-//! | stepper tilt STEP / DIR | PE11 / PE12 (likewise) |
+//! | stepper pan STEP / DIR  | PE9 TIM1_CH1 (AF1, one-pulse: the pulse timed by TIM1) / PE10 GPIO (the step events on an interrupt executor, `tasks.rs`) |
+//! | stepper tilt STEP / DIR | PE11 TIM1_CH2 (AF1, one-pulse) / PE12 GPIO |
 //! | stepper ENABLE (both)   | PE13 (polarity a parameter; released = the idle level) |
 //! | stepper limit switches  | PE7 pan, PE8 tilt (pull-up inputs, normally-open switch to GND: low = pressed) |
 //!
@@ -135,7 +135,8 @@ pub struct Stm32Board {
     pub settings: FlashSettings,
     /// Independent watchdog (not started).
     pub watchdog: IndependentDog,
-    /// Stepper pan/tilt driver inputs (PE9–PE13), limit switches (PE7, PE8).
+    /// Stepper pan/tilt driver inputs (PE9–PE13, STEP from TIM1), limit
+    /// switches (PE7, PE8).
     pub stepper: TimerStepper,
 }
 
