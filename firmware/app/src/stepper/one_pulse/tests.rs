@@ -141,12 +141,12 @@ fn check(hz: u32, s: DriverSignals) {
     for step in [[true, false], [false, true], [true, true]] {
         for changed in [false, true] {
             let p = t.event(step, changed).unwrap();
-            for axis in 0..2 {
+            for (axis, &steps) in step.iter().enumerate() {
                 let Some((rise, fall)) = channel_output(&p, axis) else {
-                    assert!(!step[axis], "{p:?}: axis {axis} steps");
+                    assert!(!steps, "{p:?}: axis {axis} steps");
                     continue;
                 };
-                assert!(step[axis], "{p:?}: axis {axis} does not step");
+                assert!(steps, "{p:?}: axis {axis} does not step");
                 let high = fall - rise;
                 assert!(at_least(high, divisor, hz, s.pulse_ns), "{p:?}");
                 assert!(within_one_count(high, divisor, hz, s.pulse_ns), "{p:?}");
