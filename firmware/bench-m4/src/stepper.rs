@@ -39,6 +39,16 @@ fn segment(events: u32, starts_block: bool) -> Segment {
     }
 }
 
+/// A full queue of `QUEUE` segments of `events` events each, the first
+/// starting the block, and a generator at rest.
+fn loaded(events: u32) -> (SegmentQueue<QUEUE>, StepGenerator) {
+    let mut queue = SegmentQueue::new();
+    for k in 0..QUEUE {
+        let _ = queue.push(segment(events, k == 0));
+    }
+    (queue, StepGenerator::new())
+}
+
 /// Per step event and per segment, and the prep for scale.
 pub fn stepper(b: &mut Bench) {
     per_event(b);
@@ -51,11 +61,7 @@ pub fn stepper(b: &mut Bench) {
 /// 50 kHz with 1.5 ms segments.
 #[inline(always)]
 fn per_event(b: &mut Bench) {
-    let mut queue: SegmentQueue<QUEUE> = SegmentQueue::new();
-    let mut generator = StepGenerator::new();
-    for k in 0..QUEUE {
-        let _ = queue.push(segment(EVENTS_PER_SEGMENT, k == 0));
-    }
+    let (mut queue, mut generator) = loaded(EVENTS_PER_SEGMENT);
     let events = EVENTS_PER_SEGMENT * QUEUE as u32;
     let ticks = window(|| {
         for _ in 0..events {
@@ -71,11 +77,7 @@ fn per_event(b: &mut Bench) {
 /// and 5 µs DIR setup).
 #[inline(always)]
 fn per_event_one_pulse(b: &mut Bench) {
-    let mut queue: SegmentQueue<QUEUE> = SegmentQueue::new();
-    let mut generator = StepGenerator::new();
-    for k in 0..QUEUE {
-        let _ = queue.push(segment(EVENTS_PER_SEGMENT, k == 0));
-    }
+    let (mut queue, mut generator) = loaded(EVENTS_PER_SEGMENT);
     let signals = DriverSignals {
         pulse_ns: 2_500,
         dir_setup_ns: 5_000,
@@ -99,11 +101,7 @@ fn per_event_one_pulse(b: &mut Bench) {
 /// One-event segments: every event loads a segment (the worst case).
 #[inline(always)]
 fn per_segment(b: &mut Bench) {
-    let mut queue: SegmentQueue<QUEUE> = SegmentQueue::new();
-    let mut generator = StepGenerator::new();
-    for k in 0..QUEUE {
-        let _ = queue.push(segment(1, k == 0));
-    }
+    let (mut queue, mut generator) = loaded(1);
     let ticks = window(|| {
         for _ in 0..QUEUE {
             black_box(generator.tick(black_box(&mut queue)));
