@@ -6,7 +6,7 @@ use core::iter::FusedIterator;
 use super::{MAX_STEPS, Rotation};
 use crate::error::Error;
 use crate::frames::BoardPoint;
-use crate::numeric::finite;
+use crate::numeric::{finite, trig};
 
 /// A path segment in the board plane (cm).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -113,7 +113,7 @@ impl Shape {
                 start_rad,
                 sweep_rad,
             } => {
-                let (s, c) = libm::sincos(start_rad + t * sweep_rad);
+                let (s, c) = trig::sin_cos(start_rad + t * sweep_rad);
                 BoardPoint {
                     x_cm: centre.x_cm + radius_cm * c,
                     y_cm: centre.y_cm + radius_cm * s,
