@@ -36,17 +36,14 @@ impl fmt::Display for Shortest {
             });
         }
         // Whole numbers (parameter values, limits) print without ".0".
-        // Sign and magnitude through u64 formatting (linked anyway for
-        // `Fixed`): the i64 and i32 writers cost 520 B of flash.
         if v == libm::trunc(v) && v.abs() < 1e15 {
-            if v < 0.0 {
-                f.write_str("-")?;
-            }
-            return write!(f, "{}", libm::fabs(v) as u64);
+            return fmt::Display::fmt(&Int(v as i64), f);
         }
         shortest::write_finite(v, f)
     }
 }
+
+pub use kinematics_core::error::Int;
 
 /// `f64` rounded to `DECIMALS` places (`Fixed::<3>(5.0)` → `5.000`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -147,6 +144,9 @@ mod tests {
             "-999999999999999"
         );
         assert_eq!(format!("{}", Shortest(-1.5e-7)), "-1.5e-7");
+        for v in [0, 7, -7, i64::from(i16::MIN), i64::MAX, i64::MIN] {
+            assert_eq!(format!("{}", Int(v)), format!("{v}"));
+        }
         assert_eq!(format!("{}", Shortest(f64::NEG_INFINITY)), "-inf");
     }
 

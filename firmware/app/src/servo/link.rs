@@ -8,6 +8,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 
 use super::plausibility::WIRE_LIMIT_TENTHS;
+use crate::text::Int;
 
 /// Servo ids and timing of the servo bus. All durations in ms, angles in
 /// the servo's wire unit (0.1°).
@@ -126,11 +127,17 @@ impl core::fmt::Debug for ServoFault {
                 target_tenths,
             } => write!(
                 f,
-                "NotArrived {{ at_tenths: {at_tenths}, target_tenths: {target_tenths} }}"
+                "NotArrived {{ at_tenths: {}, target_tenths: {} }}",
+                Int(at_tenths.into()),
+                Int(target_tenths.into())
             ),
             ServoFault::BusError => f.write_str("BusError"),
             ServoFault::ImplausibleReading { at_tenths } => {
-                write!(f, "ImplausibleReading {{ at_tenths: {at_tenths} }}")
+                write!(
+                    f,
+                    "ImplausibleReading {{ at_tenths: {} }}",
+                    Int(at_tenths.into())
+                )
             }
         }
     }
@@ -213,6 +220,7 @@ mod tests {
 
     /// The same shape with the derived `Debug`: what replies printed before.
     #[derive(Debug)]
+    #[allow(dead_code)] // the fields are read by the derived Debug only
     enum Derived {
         NoResponse,
         NotArrived { at_tenths: i16, target_tenths: i16 },
