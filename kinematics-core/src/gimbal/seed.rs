@@ -34,7 +34,7 @@ pub fn ik(ol_cm: f64, p: GlobalPoint) -> Result<JointAngles, Error> {
     if op3_cm <= ol_cm {
         return Err(Error::InsideOffsetCircle);
     }
-    let lambda_rad = libm::acos(clamp(ol_cm / op3_cm, 0.0, 1.0));
+    let lambda_rad = trig::acos(clamp(ol_cm / op3_cm, 0.0, 1.0));
     let pitch_rad = core::f64::consts::FRAC_PI_2 - (theta_rad + lambda_rad);
     Ok(JointAngles {
         yaw_deg: yaw_rad.to_degrees(),

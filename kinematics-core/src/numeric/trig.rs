@@ -98,6 +98,17 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     (sin_of(&r, 0), sin_of(&r, 1))
 }
 
+/// Arccosine of `x`, rad in [0, π]; NaN for NaN and outside [−1, 1].
+///
+/// As `atan2(√((1 − x)(1 + x)), x)` with libm's `atan2` and `sqrt`,
+/// which the firmware links anyway; libm's own `acos` is 700 B of flash.
+/// Within 2 ulp of libm's `acos` (tests): `1 − x` is exact near 1, where
+/// the angle is small and every bit counts.
+#[inline(never)]
+pub fn acos(x: f64) -> f64 {
+    libm::atan2(libm::sqrt((1.0 - x) * (1.0 + x)), x)
+}
+
 /// `x = quadrant·π/2 + hi + lo` with |hi + lo| ≤ π/4 (a little more at
 /// the rounding boundaries) and `lo` a correction far below `hi`'s last
 /// bit; only `quadrant mod 4` matters.

@@ -177,7 +177,7 @@ impl UniformSampler {
                 // Largest angle whose chord stays within the tolerance, and
                 // whose arc is at most one step.
                 let cos_half = (1.0 - max_chord_error_cm / r).max(-1.0);
-                let by_chord = 2.0 * libm::acos(cos_half);
+                let by_chord = 2.0 * trig::acos(cos_half);
                 let by_step = max_step_cm / r;
                 let dphi = by_chord.min(by_step);
                 let n_f = if r == 0.0 || sweep == 0.0 {

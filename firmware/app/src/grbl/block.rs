@@ -139,7 +139,7 @@ impl Arc {
             return 1;
         }
         // A chord over angle θ strays r·(1 − cos(θ/2)) from the arc.
-        let max_angle = 2.0 * libm::acos(1.0 - tolerance_mm / r);
+        let max_angle = 2.0 * trig::acos(1.0 - tolerance_mm / r);
         let n = libm::ceil(libm::fabs(self.sweep_rad) / max_angle);
         if n.is_nan() || n < 1.0 {
             return 1;

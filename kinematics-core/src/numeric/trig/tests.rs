@@ -137,7 +137,36 @@ fn beyond_the_exact_range_finite_and_degrading_gracefully() {
     }
 }
 
+#[test]
+fn acos_within_2_ulp_of_libm() {
+    let n = 200_000;
+    for i in 0..=n {
+        let x = -1.0 + 2.0 * f64::from(i) / f64::from(n);
+        assert!(ulps(acos(x), libm::acos(x)) <= 2, "acos({x:e})");
+    }
+    // Next to ±1 and 0, where the result is small, π or π/2.
+    let mut d = 1e-300;
+    while d < 0.5 {
+        for x in [1.0 - d, -1.0 + d, d, -d] {
+            assert!(ulps(acos(x), libm::acos(x)) <= 2, "acos({x:e})");
+        }
+        d *= 1.7;
+    }
+    assert_eq!(acos(1.0), 0.0);
+    assert_eq!(acos(-1.0), PI);
+    assert_eq!(acos(0.0), FRAC_PI_2);
+    for x in [f64::NAN, 1.0 + 1e-15, -1.000_001, f64::INFINITY] {
+        assert!(acos(x).is_nan(), "{x}");
+    }
+}
+
 proptest! {
+    #[test]
+    fn acos_within_2_ulp_of_libm_anywhere(x in -1.0f64..=1.0) {
+        prop_assert!(ulps(acos(x), libm::acos(x)) <= 2, "acos({:e})", x);
+    }
+
+
     #[test]
     fn within_2_ulp_of_libm_up_to_100(x in -100.0f64..100.0) {
         let (s, c) = sin_cos(x);
