@@ -73,6 +73,8 @@ pub(super) struct GalvoStroke {
     ahead: [Option<ahead::Ahead>; AHEAD],
     /// The piece after a finished one, in flight from the next step.
     adopt: Option<ahead::Ahead>,
+    /// A feed hold waits for the galvo to report where it stopped.
+    stopping: bool,
 }
 
 /// A piece built: the stroke, its feed (the slowest, mm/min), its cover.
@@ -310,5 +312,6 @@ fn feed_of(block: &Block) -> Option<f64> {
 }
 
 mod ahead;
+mod hold;
 #[cfg(test)]
 mod tests;

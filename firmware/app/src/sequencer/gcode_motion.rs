@@ -326,15 +326,23 @@ impl Core {
         let motion = &mut self.gcode.motion;
         motion.gimbal_lit = false;
         let galvo_in_flight = motion.current.is_some_and(|c| c.galvo_seq.is_some());
+        // A galvo stroke: held where the galvo reports it stopped marking.
+        let stroke = self.gcode_galvo_hold();
+        let motion = &mut self.gcode.motion;
         if let Some(c) = motion.current.as_mut() {
-            // The galvo's step is redone from its start on resume.
+            // Its `done` no longer counts: a galvo step (not a stroke) is
+            // redone from its start on resume.
             c.galvo_seq = None;
         }
         // A dwell runs to its end, dark; a servo move to its point.
         let waiting = motion
             .current
             .is_some_and(|c| c.servo_seq.is_some() || c.until.is_some());
-        motion.hold = if waiting { Hold::Stopping } else { Hold::Held };
+        motion.hold = if waiting || stroke {
+            Hold::Stopping
+        } else {
+            Hold::Held
+        };
         if galvo_in_flight {
             // Closing the gate also darkens the samples the DAC holds.
             self.close_gate(out);
@@ -381,6 +389,7 @@ impl Core {
         if self.gcode.motion.clear() {
             self.ok(out);
         }
+        self.gcode.galvo = Default::default();
         self.grbl_sync_position();
     }
 }
