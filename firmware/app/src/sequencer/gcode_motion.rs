@@ -12,8 +12,10 @@
 //!   alone, consecutive lit blocks are joined into one stroke
 //!   ([`super::gcode_galvo`]).
 //!
-//! Feed hold stops after the step in flight (the galvo at once, braking
-//! along its stroke), laser dark; `~` goes on from there.
+//! Feed hold stops after the step in flight, laser dark; `~` goes on
+//! from there. The galvo stops at once, braking along its stroke, and
+//! the hold waits (`Hold:1`) for it to report where marking stopped: `~`
+//! goes on from that point ([`super::gcode_galvo`]).
 
 use embassy_time::{Duration, Instant};
 use heapless::Deque;
@@ -46,7 +48,8 @@ const MAX_STEPS: u32 = 100_000;
 pub(super) enum Hold {
     /// Running.
     None,
-    /// Stopping after the step in flight (laser already dark).
+    /// Stopping after the step in flight, or until the galvo reports
+    /// where it stopped marking (laser already dark).
     Stopping,
     /// Stopped; `~` resumes.
     Held,
@@ -317,7 +320,8 @@ impl Core {
     }
 
     /// `!`: laser dark at once; the gimbal stops after the step in
-    /// flight, the galvo brakes along its stroke.
+    /// flight, the galvo brakes along its stroke (held where it reports
+    /// marking stopped).
     pub(super) fn grbl_hold(&mut self, out: &mut dyn ActionSink) {
         let motion = &self.gcode.motion;
         if motion.hold != Hold::None || motion.is_idle() || self.gcode_stepper_hold(out) {

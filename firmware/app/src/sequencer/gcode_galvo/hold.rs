@@ -19,7 +19,8 @@ impl Core {
     pub(in crate::sequencer) fn gcode_galvo_hold(&mut self) -> bool {
         let c = self.gcode.motion.current;
         let record = &mut self.gcode.galvo;
-        record.stopping = !self.actuator.uses_gimbal()
+        // (Still waiting after a `!`, `~` before the report, `!`.)
+        record.stopping |= !self.actuator.uses_gimbal()
             && c.is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == record.seq);
         record.stopping
     }
