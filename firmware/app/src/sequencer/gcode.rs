@@ -296,6 +296,11 @@ impl Core {
     /// interrupted motion.
     fn grbl_reset(&mut self, out: &mut dyn ActionSink) {
         let moving = self.gcode.motion.current.is_some() && self.gcode.motion.hold != Hold::Held;
+        if self.actuator.uses_stepper() {
+            // grbl's reset kills the steps at once (the position is then
+            // uncertain: ALARM:3); `stop` would brake at the limit.
+            out.act(Action::Stepper(crate::stepper::StepperRequest::Halt));
+        }
         self.stop("grbl soft reset", out);
         self.gcode.parser.soft_reset();
         self.grbl_sync_position();

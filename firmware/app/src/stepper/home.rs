@@ -134,7 +134,10 @@ impl Running {
                 }
                 // A feed hold while homing stops it, as a stop does.
                 Either3::Third(
-                    StepperRequest::Stop | StepperRequest::Home | StepperRequest::Hold,
+                    StepperRequest::Stop
+                    | StepperRequest::Halt
+                    | StepperRequest::Home
+                    | StepperRequest::Hold,
                 ) => link.halt(),
                 Either3::Third(StepperRequest::Resume)
                 | Either3::First(())

@@ -216,6 +216,7 @@ impl Running {
                 self.deferred = Some(request);
             }
             StepperRequest::MoveTo { .. } => self.move_to(request, link).await,
+            StepperRequest::Halt => link.halt(),
             StepperRequest::Stop => {
                 self.motion.stop();
                 self.deferred = None;

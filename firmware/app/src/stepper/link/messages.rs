@@ -26,6 +26,10 @@ pub enum StepperRequest {
     /// Decelerate to rest at the acceleration limit along the path, drop
     /// the rest.
     Stop,
+    /// Halt the steps at once (a G-code soft reset): the sequencer's
+    /// shell calls [`StepperLink::halt`](super::StepperLink::halt) itself,
+    /// so the step timer drops what is prepared at its next event.
+    Halt,
     /// Home the axes with switches: seek, back off, latch, set the zero,
     /// pull off.
     Home,
