@@ -5,6 +5,8 @@
 
 use laser_sim::stepper::{StepEdge, StepPin};
 use laser_sim::world::{SimOptions, SimReport};
+use system_tests::gcode_job::{Piece, fit};
+use system_tests::gcode_toolpath::{gimbal_spot_mm, lit_mm};
 use system_tests::{gimbal_dark_after, run_with, terminal_lines};
 
 /// Runs `script` on `target stepper` with default options.
@@ -112,5 +114,103 @@ fn a_soft_reset_mid_move_halts_the_steps_at_once_dark_with_alarm_3() {
             spot[0] > -35.0 && spot[0] < 35.0,
             "stopped mid-line: {spot:?}"
         );
+    }
+}
+
+/// Step rates of axis `axis` (one per interval between rising edges),
+/// `(t_ns, steps/s)`.
+fn step_rates(report: &SimReport, axis: u8) -> Vec<(u64, f64)> {
+    step_times_ns(report, axis)
+        .windows(2)
+        .map(|w| (w[1], 1e9 / (w[1] - w[0]) as f64))
+        .collect()
+}
+
+/// The stepper's acceleration limit in pan steps/s² (default settings:
+/// 900 °/s² at 0.05625° per step).
+const ACCEL_STEPS_S2: f64 = 900.0 / 0.05625;
+
+/// Every change of the step rate between successive intervals of `axis`
+/// within the acceleration limit (over the two intervals' mean time),
+/// a timer tick of rounding allowed, from `from_ns` on.
+fn assert_within_accel(report: &SimReport, axis: u8, from_ns: u64) {
+    let rates = step_rates(report, axis);
+    for w in rates.windows(2).filter(|w| w[0].0 >= from_ns) {
+        let (r0, r1) = (w[0].1, w[1].1);
+        // A pause (a new move from rest) is no deceleration.
+        if r1 < 1.0 || r0 < 1.0 {
+            continue;
+        }
+        let dt = (1.0 / r0 + 1.0 / r1) / 2.0;
+        let allowed = ACCEL_STEPS_S2 * dt * 1.01 + (r0 * r0 + r1 * r1) / 1e6;
+        assert!(
+            (r1 - r0).abs() <= allowed,
+            "rate {r0:.1} -> {r1:.1} steps/s at {} ns (allowed {allowed:.1})",
+            w[1].0
+        );
+    }
+}
+
+#[test]
+fn a_feed_hold_brakes_at_once_dark_and_resumes_where_it_stopped() {
+    for feed in [1200.0, 3000.0] {
+        let report = run(&format!(
+            "G0 X-40 Y0\nG1 X40 F{feed} M3 S1000\nwait 1000\n!\nwait 400\n?\nwait 400\n?\n~\nG4 P0.2\n"
+        ));
+        let (hold_at, resume_at) = (
+            system_tests::sent_at(&report, "!"),
+            system_tests::sent_at(&report, "~"),
+        );
+        let states = statuses(&report);
+        assert!(
+            states.iter().all(|s| s.starts_with("<Hold:0|")),
+            "{states:?}"
+        );
+        assert_eq!(mpos(states[0]), mpos(states[1]), "held still");
+        assert!(
+            gimbal_dark_after(&report, hold_at) <= 1_000,
+            "F{feed}: dark within 1 ms of the hold"
+        );
+        let lit_in_hold = report
+            .recording
+            .spot
+            .iter()
+            .any(|s| s.laser && s.t_us > hold_at + 1_000 && s.t_us < resume_at);
+        assert!(!lit_in_hold, "F{feed}: lit during the hold");
+        // The dark stretch: from the spot at `!` to where it came to rest.
+        let (at_hold, at_rest) = (spot_mm_at(&report, hold_at), spot_mm_at(&report, resume_at));
+        let dark_mm = dist(at_hold, at_rest);
+        let rests = report
+            .stepper
+            .edges
+            .iter()
+            .filter(|e| e.pin == StepPin::Step && e.high && e.t_ns > hold_at * 1000)
+            .find(|e| e.t_ns > resume_at * 1000)
+            .is_some();
+        let v = feed / 60.0;
+        eprintln!(
+            "F{feed}: {dark_mm:.3} mm travelled dark after the hold ({} µs to rest)",
+            step_times_ns(&report, 0)
+                .into_iter()
+                .filter(|&t| t < resume_at * 1000)
+                .last()
+                .map_or(0, |t| t / 1000 - hold_at)
+        );
+        // One step of the running segment (≈ 0.25 mm at 25 cm) and v²/2a
+        // (≤ 1.25 steps at 50 mm/s) at most.
+        assert!(dark_mm <= 0.75, "F{feed}: {dark_mm} mm dark ({v} mm/s)");
+        assert!(rests, "F{feed}: steps again after the resume");
+        assert_within_accel(&report, 0, hold_at * 1000);
+        // Resumed from exactly where it stopped, the whole line drawn.
+        let pieces = [Piece::Line {
+            a: [-40.0, 0.0],
+            b: [40.0, 0.0],
+        }];
+        let fit = fit(&lit_mm(&gimbal_spot_mm(&report)), &pieces);
+        eprintln!("F{feed}: {fit:?}");
+        assert!(fit.worst_missed_mm <= 0.5, "F{feed}: {fit:?}");
+        for axis in &report.stepper.axes {
+            assert!(axis.stalls().is_empty(), "{}", report.stepper.report());
+        }
     }
 }

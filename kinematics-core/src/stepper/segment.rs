@@ -111,6 +111,12 @@ fn reachable_f(rate: f64, accel: f64, events: f64) -> f64 {
     libm::sqrt(rate * rate + 2.0 * accel * events)
 }
 
+/// Blocks a hold can take back: the generator's and one per prepared
+/// segment (the step queue's 8).
+const TAKE_BACK: usize = 9;
+
+mod take_back;
+
 /// Fixed-capacity ring of prepared segments (prep pushes, the step
 /// generator pops).
 #[derive(Debug, Clone)]
@@ -254,6 +260,11 @@ pub struct SegmentPrep {
     current: Option<Cutting>,
     /// On a hold: the rate the next block starts at, steps/s.
     hold_rate: Option<f64>,
+    /// On a hold: the rest of the blocks taken back from the step queue
+    /// (a segment per block: its events left), cut before the planner's.
+    taken_back: SegmentQueue<TAKE_BACK>,
+    /// Acceleration of the last block taken from the planner, steps/s².
+    accel: f64,
 }
 
 impl SegmentPrep {
@@ -271,12 +282,14 @@ impl SegmentPrep {
             segment_s,
             current: None,
             hold_rate: None,
+            taken_back: SegmentQueue::new(),
+            accel: 0.0,
         })
     }
 
     /// Whether a block is being cut.
     pub fn is_busy(&self) -> bool {
-        self.current.is_some()
+        self.current.is_some() || !self.taken_back.is_empty()
     }
 
     /// Whether a hold is decelerating (until it has cut its last segment).
@@ -308,6 +321,7 @@ impl SegmentPrep {
     fn stop_holding<const P: usize>(&mut self, planner: &mut Planner<P>) {
         planner.clear();
         self.hold_rate = None;
+        self.taken_back.clear();
     }
 
     /// Forgets the block being cut and any hold (after the step generator
@@ -315,6 +329,7 @@ impl SegmentPrep {
     pub fn reset(&mut self) {
         self.current = None;
         self.hold_rate = None;
+        self.taken_back.clear();
     }
 
     /// Prepares segments into `queue` until it is full or the planner has
@@ -339,7 +354,11 @@ impl SegmentPrep {
 
     /// Takes the next block from `planner` (decelerating on a hold).
     fn start_block<const P: usize>(&mut self, planner: &mut Planner<P>) -> Option<Cutting> {
+        if let Some(cutting) = self.resume_taken_back() {
+            return Some(cutting);
+        }
         let b = planner.pop()?;
+        self.accel = b.accel_steps_per_s2;
         let mut cutting = Cutting {
             block: StepBlock {
                 steps: [b.steps[0].unsigned_abs(), b.steps[1].unsigned_abs()],

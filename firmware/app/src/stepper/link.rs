@@ -10,7 +10,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
-use kinematics_core::stepper::{SegmentQueue, StepGenerator, StepTick};
+use kinematics_core::stepper::{SegmentQueue, StepBlock, StepGenerator, StepTick};
 
 use super::{DriverSignals, StepperConfig};
 
@@ -247,6 +247,20 @@ impl StepperLink {
         f: impl FnOnce(&mut SegmentQueue<STEP_QUEUE_LEN>) -> R,
     ) -> R {
         self.core.lock(|core| f(&mut core.borrow_mut().queue))
+    }
+
+    /// Runs `f` on the prepared segments with the step generator's block
+    /// in progress and running segment's period (a hold takes the
+    /// prepared segments back and brakes from there), under the step
+    /// timer's lock.
+    pub(super) fn with_queue_executing<R>(
+        &self,
+        f: impl FnOnce(&mut SegmentQueue<STEP_QUEUE_LEN>, (StepBlock, Option<u32>)) -> R,
+    ) -> R {
+        self.core.lock(|core| {
+            let StepCore { queue, generator } = &mut *core.borrow_mut();
+            f(queue, generator.executing())
+        })
     }
 
     /// Whether a step may come at the next event (prepared segments or

@@ -11,7 +11,7 @@ use cut::{Curve, PieceCut};
 
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::JointAngles;
-use kinematics_core::stepper::{Planner, Segment, SegmentPrep, StepMove};
+use kinematics_core::stepper::{Planner, Segment, SegmentPrep, SegmentQueue, StepBlock, StepMove};
 
 use super::{MoveShape, SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
 use kinematics_core::numeric::clamp;
@@ -22,6 +22,8 @@ use kinematics_core::numeric::clamp;
 pub const LINE_TOLERANCE_MM: f64 = 0.05;
 /// Most pieces one line is cut into.
 const MAX_PIECES: u32 = 4096;
+/// The step timer's queue of prepared segments.
+pub type StepQueue = SegmentQueue<{ super::STEP_QUEUE_LEN }>;
 /// Look-ahead depth of the planner, blocks.
 const PLANNER_LEN: usize = 16;
 
@@ -279,20 +281,24 @@ impl StepperMotion {
         self.prep.next_segment(&mut self.planner)
     }
 
-    /// Decelerates to rest at the limit along the path; what is left of
-    /// the move is dropped.
-    pub fn stop(&mut self) {
-        self.hold();
+    /// Decelerates to rest at the limit along the path from where the
+    /// step generator is (`queue`, `executing`: see [`Self::hold`]); what
+    /// is left of the move is dropped.
+    pub fn stop(&mut self, queue: &mut StepQueue, executing: (StepBlock, Option<u32>)) {
+        self.hold(queue, executing);
         self.history.rest(None);
     }
 
     /// A feed hold: as [`Self::stop`], but the moves since the last rest
-    /// are kept for [`Self::resume`].
-    pub fn hold(&mut self) {
+    /// are kept for [`Self::resume`]. The segments prepared in the step
+    /// `queue` are taken back and the braking starts where the segment
+    /// the generator runs ends (`executing`: its block and period, from
+    /// [`kinematics_core::stepper::StepGenerator::executing`]).
+    pub fn hold(&mut self, queue: &mut StepQueue, executing: (StepBlock, Option<u32>)) {
         self.line = None;
         self.next = None;
         self.pending = None;
-        self.prep.hold(&mut self.planner);
+        self.prep.hold_now(&mut self.planner, executing, queue);
     }
 
     /// The steps were halted (or a stop came to rest) at `position`:

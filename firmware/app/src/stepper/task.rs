@@ -218,9 +218,10 @@ impl Running {
             StepperRequest::MoveTo { .. } => self.move_to(request, link).await,
             StepperRequest::Halt => link.halt(),
             StepperRequest::Stop => {
-                self.motion.stop();
+                link.with_queue_executing(|q, e| self.motion.stop(q, e));
                 self.deferred = None;
                 self.stopping = true;
+                self.refill(link);
             }
             StepperRequest::Home => {
                 let event = match self.home(link).await {
@@ -230,9 +231,10 @@ impl Running {
                 link.events.send(event).await;
             }
             StepperRequest::Hold => {
-                self.motion.hold();
+                link.with_queue_executing(|q, e| self.motion.hold(q, e));
                 self.deferred = None;
                 self.stopping = true;
+                self.refill(link);
             }
             StepperRequest::Resume => {
                 if let Err(e) = self.motion.resume(link.position_steps()) {
