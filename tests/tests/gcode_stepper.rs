@@ -117,36 +117,40 @@ fn a_soft_reset_mid_move_halts_the_steps_at_once_dark_with_alarm_3() {
     }
 }
 
-/// Step rates of axis `axis` (one per interval between rising edges),
-/// `(t_ns, steps/s)`.
-fn step_rates(report: &SimReport, axis: u8) -> Vec<(u64, f64)> {
-    step_times_ns(report, axis)
-        .windows(2)
-        .map(|w| (w[1], 1e9 / (w[1] - w[0]) as f64))
-        .collect()
-}
-
 /// The stepper's acceleration limit in pan steps/s² (default settings:
 /// 900 °/s² at 0.05625° per step).
 const ACCEL_STEPS_S2: f64 = 900.0 / 0.05625;
 
-/// Every change of the step rate between successive intervals of `axis`
-/// within the acceleration limit (over the two intervals' mean time),
-/// a timer tick of rounding allowed, from `from_ns` on.
+/// Every change of the step rate of `axis` within the acceleration
+/// limit, from `from_ns` on: the step intervals grouped into constant-rate
+/// segments, successive segments' rates differ by at most the limit over
+/// their mean duration (a timer tick of rounding allowed).
 fn assert_within_accel(report: &SimReport, axis: u8, from_ns: u64) {
-    let rates = step_rates(report, axis);
-    for w in rates.windows(2).filter(|w| w[0].0 >= from_ns) {
-        let (r0, r1) = (w[0].1, w[1].1);
-        // A pause (a new move from rest) is no deceleration.
-        if r1 < 1.0 || r0 < 1.0 {
+    let times: Vec<u64> = step_times_ns(report, axis)
+        .into_iter()
+        .filter(|&t| t >= from_ns)
+        .collect();
+    // (rate steps/s, duration s) of each run of equal intervals (±1 µs).
+    let mut segments: Vec<(f64, f64)> = Vec::new();
+    let mut last_ns = 0;
+    for w in times.windows(2) {
+        let dt_ns = w[1] - w[0];
+        match segments.last_mut() {
+            Some((_, total)) if dt_ns.abs_diff(last_ns) <= 1_000 => *total += dt_ns as f64 / 1e9,
+            _ => segments.push((1e9 / dt_ns as f64, dt_ns as f64 / 1e9)),
+        }
+        last_ns = dt_ns;
+    }
+    for w in segments.windows(2) {
+        let ((r0, t0), (r1, t1)) = (w[0], w[1]);
+        // A pause (a new move from rest, a dwell) is no deceleration.
+        if t0 > 0.1 || t1 > 0.1 {
             continue;
         }
-        let dt = (1.0 / r0 + 1.0 / r1) / 2.0;
-        let allowed = ACCEL_STEPS_S2 * dt * 1.01 + (r0 * r0 + r1 * r1) / 1e6;
+        let allowed = ACCEL_STEPS_S2 * (t0 + t1) / 2.0 * 1.01 + (r0 * r0 + r1 * r1) / 1e6;
         assert!(
             (r1 - r0).abs() <= allowed,
-            "rate {r0:.1} -> {r1:.1} steps/s at {} ns (allowed {allowed:.1})",
-            w[1].0
+            "rate {r0:.1} -> {r1:.1} steps/s (allowed {allowed:.1})"
         );
     }
 }
@@ -180,26 +184,22 @@ fn a_feed_hold_brakes_at_once_dark_and_resumes_where_it_stopped() {
         // The dark stretch: from the spot at `!` to where it came to rest.
         let (at_hold, at_rest) = (spot_mm_at(&report, hold_at), spot_mm_at(&report, resume_at));
         let dark_mm = dist(at_hold, at_rest);
-        let rests = report
-            .stepper
-            .edges
+        let resumed = step_times_ns(&report, 0)
             .iter()
-            .filter(|e| e.pin == StepPin::Step && e.high && e.t_ns > hold_at * 1000)
-            .find(|e| e.t_ns > resume_at * 1000)
-            .is_some();
+            .any(|&t| t > resume_at * 1000);
         let v = feed / 60.0;
         eprintln!(
             "F{feed}: {dark_mm:.3} mm travelled dark after the hold ({} µs to rest)",
             step_times_ns(&report, 0)
                 .into_iter()
-                .filter(|&t| t < resume_at * 1000)
-                .last()
+                .rev()
+                .find(|&t| t < resume_at * 1000)
                 .map_or(0, |t| t / 1000 - hold_at)
         );
         // One step of the running segment (≈ 0.25 mm at 25 cm) and v²/2a
         // (≤ 1.25 steps at 50 mm/s) at most.
         assert!(dark_mm <= 0.75, "F{feed}: {dark_mm} mm dark ({v} mm/s)");
-        assert!(rests, "F{feed}: steps again after the resume");
+        assert!(resumed, "F{feed}: steps again after the resume");
         assert_within_accel(&report, 0, hold_at * 1000);
         // Resumed from exactly where it stopped, the whole line drawn.
         let pieces = [Piece::Line {
@@ -212,5 +212,47 @@ fn a_feed_hold_brakes_at_once_dark_and_resumes_where_it_stopped() {
         for axis in &report.stepper.axes {
             assert!(axis.stalls().is_empty(), "{}", report.stepper.report());
         }
+    }
+}
+
+/// Spot speed over the 100 ms after `t_us`, mm/s.
+fn speed_after(report: &SimReport, t_us: u64) -> f64 {
+    dist(spot_mm_at(report, t_us), spot_mm_at(report, t_us + 100_000)) / 0.1
+}
+
+#[test]
+fn the_feed_override_changes_the_stepper_speed_mid_block() {
+    // Spaced: the console queues 8 realtime commands at a time.
+    let down = "@realtime 0x92\nwait 10\n".repeat(5);
+    let up = "@realtime 0x91\nwait 10\n".repeat(10);
+    let report = run(&format!(
+        "G0 X-60 Y0\nG1 X60 F1200 M3 S1000\nwait 1000\n{down}wait 1000\n{up}wait 1000\n?\nG4 P0.1\n"
+    ));
+    system_tests::assert_all_ok(&report, "override");
+    let times: Vec<u64> = report
+        .transcript
+        .lines
+        .iter()
+        .filter(|(_, l)| l.starts_with(">> 0x9"))
+        .map(|(t, _)| *t)
+        .collect();
+    let (down_at, up_at) = (times[4], times[14]);
+    let before = speed_after(&report, down_at - 200_000);
+    // The prepared segments (≤ 8 steps ≈ 100 ms at 20 mm/s), then the
+    // new cruise.
+    let slow = speed_after(&report, down_at + 200_000);
+    let fast = speed_after(&report, up_at + 200_000);
+    eprintln!("speed {before:.2} → {slow:.2} (50 %) → {fast:.2} mm/s (150 %)");
+    assert!((before - 20.0).abs() < 1.0, "{before}");
+    assert!((slow - 10.0).abs() < 0.6, "{slow}");
+    assert!((fast - 30.0).abs() < 1.5, "{fast}");
+    // The change shows within ≈ 100 ms (one line block, no new block).
+    let first_slow = speed_after(&report, down_at + 100_000);
+    assert!(first_slow < 12.0, "{first_slow}");
+    let status = statuses(&report).pop().expect("a status");
+    assert!(status.contains("|Ov:150,"), "{status}");
+    assert_within_accel(&report, 0, 0);
+    for axis in &report.stepper.axes {
+        assert!(axis.stalls().is_empty(), "{}", report.stepper.report());
     }
 }

@@ -283,7 +283,10 @@ impl Core {
             Realtime::CycleStart => self.grbl_resume(out),
             Realtime::SoftReset => self.grbl_reset(out),
             Realtime::JogCancel => self.grbl_jog_cancel(out),
-            Realtime::FeedOverride(step) => ov.feed = step.apply(ov.feed, 10, 200),
+            Realtime::FeedOverride(step) => {
+                ov.feed = step.apply(ov.feed, 10, 200);
+                self.gcode_stepper_override(out);
+            }
             Realtime::RapidOverride(percent) => ov.rapid = percent,
             Realtime::SpindleOverride(step) => ov.spindle = step.apply(ov.spindle, 10, 200),
             Realtime::SpindleStop | Realtime::Ignored(_) => {}

@@ -30,6 +30,9 @@ pub(super) struct StepperJob {
     waiting: bool,
     /// A hold came to rest: `~` asks the stepper to go on with its moves.
     held: bool,
+    /// The feed override the stepper task has, % (`None`: not sent since
+    /// the last stop).
+    feed_percent: Option<u8>,
 }
 
 /// The stepper move of a motion block: end point (cm) and shape.
@@ -80,6 +83,7 @@ impl Core {
         let Some((point, shape)) = stepper_move(&current.block) else {
             return;
         };
+        self.gcode_stepper_override(out);
         let feed_mm_s = self.stepper_feed(&current.block);
         let seq = self.stepper_request(point, shape, feed_mm_s, out);
         let motion = &mut self.gcode.motion;
@@ -90,17 +94,28 @@ impl Core {
         motion.gimbal_lit = lit && motion.arrived;
     }
 
-    /// The spot speed of a feed move with the feed override, mm/s
-    /// (`None`: G0, at the axes' limit).
+    /// The programmed spot speed of a feed move, mm/s (`None`: G0, at
+    /// the axes' limit); the stepper task applies the feed override.
     #[inline(never)]
     fn stepper_feed(&self, block: &Block) -> Option<f64> {
-        let feed_mm_min = match *block {
+        match *block {
             Block::Line { feed_mm_min, .. }
             | Block::Arc { feed_mm_min, .. }
-            | Block::Jog { feed_mm_min, .. } => feed_mm_min,
-            _ => return None,
-        };
-        Some(self.gcode.overrides.feed_mm_min(feed_mm_min) / 60.0)
+            | Block::Jog { feed_mm_min, .. } => Some(feed_mm_min / 60.0),
+            _ => None,
+        }
+    }
+
+    /// Tells the stepper task the feed override when it changed (it
+    /// applies it on the fly, to the move being cut too).
+    #[inline(never)]
+    pub(super) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
+        let percent = self.gcode.overrides.feed;
+        let job = &mut self.gcode.motion.stepper;
+        if self.actuator.uses_stepper() && job.feed_percent != Some(percent) {
+            job.feed_percent = Some(percent);
+            out.act(Action::Stepper(StepperRequest::FeedOverride { percent }));
+        }
     }
 
     /// One move request to the stepper; returns its number.

@@ -355,6 +355,9 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
             Action::AllowGalvoLaser(allowed) => self.galvo.allow_laser(allowed),
             // At once, not through the stepper task's queue.
             Action::Stepper(StepperRequest::Halt) => self.stepper.halt(),
+            Action::Stepper(StepperRequest::FeedOverride { percent }) => {
+                self.stepper.set_feed_override(percent);
+            }
             Action::Stepper(request) => {
                 if self.stepper.requests.try_send(request).is_err() {
                     log::warning!("stepper: request queue full");

@@ -139,7 +139,7 @@ impl Running {
                     | StepperRequest::Home
                     | StepperRequest::Hold,
                 ) => link.halt(),
-                Either3::Third(StepperRequest::Resume)
+                Either3::Third(StepperRequest::Resume | StepperRequest::FeedOverride { .. })
                 | Either3::First(())
                 | Either3::Second(()) => {}
             }

@@ -48,6 +48,8 @@ pub struct StepperMotion {
     started: Option<u32>,
     /// The moves since the last rest, for a hold's resume.
     history: resume::History,
+    /// Feed override: moves at a feed run at feed × this.
+    feed_scale: f64,
 }
 
 /// A move waiting behind the line being cut.
@@ -74,6 +76,7 @@ impl StepperMotion {
             next: None,
             started: None,
             history: resume::History::default(),
+            feed_scale: 1.0,
         })
     }
 
@@ -223,18 +226,19 @@ impl StepperMotion {
             end[1].wrapping_sub(self.planned[1]),
         ];
         let mut mv = Self::step_move(&self.config, delta);
+        let mut feed_rate = 0.0;
         if let Some((speed_mm_s, length_mm)) = feed.filter(|f| f.1 > 0.0) {
             // Step events per mm of the piece, at the feed.
             let events = delta[0].unsigned_abs().max(delta[1].unsigned_abs());
-            let rate = speed_mm_s * f64::from(events) / length_mm;
+            feed_rate = speed_mm_s * f64::from(events) / length_mm;
             mv.nominal_rate_steps_per_s = clamp(
-                rate,
+                feed_rate * self.feed_scale,
                 kinematics_core::stepper::motion::MIN_RATE_STEPS_PER_S,
                 mv.nominal_rate_steps_per_s,
             );
         }
         self.planner
-            .push(&mv)
+            .push_feed(&mv, feed_rate)
             .map_err(|_| StepperRefusal::BadConfig)?;
         self.planned = end;
         Ok(())
@@ -342,6 +346,18 @@ impl StepperMotion {
         ];
         self.last_point = None;
         Ok(())
+    }
+
+    /// G-code's feed override, % (10–200; others ignored): the queued
+    /// moves at a feed and the one being cut change speed now.
+    pub fn set_feed_percent(&mut self, percent: u8) {
+        if !(10..=200).contains(&percent) {
+            return;
+        }
+        self.feed_scale = f64::from(percent) / 100.0;
+        let max_rate = Self::step_move(&self.config, [1, 0]).nominal_rate_steps_per_s;
+        self.prep
+            .set_feed_scale(self.feed_scale, max_rate, &mut self.planner);
     }
 
     /// Step position where the queued moves end.

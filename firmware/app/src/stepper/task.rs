@@ -144,6 +144,9 @@ impl Running {
             };
             link.events.send(event).await;
         }
+        if let Some(percent) = link.take_feed_override() {
+            self.motion.set_feed_percent(percent);
+        }
         self.refill(link);
         if let Some(seq) = self.motion.take_started() {
             link.events.send(StepperEvent::Taken { seq }).await;
@@ -236,6 +239,7 @@ impl Running {
                 self.stopping = true;
                 self.refill(link);
             }
+            StepperRequest::FeedOverride { percent } => self.motion.set_feed_percent(percent),
             StepperRequest::Resume => {
                 if let Err(e) = self.motion.resume(link.position_steps()) {
                     log::warning!("stepper: resume refused: {:?}", e);

@@ -102,6 +102,7 @@ impl SegmentPrep {
                 done,
                 end: run.block.event_count,
                 fresh: run.starts_block,
+                feed_rate: 0.0,
             };
             let exit = cutting.decelerate_from(self.hold_rate.unwrap_or(0.0));
             self.hold_rate = Some(exit);

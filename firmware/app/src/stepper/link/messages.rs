@@ -38,6 +38,15 @@ pub enum StepperRequest {
     /// After a hold came to rest: the kept moves again, from the rest
     /// point (the rest of the one it stopped in first).
     Resume,
+    /// G-code's feed override, % (10–200): moves at a feed run at feed ×
+    /// percent / 100 from now on, the one being cut too (within the
+    /// acceleration limit). The sequencer's shell hands it over through
+    /// [`StepperLink::set_feed_override`](super::StepperLink::set_feed_override)
+    /// (the latest wins), not the request queue.
+    FeedOverride {
+        /// Percent of the programmed feed.
+        percent: u8,
+    },
 }
 
 /// How a move gets to its point.
