@@ -256,3 +256,86 @@ fn the_feed_override_changes_the_stepper_speed_mid_block() {
         assert!(axis.stalls().is_empty(), "{}", report.stepper.report());
     }
 }
+
+/// A run with a pan homing switch closing at `switch_deg` (towards
+/// positive angles), the pan axis powered up at 0°.
+fn run_with_pan_switch(script: &str, switch_deg: f64) -> SimReport {
+    run_with(
+        &format!(
+            "set stepper.pan.home_dir 1\nset stepper.pan.home_deg {switch_deg}\ntarget stepper\n{script}"
+        ),
+        SimOptions {
+            stepper_switches: [
+                Some(laser_sim::stepper::LimitSwitch {
+                    closes_at_deg: switch_deg,
+                    towards_positive: true,
+                    hysteresis_deg: 0.4,
+                }),
+                None,
+            ],
+            ..SimOptions::default()
+        },
+    )
+}
+
+/// Time of the first line after `> sent` that satisfies `is`, µs, and
+/// the line.
+fn first_after(report: &SimReport, sent: &str, is: impl Fn(&str) -> bool) -> (u64, String) {
+    let lines = &report.transcript.lines;
+    let from = lines
+        .iter()
+        .position(|(_, l)| l.strip_prefix("> ") == Some(sent))
+        .unwrap_or_else(|| panic!("{sent:?} not sent"));
+    lines[from..]
+        .iter()
+        .find(|(_, l)| is(l))
+        .cloned()
+        .unwrap_or_else(|| panic!("nothing after {sent:?}"))
+}
+
+#[test]
+fn dollar_h_on_the_stepper_answers_when_homing_has_ended() {
+    // A sender streams `$H` and the job behind it without waiting.
+    let report = run_with_pan_switch(
+        "@type-ahead $H\n@type-ahead G1 X10 F600 M3 S1000\n@type-ahead G1 X20\nG4 P0.2\n",
+        30.0,
+    );
+    system_tests::assert_all_ok(&report, "$H then G1s");
+    let (homed_at, _) = first_after(&report, "$H", |l| l.starts_with("[homed: stepper"));
+    let (ok_at, reply) = first_after(&report, "$H", |l| l == "ok" || l.starts_with("error"));
+    assert_eq!(reply, "ok");
+    eprintln!("$H: homed at {homed_at} µs, ok at {ok_at} µs");
+    assert!(ok_at >= homed_at, "ok before homing ended");
+    // Homing takes seconds: seek 30° at 20 °/s, latch, pull-off.
+    assert!(ok_at > 1_500_000, "{ok_at}");
+    // Nothing of the G1s moved before the reply: the spot is where
+    // homing left it, then it draws the job.
+    assert_eq!(spot_mm_at(&report, homed_at), spot_mm_at(&report, ok_at));
+    let end = spot_mm_at(&report, report.end_time_us);
+    assert!(dist(end, [20.0, 0.0]) < 0.3, "{end:?}");
+    assert!(
+        report
+            .recording
+            .spot
+            .iter()
+            .filter(|s| s.laser)
+            .all(|s| s.t_us > ok_at),
+        "lit only in the G1s"
+    );
+}
+
+#[test]
+fn a_failed_dollar_h_raises_alarm_9_before_its_reply_and_locks() {
+    // The switch lies beyond the travel: never found.
+    let report = run_with_pan_switch("$H\nG1 X10 F600\n", 170.0);
+    let lines = terminal_lines(&report);
+    let h = lines.iter().position(|l| *l == "> $H").expect("sent");
+    let after: Vec<&str> = lines[h + 1..]
+        .iter()
+        .copied()
+        .filter(|l| !l.starts_with('[') && !l.starts_with("Grbl "))
+        .collect();
+    eprintln!("{after:?}");
+    assert_eq!(&after[..3], ["ALARM:9", "ok", "> G1 X10 F600"]);
+    assert_eq!(after[3], "error:9", "locked by the alarm");
+}

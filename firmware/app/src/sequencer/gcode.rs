@@ -56,6 +56,8 @@ pub(super) struct Gcode {
     /// Actual over programmed speed of the gimbal step in flight, 0..=1
     /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
     pub(super) step_speed_ratio: f32,
+    /// A `$H` on the stepper waits for homing to end for its reply.
+    pub(super) homing: bool,
 }
 
 impl Gcode {
@@ -70,6 +72,7 @@ impl Gcode {
             reports: 0,
             galvo: GalvoStroke::default(),
             step_speed_ratio: 0.0,
+            homing: false,
         }
     }
 }
@@ -224,8 +227,10 @@ impl Core {
             return self.grbl_error(out, GrblError::NotIdle);
         }
         if self.actuator.uses_stepper() {
+            // The reply waits for the end of homing (grbl's `$H`): a
+            // sender's next lines wait with it.
             return match self.start_homing(out) {
-                Ok(()) => self.ok(out),
+                Ok(()) => self.gcode.homing = true,
                 Err(_) => self.grbl_error(out, GrblError::HomingDisabled),
             };
         }

@@ -12,12 +12,15 @@
 use kinematics_core::Rotation;
 use kinematics_core::frames::BoardPoint;
 
+use super::gcode::GrblMode;
 use super::gcode_motion::{Hold, cm};
 use super::gcode_stream::planned_length;
 use super::machine::{Action, ActionSink, Core};
 use crate::domain::PointCm;
+use crate::grbl::{Alarm, GrblError};
 use crate::grbl::{Block, PointMm};
-use crate::stepper::{MoveShape, StepperEvent, StepperRequest};
+use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
+use crate::text::reply_text;
 
 /// What the stepper has of the G-code job.
 #[derive(Debug, Clone, Copy, Default)]
@@ -179,18 +182,8 @@ impl Core {
                 true
             }
             StepperEvent::Stopped { steps } => {
-                let config = self.stepper_config();
-                let at = config
-                    .joints_of(steps)
-                    .and_then(|j| config.gimbal.fk(j).ok());
+                self.gcode_stepper_at(steps);
                 let motion = &mut self.gcode.motion;
-                motion.stepper.inflight = None;
-                if let Some(p) = at {
-                    motion.position = PointMm {
-                        x_mm: p.x_cm * 10.0,
-                        y_mm: p.y_cm * 10.0,
-                    };
-                }
                 if motion.hold == Hold::Stopping {
                     motion.hold = Hold::Held;
                     motion.stepper.held = true;
@@ -198,8 +191,63 @@ impl Core {
                 self.grbl_sync_position();
                 false
             }
+
             _ => false,
         }
+    }
+
+    /// The stepper is at rest at `steps`: MPos from the counted steps.
+    #[inline(never)]
+    fn gcode_stepper_at(&mut self, steps: [i32; 2]) {
+        let config = self.stepper_config();
+        let at = config
+            .joints_of(steps)
+            .and_then(|j| config.gimbal.fk(j).ok());
+        let motion = &mut self.gcode.motion;
+        motion.stepper.inflight = None;
+        if let Some(p) = at {
+            motion.position = PointMm {
+                x_mm: p.x_cm * 10.0,
+                y_mm: p.y_cm * 10.0,
+            };
+        }
+    }
+
+    /// The end of homing: when a `$H` waits, its reply — `ok` (unlocked,
+    /// MPos where homing left the spot, at `steps`) or, as grbl, `ALARM:N`
+    /// (locked) and then `ok`; parameters that allow no homing: `error:5`.
+    #[inline(never)]
+    pub(super) fn gcode_homing_done(
+        &mut self,
+        homed: Result<[i32; 2], HomingFailure>,
+        out: &mut dyn ActionSink,
+    ) {
+        if !core::mem::take(&mut self.gcode.homing) {
+            return;
+        }
+        let failed = match homed {
+            Ok(steps) => {
+                self.gcode_stepper_at(steps);
+                self.grbl_sync_position();
+                None
+            }
+            Err(why) => Some(why),
+        };
+        let alarm = match failed {
+            None => {
+                self.gcode.mode = GrblMode::Normal;
+                return self.ok(out);
+            }
+            Some(HomingFailure::NoSwitches | HomingFailure::BadConfig) => {
+                return self.grbl_error(out, GrblError::HomingDisabled);
+            }
+            Some(HomingFailure::NotFound(_)) => Alarm::HomingNotFound,
+            Some(HomingFailure::StillPressed(_)) => Alarm::HomingPullOff,
+            Some(HomingFailure::Interrupted) => Alarm::HomingReset,
+        };
+        self.gcode.mode = GrblMode::Alarm;
+        self.grbl_data(out, reply_text(format_args!("ALARM:{}", alarm.code())));
+        self.ok(out);
     }
 
     /// The current block is done on the stepper's side.

@@ -199,6 +199,7 @@ impl Core {
                         Fixed::<3>(j.pitch_deg)
                     ),
                 );
+                self.gcode_homing_done(Ok(steps), out);
             }
             StepperEvent::HomingFailed(why) => {
                 let text = match why {
@@ -210,6 +211,7 @@ impl Core {
                     HomingFailure::BadConfig => "parameters refused for the homing moves",
                 };
                 self.notify(out, format_args!("error: home failed: {text}; not homed"));
+                self.gcode_homing_done(Err(why), out);
             }
         }
     }
