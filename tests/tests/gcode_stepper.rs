@@ -339,3 +339,64 @@ fn a_failed_dollar_h_raises_alarm_9_before_its_reply_and_locks() {
     assert_eq!(&after[..3], ["ALARM:9", "ok", "> G1 X10 F600"]);
     assert_eq!(after[3], "error:9", "locked by the alarm");
 }
+
+/// The `$11=` line of the last `$$` listing.
+fn dollar_11(report: &SimReport) -> String {
+    terminal_lines(report)
+        .into_iter()
+        .rev()
+        .find(|l| l.starts_with("$11="))
+        .unwrap_or_else(|| panic!("no $11 line: {:?}", terminal_lines(report)))
+        .to_string()
+}
+
+#[test]
+fn dollar_11_is_checked_listed_saved_and_survives_a_reset_and_a_reboot() {
+    let report = run_with(
+        "$11=0.05\n$11=-1\n$11=11\n$$\nsave\n@realtime 0x18\n$$\n",
+        SimOptions::default(),
+    );
+    let lines = terminal_lines(&report);
+    let replies: Vec<&str> = lines
+        .iter()
+        .copied()
+        .filter(|l| *l == "ok" || l.starts_with("error"))
+        .collect();
+    // 0.05 accepted, −1 (negative: error:4) and 11 (range 0–10 mm) refused.
+    assert_eq!(&replies[..3], ["ok", "error:4", "error:3"], "{lines:?}");
+    assert_eq!(dollar_11(&report), "$11=0.050");
+    let rebooted = run_with(
+        "$$\n",
+        SimOptions {
+            settings_flash: Some(report.settings_flash.clone()),
+            ..SimOptions::default()
+        },
+    );
+    assert_eq!(dollar_11(&rebooted), "$11=0.050");
+    let fresh = run_with("$$\n", SimOptions::default());
+    assert_eq!(dollar_11(&fresh), "$11=0.010");
+}
+
+/// A zig-zag of `n` 90° corners, 5 mm legs, at F3000, after `prefix`.
+fn zigzag_with(prefix: &str, target: &str) -> f64 {
+    let mut script = format!("{prefix}target {target}\nG0 X0 Y0\nG1 F3000 M3 S1000\n");
+    for k in 1..=20 {
+        let (x, y) = (5.0 * ((k + 1) / 2) as f64, 5.0 * (k / 2) as f64);
+        script.push_str(&format!("G1 X{x} Y{y}\n"));
+    }
+    script.push_str("G4 P0.1\n");
+    let report = run_with(&script, SimOptions::default());
+    system_tests::assert_all_ok(&report, target);
+    let start = system_tests::sent_at(&report, "G1 F3000 M3 S1000");
+    (report.end_time_us - start) as f64 / 1e6
+}
+
+#[test]
+fn dollar_11_sets_the_corner_speed_of_the_gimbal_and_the_stepper() {
+    for target in ["gimbal", "stepper"] {
+        let tight = zigzag_with("$11=0.002\n", target);
+        let loose = zigzag_with("$11=2\n", target);
+        eprintln!("{target}: 20 corners at $11=0.002 {tight:.2} s, at $11=2 {loose:.2} s");
+        assert!(loose < tight * 0.95, "{target}: {tight} vs {loose}");
+    }
+}

@@ -14,6 +14,7 @@ use crate::grbl::realtime::Realtime;
 use crate::grbl::report::{self, Overrides};
 use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError, ParserState};
+use crate::settings::Settings;
 use crate::text::{ReplyText, reply_text};
 
 /// grbl's RX buffer as `$I` advertises it, bytes.
@@ -58,6 +59,9 @@ pub(super) struct Gcode {
     pub(super) step_speed_ratio: f32,
     /// A `$H` on the stepper waits for homing to end for its reply.
     pub(super) homing: bool,
+    /// The junction deviation the stepper plans with when G-code set it
+    /// (`$11` in joint degrees; `None`: the product's, from its settings).
+    pub(super) stepper_junction_deg: Option<f64>,
 }
 
 impl Gcode {
@@ -73,6 +77,7 @@ impl Gcode {
             galvo: GalvoStroke::default(),
             step_speed_ratio: 0.0,
             homing: false,
+            stepper_junction_deg: None,
         }
     }
 }
@@ -182,6 +187,7 @@ impl Core {
                 }
                 if matches!(scope, RestoreScope::Settings | RestoreScope::All) {
                     self.gcode.values = GrblValues::default();
+                    self.settings.gcode_junction_mm = Settings::default().gcode_junction_mm;
                 }
                 if matches!(scope, RestoreScope::Offsets | RestoreScope::All) {
                     self.gcode.parser.g54 = crate::grbl::PointMm::ZERO;

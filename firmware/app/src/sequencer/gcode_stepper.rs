@@ -87,6 +87,7 @@ impl Core {
             return;
         };
         self.gcode_stepper_override(out);
+        self.stepper_junction(true, out);
         let feed_mm_s = self.stepper_feed(&current.block);
         let seq = self.stepper_request(point, shape, feed_mm_s, out);
         let motion = &mut self.gcode.motion;

@@ -139,7 +139,11 @@ impl Running {
                     | StepperRequest::Home
                     | StepperRequest::Hold,
                 ) => link.halt(),
-                Either3::Third(StepperRequest::Resume | StepperRequest::FeedOverride { .. })
+                Either3::Third(
+                    StepperRequest::Resume
+                    | StepperRequest::FeedOverride { .. }
+                    | StepperRequest::Junction { .. },
+                )
                 | Either3::First(())
                 | Either3::Second(()) => {}
             }

@@ -50,6 +50,8 @@ pub struct StepperMotion {
     history: resume::History,
     /// Feed override: moves at a feed run at feed × this.
     feed_scale: f64,
+    /// A junction deviation (deg) to plan with once the planner is empty.
+    junction_pending: Option<f64>,
 }
 
 /// A move waiting behind the line being cut.
@@ -77,6 +79,7 @@ impl StepperMotion {
             started: None,
             history: resume::History::default(),
             feed_scale: 1.0,
+            junction_pending: None,
         })
     }
 
@@ -117,6 +120,7 @@ impl StepperMotion {
         self.planner = planner;
         self.prep = prep;
         self.last_point = None;
+        self.junction_pending = None;
         Ok(())
     }
 
@@ -164,6 +168,7 @@ impl StepperMotion {
             return Err(StepperRefusal::Busy);
         }
         let end = self.steps_at(point)?;
+        self.apply_junction();
         let queued = match self
             .last_point
             .and_then(|from| Curve::of(from, point, shape))
@@ -358,6 +363,30 @@ impl StepperMotion {
         let max_rate = Self::step_move(&self.config, [1, 0]).nominal_rate_steps_per_s;
         self.prep
             .set_feed_scale(self.feed_scale, max_rate, &mut self.planner);
+    }
+
+    /// The junction deviation from now on, degrees of joint travel (in
+    /// use once the planner is next empty; refused values are ignored).
+    pub fn set_junction_deg(&mut self, deg: f64) {
+        if deg.is_finite() && deg >= 0.0 && deg != self.config.junction_deviation_deg {
+            self.junction_pending = Some(deg);
+            self.apply_junction();
+        }
+    }
+
+    /// Plans with the pending junction deviation when nothing is queued.
+    fn apply_junction(&mut self) {
+        let Some(deg) = self.junction_pending else {
+            return;
+        };
+        if !self.planner.is_empty() || self.prep.is_busy() {
+            return;
+        }
+        if let Ok(planner) = Planner::new(deg / self.config.deg_per_step()) {
+            self.planner = planner;
+            self.config.junction_deviation_deg = deg;
+        }
+        self.junction_pending = None;
     }
 
     /// Step position where the queued moves end.

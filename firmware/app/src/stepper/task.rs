@@ -240,6 +240,9 @@ impl Running {
                 self.refill(link);
             }
             StepperRequest::FeedOverride { percent } => self.motion.set_feed_percent(percent),
+            StepperRequest::Junction { deviation_deg } => {
+                self.motion.set_junction_deg(deviation_deg)
+            }
             StepperRequest::Resume => {
                 if let Err(e) = self.motion.resume(link.position_steps()) {
                     log::warning!("stepper: resume refused: {:?}", e);

@@ -47,6 +47,13 @@ pub enum StepperRequest {
         /// Percent of the programmed feed.
         percent: u8,
     },
+    /// grbl's junction deviation for the moves from now on (G-code's
+    /// `$11`; the product's runs use `stepper.junction_deg`), degrees of
+    /// joint travel; takes effect when the planner is next empty.
+    Junction {
+        /// Junction deviation, degrees.
+        deviation_deg: f64,
+    },
 }
 
 /// How a move gets to its point.
