@@ -400,3 +400,66 @@ fn dollar_11_sets_the_corner_speed_of_the_gimbal_and_the_stepper() {
         assert!(loose < tight * 0.95, "{target}: {tight} vs {loose}");
     }
 }
+
+/// How long the laser ran at `level` ‰, µs.
+fn time_at_level(report: &SimReport, level: u16) -> u64 {
+    let changes = &report.recording.laser_power;
+    changes
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.1 == level)
+        .map(|(k, c)| changes.get(k + 1).map_or(report.end_time_us, |n| n.0) - c.0)
+        .sum()
+}
+
+#[test]
+fn s_and_the_power_override_set_the_duty_on_the_stepper_where_the_blocks_are() {
+    let report = run(
+        "$30=1000\n$31=0\nG0 X-20 Y0\nG1 X0 F600 M3 S300\nG1 X20 S1000\n\
+         G1 X40 S500\nwait 500\n@realtime 0x9b\n@realtime 0x9d\nwait 6000\nM5\n",
+    );
+    let levels: Vec<(u64, u16)> = report.recording.laser_power.clone();
+    eprintln!("levels (µs, ‰): {levels:?}");
+    // S300, from 0.5 s −11 %: 267; then S1000 and S500 at 89 %.
+    let order: Vec<u16> = levels.iter().map(|l| l.1).collect();
+    assert_eq!(order, [300, 267, 890, 445, 0], "{levels:?}");
+    // Each S from where its block starts (20 mm at 10 mm/s: 2 s each).
+    for (&(t, level), x) in levels[2..4].iter().zip([0.0, 20.0]) {
+        let at = spot_mm_at(&report, t);
+        assert!(dist(at, [x, 0.0]) < 0.3, "{level} ‰ from {at:?}");
+    }
+    assert!(time_at_level(&report, 890) > 1_900_000, "{levels:?}");
+    assert!(time_at_level(&report, 445) > 1_900_000, "{levels:?}");
+    assert_eq!(report.recording.power_at(report.end_time_us), 0, "M5: dark");
+}
+
+#[test]
+fn m4_on_the_stepper_lights_while_it_steps_and_is_dark_at_rest_and_in_dwells() {
+    let report = run("G0 X-20 Y0\nG1 X0 F600 M4 S600\nG4 P0.5\nG1 X20\nG4 P0.3\n");
+    let levels: Vec<(u64, u16)> = report.recording.laser_power.clone();
+    eprintln!("M4 levels (µs, ‰): {levels:?}");
+    let lit: Vec<_> = report
+        .recording
+        .laser_events
+        .iter()
+        .filter(|e| e.1)
+        .collect();
+    assert_eq!(
+        lit.len(),
+        2,
+        "two lit moves: {:?}",
+        report.recording.laser_events
+    );
+    assert!(levels.iter().all(|l| l.1 == 0 || l.1 == 600), "{levels:?}");
+    // Dark through the dwell between them (0.5 s).
+    let dwell = system_tests::sent_at(&report, "G4 P0.5");
+    let dark: u64 = report
+        .recording
+        .laser_events
+        .windows(2)
+        .filter(|w| !w[0].1 && w[0].0 > dwell)
+        .map(|w| w[1].0 - w[0].0)
+        .next()
+        .expect("a dark stretch");
+    assert!(dark >= 450_000, "{dark} µs dark in the dwell");
+}

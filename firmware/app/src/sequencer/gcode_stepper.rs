@@ -4,8 +4,9 @@
 //! its look-ahead planner. A block is handed on as soon as the stepper
 //! has taken the one before ([`StepperEvent::Taken`]), so the planner
 //! joins them at speed; the block before a change of the laser (dark ↔
-//! lit), a dwell, a pause or the end waits for rest, so the laser switches
-//! where the spot is. A feed hold decelerates along the path at the
+//! lit, or of its M3/M4 and S), a dwell, a pause or the end waits for
+//! rest, so the laser switches where the spot is (the stepper runs
+//! several blocks ahead of the one the sequencer hands over). A feed hold decelerates along the path at the
 //! limit (laser dark at once); `~` goes on from the point it stopped at:
 //! the rest of the block it stopped in, then the queue.
 
@@ -17,7 +18,7 @@ use super::gcode_motion::{Hold, cm};
 use super::gcode_stream::planned_length;
 use super::machine::{Action, ActionSink, Core};
 use crate::domain::PointCm;
-use crate::grbl::{Alarm, GrblError};
+use crate::grbl::{Alarm, GrblError, Laser};
 use crate::grbl::{Block, PointMm};
 use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
 use crate::text::reply_text;
@@ -27,8 +28,9 @@ use crate::text::reply_text;
 pub(super) struct StepperJob {
     /// The last move handed over and not yet at rest.
     inflight: Option<u32>,
-    /// The laser of the blocks handed over.
+    /// The laser of the blocks handed over: lit, and with what setting.
     lit: bool,
+    laser: Laser,
     /// The current block waits for rest before it is handed over.
     waiting: bool,
     /// A hold came to rest: `~` asks the stepper to go on with its moves.
@@ -36,6 +38,14 @@ pub(super) struct StepperJob {
     /// The feed override the stepper task has, % (`None`: not sent since
     /// the last stop).
     feed_percent: Option<u8>,
+}
+
+/// The laser setting of a feed block (default for others).
+fn block_laser(block: &Block) -> Laser {
+    match *block {
+        Block::Line { laser, .. } | Block::Arc { laser, .. } => laser,
+        _ => Laser::default(),
+    }
 }
 
 /// The stepper move of a motion block: end point (cm) and shape.
@@ -68,8 +78,9 @@ impl Core {
             return;
         };
         let lit = self.lights(&current.block) && self.gcode.motion.hold == Hold::None;
+        let laser = block_laser(&current.block);
         let job = &mut self.gcode.motion.stepper;
-        if job.inflight.is_some() && lit != job.lit {
+        if job.inflight.is_some() && (lit != job.lit || (lit && laser != job.laser)) {
             job.waiting = true;
             return;
         }
@@ -95,6 +106,7 @@ impl Core {
             c.stepper_seq = Some(seq);
         }
         motion.stepper.lit = lit;
+        motion.stepper.laser = laser;
         motion.gimbal_lit = lit && motion.arrived;
     }
 
@@ -144,11 +156,14 @@ impl Core {
     }
 
     /// Whether the block after the current one joins it at speed: a
-    /// motion with the same laser, no hold.
+    /// motion with the same laser (dark, or lit with the same M3/M4 and
+    /// S), no hold.
     #[inline(never)]
     fn stepper_joins_next(&self) -> bool {
         let motion = &self.gcode.motion;
-        let same_laser = |b: &Block| self.lights(b) == motion.stepper.lit;
+        let job = &motion.stepper;
+        let same_laser =
+            |b: &Block| self.lights(b) == job.lit && (!job.lit || block_laser(b) == job.laser);
         motion.hold == Hold::None
             && motion
                 .queue
@@ -282,6 +297,13 @@ impl Core {
             .gimbal
             .ik(BoardPoint::new(p.x_cm, p.y_cm))
             .is_ok_and(|j| config.steps_of(j).is_ok())
+    }
+}
+
+impl super::gcode_motion::Motion {
+    /// Whether the stepper runs a move of the job.
+    pub(super) fn stepper_moving(&self) -> bool {
+        self.stepper.inflight.is_some()
     }
 }
 
