@@ -4,7 +4,7 @@
 
 extern crate std;
 
-use super::motion_tests::{Event, SEGMENT_S, TIMER_HZ, accel_bounded, arb_move, cases};
+use super::motion_tests::{Event, accel_bounded, arb_move, cases, run_acting};
 use super::*;
 use proptest::prelude::*;
 use std::vec::Vec;
@@ -19,29 +19,9 @@ fn run_with_override(
     scale: f64,
     max_rate: f64,
 ) -> Vec<Event> {
-    let mut planner: Planner<16> = Planner::new(jd).unwrap();
-    for mv in moves {
-        planner.push_feed(mv, mv.nominal_rate_steps_per_s).unwrap();
-    }
-    let mut prep = SegmentPrep::new(TIMER_HZ, SEGMENT_S).unwrap();
-    let mut queue: SegmentQueue<4> = SegmentQueue::default();
-    let mut generator = StepGenerator::new();
-    let mut events = Vec::new();
-    loop {
-        if events.len() == at {
-            prep.set_feed_scale(scale, max_rate, &mut planner);
-        }
-        prep.fill(&mut planner, &mut queue);
-        let Some(tick) = generator.tick(&mut queue) else {
-            break;
-        };
-        events.push(Event {
-            tick,
-            rate: f64::from(TIMER_HZ) / f64::from(tick.period_ticks),
-        });
-    }
-    assert!(planner.is_empty() && !prep.is_busy());
-    events
+    run_acting(moves, jd, true, at, |prep, planner, _, _| {
+        prep.set_feed_scale(scale, max_rate, planner)
+    })
 }
 
 proptest! {

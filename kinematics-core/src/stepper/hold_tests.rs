@@ -3,7 +3,7 @@
 
 extern crate std;
 
-use super::motion_tests::{Event, SEGMENT_S, TIMER_HZ, accel_bounded, arb_move, cases};
+use super::motion_tests::{Event, SEGMENT_S, TIMER_HZ, accel_bounded, arb_move, cases, run_acting};
 use super::*;
 use proptest::prelude::*;
 use std::vec::Vec;
@@ -13,36 +13,20 @@ use std::vec::Vec;
 /// else after them, [`SegmentPrep::hold`]) and runs to rest. Returns the
 /// events and the events at the hold.
 fn run_with_hold(moves: &[StepMove], jd: f64, hold_after: usize, now: bool) -> (Vec<Event>, usize) {
-    let mut planner: Planner<16> = Planner::new(jd).unwrap();
-    for mv in moves {
-        planner.push(mv).unwrap();
-    }
-    let mut prep = SegmentPrep::new(TIMER_HZ, SEGMENT_S).unwrap();
-    let mut queue: SegmentQueue<4> = SegmentQueue::default();
-    let mut generator = StepGenerator::new();
-    let mut events = Vec::new();
-    let mut held_at = None;
-    loop {
-        if events.len() == hold_after && held_at.is_none() {
+    let events = run_acting(
+        moves,
+        jd,
+        false,
+        hold_after,
+        |prep, planner, queue, generator| {
             if now {
-                prep.hold_now(&mut planner, generator.executing(), &mut queue);
+                prep.hold_now(planner, generator.executing(), queue);
             } else {
-                prep.hold(&mut planner);
+                prep.hold(planner);
             }
-            held_at = Some(events.len());
-        }
-        prep.fill(&mut planner, &mut queue);
-        let Some(tick) = generator.tick(&mut queue) else {
-            break;
-        };
-        events.push(Event {
-            tick,
-            rate: f64::from(TIMER_HZ) / f64::from(tick.period_ticks),
-        });
-    }
-    assert!(planner.is_empty());
-    assert!(!prep.is_holding() && !prep.is_busy());
-    let held = held_at.unwrap_or(events.len());
+        },
+    );
+    let held = hold_after.min(events.len());
     (events, held)
 }
 
