@@ -11,8 +11,8 @@
 //! | laser enable / power | PB0 (active high): TIM3_CH3 PWM (AF2, 1 kHz) for a power level, GPIO when dark or full (`laser_pwm`); galvo laser stream DMA2 stream 1 ch 7 (TIM8_UP) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
-//! | stepper pan STEP / DIR  | PE9 / PE10 (STEP on a TIM1 channel pin, for a later one-pulse timer; the step timer runs on an interrupt executor, `tasks.rs`) |
-//! | stepper tilt STEP / DIR | PE11 / PE12 (likewise) |
+//! | stepper pan STEP / DIR  | PE9 TIM1_CH1 (AF1, one-pulse: the pulse timed by TIM1) / PE10 GPIO (the step events on an interrupt executor, `tasks.rs`) |
+//! | stepper tilt STEP / DIR | PE11 TIM1_CH2 (AF1, one-pulse) / PE12 GPIO |
 //! | stepper ENABLE (both)   | PE13 (polarity a parameter; released = the idle level) |
 //! | stepper limit switches  | PE7 pan, PE8 tilt (pull-up inputs, normally-open switch to GND: low = pressed) |
 //!
@@ -43,7 +43,7 @@ use static_cell::StaticCell;
 
 use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac, darken_laser_stream};
 use crate::laser_pwm::{LaserPin, laser_dark};
-use crate::parts::{GpioStepper, IndependentDog, StatusLeds, UsbConsole, UsbDriver, UserButton};
+use crate::parts::{IndependentDog, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::{FlashSettings, settings_store};
 
 bind_interrupts!(struct Irqs {
@@ -135,8 +135,9 @@ pub struct Stm32Board {
     pub settings: FlashSettings,
     /// Independent watchdog (not started).
     pub watchdog: IndependentDog,
-    /// Stepper pan/tilt driver inputs (PE9–PE13), limit switches (PE7, PE8).
-    pub stepper: GpioStepper,
+    /// Stepper pan/tilt driver inputs (PE9–PE13, STEP from TIM1), limit
+    /// switches (PE7, PE8).
+    pub stepper: TimerStepper,
 }
 
 impl Board for Stm32Board {
@@ -146,7 +147,7 @@ impl Board for Stm32Board {
     type Laser = LaserPin;
     type Settings = FlashSettings;
     type GalvoDac = Stm32GalvoDac;
-    type Stepper = GpioStepper;
+    type Stepper = TimerStepper;
     type Indicators = StatusLeds;
     type StopButton = UserButton;
     type Watchdog = IndependentDog;
@@ -226,21 +227,17 @@ pub fn init(spawner: Spawner) -> Stm32Board {
         },
         settings: settings_store(Flash::new(p.FLASH, Irqs)),
         watchdog: IndependentDog::new(p.IWDG),
-        stepper: GpioStepper {
-            step: [
-                Output::new(p.PE9, Level::Low, Speed::VeryHigh),
-                Output::new(p.PE11, Level::Low, Speed::VeryHigh),
-            ],
-            dir: [
+        stepper: TimerStepper::new(
+            p.TIM1,
+            (p.PE9, p.PE11),
+            [
                 Output::new(p.PE10, Level::Low, Speed::VeryHigh),
                 Output::new(p.PE12, Level::Low, Speed::VeryHigh),
             ],
             // Active-low ENABLE by default: high = released at reset.
-            enable: Output::new(p.PE13, Level::High, Speed::Low),
-            limit: [Input::new(p.PE7, Pull::Up), Input::new(p.PE8, Pull::Up)],
-            signals: laser_app::stepper::StepperConfig::default().signals,
-            pace: laser_app::stepper::StepPace::new(),
-        },
+            Output::new(p.PE13, Level::High, Speed::Low),
+            [Input::new(p.PE7, Pull::Up), Input::new(p.PE8, Pull::Up)],
+        ),
     }
 }
 

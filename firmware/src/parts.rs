@@ -4,14 +4,23 @@
 
 use embassy_stm32::Peri;
 use embassy_stm32::exti::ExtiInput;
+use embassy_stm32::gpio::OutputType;
 use embassy_stm32::gpio::{Input, Output};
 use embassy_stm32::mode::Async;
-use embassy_stm32::peripherals::{IWDG, USB_OTG_FS};
+use embassy_stm32::pac;
+use embassy_stm32::pac::timer::regs::CcmrOutputGp16;
+use embassy_stm32::peripherals::{IWDG, PE9, PE11, TIM1, USB_OTG_FS};
+use embassy_stm32::timer::low_level::Timer as HalTimer;
+use embassy_stm32::timer::simple_pwm::PwmPin;
+use embassy_stm32::timer::{Ch1, Ch2};
 use embassy_stm32::usb::Driver;
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_time::{Duration, Instant, Timer};
 use embassy_usb::class::cdc_acm::{BufferedReceiver, Sender};
 use laser_app::app::{Console, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog};
+use laser_app::stepper::{
+    CCMR1_IDLE, DriverSignals, OnePulseTiming, StepPace, StepperConfig, StepperDrive,
+};
 
 /// The USB driver type of this board.
 pub type UsbDriver = Driver<'static, USB_OTG_FS>;
@@ -96,45 +105,104 @@ impl Watchdog for IndependentDog {
     }
 }
 
-/// The stepper pan/tilt's driver inputs: STEP and DIR per axis (PE9/PE10
-/// pan, PE11/PE12 tilt) and the shared ENABLE (PE13); the limit switch
-/// inputs (PE7 pan, PE8 tilt). Pulses are timed by
-/// busy-waiting on the cycle counter's clock (2.5 µs STEP, 5 µs DIR setup
-/// by default); the step schedule is embassy-time deadlines (1 µs ticks).
-pub struct GpioStepper {
-    /// STEP outputs, `[pan, tilt]`.
-    pub step: [Output<'static>; 2],
+/// The stepper pan/tilt's driver inputs: STEP per axis from TIM1 in
+/// one-pulse mode (PE9 = TIM1_CH1 pan, PE11 = TIM1_CH2 tilt, AF1), DIR per
+/// axis (PE10 pan, PE12 tilt) and the shared ENABLE (PE13) as GPIO
+/// outputs; the limit switch inputs (PE7 pan, PE8 tilt). A step event sets
+/// DIR, writes the event's compare/reload/mode values
+/// ([`OnePulseTiming::event`]) and starts the timer: it returns at once
+/// and the hardware makes one pulse of the configured width per stepping
+/// axis, the DIR setup time later when a DIR pin changed. The timer stops
+/// itself at the pulse's end with both STEP pins low, so a halt, stop or
+/// fault (nothing starts it again) leaves them low within one pulse. The
+/// step schedule is embassy-time deadlines (1 µs ticks).
+pub struct TimerStepper {
+    /// TIM1 (its clock stays on while this lives).
+    timer: HalTimer<'static, TIM1>,
+    /// Pan STEP, PE9 in AF1 (TIM1_CH1).
+    _pan_step: PwmPin<'static, TIM1, Ch1>,
+    /// Tilt STEP, PE11 in AF1 (TIM1_CH2).
+    _tilt_step: PwmPin<'static, TIM1, Ch2>,
     /// DIR outputs, `[pan, tilt]` (high = negative).
-    pub dir: [Output<'static>; 2],
+    dir: [Output<'static>; 2],
     /// The drivers' shared ENABLE.
-    pub enable: Output<'static>,
+    enable: Output<'static>,
     /// Limit switch inputs, `[pan, tilt]` (PE7, PE8): pulled up, a
     /// normally-open switch to ground closes (low = pressed; no switch
     /// reads open).
-    pub limit: [Input<'static>; 2],
+    limit: [Input<'static>; 2],
     /// Current pulse timing and ENABLE polarity.
-    pub signals: laser_app::stepper::DriverSignals,
+    signals: DriverSignals,
+    /// The timer values for those signals.
+    timing: OnePulseTiming,
     /// The step timer's schedule.
-    pub pace: laser_app::stepper::StepPace,
+    pace: StepPace,
 }
 
-/// CPU cycles for `ns` nanoseconds at SYSCLK (rounded up).
-fn cycles_for_ns(ns: u32) -> u32 {
-    let per_us = crate::board::SYSCLK_HZ / 1_000_000;
-    ns.div_ceil(1000).saturating_mul(per_us)
+impl TimerStepper {
+    /// TIM1 set up for one-pulse STEP pulses (both channels forced
+    /// inactive, outputs enabled, MOE), then the STEP pins switched to it
+    /// (low until then); `dir` and `enable` created at their idle levels.
+    pub fn new(
+        tim1: Peri<'static, TIM1>,
+        step: (Peri<'static, PE9>, Peri<'static, PE11>),
+        dir: [Output<'static>; 2],
+        enable: Output<'static>,
+        limit: [Input<'static>; 2],
+    ) -> Self {
+        let timer = HalTimer::new(tim1);
+        let tim = pac::TIM1;
+        tim.ccmr_output(0).write_value(CcmrOutputGp16(CCMR1_IDLE));
+        tim.ccer().write(|w| {
+            w.set_cce(0, true);
+            w.set_cce(1, true);
+        });
+        tim.bdtr().write(|w| w.set_moe(true));
+        let signals = StepperConfig::default().signals;
+        let mut stepper = Self {
+            timing: OnePulseTiming::new(timer.get_clock_frequency().0, signals),
+            timer,
+            _pan_step: PwmPin::new(step.0, OutputType::PushPull),
+            _tilt_step: PwmPin::new(step.1, OutputType::PushPull),
+            dir,
+            enable,
+            limit,
+            signals,
+            pace: StepPace::new(),
+        };
+        stepper.set_signals(signals);
+        stepper
+    }
+
+    /// Waits for a pulse still in flight to end (the timer clears CEN at
+    /// its update): an event that comes early, after a late one, must not
+    /// change DIR under a high STEP or restart a running pulse. At most
+    /// the DIR setup plus the pulse (≤ 200 µs); none at the scheduled rate
+    /// (the settings keep both within one step period).
+    fn wait_idle(&self) {
+        while pac::TIM1.cr1().read().cen() {}
+    }
 }
 
-impl laser_app::stepper::StepperDrive for GpioStepper {
+impl StepperDrive for TimerStepper {
     fn set_enabled(&mut self, enabled: bool) {
         self.enable
             .set_level((enabled == self.signals.enable_active_high).into());
     }
 
-    fn set_signals(&mut self, signals: laser_app::stepper::DriverSignals) {
+    /// The counts for `signals` (the only division of the step path's
+    /// arithmetic, here at rest), the prescaler loaded at once by an
+    /// update event with the counter stopped.
+    fn set_signals(&mut self, signals: DriverSignals) {
+        self.wait_idle();
         self.signals = signals;
+        self.timing = OnePulseTiming::new(self.timer.get_clock_frequency().0, signals);
+        pac::TIM1.psc().write_value(self.timing.prescaler());
+        self.timer.generate_update_event();
     }
 
     fn step(&mut self, step: [bool; 2], negative: [bool; 2]) {
+        self.wait_idle();
         let mut dir_changed = false;
         for (pin, negative) in self.dir.iter_mut().zip(negative) {
             if pin.is_set_high() != negative {
@@ -142,16 +210,20 @@ impl laser_app::stepper::StepperDrive for GpioStepper {
                 dir_changed = true;
             }
         }
-        if dir_changed {
-            cortex_m::asm::delay(cycles_for_ns(self.signals.dir_setup_ns));
+        let Some(pulse) = self.timing.event(step, dir_changed) else {
+            return;
+        };
+        let tim = pac::TIM1;
+        tim.ccmr_output(0).write_value(CcmrOutputGp16(pulse.ccmr1));
+        for channel in 0..2 {
+            tim.ccr(channel).write(|w| w.set_ccr(pulse.compare));
         }
-        for (pin, _) in self.step.iter_mut().zip(step).filter(|(_, s)| *s) {
-            pin.set_high();
-        }
-        cortex_m::asm::delay(cycles_for_ns(self.signals.pulse_ns));
-        for pin in &mut self.step {
-            pin.set_low();
-        }
+        tim.arr().write(|w| w.set_arr(pulse.reload));
+        // Up-counting, no preload: one pulse, then the timer stops itself.
+        tim.cr1().write(|w| {
+            w.set_opm(true);
+            w.set_cen(true);
+        });
     }
 
     async fn wait_ticks(&mut self, ticks: u32) {

@@ -23,7 +23,7 @@ use static_cell::StaticCell;
 use crate::board::Stm32Board;
 use crate::galvo_dac::{self, Stm32GalvoDac};
 use crate::laser_pwm::LaserPin;
-use crate::parts::{GpioStepper, IndependentDog, StatusLeds, UsbConsole, UsbDriver, UserButton};
+use crate::parts::{IndependentDog, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton};
 use crate::settings_flash::FlashSettings;
 use laser_app::stepper::{StepPulseTask, StepperTask};
 
@@ -61,17 +61,20 @@ async fn galvo(task: GalvoTask<Stm32GalvoDac>) {
     task.run_in(GalvoMemory::init_in(MEMORY.uninit())).await
 }
 
-/// The stepper step timer: executes the prepared segments on PE9–PE13.
-/// Runs on [`STEP_EXECUTOR`], above the galvo executor and thread mode.
+/// The stepper step timer: executes the prepared segments on PE9–PE13
+/// (each event sets DIR and starts TIM1's one-pulse STEP pulses). Runs on
+/// [`STEP_EXECUTOR`], above the galvo executor and thread mode.
 #[embassy_executor::task]
-async fn step_pulses(task: StepPulseTask<GpioStepper>) -> ! {
+async fn step_pulses(task: StepPulseTask<TimerStepper>) -> ! {
     task.run().await
 }
 
 /// Priority of the step timer's executor: P0, with the short peripheral
-/// handlers (one step event is ≤ 8 µs with the busy-waited pulse and DIR
-/// setup), above the galvo executor (P1), whose refills (up to ~0.5 ms)
-/// would otherwise delay steps by most of a period at 1 600 steps/s.
+/// handlers (a step event is about 1 µs: Bresenham, DIR pins and five
+/// TIM1 register writes; the pulse and DIR setup are timed by TIM1, not
+/// waited for), above the galvo executor (P1), whose refills (up to
+/// ~0.5 ms) would otherwise delay steps by most of a period at
+/// 1 600 steps/s.
 const STEP_PRIORITY: Priority = Priority::P0;
 
 /// The step timer's executor: an interrupt executor on CAN2_RX1 (a
@@ -135,7 +138,7 @@ impl Spawn<Stm32Board> for TaskSpawner {
         self.galvo.spawn(defmt::unwrap!(galvo(task)));
     }
 
-    fn step_pulses(&mut self, task: StepPulseTask<GpioStepper>) {
+    fn step_pulses(&mut self, task: StepPulseTask<TimerStepper>) {
         interrupt::CAN2_RX1.set_priority(STEP_PRIORITY);
         let spawner = STEP_EXECUTOR.start(interrupt::CAN2_RX1);
         spawner.spawn(defmt::unwrap!(step_pulses(task)));

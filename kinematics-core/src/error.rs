@@ -124,9 +124,11 @@ impl fmt::Display for Error {
             }
             Error::StepsOutOfRange => f.write_str("stepper angle out of the i32 microstep range"),
             Error::GridIndexOutOfRange { xi, yi } => {
+                let (xi, yi) = (Int(xi.into()), Int(yi.into()));
                 write!(f, "grid index ({xi}, {yi}) is outside the grid")
             }
             Error::DacCodeOutOfRange { code } => {
+                let code = u32::from(code);
                 write!(f, "DAC code {code} is above full scale")
             }
             Error::TooManySteps => f.write_str("path needs too many interpolation steps"),
@@ -149,6 +151,23 @@ impl fmt::Display for Error {
 }
 
 impl core::error::Error for Error {}
+
+/// A signed integer as sign and magnitude through `u64`'s writer. Each
+/// integer type's own `Display` is 100–280 B of the firmware's flash;
+/// messages (here and laser-app's replies, `laser_app::text::Int`) print
+/// signed values through this and unsigned ones as `u32` or `u64`, the
+/// writers linked anyway.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Int(pub i64);
+
+impl fmt::Display for Int {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.0 < 0 {
+            f.write_str("-")?;
+        }
+        write!(f, "{}", self.0.unsigned_abs())
+    }
+}
 
 /// Writes `v` with two decimals by integer arithmetic: the firmware links
 /// no `core` float formatting (its flash budget), so neither does this

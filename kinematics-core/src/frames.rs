@@ -8,7 +8,7 @@
 //! `x_g = OQ, y_g = −x_b, z_g = y_b`.
 
 use crate::error::Error;
-use crate::numeric::finite;
+use crate::numeric::{finite, trig};
 use crate::real::Real;
 
 /// Centimetres per millimetre.
@@ -196,7 +196,7 @@ impl BoardFrame {
 
     fn roll_sin_cos(&self) -> (f64, f64) {
         let roll_rad = self.pose.roll_deg.to_radians();
-        (libm::sin(roll_rad), libm::cos(roll_rad))
+        (trig::sin(roll_rad), trig::cos(roll_rad))
     }
 
     /// Board point (cm, before the offsets are added) → global point (cm).

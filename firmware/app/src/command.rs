@@ -308,8 +308,10 @@ impl CommandLink {
     /// Closes the current reply with grbl's `error:N` (never waits; a
     /// closer always has room).
     pub fn grbl_error(&self, error: crate::grbl::GrblError) {
-        self.outbound
-            .push_fmt(LineKind::GrblError, format_args!("{}", error.code()));
+        self.outbound.push_fmt(
+            LineKind::GrblError,
+            format_args!("{}", u32::from(error.code())),
+        );
     }
 
     /// Closes the current reply with `error: <reason>` (never waits; a

@@ -37,11 +37,13 @@ impl fmt::Display for Shortest {
         }
         // Whole numbers (parameter values, limits) print without ".0".
         if v == libm::trunc(v) && v.abs() < 1e15 {
-            return write!(f, "{}", v as i64);
+            return fmt::Display::fmt(&Int(v as i64), f);
         }
         shortest::write_finite(v, f)
     }
 }
+
+pub use kinematics_core::error::Int;
 
 /// `f64` rounded to `DECIMALS` places (`Fixed::<3>(5.0)` → `5.000`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -137,6 +139,14 @@ mod tests {
         assert_eq!(format!("{}", Shortest(-135.0)), "-135");
         assert_eq!(format!("{}", Shortest(0.25)), "0.25");
         assert_eq!(format!("{}", Shortest(-0.0)), "0");
+        assert_eq!(
+            format!("{}", Shortest(-999_999_999_999_999.0)),
+            "-999999999999999"
+        );
+        assert_eq!(format!("{}", Shortest(-1.5e-7)), "-1.5e-7");
+        for v in [0, 7, -7, i64::from(i16::MIN), i64::MAX, i64::MIN] {
+            assert_eq!(format!("{}", Int(v)), format!("{v}"));
+        }
         assert_eq!(format!("{}", Shortest(f64::NEG_INFINITY)), "-inf");
     }
 

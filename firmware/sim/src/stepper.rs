@@ -32,7 +32,7 @@ mod drive;
 mod pan_tilt;
 mod switch;
 
-pub use drive::SimStepperDrive;
+pub use drive::{SimStepperDrive, TIMER_HZ};
 pub use pan_tilt::{PanTiltDrivers, StepEdge, StepPin, StepperGeometry};
 pub use switch::LimitSwitch;
 

@@ -2,6 +2,7 @@
 //! arithmetic for the two electrical poles).
 
 use crate::linalg::{Matrix, Vector, at, expm_and_integral, mat_vec};
+use kinematics_core::numeric::trig;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct C {
@@ -40,10 +41,10 @@ impl C {
     }
     /// `e^z − 1`, accurate for small |z|.
     fn exp_m1(self) -> C {
-        let s = libm::sin(0.5 * self.im);
+        let s = trig::sin(0.5 * self.im);
         C::new(
-            libm::expm1(self.re) * libm::cos(self.im) - 2.0 * s * s,
-            libm::exp(self.re) * libm::sin(self.im),
+            libm::expm1(self.re) * trig::cos(self.im) - 2.0 * s * s,
+            libm::exp(self.re) * trig::sin(self.im),
         )
     }
 }

@@ -25,7 +25,7 @@ impl ArcRotor {
 
     /// Pointing at `angle_rad` (computed in `f64`, once).
     pub fn at_angle(angle_rad: f64) -> Self {
-        let (s, c) = libm::sincos(angle_rad);
+        let (s, c) = kinematics_core::numeric::trig::sin_cos(angle_rad);
         ArcRotor {
             c: c as f32,
             s: s as f32,

@@ -4,6 +4,7 @@
 use super::block::{Block, EMPTY_BLOCK, Geometry};
 use super::{PathPlanner, finite_point};
 use crate::error::Error;
+use kinematics_core::numeric::trig;
 
 impl<const CAP: usize> PathPlanner<CAP> {
     /// Starts a new path at `p_mm`: if the spot is elsewhere a jump is
@@ -103,7 +104,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
         }
         let length = r0 * libm::fabs(sweep);
         let a = self.limits.accel_mm_s2;
-        let tangent = |ang: f64| [-dir * libm::sin(ang), dir * libm::cos(ang)];
+        let tangent = |ang: f64| [-dir * trig::sin(ang), dir * trig::cos(ang)];
         let v_cap = libm::sqrt(a * r0 * core::f64::consts::FRAC_1_SQRT_2);
         let b = Block {
             geom: Geometry::Arc {

@@ -11,7 +11,7 @@
 use super::JointAngles;
 use crate::error::Error;
 use crate::frames::GlobalPoint;
-use crate::numeric::{clamp, finite};
+use crate::numeric::{clamp, finite, trig};
 
 /// Joint angles that put the spot on the global point `p` (cm).
 ///
@@ -35,7 +35,7 @@ pub fn ik(ol_cm: f64, p: GlobalPoint) -> Result<JointAngles, Error> {
         return Err(Error::InsideOffsetCircle);
     }
     let theta_rad = libm::atan2(p.z_cm, h_cm);
-    let lambda_rad = libm::acos(clamp(ol_cm / r_cm, 0.0, 1.0));
+    let lambda_rad = trig::acos(clamp(ol_cm / r_cm, 0.0, 1.0));
     let pitch_rad = core::f64::consts::FRAC_PI_2 - (theta_rad + lambda_rad);
     Ok(JointAngles {
         yaw_deg: yaw_rad.to_degrees(),
@@ -48,8 +48,8 @@ pub fn ik(ol_cm: f64, p: GlobalPoint) -> Result<JointAngles, Error> {
 /// Errors: [`Error::NonFinite`], [`Error::InvalidConfig`] (OL < 0).
 pub fn beam(ol_cm: f64, j: JointAngles) -> Result<(GlobalPoint, [f64; 3]), Error> {
     check_ol(ol_cm)?;
-    let (sa, ca) = libm::sincos(finite(j.yaw_deg, "yaw_deg")?.to_radians());
-    let (sb, cb) = libm::sincos(finite(j.pitch_deg, "pitch_deg")?.to_radians());
+    let (sa, ca) = trig::sin_cos(finite(j.yaw_deg, "yaw_deg")?.to_radians());
+    let (sb, cb) = trig::sin_cos(finite(j.pitch_deg, "pitch_deg")?.to_radians());
     let origin = GlobalPoint {
         x_cm: ol_cm * sb * ca,
         y_cm: ol_cm * sb * sa,

@@ -15,7 +15,7 @@ use super::JointAngles;
 use super::exact::{MIN_BEAM_X, check_ol};
 use crate::error::Error;
 use crate::frames::GlobalPoint;
-use crate::numeric::{clamp, finite};
+use crate::numeric::{clamp, finite, trig};
 
 /// Seed IK: joint angles for the global point `p` (cm), `ol_cm` = OL (cm).
 ///
@@ -34,7 +34,7 @@ pub fn ik(ol_cm: f64, p: GlobalPoint) -> Result<JointAngles, Error> {
     if op3_cm <= ol_cm {
         return Err(Error::InsideOffsetCircle);
     }
-    let lambda_rad = libm::acos(clamp(ol_cm / op3_cm, 0.0, 1.0));
+    let lambda_rad = trig::acos(clamp(ol_cm / op3_cm, 0.0, 1.0));
     let pitch_rad = core::f64::consts::FRAC_PI_2 - (theta_rad + lambda_rad);
     Ok(JointAngles {
         yaw_deg: yaw_rad.to_degrees(),
@@ -55,8 +55,8 @@ pub fn fk(ol_cm: f64, plane_x_cm: f64, j: JointAngles) -> Result<GlobalPoint, Er
     if x_cm <= 0.0 {
         return Err(Error::BehindGimbal);
     }
-    let (sa, ca) = libm::sincos(finite(j.yaw_deg, "yaw_deg")?.to_radians());
-    let (sb, cb) = libm::sincos(finite(j.pitch_deg, "pitch_deg")?.to_radians());
+    let (sa, ca) = trig::sin_cos(finite(j.yaw_deg, "yaw_deg")?.to_radians());
+    let (sb, cb) = trig::sin_cos(finite(j.pitch_deg, "pitch_deg")?.to_radians());
     if ca <= MIN_BEAM_X || cb <= MIN_BEAM_X || x_cm - ol_cm * sb <= 0.0 {
         return Err(Error::MissesBoard);
     }

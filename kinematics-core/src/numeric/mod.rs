@@ -1,7 +1,10 @@
 //! Numeric helpers shared by the math crates (this one and `galvo-planner`):
-//! the finiteness check, a panic-free clamp and the upper-triangular
-//! (back-substitution) solve. Each crate maps [`NonFinite`] into its own
+//! the finiteness check, a panic-free clamp, the upper-triangular
+//! (back-substitution) solve and the `f64` sine and cosine ([`trig`],
+//! used by laser-app too). Each crate maps [`NonFinite`] into its own
 //! error type (`From`), so `finite(v, "x_cm")?` reads the same in both.
+
+pub mod trig;
 
 /// A value that must be finite is NaN or infinite.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

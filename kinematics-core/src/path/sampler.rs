@@ -6,7 +6,7 @@ use core::iter::FusedIterator;
 use super::{MAX_STEPS, Rotation};
 use crate::error::Error;
 use crate::frames::BoardPoint;
-use crate::numeric::finite;
+use crate::numeric::{finite, trig};
 
 /// A path segment in the board plane (cm).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -113,7 +113,7 @@ impl Shape {
                 start_rad,
                 sweep_rad,
             } => {
-                let (s, c) = libm::sincos(start_rad + t * sweep_rad);
+                let (s, c) = trig::sin_cos(start_rad + t * sweep_rad);
                 BoardPoint {
                     x_cm: centre.x_cm + radius_cm * c,
                     y_cm: centre.y_cm + radius_cm * s,
@@ -177,7 +177,7 @@ impl UniformSampler {
                 // Largest angle whose chord stays within the tolerance, and
                 // whose arc is at most one step.
                 let cos_half = (1.0 - max_chord_error_cm / r).max(-1.0);
-                let by_chord = 2.0 * libm::acos(cos_half);
+                let by_chord = 2.0 * trig::acos(cos_half);
                 let by_step = max_step_cm / r;
                 let dphi = by_chord.min(by_step);
                 let n_f = if r == 0.0 || sweep == 0.0 {

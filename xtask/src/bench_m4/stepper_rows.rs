@@ -20,6 +20,16 @@ pub const STEPPER_ROWS: &[Row] = &[
         )),
     },
     Row {
+        id: "stepper.step_tick.event_one_pulse",
+        what: "stepper step event with the one-pulse timer's values (DIR change, compare, reload, modes; without the five register stores)",
+        unit: "event",
+        budget: Some((
+            0.20 * EVENT_US,
+            "20 % of a 50 kHz step event on two axes",
+            Enforcement::Enforced,
+        )),
+    },
+    Row {
         id: "stepper.step_tick.segment",
         what: "stepper step generator, an event that loads a new segment",
         unit: "segment",

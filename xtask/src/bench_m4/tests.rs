@@ -14,7 +14,8 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench loop.stroke.prep 2000 1\n\
     bench plan.xy.optimal.1lsb 250 1\nbench plan.xy.optimal.160mm 300 1\n\
     bench plan.seed.1deg 100 1\n\
-    bench stepper.step_tick.event 100 50\nbench stepper.step_tick.segment 20 8\n\
+    bench stepper.step_tick.event 100 50\nbench stepper.step_tick.event_one_pulse 100 50\n\
+    bench stepper.step_tick.segment 20 8\n\
     done 0\n";
 
 #[test]

@@ -103,7 +103,7 @@ pub(super) fn figure_probes(figure: &Figure) -> heapless::Vec<Probe, MAX_PROBES>
             for k in 0..MAX_PROBES {
                 let angle = core::f64::consts::FRAC_PI_2
                     + core::f64::consts::TAU * k as f64 / MAX_PROBES as f64;
-                let (sin, cos) = libm::sincos(angle);
+                let (sin, cos) = kinematics_core::numeric::trig::sin_cos(angle);
                 push(centre.x_cm + radius_cm * cos, centre.y_cm + radius_cm * sin);
             }
         }

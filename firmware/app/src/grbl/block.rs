@@ -4,6 +4,7 @@
 //! work offsets are applied; feeds are mm/min.
 
 use core::f64::consts::TAU;
+use kinematics_core::numeric::trig;
 
 /// A point on the board plane, mm.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -118,7 +119,7 @@ impl Arc {
             return self.to;
         }
         let angle = self.sweep_rad * fraction.max(0.0);
-        let (sin, cos) = (libm::sin(angle), libm::cos(angle));
+        let (sin, cos) = trig::sin_cos(angle);
         let (sx, sy) = (
             self.from.x_mm - self.centre.x_mm,
             self.from.y_mm - self.centre.y_mm,
@@ -138,7 +139,7 @@ impl Arc {
             return 1;
         }
         // A chord over angle θ strays r·(1 − cos(θ/2)) from the arc.
-        let max_angle = 2.0 * libm::acos(1.0 - tolerance_mm / r);
+        let max_angle = 2.0 * trig::acos(1.0 - tolerance_mm / r);
         let n = libm::ceil(libm::fabs(self.sweep_rad) / max_angle);
         if n.is_nan() || n < 1.0 {
             return 1;

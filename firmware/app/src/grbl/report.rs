@@ -146,7 +146,7 @@ pub fn write_status(w: &mut impl Write, s: &Status) -> fmt::Result {
         )?;
     }
     if let Some((blocks, bytes)) = s.buffer {
-        write!(w, "|Bf:{blocks},{bytes}")?;
+        write!(w, "|Bf:{},{}", u32::from(blocks), u32::from(bytes))?;
     }
     if let Some(n) = s.line_number {
         write!(w, "|Ln:{n}")?;
@@ -162,7 +162,9 @@ pub fn write_status(w: &mut impl Write, s: &Status) -> fmt::Result {
         write_point(w, s.work_offset_mm)?;
     }
     if let Some((ov, spindle, coolant)) = s.overrides {
-        write!(w, "|Ov:{},{},{}", ov.feed, ov.rapid, ov.spindle)?;
+        // As u32: the u8 writer is not linked (text::Int).
+        let [feed, rapid, power] = [ov.feed, ov.rapid, ov.spindle].map(u32::from);
+        write!(w, "|Ov:{feed},{rapid},{power}")?;
         let mut accessories = heapless::String::<4>::new();
         let _ = match spindle {
             SpindleMode::Constant => accessories.push('S'),
@@ -229,7 +231,7 @@ pub fn write_parser_state(w: &mut impl Write, s: &ParserState) -> fmt::Result {
     write!(
         w,
         " T{} F{} S{}]",
-        s.tool,
+        u32::from(s.tool),
         Fixed::<0>(s.feed_mm_min),
         Fixed::<0>(s.power)
     )
@@ -283,7 +285,7 @@ pub fn write_options(
 
 /// One `$$` line: `$N=value` with grbl's decimals for N.
 pub fn write_setting(w: &mut impl Write, setting: &GrblSetting, value: f64) -> fmt::Result {
-    write!(w, "${}=", setting.number)?;
+    write!(w, "${}=", u32::from(setting.number))?;
     match setting.decimals {
         0 => write!(w, "{}", Fixed::<0>(value)),
         1 => write!(w, "{}", Fixed::<1>(value)),

@@ -90,6 +90,8 @@ impl Core {
     /// The servo task reports servo `id` answering again.
     pub(super) fn servo_recovered(&mut self, id: u8, out: &mut dyn ActionSink) {
         self.faults.recovered(id);
+        // As u32: the u8 writer is not linked (text::Int).
+        let id = u32::from(id);
         self.notify(out, format_args!("info: servo {id} answering again"));
     }
 
@@ -115,6 +117,7 @@ impl Core {
         {
             return;
         }
+        let id = u32::from(id);
         if gimbal_run {
             self.notify(
                 out,
@@ -143,7 +146,8 @@ impl Core {
         }
         let id = self
             .faults
-            .dead_among(self.settings.yaw.id, self.settings.pitch.id)?;
+            .dead_among(self.settings.yaw.id, self.settings.pitch.id)
+            .map(u32::from)?;
         Some(reply_text(format_args!(
             "servo {id} not responding: check its power and cable; pinged every 0.5 s, \
              wait for [info: servo {id} answering again]"

@@ -106,7 +106,10 @@ impl Core {
     pub(super) fn grbl_alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
         self.stop("grbl alarm", out);
         self.gcode.mode = GrblMode::Alarm;
-        self.grbl_data(out, reply_text(format_args!("ALARM:{}", alarm.code())));
+        self.grbl_data(
+            out,
+            reply_text(format_args!("ALARM:{}", u32::from(alarm.code()))),
+        );
     }
 
     fn grbl_gcode(&mut self, line: &str, out: &mut dyn ActionSink) {
@@ -326,7 +329,10 @@ impl Core {
             self.gcode.mode = GrblMode::Alarm;
             self.grbl_data(
                 out,
-                reply_text(format_args!("ALARM:{}", Alarm::ResetWhileMoving.code())),
+                reply_text(format_args!(
+                    "ALARM:{}",
+                    u32::from(Alarm::ResetWhileMoving.code())
+                )),
             );
         }
         self.grbl_data(out, reply_text(format_args!("{}", report::BANNER)));

@@ -36,8 +36,9 @@ impl Core {
                     crate::build_info::PRODUCT
                 ));
                 self.grbl_data(out, version);
-                let options =
-                    reply_text(format_args!("[OPT:VN,{PLANNER_BLOCKS},{RX_BUFFER_BYTES}]"));
+                // As u32: the u16 writer is not linked (text::Int).
+                let rx_bytes = u32::from(RX_BUFFER_BYTES);
+                let options = reply_text(format_args!("[OPT:VN,{PLANNER_BLOCKS},{rx_bytes}]"));
                 self.grbl_data(out, options);
             }
             SystemCommand::StartupLines => {

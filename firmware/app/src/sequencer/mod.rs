@@ -378,9 +378,10 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
                     Line::Notice(text) => outbound.push(LineKind::Notice, text),
                     Line::Ok => outbound.push(LineKind::Ok, ""),
                     Line::Error(text) => outbound.push(LineKind::Error, text),
-                    Line::GrblError(error) => {
-                        outbound.push_fmt(LineKind::GrblError, format_args!("{}", error.code()))
-                    }
+                    Line::GrblError(error) => outbound.push_fmt(
+                        LineKind::GrblError,
+                        format_args!("{}", u32::from(error.code())),
+                    ),
                 };
             }
             Action::Save => self.follow_up = FollowUp::Save,

@@ -7,7 +7,7 @@ use crate::command::Command;
 use crate::command::HELP_LINES;
 use crate::domain::{AimModel, PointCm};
 use crate::status::{Activity, Phase, Snapshot};
-use crate::text::Fixed;
+use crate::text::{Fixed, Int};
 
 impl Core {
     /// The data lines of `command` (`help`, `version`, `status`, `get`).
@@ -103,10 +103,13 @@ impl Core {
             let PointCm { x_cm, y_cm } = target.point;
             let (x_cm, y_cm) = (Fixed::<3>(x_cm), Fixed::<3>(y_cm));
             match target.grid {
-                Some((xi, yi)) => self.data(
-                    out,
-                    format_args!("target: ({x_cm}, {y_cm}) cm grid ({xi}, {yi})"),
-                ),
+                Some((xi, yi)) => {
+                    let (xi, yi) = (Int(xi.into()), Int(yi.into()));
+                    self.data(
+                        out,
+                        format_args!("target: ({x_cm}, {y_cm}) cm grid ({xi}, {yi})"),
+                    )
+                }
                 None => self.data(out, format_args!("target: ({x_cm}, {y_cm}) cm")),
             }
             self.data(
@@ -123,8 +126,8 @@ impl Core {
                     "servo: yaw {} deg pitch {} deg (wire {} {})",
                     Fixed::<1>(f64::from(aim.yaw_wire) / 10.0),
                     Fixed::<1>(f64::from(aim.pitch_wire) / 10.0),
-                    aim.yaw_wire,
-                    aim.pitch_wire
+                    Int(aim.yaw_wire.into()),
+                    Int(aim.pitch_wire.into())
                 ),
             );
         }
@@ -151,7 +154,10 @@ impl Core {
             ),
         );
         match s.faulty_servo {
-            Some(id) => self.data(out, format_args!("faults: servo {id} not responding")),
+            Some(id) => {
+                let id = u32::from(id);
+                self.data(out, format_args!("faults: servo {id} not responding"))
+            }
             None => self.data(out, format_args!("faults: none")),
         }
         self.data(

@@ -8,6 +8,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 
 use super::plausibility::WIRE_LIMIT_TENTHS;
+use crate::text::Int;
 
 /// Servo ids and timing of the servo bus. All durations in ms, angles in
 /// the servo's wire unit (0.1°).
@@ -89,8 +90,11 @@ impl ServoRequest {
     }
 }
 
-/// Why a servo is considered faulty.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Why a servo is considered faulty. `Debug` prints what `derive(Debug)`
+/// would (`NotArrived { at_tenths: 12, target_tenths: 30 }`; replies show
+/// it), written out: the derived one links `core`'s struct-debug builder
+/// (~800 B of flash) for this one type.
+#[derive(Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ServoFault {
     /// No valid response after all retries.
@@ -112,6 +116,31 @@ pub enum ServoFault {
         /// The last rejected reading, 0.1°.
         at_tenths: i16,
     },
+}
+
+impl core::fmt::Debug for ServoFault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            ServoFault::NoResponse => f.write_str("NoResponse"),
+            ServoFault::NotArrived {
+                at_tenths,
+                target_tenths,
+            } => write!(
+                f,
+                "NotArrived {{ at_tenths: {}, target_tenths: {} }}",
+                Int(at_tenths.into()),
+                Int(target_tenths.into())
+            ),
+            ServoFault::BusError => f.write_str("BusError"),
+            ServoFault::ImplausibleReading { at_tenths } => {
+                write!(
+                    f,
+                    "ImplausibleReading {{ at_tenths: {} }}",
+                    Int(at_tenths.into())
+                )
+            }
+        }
+    }
 }
 
 /// What the servo task reports.
@@ -182,3 +211,47 @@ impl Default for ServoLink {
 
 /// Largest single-turn angle, 0.1° (default range before the first move).
 const WIRE: i16 = WIRE_LIMIT_TENTHS as i16;
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::ServoFault;
+    use std::format;
+
+    /// The same shape with the derived `Debug`: what replies printed before.
+    #[derive(Debug)]
+    #[allow(dead_code)] // the fields are read by the derived Debug only
+    enum Derived {
+        NoResponse,
+        NotArrived { at_tenths: i16, target_tenths: i16 },
+        BusError,
+        ImplausibleReading { at_tenths: i16 },
+    }
+
+    #[test]
+    fn fault_debug_text_is_the_derived_one() {
+        for (a, b) in [(0, 0), (12, -30), (i16::MIN, i16::MAX), (-1, 1800)] {
+            let cases = [
+                (ServoFault::NoResponse, Derived::NoResponse),
+                (
+                    ServoFault::NotArrived {
+                        at_tenths: a,
+                        target_tenths: b,
+                    },
+                    Derived::NotArrived {
+                        at_tenths: a,
+                        target_tenths: b,
+                    },
+                ),
+                (ServoFault::BusError, Derived::BusError),
+                (
+                    ServoFault::ImplausibleReading { at_tenths: a },
+                    Derived::ImplausibleReading { at_tenths: a },
+                ),
+            ];
+            for (ours, derived) in cases {
+                assert_eq!(format!("{ours:?}"), format!("{derived:?}"));
+            }
+        }
+    }
+}

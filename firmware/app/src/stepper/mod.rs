@@ -17,6 +17,7 @@
 mod home;
 mod link;
 mod motion;
+mod one_pulse;
 mod pace;
 mod task;
 
@@ -25,6 +26,7 @@ pub use self::link::{
     StepperRequest,
 };
 pub use self::motion::{LINE_TOLERANCE_MM, StepperMotion};
+pub use self::one_pulse::{CCMR1_IDLE, OnePulse, OnePulseTiming};
 pub use self::pace::StepPace;
 pub use self::task::{StepPulseTask, StepperTask};
 
@@ -59,11 +61,15 @@ pub trait StepperDrive {
     /// Energises (`true`) or releases the drivers (the board applies the
     /// configured ENABLE polarity).
     fn set_enabled(&mut self, enabled: bool);
-    /// The pulse timing and ENABLE polarity from now on.
+    /// The pulse timing and ENABLE polarity from now on (at rest: the
+    /// place for any arithmetic the step path would otherwise do).
     fn set_signals(&mut self, signals: DriverSignals);
     /// One step event: DIR to `negative` (high = negative) on both axes,
-    /// then — the DIR setup time later — a STEP pulse on each axis in
-    /// `step`.
+    /// then — the DIR setup time later when a DIR pin changed — a STEP
+    /// pulse of the configured width on each axis in `step`. May return
+    /// before the pulse ends (the STM32 board times it with a one-pulse
+    /// timer, [`OnePulseTiming`]); a pulse still running from the event
+    /// before ends before DIR changes.
     fn step(&mut self, step: [bool; 2], negative: [bool; 2]);
     /// Waits until `ticks` step-timer ticks after the previous event (the
     /// schedule does not drift with the time the step took).

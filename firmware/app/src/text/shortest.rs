@@ -175,7 +175,10 @@ pub(super) fn write_finite(v: f64, f: &mut fmt::Formatter<'_>) -> fmt::Result {
             f.write_str(".")?;
             d.write(f, 1, d.len)?;
         }
-        write!(f, "e{}", point - 1)
+        // Through u64 formatting: the one integer writer linked anyway.
+        let exp = point - 1;
+        f.write_str(if exp < 0 { "e-" } else { "e" })?;
+        write!(f, "{}", u64::from(exp.unsigned_abs()))
     }
 }
 

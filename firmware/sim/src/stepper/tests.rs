@@ -230,3 +230,59 @@ fn spot_from_counted_steps_through_the_exact_fk() {
     assert!(err_mm > 0.0);
     assert!(g.spot_cm([i64::MAX, 0]).is_none());
 }
+
+/// The simulated board's step: the STEP edges where the one-pulse timer
+/// puts them (the DIR setup, then the pulse, in whole timer counts), and
+/// an event that comes while a pulse still runs waits for its end before
+/// DIR changes, as the STM32 board's does.
+#[test]
+fn the_sim_drive_pulses_as_the_one_pulse_timer_does() {
+    use std::cell::RefCell;
+    use std::rc::Rc;
+
+    use laser_app::stepper::{DriverSignals, StepperDrive};
+
+    crate::clock::reset(false);
+    let drivers = Rc::new(RefCell::new(drivers()));
+    let mut drive = SimStepperDrive::new(drivers.clone(), StepperGeometry::default(), [None; 2]);
+    drive.set_signals(DriverSignals {
+        pulse_ns: 2_500,
+        dir_setup_ns: 5_000,
+        enable_active_high: false,
+    });
+    crate::clock::advance_to(100);
+    drive.step([true, false], [true, false]);
+    // 2 µs later, before the pulse (5 µs setup + 2.5 µs) has ended.
+    crate::clock::advance_to(102);
+    drive.step([true, true], [false, false]);
+    // No DIR change: the pulse one count (5.95 ns) after the start.
+    crate::clock::advance_to(200);
+    drive.step([false, true], [false, false]);
+    let edges: Vec<_> = drivers
+        .borrow()
+        .edges
+        .iter()
+        .map(|e| (e.t_ns, e.axis, e.pin == StepPin::Step, e.high))
+        .collect();
+    let (dir, step) = (false, true);
+    assert_eq!(
+        edges,
+        [
+            (100_000, 0, dir, true),
+            (105_000, 0, step, true),
+            (107_500, 0, step, false),
+            (107_500, 0, dir, false),
+            (112_500, 0, step, true),
+            (115_000, 0, step, false),
+            (112_500, 1, step, true),
+            (115_000, 1, step, false),
+            (200_005, 1, step, true),
+            (202_505, 1, step, false),
+        ]
+    );
+    let drivers = drivers.borrow();
+    for axis in &drivers.axes {
+        assert_eq!(axis.violations().total(), 0);
+    }
+    assert_eq!(drivers.counted_steps(), [0, 2]);
+}
