@@ -94,6 +94,14 @@ fn m4_cost_model_matches_the_bench_table() {
         .max(row(&table, "loop.line.prep"))
         .max(row(&table, "loop.stroke.prep"));
     fits("stroke_prepared", m.stroke_prepared, stroke);
+    // A continuation joined to the stroke being marked is charged as a
+    // stroke step: an upper bound.
+    let join = row(&table, "loop.join.prep");
+    assert!(
+        join <= m.stroke_prepared as f64,
+        "loop.join.prep {join} is charged as a stroke step, {}",
+        m.stroke_prepared
+    );
     fits("rebuild", m.rebuild, row(&table, "loop.reconfigure"));
     fits(
         "bisection_axis",

@@ -1,7 +1,10 @@
-//! Consecutive lit G-code blocks on the galvo are marked as joined
-//! strokes (issue 12's galvo look-ahead): one jump and one pair of laser
-//! delays per stroke, corners at the path planner's junction speed, and
-//! the drawn path still on the toolpath.
+//! Consecutive lit G-code blocks on the galvo are marked as one stroke
+//! per contour, however many blocks it has (issue 12's galvo look-ahead;
+//! the sequencer sends the contour in pieces that the galvo loop joins
+//! while it marks): one jump and one pair of laser delays per contour,
+//! corners at the path planner's junction speed, and the drawn path
+//! still on the toolpath. Hold and reset mid-contour darken at once; a
+//! sender that pauses mid-contour ends the stroke dark.
 
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Job, fit, rapids_dark};
@@ -15,8 +18,6 @@ fn galvo_lit_mm(report: &SimReport) -> Vec<[f64; 2]> {
 
 /// The galvo's tolerance (issue 12).
 const GALVO_TOLERANCE_MM: f64 = 0.2;
-/// Lines one galvo stroke joins (`StrokeCm::MAX_SEGMENTS`).
-const STROKE_SEGMENTS: usize = laser_app::domain::StrokeCm::MAX_SEGMENTS;
 
 /// A galvo job drawing `points` as lit G1s at F1200, then a G0 home.
 fn job_of(points: &[[f64; 2]]) -> Job {
@@ -72,6 +73,14 @@ fn run_galvo(job: &Job, extra: &[(usize, &str)]) -> SimReport {
     report
 }
 
+/// The lit samples lie on `job`'s toolpath (within the galvo's
+/// tolerance) and cover it (gaps within 0.5 mm).
+fn assert_on_toolpath(report: &SimReport, job: &Job) {
+    let fit = fit(&galvo_lit_mm(report), &job.pieces);
+    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
+    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+}
+
 /// Times (ns) the galvo laser turned on.
 fn laser_on_times_ns(report: &SimReport) -> Vec<u64> {
     let mut lit = false;
@@ -88,8 +97,13 @@ fn laser_on_times_ns(report: &SimReport) -> Vec<u64> {
 /// Draws `points`: returns its strokes (laser on-transitions) and job
 /// time (s), after checking the lit path and the dark G0s.
 fn draw(label: &str, points: &[[f64; 2]]) -> (usize, f64) {
-    let job = job_of(points);
-    let report = run_galvo(&job, &[]);
+    draw_job(label, &job_of(points))
+}
+
+/// Draws `job` on the galvo: returns its strokes (laser on-transitions)
+/// and job time (s), after checking the lit path and the dark G0s.
+fn draw_job(label: &str, job: &Job) -> (usize, f64) {
+    let report = run_galvo(job, &[]);
     let (lit, timeline) = (galvo_lit_mm(&report), galvo_spot_mm(&report));
     let fit = fit(&lit, &job.pieces);
     assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{label}: {fit:?}");
@@ -104,9 +118,10 @@ fn draw(label: &str, points: &[[f64; 2]]) -> (usize, f64) {
     let strokes = laser_on_times_ns(&report).len();
     let seconds = report.end_time_us as f64 / 1e6;
     eprintln!(
-        "{label}: {} G1s, {strokes} strokes, worst off path {:.3} mm, job {seconds:.3} s",
-        points.len() - 1,
-        fit.worst_lit_mm
+        "{label}: {} lit pieces, {strokes} strokes, worst off path {:.3} mm, gap {:.3} mm, job {seconds:.3} s",
+        job.pieces.len(),
+        fit.worst_lit_mm,
+        fit.worst_missed_mm,
     );
     (strokes, seconds)
 }
@@ -118,14 +133,14 @@ fn a_square_of_four_g1s_is_one_stroke_on_the_toolpath() {
 }
 
 #[test]
-fn a_circle_of_36_g1s_is_marked_in_strokes_of_the_polyline_capacity() {
+fn a_circle_of_36_g1s_is_one_stroke() {
     let (strokes, seconds) = draw("circle", &circle_of_chords());
-    // 36 lines, STROKE_SEGMENTS per stroke (one stroke per G1 before).
-    assert_eq!(strokes, 36usize.div_ceil(STROKE_SEGMENTS));
-    // The 2π·10 mm path at 20 mm/s alone takes 3.13 s; 36 separate
-    // strokes added a jump and both laser delays (≈ 1.3 ms) and a stop
-    // at every corner.
-    assert!(seconds < 3.6, "{seconds} s");
+    // One laser on/off pair (9 strokes of four lines before, 36 before
+    // that).
+    assert_eq!(strokes, 1);
+    // The 2π·10 mm path at 20 mm/s alone takes 3.13 s; 3.188 s with a
+    // stroke every four lines, 3.326 s with one per G1.
+    assert!(seconds < 3.17, "{seconds} s");
 }
 
 #[test]
@@ -151,52 +166,112 @@ fn a_hold_mid_stroke_is_dark_and_resume_completes_the_square() {
     // Marked before the hold, then again from the stroke's start.
     assert_eq!(ons.len(), 2, "{ons:?}");
     assert!(ons[0] < hold_us * 1_000 && ons[1] > resume_us * 1_000);
-    let lit = galvo_lit_mm(&report);
-    let fit = fit(&lit, &job.pieces);
-    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
+    assert_on_toolpath(&report, &job);
 }
 
-/// Strokes of an arc block alone: its chords within grbl's default `$12`,
-/// `STROKE_SEGMENTS` a stroke.
-fn arc_strokes(from: [f64; 2], to: [f64; 2], centre: [f64; 2], clockwise: bool) -> usize {
-    use laser_app::grbl::block::{Arc, PointMm};
-    let tolerance = laser_app::grbl::settings_map::find(12)
-        .expect("$12")
-        .default;
-    let p = |[x_mm, y_mm]: [f64; 2]| PointMm { x_mm, y_mm };
-    let arc = Arc::new(p(from), p(to), p(centre), clockwise);
-    (arc.segment_count(tolerance, 100_000) as usize).div_ceil(STROKE_SEGMENTS)
+/// Index of the `n`-th (from 1) line of `job` starting with `prefix`.
+fn nth_line(job: &Job, prefix: &str, n: usize) -> usize {
+    job.lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.starts_with(prefix))
+        .nth(n - 1)
+        .map(|(i, _)| i)
+        .expect("line")
 }
 
 #[test]
-fn the_laser_job_marks_runs_of_lines_as_strokes() {
-    // Frame (4 G1s): 1 stroke; the "L" outline (6 G1s) and the "A"
-    // outline (8 G1s): 2 strokes each, its counter (3 G1s): 1; the
-    // raster's 30 dashes, separated by S0 moves: 30. Circles: each arc
-    // block's chords, 4 a stroke (circles r 6.25 and 3.75 mm as two G2
-    // halves, r 5 mm as one full G3).
-    let job = system_tests::gcode_job::laser_job(25.0);
-    let half_arcs = |c: [f64; 2], r: f64| {
-        let (right, left) = ([c[0] + r, c[1]], [c[0] - r, c[1]]);
-        arc_strokes(right, left, c, true) + arc_strokes(left, right, c, true)
-    };
-    let circles = half_arcs([-15.0, 8.75], 6.25)
-        + arc_strokes([5.0, 8.75], [5.0, 8.75], [0.0, 8.75], false)
-        + half_arcs([15.0, 8.75], 3.75);
-    let report = run_galvo(&job, &[]);
-    let (lit, timeline) = (galvo_lit_mm(&report), galvo_spot_mm(&report));
-    let fit = fit(&lit, &job.pieces);
-    let strokes = laser_on_times_ns(&report).len();
-    eprintln!(
-        "laser job: {strokes} strokes ({circles} on the circles), worst off path {:.3} mm, gap {:.3} mm, job {:.3} s",
-        fit.worst_lit_mm,
-        fit.worst_missed_mm,
-        report.end_time_us as f64 / 1e6
+fn a_hold_mid_contour_is_dark_within_a_millisecond_and_resume_completes_it() {
+    let job = job_of(&circle_of_chords());
+    // The sender has 16 G1s queued (the queue's size) when it holds,
+    // 0.7 s into the 3.1 s contour; the rest follow the resume.
+    let at = nth_line(&job, "G1", 17);
+    let report = run_galvo(
+        &job,
+        &[(at, "wait 700"), (at, "!"), (at, "wait 500"), (at, "~")],
     );
-    assert_eq!(strokes, 1 + 2 + 2 + 1 + 30 + circles);
-    assert!(fit.worst_lit_mm <= GALVO_TOLERANCE_MM, "{fit:?}");
-    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
-    let spans = rapids_dark(&timeline, &job.rapids, GALVO_TOLERANCE_MM).expect("G0s found");
-    assert!(spans.iter().all(|s| s.lit == 0), "lit G0 {spans:?}");
+    let lit_in_hold = system_tests::lit_between_ns(&report, "!", "~");
+    assert!(lit_in_hold.is_empty(), "lit in the hold: {lit_in_hold:?}");
+    let ons = laser_on_times_ns(&report);
+    // Marked up to the hold, then from the step in flight again.
+    assert_eq!(ons.len(), 2, "{ons:?}");
+    assert_on_toolpath(&report, &job);
+}
+
+#[test]
+fn a_soft_reset_mid_contour_is_dark_within_a_millisecond() {
+    let job = job_of(&circle_of_chords());
+    let mut text = String::from("target galvo\n");
+    let at = nth_line(&job, "G1", 17);
+    for (i, l) in job.lines.iter().enumerate() {
+        if i == at {
+            text.push_str("wait 700\n\u{18}\n");
+        }
+        text.push_str(l);
+        text.push('\n');
+    }
+    let report = run_with(&text, SimOptions::default());
+    let lines = terminal_lines(&report);
+    assert!(lines.contains(&"ALARM:3"), "{lines:?}");
+    let reset_us = system_tests::sent_at(&report, "\u{18}");
+    let lit_at = system_tests::lit_sample_times_ns(&report);
+    assert!(
+        lit_at.iter().any(|&t| t < reset_us * 1_000),
+        "marking before the reset"
+    );
+    let late: Vec<u64> = lit_at
+        .into_iter()
+        .filter(|&t| t > (reset_us + 1_000) * 1_000)
+        .collect();
+    assert!(late.is_empty(), "lit after the reset: {:?}", late.first());
+}
+
+#[test]
+fn a_sender_pausing_mid_contour_ends_the_stroke_dark_and_goes_on() {
+    let job = job_of(&circle_of_chords());
+    // The sender stops after the 18th G1 for 2 s: the queue runs dry
+    // (18 blocks take 1.6 s).
+    let at = nth_line(&job, "G1", 19);
+    let resumed = job.lines[at].clone();
+    let report = run_galvo(&job, &[(at, "wait 2000")]);
+    let ons = laser_on_times_ns(&report);
+    // The stroke ended (dark) at the last block queued, then a new one
+    // started once the sender went on.
+    assert_eq!(ons.len(), 2, "{ons:?}");
+    let resumed_us = system_tests::sent_at(&report, &resumed);
+    assert!(ons[1] > resumed_us * 1_000, "{ons:?} vs {resumed_us} µs");
+    let dark_before = report
+        .dac
+        .iter()
+        .filter(|(t, _)| *t > ons[0] && *t < ons[1])
+        .any(|(_, s)| !s.laser);
+    assert!(dark_before, "dark between the two strokes");
+    assert_on_toolpath(&report, &job);
+}
+
+#[test]
+fn the_laser_job_marks_each_contour_as_one_stroke() {
+    // One stroke per contour: the frame (4 G1s), the "L" outline (6),
+    // the "A" outline (8) and its counter (3), the three circles (r 6.25
+    // and 3.75 mm as two G2 halves, r 5 mm as one full G3, each arc as
+    // its chords within $12), and the raster's 30 dashes (separated by S0
+    // moves).
+    let job = system_tests::gcode_job::laser_job(25.0);
+    let (strokes, _) = draw_job("laser job", &job);
+    assert_eq!(strokes, 1 + 1 + 1 + 1 + 3 + 30);
+}
+
+#[test]
+fn the_svg2gcode_job_marks_each_contour_as_one_stroke() {
+    // The senders' CAM job (svg2gcode 3.3.7): 37 contours, each after
+    // its own G0 (frame, three circles, three glyph contours, 30
+    // dashes), 387 lit G1s; sent as a plain script (no sender).
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/senders/job/job-galvo.nc");
+    let text = std::fs::read_to_string(path).expect("the job file");
+    let mut job = Job::from_gcode(&text).expect("the job's toolpath");
+    job.lines
+        .retain(|l| !l.trim().is_empty() && !l.trim_start().starts_with(';'));
+    let (strokes, _) = draw_job("svg2gcode job", &job);
+    assert_eq!(job.rapids.len(), 37);
+    assert_eq!(strokes, job.rapids.len(), "one stroke per contour");
 }

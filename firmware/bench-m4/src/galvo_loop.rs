@@ -1,5 +1,6 @@
 //! The galvo loop's half-buffer fills: holding, marking a line, a circle
-//! (r = 40 mm) and a G-code stroke, jumping; `GalvoLoop::new`.
+//! (r = 40 mm) and a G-code stroke, joining a continuation to a stroke
+//! being marked, jumping; `GalvoLoop::new`.
 
 use core::hint::black_box;
 
@@ -119,6 +120,7 @@ pub fn loop_halves(b: &mut Bench) {
     holding(b, &mut galvo, &mut half);
     reconfigure(b, &mut galvo, config, &mut half);
     marking(b, &mut galvo, &mut half);
+    joining(b, &mut galvo, &mut half);
     jumping(b, config, &mut half);
 }
 
@@ -264,6 +266,62 @@ fn marking(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
             continue;
         }
         job_halves(b, id, galvo, half, ScanPhase::Marking);
+    }
+}
+
+/// Joining: the prep step that joins a G-code piece of two lines
+/// continuing the four-line stroke being marked (`loop.join.prep`: its
+/// lines into the running path planner, the look-ahead passes, its end
+/// IK).
+#[inline(always)]
+fn joining(b: &mut Bench, galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
+    let piece = StrokeCm::continuing(PointCm::new(6.0, 2.0)).and_then(|mut s| {
+        for (x_cm, y_cm) in [(7.0, -2.0), (8.0, 2.0)] {
+            s.line_to(PointCm::new(x_cm, y_cm)).then_some(())?;
+        }
+        Some(s)
+    });
+    let (Some(stroke), Some(piece)) = (g_code_stroke(), piece) else {
+        return b.fail("loop.join.prep", "the strokes were refused");
+    };
+    galvo.request(GalvoRequest::Point {
+        seq: 300,
+        x_mm: -60.0,
+        y_mm: -20.0,
+        dwell_us: 0,
+    });
+    settle(galvo, half);
+    for (seq, path) in [(301, Figure::Stroke(stroke)), (302, Figure::Stroke(piece))] {
+        let request = GalvoRequest::Path {
+            seq,
+            path,
+            mark_speed_mm_s: None,
+        };
+        if let Some(refused) = galvo.request(request) {
+            return b.fail("loop.join.prep", refused);
+        }
+    }
+    let mut joined: Option<u32> = None;
+    let mut dones = 0u32;
+    for _ in 0..20_000usize {
+        if galvo.phase() == ScanPhase::Idle && galvo.queued_points() == 0 {
+            break;
+        }
+        let (waiting, mut steps) = (galvo.queued_points(), 0);
+        let ticks = window(|| steps = galvo.prep_up_to(1));
+        if waiting == 1 && galvo.queued_points() == 0 && steps == 1 {
+            joined = Some(joined.map_or(ticks, |t| t.max(ticks)));
+        }
+        galvo.refill(half, |e| {
+            dones += u32::from(matches!(e, laser_app::galvo::GalvoEvent::Done { .. }))
+        });
+    }
+    match joined {
+        Some(ticks) if dones == 2 => b.report("loop.join.prep", ticks, 1),
+        _ => b.fail(
+            "loop.join.prep",
+            ("joined, done", (joined.is_some(), dones)),
+        ),
     }
 }
 

@@ -135,6 +135,12 @@ pub const ROWS: &[Row] = &[
         budget: prep_budget(PREP),
     },
     Row {
+        id: "loop.join.prep",
+        what: "prep: a G-code piece of two lines joined to the stroke being marked",
+        unit: "step",
+        budget: prep_budget(PREP),
+    },
+    Row {
         id: "loop.tuning.steady",
         what: "loop, marking the 80 mm tuning figure (square, circle, cross)",
         unit: "sample",

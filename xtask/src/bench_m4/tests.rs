@@ -11,7 +11,7 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench loop.tuning.steady 100 128\nbench loop.tuning.refill 100 1\n\
     bench loop.tuning.prep 2000 1\nbench loop.reconfigure 150 1\n\
     bench loop.stroke.steady 100 128\nbench loop.stroke.refill 100 1\n\
-    bench loop.stroke.prep 2000 1\n\
+    bench loop.stroke.prep 2000 1\nbench loop.join.prep 700 1\n\
     bench plan.xy.optimal.1lsb 250 1\nbench plan.xy.optimal.160mm 300 1\n\
     bench plan.seed.1deg 100 1\n\
     bench stepper.step_tick.event 100 50\nbench stepper.step_tick.event_one_pulse 100 50\n\

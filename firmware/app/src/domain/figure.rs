@@ -51,7 +51,9 @@ pub enum Figure {
     },
     /// One stroke of up to [`StrokeCm::MAX_SEGMENTS`] lines (the galvo
     /// marks consecutive G-code feed moves as one: corners at the path
-    /// planner's junction speed, the laser on through them).
+    /// planner's junction speed, the laser on through them), or a piece
+    /// continuing the stroke sent before it
+    /// ([`StrokeCm::continuing`]).
     Stroke(StrokeCm),
 }
 

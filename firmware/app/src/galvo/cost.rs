@@ -99,10 +99,11 @@ pub const M4_COST: CostModel = CostModel {
     step_started: 9_560,
     // `loop.jump.prep`.
     point_prepared: 66_320,
-    // `loop.stroke.prep` (75 240): the dearest stroke step, a jump and a
+    // `loop.stroke.prep` (75 720–75 760): the dearest stroke step, a jump and a
     // G-code stroke of four lines (its open end needs its own IK); one
-    // 40-instruction timer tick of margin, rounded up.
-    stroke_prepared: 75_400,
+    // 40-instruction timer tick of margin. A G-code piece joined to the
+    // stroke being marked (`loop.join.prep`, 25 320) is charged as one.
+    stroke_prepared: 75_800,
     // `plan.seed.0.1deg` (1.572 M), rounded up: the cheapest bisection
     // plan, a lower bound for any jump.
     bisection_axis: 1_580_000,

@@ -170,6 +170,9 @@ pub struct GalvoLoop {
     off_delay_samples: u32,
     /// How jumps are planned on this board ([`DacStream::F64_PLANNING`]).
     jump_planning: prep::Planning,
+    /// A continuation stroke joined to the running one, its `Done` due
+    /// when the sampler reaches its blocks ([`join`]).
+    joining: Option<join::Joining>,
 }
 
 impl GalvoLoop {
@@ -369,6 +372,7 @@ impl Active {
 
 mod build;
 mod jobs;
+mod join;
 mod memory;
 
 pub use self::memory::GalvoMemory;

@@ -139,6 +139,7 @@ impl Core {
         self.gcode.motion.owed = Some(blocks);
         self.grbl_take_owed(out);
         self.grbl_advance(out);
+        self.gcode_galvo_send_ahead(out);
     }
 
     /// Moves the blocks of the line waiting for room into the queue when

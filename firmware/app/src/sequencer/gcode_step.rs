@@ -64,6 +64,9 @@ impl Core {
             c.servo_seq = servo_seq;
             c.galvo_seq = galvo_seq;
         }
+        if galvo_seq.is_some() {
+            self.gcode_galvo_send_ahead(out);
+        }
     }
 
     /// The galvo's marking feed for programmed feed `feed_mm_min`: the feed
@@ -145,6 +148,7 @@ impl Core {
         c.galvo_seq = None;
         self.gcode_galvo_stroke_done(seq, out);
         self.gcode_step_done(out);
+        self.gcode_galvo_drop_unadopted(out);
         true
     }
 
@@ -253,5 +257,6 @@ impl Core {
             .motion
             .current
             .is_some_and(|c| c.galvo_seq == Some(seq))
+            || self.gcode_galvo_ahead_is(seq)
     }
 }

@@ -8,6 +8,10 @@
 //! step may take, and 331 instructions per sample across its arc
 //! junctions, over the 2 µs budget), so G-code arcs reach the galvo as
 //! chords within `$12`, as before.
+//!
+//! A contour longer than four lines travels as several: the first, then
+//! pieces marked [`StrokeCm::continuing`] it, which the galvo joins to
+//! the stroke it is marking.
 
 use super::super::point::PointCm;
 use super::super::units::Unit;
@@ -21,6 +25,8 @@ pub struct StrokeCm {
     /// Start, then each line's end, cm.
     points: [[f32; 2]; STROKE_SEGMENTS + 1],
     len: u8,
+    /// Continues the stroke before it (see [`Self::continuing`]).
+    continues: bool,
 }
 
 impl StrokeCm {
@@ -34,8 +40,25 @@ impl StrokeCm {
         let mut stroke = Self {
             points: [[0.0; 2]; STROKE_SEGMENTS + 1],
             len: 0,
+            continues: false,
         };
         stroke.set(0, start).then_some(stroke)
+    }
+
+    /// A stroke that continues the one sent before it, which ends at
+    /// `start`: the galvo joins it to that stroke while it is still being
+    /// marked (no laser off/on, no stop at the joint), and marks it as a
+    /// stroke of its own when that one has already ended. `None` for a
+    /// non-finite point.
+    pub fn continuing(start: PointCm) -> Option<Self> {
+        let mut stroke = Self::new(start)?;
+        stroke.continues = true;
+        Some(stroke)
+    }
+
+    /// Whether it continues the stroke before it ([`Self::continuing`]).
+    pub fn continues(&self) -> bool {
+        self.continues
     }
 
     /// Adds a line to `to`; `false` (nothing added) when full or `to` is

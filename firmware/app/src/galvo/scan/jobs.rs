@@ -176,6 +176,7 @@ impl GalvoLoop {
     /// and the mirrors hold.
     pub fn stop(&mut self) {
         self.queue.clear();
+        self.joining = None;
         self.steps.clear();
         self.running = false;
         self.active = match self.active {

@@ -42,6 +42,8 @@ impl GalvoLoop {
         let mut last = [self.last.x_code, self.last.y_code];
         let [mut prev, mut position] = [self.motion.position_mm; 2];
         let mut n = 0;
+        // Planner blocks left after these samples.
+        let mut left = 0;
         if let Some(stroke) = self
             .steps
             .get_mut(0)
@@ -67,7 +69,9 @@ impl GalvoLoop {
                     break;
                 }
             }
+            left = stroke.len();
         }
+        self.reach_joined(left, on_event);
         self.last = DacSample {
             x_code: last[0],
             y_code: last[1],

@@ -175,6 +175,10 @@ impl GalvoLoop {
     /// prepares one per half buffer, to stay within its window).
     #[inline(never)]
     pub fn prep_up_to(&mut self, max_steps: usize) -> usize {
+        if max_steps > 0 && self.join_next_piece() {
+            // Joining a continuation is this call's step.
+            return 1;
+        }
         let mut prepared = 0;
         while prepared < max_steps && self.steps.len() - self.started() < PREP_DEPTH {
             let Some(step) = self.next_unprepared_step() else {
@@ -204,7 +208,7 @@ impl GalvoLoop {
 
     /// Steps at the front of [`Self::steps`] already started: the running
     /// one (0 or 1).
-    fn started(&self) -> usize {
+    pub(super) fn started(&self) -> usize {
         usize::from(self.running && self.steps.len() > 0)
     }
 
@@ -237,6 +241,9 @@ impl GalvoLoop {
                     .filter(|&i| self.steps.get(i).is_some_and(|p| p.starts_job))
                     .count();
                 let &(seq, job) = self.queue.iter().nth(covered)?;
+                if self.waits_to_join(&job) {
+                    return None;
+                }
                 (seq, job, 0, true)
             }
         };
@@ -334,17 +341,17 @@ impl GalvoLoop {
         segments: &[Segment],
         speed_mm_s: Option<f32>,
     ) -> LoadedStroke {
-        let configured = self.config.mark_speed_mm_s;
         let limits = MarkLimits {
-            speed_mm_s: speed_mm_s
-                .map(f64::from)
-                .filter(|s| s.is_finite() && *s > 0.0)
-                .map_or(configured, |s| s.min(configured)),
+            // The configured speed caps every stroke joined to this one;
+            // each marks at its own feed.
+            speed_mm_s: self.config.mark_speed_mm_s,
             accel_mm_s2: self.config.mark_accel_mm_s2,
             junction_deviation_mm: JUNCTION_DEVIATION_MM,
             ts_s: self.config.sample_period_s,
         };
+        let speed = self.marking_speed_mm_s(speed_mm_s);
         let loaded = PathPlanner::new(limits, start).and_then(|mut planner| {
+            planner.set_feed_mm_s(speed)?;
             for segment in segments {
                 match *segment {
                     Segment::Line { to } => planner.line_to(to)?,
@@ -360,6 +367,16 @@ impl GalvoLoop {
             Ok(planner)
         });
         loaded.map_err(|_| GalvoError::Planner)
+    }
+
+    /// The marking speed asked (mm/s), capped by the configured one
+    /// (`None`, or not a positive speed: the configured one).
+    pub(super) fn marking_speed_mm_s(&self, speed_mm_s: Option<f32>) -> f64 {
+        let configured = self.config.mark_speed_mm_s;
+        speed_mm_s
+            .map(f64::from)
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .map_or(configured, |s| s.min(configured))
     }
 
     /// Whether the first step not started is step `stroke` of job

@@ -293,14 +293,16 @@ fn the_galvo_marks_at_f_with_the_feed_override_capped_by_its_marking_speed() {
     let report = status(&mut core, 5);
     assert!(report.contains("|FS:720,1000"), "{report}");
     // A feed beyond the galvo's marking speed (1000 mm/s) marks at it.
-    assert_eq!(closers(&line(&mut core, 6, "G1 X20 F120000")), 1);
-    let out = on(
+    // (Sent ahead of the stroke in flight, as the piece continuing it.)
+    let out = line(&mut core, 6, "G1 X20 F120000");
+    assert_eq!(closers(&out), 1);
+    let (_, speed) = mark_speed(&out).expect("the next stroke");
+    assert_eq!(speed, Some(1000.0));
+    on(
         &mut core,
         7,
         Event::Galvo(crate::galvo::GalvoEvent::Done { seq }),
     );
-    let (_, speed) = mark_speed(&out).expect("the next stroke");
-    assert_eq!(speed, Some(1000.0));
     let report = status(&mut core, 8);
     assert!(report.contains("|FS:60000,1000"), "{report}");
 }

@@ -11,7 +11,7 @@ use embassy_time::Instant;
 use super::super::gcode::tests::{closers, line, on, status};
 use super::super::gcode_motion::PLANNER_BLOCKS;
 use super::super::machine::{Action, Core, Event};
-use crate::domain::{Actuator, Figure, StrokeCm};
+use crate::domain::{Actuator, Figure};
 use crate::galvo::{GalvoEvent, GalvoRequest};
 
 /// The galvo requests in `actions`: (seq, stroke segments or `None` for
@@ -65,29 +65,56 @@ fn consecutive_lit_blocks_are_one_stroke_and_finish_together() {
     }
     assert_eq!(closers(&line(&mut core, 4, "G1 X5 Y5")), 0, "queue full");
     // The jump ends: the square's four G1s go as one stroke at the
-    // slowest feed, 600 mm/min; the first leaving the queue makes room
-    // for the waiting line.
+    // slowest feed, 600 mm/min, and the lit lines after it as pieces
+    // continuing it (two lines each, two ahead); the first leaving the
+    // queue makes room for the waiting line.
     let out = done(&mut core, 5, jump_seq);
     assert_eq!(closers(&out), 1, "the waiting line's ok");
-    let square = galvo_requests(&out);
-    let [(square_seq, Some(4), Some(speed))] = square[..] else {
-        panic!("one four-line stroke: {square:?}");
+    let sent = galvo_requests(&out);
+    let [
+        (square_seq, Some(4), Some(speed)),
+        (b_seq, Some(2), _),
+        (c_seq, Some(2), _),
+    ] = sent[..]
+    else {
+        panic!("a four-line stroke and two pieces ahead: {sent:?}");
     };
     assert_eq!(speed, 10.0);
+    let continues = |actions: &[Action]| -> Vec<bool> {
+        actions
+            .iter()
+            .filter_map(|a| match a {
+                Action::Galvo(GalvoRequest::Path {
+                    path: Figure::Stroke(s),
+                    ..
+                }) => Some(s.continues()),
+                _ => None,
+            })
+            .collect()
+    };
+    assert_eq!(continues(&out), [false, true, true]);
     assert_eq!(closers(&line(&mut core, 5, "G1 X6 Y6")), 0, "full again");
     assert!(status(&mut core, 6).contains("MPos:-10.000,-10.000,"));
     // Its end frees its slots: the line waiting now is answered, the
-    // position is the square's end, the next lit blocks are one stroke.
+    // position is the square's end; the piece sent ahead is in flight
+    // (nothing sent again) and one more piece goes ahead.
     let out = done(&mut core, 7, square_seq);
     assert_eq!(closers(&out), 1, "the waiting line's ok");
     let next = galvo_requests(&out);
-    let max = StrokeCm::MAX_SEGMENTS;
     assert!(
-        matches!(next[..], [(_, Some(n), _)] if n == max),
+        matches!(next[..], [(d, Some(2), _)] if d > c_seq),
         "{next:?}"
     );
     let report = status(&mut core, 8);
     assert!(report.contains("MPos:-10.000,0.000,"), "{report}");
+    // Each piece's end finishes its two blocks.
+    let out = done(&mut core, 9, b_seq);
+    assert!(galvo_requests(&out).len() <= 1, "{out:?}");
+    let report = status(&mut core, 10);
+    assert!(report.contains("MPos:1.000,-10.000,"), "{report}");
+    let out = done(&mut core, 11, c_seq);
+    let report = status(&mut core, 12);
+    assert!(report.contains("MPos:1.000,-10.000,"), "{report} {out:?}");
 }
 
 #[test]
