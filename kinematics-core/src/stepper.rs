@@ -13,6 +13,8 @@
 //! the [`StepGenerator`] only executes those (Bresenham, integers only).
 
 #[cfg(test)]
+mod feed_tests;
+#[cfg(test)]
 mod hold_tests;
 pub mod motion;
 #[cfg(test)]

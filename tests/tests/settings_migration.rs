@@ -41,8 +41,8 @@ fn the_store_reads_the_record_the_earlier_firmware_saved() {
     assert_eq!(record, V2_RECORD);
     let loaded = Settings::load_record(&record).expect("it loads");
     assert_eq!(loaded.layout, RecordLayout::Positional);
-    // The stepper's 24 parameters came later: at their defaults.
-    assert_eq!((loaded.unknown, loaded.defaulted), (0, 24));
+    // The stepper's 24 parameters and `$11` came later: at their defaults.
+    assert_eq!((loaded.unknown, loaded.defaulted), (0, 25));
 }
 
 #[test]

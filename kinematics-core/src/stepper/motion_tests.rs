@@ -32,6 +32,48 @@ pub(super) struct Event {
     pub(super) rate: f64,
 }
 
+/// Runs `moves` (all queued at once; as programmed feeds at their rate
+/// when `feed`) through the whole pipeline, calls `act` on the prep, the
+/// planner, the step queue and the generator once `at` step events have
+/// run, and runs to rest. Returns every step event.
+pub(super) fn run_acting(
+    moves: &[StepMove],
+    jd: f64,
+    feed: bool,
+    at: usize,
+    mut act: impl FnMut(&mut SegmentPrep, &mut Planner<16>, &mut SegmentQueue<4>, &StepGenerator),
+) -> Vec<Event> {
+    let mut planner: Planner<16> = Planner::new(jd).unwrap();
+    for mv in moves {
+        let rate = if feed {
+            mv.nominal_rate_steps_per_s
+        } else {
+            0.0
+        };
+        planner.push_feed(mv, rate).unwrap();
+    }
+    let mut prep = SegmentPrep::new(TIMER_HZ, SEGMENT_S).unwrap();
+    let mut queue: SegmentQueue<4> = SegmentQueue::default();
+    let mut generator = StepGenerator::new();
+    let mut events = Vec::new();
+    loop {
+        if events.len() == at {
+            act(&mut prep, &mut planner, &mut queue, &generator);
+        }
+        prep.fill(&mut planner, &mut queue);
+        let Some(tick) = generator.tick(&mut queue) else {
+            break;
+        };
+        events.push(Event {
+            tick,
+            rate: f64::from(TIMER_HZ) / f64::from(tick.period_ticks),
+        });
+    }
+    assert!(planner.is_empty());
+    assert!(!prep.is_holding() && !prep.is_busy());
+    events
+}
+
 /// Runs `moves` through the whole pipeline, pushing each move after
 /// `prep_between` prep/tick rounds, and returns every step event.
 fn run(moves: &[StepMove], jd_steps: f64, prep_between: usize) -> Vec<Event> {

@@ -49,6 +49,9 @@ pub struct PlannedBlock {
     /// Planned exit rate, steps/s (set when the block leaves the queue:
     /// the next block's entry rate, or 0 when it is the last).
     pub exit_rate_steps_per_s: f64,
+    /// The programmed feed before the feed override, steps/s (0: a move
+    /// at a fixed rate, which the override leaves alone).
+    pub feed_rate_steps_per_s: f64,
 }
 
 /// Fixed-capacity look-ahead planner of up to `N` blocks.
@@ -57,6 +60,8 @@ pub struct Planner<const N: usize> {
     plan: Lookahead<N>,
     /// Signed microsteps of each queued block, in the plan's ring order.
     steps: [[i32; 2]; N],
+    /// Feed of each queued block before the override, steps/s (0: fixed).
+    feed: [f64; N],
     /// Index in `steps` of the head block.
     head: usize,
 }
@@ -76,6 +81,7 @@ impl<const N: usize> Planner<N> {
         Ok(Self {
             plan,
             steps: [[0; 2]; N],
+            feed: [0.0; N],
             head: 0,
         })
     }
@@ -93,13 +99,15 @@ impl<const N: usize> Planner<N> {
     /// The `i`-th queued block (0 = next to execute).
     pub fn block(&self, i: usize) -> Option<PlannedBlock> {
         let b = self.plan.block(i)?;
-        let steps = *self.steps.get((self.head + i) % N)?;
-        Some(Self::planned(steps, b))
+        let slot = (self.head + i) % N;
+        let (steps, feed) = (*self.steps.get(slot)?, *self.feed.get(slot)?);
+        Some(Self::planned(steps, feed, b))
     }
 
-    fn planned(steps: [i32; 2], b: &LookaheadBlock) -> PlannedBlock {
+    fn planned(steps: [i32; 2], feed: f64, b: &LookaheadBlock) -> PlannedBlock {
         PlannedBlock {
             steps,
+            feed_rate_steps_per_s: feed,
             // Lengths are whole step-event counts (≤ 2³⁰): exact.
             event_count: b.length as u32,
             nominal_rate_steps_per_s: b.nominal_speed,
@@ -116,28 +124,90 @@ impl<const N: usize> Planner<N> {
     /// Errors: [`MotionError::QueueFull`] and the move checks of
     /// [`validate_move`].
     pub fn push(&mut self, mv: &StepMove) -> Result<(), MotionError> {
+        self.push_feed(mv, 0.0)
+    }
+
+    /// As [`Self::push`], for a move at a programmed feed: `feed_rate`
+    /// (steps/s) is its rate before the feed override, kept for
+    /// [`Self::rescale`] (0: a fixed rate).
+    ///
+    /// Errors: as [`Self::push`].
+    pub fn push_feed(&mut self, mv: &StepMove, feed_rate: f64) -> Result<(), MotionError> {
         let event_count = validate_move(mv)?;
         if event_count == 0 {
             return Ok(());
         }
-        let norm = libm::hypot(f64::from(mv.steps[0]), f64::from(mv.steps[1]));
-        let unit = [f64::from(mv.steps[0]) / norm, f64::from(mv.steps[1]) / norm];
         let slot = (self.head + self.plan.len()) % N;
-        self.plan
-            .push(
-                f64::from(event_count),
-                [unit; 2],
-                mv.nominal_rate_steps_per_s,
-                mv.accel_steps_per_s2,
-            )
-            .map_err(|e| match e {
-                LookaheadError::Full => MotionError::QueueFull,
-                _ => MotionError::InvalidRate,
-            })?;
+        Self::push_plan(&mut self.plan, mv)?;
         if let Some(s) = self.steps.get_mut(slot) {
             *s = mv.steps;
         }
+        if let Some(f) = self.feed.get_mut(slot) {
+            *f = feed_rate;
+        }
         Ok(())
+    }
+
+    /// A new feed override: every queued block at a programmed feed
+    /// cruises at `rate_of(feed)` from now on and the queue is re-planned;
+    /// the head block's entry stays as it was (the block before it is
+    /// already heading there).
+    pub fn rescale(&mut self, rate_of: impl Fn(f64) -> f64) {
+        let Some(entry) = self.plan.block(0).map(|b| b.entry_speed) else {
+            return;
+        };
+        let old = self.plan.clone();
+        self.plan.clear();
+        for i in 0..old.len() {
+            let slot = (self.head + i) % N;
+            let (Some(b), Some(&steps), Some(&feed)) =
+                (old.block(i), self.steps.get(slot), self.feed.get(slot))
+            else {
+                continue;
+            };
+            let mv = StepMove {
+                steps,
+                nominal_rate_steps_per_s: if feed > 0.0 {
+                    rate_of(feed)
+                } else {
+                    b.nominal_speed
+                },
+                accel_steps_per_s2: b.accel,
+            };
+            // Re-pushing what was queued: only a refused rate can fail,
+            // and then the block keeps its old one.
+            if Self::push_plan(&mut self.plan, &mv).is_err() {
+                let mv = StepMove {
+                    nominal_rate_steps_per_s: b.nominal_speed,
+                    ..mv
+                };
+                let _ = Self::push_plan(&mut self.plan, &mv);
+            }
+        }
+        self.plan.limit_head_entry(entry);
+    }
+
+    /// Pushes a validated, non-empty move onto the plan.
+    fn push_plan(plan: &mut Lookahead<N>, mv: &StepMove) -> Result<(), MotionError> {
+        let event_count = validate_move(mv)?;
+        let norm = libm::hypot(f64::from(mv.steps[0]), f64::from(mv.steps[1]));
+        let unit = [f64::from(mv.steps[0]) / norm, f64::from(mv.steps[1]) / norm];
+        plan.push(
+            f64::from(event_count),
+            [unit; 2],
+            mv.nominal_rate_steps_per_s,
+            mv.accel_steps_per_s2,
+        )
+        .map_err(|e| match e {
+            LookaheadError::Full => MotionError::QueueFull,
+            _ => MotionError::InvalidRate,
+        })
+    }
+
+    /// Lowers the head block's entry rate to at most `rate` (steps/s: the
+    /// block being executed now ends slower) and re-plans.
+    pub fn limit_head_entry(&mut self, rate: f64) {
+        self.plan.limit_head_entry(rate);
     }
 
     /// Drops every queued block (after a hold or a halt); the next block
@@ -151,9 +221,10 @@ impl<const N: usize> Planner<N> {
     /// the speeds of the blocks before them, so that entry stays feasible.
     pub fn pop(&mut self) -> Option<PlannedBlock> {
         let steps = *self.steps.get(self.head)?;
+        let feed = *self.feed.get(self.head)?;
         let b = self.plan.pop()?;
         self.head = (self.head + 1) % N;
-        Some(Self::planned(steps, &b))
+        Some(Self::planned(steps, feed, &b))
     }
 }
 

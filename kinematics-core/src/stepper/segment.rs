@@ -51,16 +51,21 @@ pub struct Profile {
 
 impl Profile {
     /// The fastest profile of `block` from its entry to its exit rate that
-    /// respects its nominal rate and acceleration.
+    /// respects its nominal rate and acceleration; an entry above the
+    /// nominal rate (a feed override lowered it) decelerates to it first.
     pub fn of(block: &PlannedBlock) -> Self {
         let a = block.accel_steps_per_s2;
         let (v0, v1) = (block.entry_rate_steps_per_s, block.exit_rate_steps_per_s);
         let d = f64::from(block.event_count);
         let meet = libm::sqrt(a * d + 0.5 * (v0 * v0 + v1 * v1));
-        let peak = meet.min(block.nominal_rate_steps_per_s).max(v0).max(v1);
+        let peak = if meet >= v0 {
+            meet.min(block.nominal_rate_steps_per_s).max(v1)
+        } else {
+            v0
+        };
         // `numeric::clamp`, not `f64::clamp`: its panic path formats floats
         // (10 KB of flash on the target).
-        let d_acc = clamp((peak * peak - v0 * v0) / (2.0 * a), 0.0, d);
+        let d_acc = clamp(libm::fabs(peak * peak - v0 * v0) / (2.0 * a), 0.0, d);
         let d_dec = clamp((peak * peak - v1 * v1) / (2.0 * a), 0.0, d - d_acc);
         Self {
             d,
@@ -73,6 +78,15 @@ impl Profile {
         }
     }
 
+    /// Rate `s` events into the first phase (towards the peak), steps/s.
+    fn first_phase_rate(&self, s: f64) -> f64 {
+        if self.peak >= self.entry {
+            reachable_f(self.entry, self.accel, s)
+        } else {
+            libm::sqrt((self.entry * self.entry - 2.0 * self.accel * s).max(0.0))
+        }
+    }
+
     /// Peak (cruise) rate, steps/s.
     pub fn peak_rate_steps_per_s(&self) -> f64 {
         self.peak
@@ -81,7 +95,7 @@ impl Profile {
     /// Profile rate at `s` events from the block start, steps/s.
     pub fn rate_at(&self, s: f64) -> f64 {
         if s < self.d_acc {
-            reachable_f(self.entry, self.accel, s)
+            self.first_phase_rate(s)
         } else if s <= self.d - self.d_dec {
             self.peak
         } else {
@@ -95,9 +109,9 @@ impl Profile {
     /// Time from the block start to `s` events, s.
     pub fn time_at(&self, s: f64) -> f64 {
         let a = self.accel;
-        let t_acc = (self.peak - self.entry) / a;
+        let t_acc = libm::fabs(self.peak - self.entry) / a;
         if s <= self.d_acc {
-            return (reachable_f(self.entry, a, s) - self.entry) / a;
+            return libm::fabs(self.first_phase_rate(s) - self.entry) / a;
         }
         let cruise_end = self.d - self.d_dec;
         if s <= cruise_end {
@@ -110,6 +124,13 @@ impl Profile {
 fn reachable_f(rate: f64, accel: f64, events: f64) -> f64 {
     libm::sqrt(rate * rate + 2.0 * accel * events)
 }
+
+/// Blocks a hold can take back: the generator's and one per prepared
+/// segment (the step queue's 8).
+const TAKE_BACK: usize = 9;
+
+mod feed;
+mod take_back;
 
 /// Fixed-capacity ring of prepared segments (prep pushes, the step
 /// generator pops).
@@ -209,6 +230,8 @@ struct Cutting {
     end: u32,
     /// Whether the next segment is the block's first.
     fresh: bool,
+    /// The block's feed before the override, steps/s (0: fixed rate).
+    feed_rate: f64,
 }
 
 impl Cutting {
@@ -254,6 +277,11 @@ pub struct SegmentPrep {
     current: Option<Cutting>,
     /// On a hold: the rate the next block starts at, steps/s.
     hold_rate: Option<f64>,
+    /// On a hold: the rest of the blocks taken back from the step queue
+    /// (a segment per block: its events left), cut before the planner's.
+    taken_back: SegmentQueue<TAKE_BACK>,
+    /// Acceleration of the last block taken from the planner, steps/s².
+    accel: f64,
 }
 
 impl SegmentPrep {
@@ -271,12 +299,14 @@ impl SegmentPrep {
             segment_s,
             current: None,
             hold_rate: None,
+            taken_back: SegmentQueue::new(),
+            accel: 0.0,
         })
     }
 
     /// Whether a block is being cut.
     pub fn is_busy(&self) -> bool {
-        self.current.is_some()
+        self.current.is_some() || !self.taken_back.is_empty()
     }
 
     /// Whether a hold is decelerating (until it has cut its last segment).
@@ -308,6 +338,7 @@ impl SegmentPrep {
     fn stop_holding<const P: usize>(&mut self, planner: &mut Planner<P>) {
         planner.clear();
         self.hold_rate = None;
+        self.taken_back.clear();
     }
 
     /// Forgets the block being cut and any hold (after the step generator
@@ -315,6 +346,7 @@ impl SegmentPrep {
     pub fn reset(&mut self) {
         self.current = None;
         self.hold_rate = None;
+        self.taken_back.clear();
     }
 
     /// Prepares segments into `queue` until it is full or the planner has
@@ -339,7 +371,11 @@ impl SegmentPrep {
 
     /// Takes the next block from `planner` (decelerating on a hold).
     fn start_block<const P: usize>(&mut self, planner: &mut Planner<P>) -> Option<Cutting> {
+        if let Some(cutting) = self.resume_taken_back() {
+            return Some(cutting);
+        }
         let b = planner.pop()?;
+        self.accel = b.accel_steps_per_s2;
         let mut cutting = Cutting {
             block: StepBlock {
                 steps: [b.steps[0].unsigned_abs(), b.steps[1].unsigned_abs()],
@@ -352,6 +388,7 @@ impl SegmentPrep {
             done: 0,
             end: b.event_count,
             fresh: true,
+            feed_rate: b.feed_rate_steps_per_s,
         };
         if let Some(rate) = self.hold_rate {
             let exit = cutting.decelerate_from(rate);

@@ -26,6 +26,8 @@ pub struct StepGenerator {
     left: u32,
     /// Position in microsteps since creation, `[pan, tilt]`.
     position: [i32; 2],
+    /// Timer period of the segment being (or last) executed, ticks.
+    period_ticks: u32,
 }
 
 impl Default for StepGenerator {
@@ -43,6 +45,7 @@ impl StepGenerator {
             segment: None,
             left: 0,
             position: [0; 2],
+            period_ticks: 0,
         }
     }
 
@@ -62,10 +65,21 @@ impl StepGenerator {
         self.segment.is_some()
     }
 
+    /// The block in progress (the last one loaded) and the timer period
+    /// of the segment running or last run, ticks (`None` after a halt or
+    /// before the first segment).
+    pub fn executing(&self) -> (StepBlock, Option<u32>) {
+        (
+            self.block,
+            (self.period_ticks > 0).then_some(self.period_ticks),
+        )
+    }
+
     /// Drops the current segment (a hard stop: steps halt at once).
     pub fn halt(&mut self) {
         self.segment = None;
         self.left = 0;
+        self.period_ticks = 0;
     }
 
     /// One timer interrupt: the next step event of the current segment,
@@ -120,6 +134,7 @@ impl StepGenerator {
             self.counter = [n - (n >> 1); 2];
         }
         self.left = seg.events;
+        self.period_ticks = seg.period_ticks;
         self.segment = (seg.events > 0).then_some(seg);
     }
 }

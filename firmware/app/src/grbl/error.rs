@@ -111,6 +111,13 @@ pub enum Alarm {
     SoftLimit,
     /// 3: a soft reset (0x18) interrupted motion; the position may be lost.
     ResetWhileMoving,
+    /// 6: homing stopped (a reset, a stop) before it ended.
+    HomingReset,
+    /// 8: homing could not pull off a switch (still closed after backing
+    /// off).
+    HomingPullOff,
+    /// 9: homing found no switch within the travel.
+    HomingNotFound,
 }
 
 impl Alarm {
@@ -119,6 +126,9 @@ impl Alarm {
         match self {
             Alarm::SoftLimit => 2,
             Alarm::ResetWhileMoving => 3,
+            Alarm::HomingReset => 6,
+            Alarm::HomingPullOff => 8,
+            Alarm::HomingNotFound => 9,
         }
     }
 }

@@ -92,7 +92,7 @@ pub const SETTINGS: &[GrblSetting] = &[
         "millimeters",
         3,
         0.010,
-        "look-ahead planner junction deviation",
+        "gcode.junction_mm (saved)",
     ),
     product(
         12,

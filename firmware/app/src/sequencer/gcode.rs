@@ -14,6 +14,7 @@ use crate::grbl::realtime::Realtime;
 use crate::grbl::report::{self, Overrides};
 use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError, ParserState};
+use crate::settings::Settings;
 use crate::text::{ReplyText, reply_text};
 
 /// grbl's RX buffer as `$I` advertises it, bytes.
@@ -56,6 +57,11 @@ pub(super) struct Gcode {
     /// Actual over programmed speed of the gimbal step in flight, 0..=1
     /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
     pub(super) step_speed_ratio: f32,
+    /// A `$H` on the stepper waits for homing to end for its reply.
+    pub(super) homing: bool,
+    /// The junction deviation the stepper plans with when G-code set it
+    /// (`$11` in joint degrees; `None`: the product's, from its settings).
+    pub(super) stepper_junction_deg: Option<f64>,
 }
 
 impl Gcode {
@@ -70,6 +76,8 @@ impl Gcode {
             reports: 0,
             galvo: GalvoStroke::default(),
             step_speed_ratio: 0.0,
+            homing: false,
+            stepper_junction_deg: None,
         }
     }
 }
@@ -183,6 +191,7 @@ impl Core {
                 }
                 if matches!(scope, RestoreScope::Settings | RestoreScope::All) {
                     self.gcode.values = GrblValues::default();
+                    self.settings.gcode_junction_mm = Settings::default().gcode_junction_mm;
                 }
                 if matches!(scope, RestoreScope::Offsets | RestoreScope::All) {
                     self.gcode.parser.g54 = crate::grbl::PointMm::ZERO;
@@ -228,8 +237,10 @@ impl Core {
             return self.grbl_error(out, GrblError::NotIdle);
         }
         if self.actuator.uses_stepper() {
+            // The reply waits for the end of homing (grbl's `$H`): a
+            // sender's next lines wait with it.
             return match self.start_homing(out) {
-                Ok(()) => self.ok(out),
+                Ok(()) => self.gcode.homing = true,
                 Err(_) => self.grbl_error(out, GrblError::HomingDisabled),
             };
         }
@@ -287,7 +298,10 @@ impl Core {
             Realtime::CycleStart => self.grbl_resume(out),
             Realtime::SoftReset => self.grbl_reset(out),
             Realtime::JogCancel => self.grbl_jog_cancel(out),
-            Realtime::FeedOverride(step) => ov.feed = step.apply(ov.feed, 10, 200),
+            Realtime::FeedOverride(step) => {
+                ov.feed = step.apply(ov.feed, 10, 200);
+                self.gcode_stepper_override(out);
+            }
             Realtime::RapidOverride(percent) => ov.rapid = percent,
             Realtime::SpindleOverride(step) => ov.spindle = step.apply(ov.spindle, 10, 200),
             Realtime::SpindleStop | Realtime::Ignored(_) => {}
@@ -300,6 +314,11 @@ impl Core {
     /// interrupted motion.
     fn grbl_reset(&mut self, out: &mut dyn ActionSink) {
         let moving = self.gcode.motion.current.is_some() && self.gcode.motion.hold != Hold::Held;
+        if self.actuator.uses_stepper() {
+            // grbl's reset kills the steps at once (the position is then
+            // uncertain: ALARM:3); `stop` would brake at the limit.
+            out.act(Action::Stepper(crate::stepper::StepperRequest::Halt));
+        }
         self.stop("grbl soft reset", out);
         self.gcode.parser.soft_reset();
         self.grbl_sync_position();

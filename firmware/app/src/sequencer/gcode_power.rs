@@ -62,7 +62,14 @@ impl Core {
             // A streamed block moves while its cursor has speed.
             let streaming = self.gcode.motion.stream.speed_mm_s() > 0.0;
             let moving = streaming || c.is_some_and(|c| c.until.is_none() && c.servo_seq.is_some());
-            fraction *= if moving {
+            // The stepper: S while its steps run (no speed feedback from
+            // the step timer: ramps are not followed), 0 at rest.
+            let stepping = self.actuator.uses_stepper()
+                && c.is_some_and(|c| c.until.is_none())
+                && self.gcode.motion.stepper_moving();
+            fraction *= if stepping {
+                1.0
+            } else if moving {
                 self.gcode.step_speed_ratio
             } else {
                 0.0

@@ -2,8 +2,9 @@
 //! meaning matches a product parameter read and write it (`$110`/`$111`
 //! max rate ↔ `galvo.mark_speed_mm_s`, `$120`/`$121` acceleration ↔
 //! `galvo.mark_accel_mm_s2`, `$130`/`$131` travel = the board extent from
-//! `grid.*`, read-only); grbl-only ones (`$10`, `$11`, `$12`, `$30`–`$32`)
-//! are kept here; the rest answer their fixed value.
+//! `grid.*`, read-only; `$11` ↔ `gcode.junction_mm`); grbl-only ones
+//! (`$10`, `$12`, `$30`–`$32`) are kept here; the rest answer their fixed
+//! value.
 
 use super::machine::{ActionSink, Core};
 use crate::grbl::GrblError;
@@ -16,8 +17,6 @@ use crate::settings::find_param;
 pub(super) struct GrblValues {
     /// `$10`: bit 0 MPos (else WPos), bit 1 `Bf:`.
     pub(super) report_mask: u8,
-    /// `$11`: junction deviation, mm.
-    pub(super) junction_mm: f64,
     /// `$12`: arc chord tolerance, mm.
     pub(super) arc_tolerance_mm: f64,
     /// `$30`: S for full laser power.
@@ -36,7 +35,6 @@ impl Default for GrblValues {
     fn default() -> Self {
         Self {
             report_mask: default_of(10) as u8,
-            junction_mm: default_of(11),
             arc_tolerance_mm: default_of(12),
             s_max: default_of(30),
             s_min: default_of(31),
@@ -49,6 +47,7 @@ impl Default for GrblValues {
 /// grbl value = parameter × factor.
 fn product_param(number: u16) -> Option<(&'static str, f64)> {
     match number {
+        11 => Some(("gcode.junction_mm", 1.0)),
         110 | 111 => Some(("galvo.mark_speed_mm_s", 60.0)),
         120 | 121 => Some(("galvo.mark_accel_mm_s2", 1.0)),
         _ => None,
@@ -62,7 +61,6 @@ impl Core {
         let s = &self.settings;
         match setting.number {
             10 => f64::from(v.report_mask),
-            11 => v.junction_mm,
             12 => v.arc_tolerance_mm,
             30 => v.s_max,
             31 => v.s_min,
@@ -87,7 +85,6 @@ impl Core {
         let v = &mut self.gcode.values;
         match number {
             10 if value <= 3.0 => v.report_mask = value as u8,
-            11 if value > 0.0 => v.junction_mm = value,
             12 if value > 0.0 => v.arc_tolerance_mm = value,
             30 if value > v.s_min => v.s_max = value,
             31 if value < v.s_max => v.s_min = value,
@@ -98,7 +95,9 @@ impl Core {
                 self.settings
                     .set(param, value / k)
                     .map_err(|_| GrblError::InvalidStatement)?;
-                self.configure_galvo(out);
+                if n != 11 {
+                    self.configure_galvo(out);
+                }
             }
             // Fixed ones (and the board extent) take only their value.
             _ if setting.binding == Binding::Fixed || matches!(number, 130 | 131) => {

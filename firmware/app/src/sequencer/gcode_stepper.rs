@@ -4,32 +4,48 @@
 //! its look-ahead planner. A block is handed on as soon as the stepper
 //! has taken the one before ([`StepperEvent::Taken`]), so the planner
 //! joins them at speed; the block before a change of the laser (dark ↔
-//! lit), a dwell, a pause or the end waits for rest, so the laser switches
-//! where the spot is. A feed hold decelerates along the path at the
+//! lit, or of its M3/M4 and S), a dwell, a pause or the end waits for
+//! rest, so the laser switches where the spot is (the stepper runs
+//! several blocks ahead of the one the sequencer hands over). A feed hold decelerates along the path at the
 //! limit (laser dark at once); `~` goes on from the point it stopped at:
 //! the rest of the block it stopped in, then the queue.
 
 use kinematics_core::Rotation;
 use kinematics_core::frames::BoardPoint;
 
+use super::gcode::GrblMode;
 use super::gcode_motion::{Hold, cm};
 use super::gcode_stream::planned_length;
 use super::machine::{Action, ActionSink, Core};
 use crate::domain::PointCm;
+use crate::grbl::{Alarm, GrblError, Laser};
 use crate::grbl::{Block, PointMm};
-use crate::stepper::{MoveShape, StepperEvent, StepperRequest};
+use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
+use crate::text::reply_text;
 
 /// What the stepper has of the G-code job.
 #[derive(Debug, Clone, Copy, Default)]
 pub(super) struct StepperJob {
     /// The last move handed over and not yet at rest.
     inflight: Option<u32>,
-    /// The laser of the blocks handed over.
+    /// The laser of the blocks handed over: lit, and with what setting.
     lit: bool,
+    laser: Laser,
     /// The current block waits for rest before it is handed over.
     waiting: bool,
     /// A hold came to rest: `~` asks the stepper to go on with its moves.
     held: bool,
+    /// The feed override the stepper task has, % (`None`: not sent since
+    /// the last stop).
+    feed_percent: Option<u8>,
+}
+
+/// The laser setting of a feed block (default for others).
+fn block_laser(block: &Block) -> Laser {
+    match *block {
+        Block::Line { laser, .. } | Block::Arc { laser, .. } => laser,
+        _ => Laser::default(),
+    }
 }
 
 /// The stepper move of a motion block: end point (cm) and shape.
@@ -62,8 +78,9 @@ impl Core {
             return;
         };
         let lit = self.lights(&current.block) && self.gcode.motion.hold == Hold::None;
+        let laser = block_laser(&current.block);
         let job = &mut self.gcode.motion.stepper;
-        if job.inflight.is_some() && lit != job.lit {
+        if job.inflight.is_some() && (lit != job.lit || (lit && laser != job.laser)) {
             job.waiting = true;
             return;
         }
@@ -80,6 +97,8 @@ impl Core {
         let Some((point, shape)) = stepper_move(&current.block) else {
             return;
         };
+        self.gcode_stepper_override(out);
+        self.stepper_junction(true, out);
         let feed_mm_s = self.stepper_feed(&current.block);
         let seq = self.stepper_request(point, shape, feed_mm_s, out);
         let motion = &mut self.gcode.motion;
@@ -87,20 +106,32 @@ impl Core {
             c.stepper_seq = Some(seq);
         }
         motion.stepper.lit = lit;
+        motion.stepper.laser = laser;
         motion.gimbal_lit = lit && motion.arrived;
     }
 
-    /// The spot speed of a feed move with the feed override, mm/s
-    /// (`None`: G0, at the axes' limit).
+    /// The programmed spot speed of a feed move, mm/s (`None`: G0, at
+    /// the axes' limit); the stepper task applies the feed override.
     #[inline(never)]
     fn stepper_feed(&self, block: &Block) -> Option<f64> {
-        let feed_mm_min = match *block {
+        match *block {
             Block::Line { feed_mm_min, .. }
             | Block::Arc { feed_mm_min, .. }
-            | Block::Jog { feed_mm_min, .. } => feed_mm_min,
-            _ => return None,
-        };
-        Some(self.gcode.overrides.feed_mm_min(feed_mm_min) / 60.0)
+            | Block::Jog { feed_mm_min, .. } => Some(feed_mm_min / 60.0),
+            _ => None,
+        }
+    }
+
+    /// Tells the stepper task the feed override when it changed (it
+    /// applies it on the fly, to the move being cut too).
+    #[inline(never)]
+    pub(super) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
+        let percent = self.gcode.overrides.feed;
+        let job = &mut self.gcode.motion.stepper;
+        if self.actuator.uses_stepper() && job.feed_percent != Some(percent) {
+            job.feed_percent = Some(percent);
+            out.act(Action::Stepper(StepperRequest::FeedOverride { percent }));
+        }
     }
 
     /// One move request to the stepper; returns its number.
@@ -125,11 +156,14 @@ impl Core {
     }
 
     /// Whether the block after the current one joins it at speed: a
-    /// motion with the same laser, no hold.
+    /// motion with the same laser (dark, or lit with the same M3/M4 and
+    /// S), no hold.
     #[inline(never)]
     fn stepper_joins_next(&self) -> bool {
         let motion = &self.gcode.motion;
-        let same_laser = |b: &Block| self.lights(b) == motion.stepper.lit;
+        let job = &motion.stepper;
+        let same_laser =
+            |b: &Block| self.lights(b) == job.lit && (!job.lit || block_laser(b) == job.laser);
         motion.hold == Hold::None
             && motion
                 .queue
@@ -164,18 +198,8 @@ impl Core {
                 true
             }
             StepperEvent::Stopped { steps } => {
-                let config = self.stepper_config();
-                let at = config
-                    .joints_of(steps)
-                    .and_then(|j| config.gimbal.fk(j).ok());
+                self.gcode_stepper_at(steps);
                 let motion = &mut self.gcode.motion;
-                motion.stepper.inflight = None;
-                if let Some(p) = at {
-                    motion.position = PointMm {
-                        x_mm: p.x_cm * 10.0,
-                        y_mm: p.y_cm * 10.0,
-                    };
-                }
                 if motion.hold == Hold::Stopping {
                     motion.hold = Hold::Held;
                     motion.stepper.held = true;
@@ -183,8 +207,63 @@ impl Core {
                 self.grbl_sync_position();
                 false
             }
+
             _ => false,
         }
+    }
+
+    /// The stepper is at rest at `steps`: MPos from the counted steps.
+    #[inline(never)]
+    fn gcode_stepper_at(&mut self, steps: [i32; 2]) {
+        let config = self.stepper_config();
+        let at = config
+            .joints_of(steps)
+            .and_then(|j| config.gimbal.fk(j).ok());
+        let motion = &mut self.gcode.motion;
+        motion.stepper.inflight = None;
+        if let Some(p) = at {
+            motion.position = PointMm {
+                x_mm: p.x_cm * 10.0,
+                y_mm: p.y_cm * 10.0,
+            };
+        }
+    }
+
+    /// The end of homing: when a `$H` waits, its reply — `ok` (unlocked,
+    /// MPos where homing left the spot, at `steps`) or, as grbl, `ALARM:N`
+    /// (locked) and then `ok`; parameters that allow no homing: `error:5`.
+    #[inline(never)]
+    pub(super) fn gcode_homing_done(
+        &mut self,
+        homed: Result<[i32; 2], HomingFailure>,
+        out: &mut dyn ActionSink,
+    ) {
+        if !core::mem::take(&mut self.gcode.homing) {
+            return;
+        }
+        let failed = match homed {
+            Ok(steps) => {
+                self.gcode_stepper_at(steps);
+                self.grbl_sync_position();
+                None
+            }
+            Err(why) => Some(why),
+        };
+        let alarm = match failed {
+            None => {
+                self.gcode.mode = GrblMode::Normal;
+                return self.ok(out);
+            }
+            Some(HomingFailure::NoSwitches | HomingFailure::BadConfig) => {
+                return self.grbl_error(out, GrblError::HomingDisabled);
+            }
+            Some(HomingFailure::NotFound(_)) => Alarm::HomingNotFound,
+            Some(HomingFailure::StillPressed(_)) => Alarm::HomingPullOff,
+            Some(HomingFailure::Interrupted) => Alarm::HomingReset,
+        };
+        self.gcode.mode = GrblMode::Alarm;
+        self.grbl_data(out, reply_text(format_args!("ALARM:{}", alarm.code())));
+        self.ok(out);
     }
 
     /// The current block is done on the stepper's side.
@@ -218,6 +297,13 @@ impl Core {
             .gimbal
             .ik(BoardPoint::new(p.x_cm, p.y_cm))
             .is_ok_and(|j| config.steps_of(j).is_ok())
+    }
+}
+
+impl super::gcode_motion::Motion {
+    /// Whether the stepper runs a move of the job.
+    pub(super) fn stepper_moving(&self) -> bool {
+        self.stepper.inflight.is_some()
     }
 }
 

@@ -43,7 +43,7 @@ use crate::outbound::LineKind;
 use crate::servo::task::ServoLink;
 use crate::settings::Settings;
 use crate::status::StatusBoard;
-use crate::stepper::StepperLink;
+use crate::stepper::{StepperLink, StepperRequest};
 
 /// Where settings are saved (defined with the settings; named here too,
 /// as the sequencer's store).
@@ -353,6 +353,11 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
             }
             Action::ConfigureGalvo(config) => self.galvo.config.signal(config),
             Action::AllowGalvoLaser(allowed) => self.galvo.allow_laser(allowed),
+            // At once, not through the stepper task's queue.
+            Action::Stepper(StepperRequest::Halt) => self.stepper.halt(),
+            Action::Stepper(StepperRequest::FeedOverride { percent }) => {
+                self.stepper.set_feed_override(percent);
+            }
             Action::Stepper(request) => {
                 if self.stepper.requests.try_send(request).is_err() {
                     log::warning!("stepper: request queue full");

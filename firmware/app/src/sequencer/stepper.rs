@@ -34,9 +34,24 @@ impl Core {
         StepperConfig::from_settings(&self.settings.stepper, gimbal)
     }
 
-    /// Sends the stepper task its parameters (applied at rest).
-    pub(super) fn configure_stepper(&self, out: &mut dyn ActionSink) {
+    /// Sends the stepper task its parameters (applied at rest; the
+    /// junction deviation the product's, `stepper.junction_deg`).
+    pub(super) fn configure_stepper(&mut self, out: &mut dyn ActionSink) {
+        self.gcode.stepper_junction_deg = None;
         out.act(Action::ConfigureStepper(self.stepper_config()));
+    }
+
+    /// The stepper plans with the junction deviation of `gcode` (grbl's
+    /// `$11`, mm at the board, as joint degrees at its centre) or of the
+    /// product (`stepper.junction_deg`); told when it changes.
+    pub(super) fn stepper_junction(&mut self, gcode: bool, out: &mut dyn ActionSink) {
+        let want = gcode
+            .then(|| (self.settings.gcode_junction_mm / (self.settings.oq_cm * 10.0)).to_degrees());
+        if want != self.gcode.stepper_junction_deg {
+            self.gcode.stepper_junction_deg = want;
+            let deviation_deg = want.unwrap_or(self.settings.stepper.junction_deviation_deg);
+            out.act(Action::Stepper(StepperRequest::Junction { deviation_deg }));
+        }
     }
 
     /// Decelerates the stepper to rest (when it draws).
@@ -63,6 +78,7 @@ impl Core {
             (RunKind::Path { .. }, false) => MoveShape::Line,
             _ => MoveShape::Travel,
         };
+        self.stepper_junction(false, out);
         self.next_seq = self.next_seq.wrapping_add(1);
         let seq = self.next_seq;
         let point = BoardPoint::new(target.point.x_cm, target.point.y_cm);
@@ -199,6 +215,7 @@ impl Core {
                         Fixed::<3>(j.pitch_deg)
                     ),
                 );
+                self.gcode_homing_done(Ok(steps), out);
             }
             StepperEvent::HomingFailed(why) => {
                 let text = match why {
@@ -210,6 +227,7 @@ impl Core {
                     HomingFailure::BadConfig => "parameters refused for the homing moves",
                 };
                 self.notify(out, format_args!("error: home failed: {text}; not homed"));
+                self.gcode_homing_done(Err(why), out);
             }
         }
     }

@@ -16,6 +16,7 @@
 //! [`SettingsError`]s; the command line prints them as they are.
 
 mod error;
+mod gcode;
 mod geometry;
 mod legacy;
 mod params;
@@ -221,6 +222,8 @@ pub struct Settings {
     pub galvo: GalvoSettings,
     /// The stepper pan/tilt.
     pub stepper: StepperSettings,
+    /// G-code's junction deviation (grbl's `$11`), mm.
+    pub gcode_junction_mm: f64,
 }
 
 impl Default for Settings {
@@ -254,6 +257,7 @@ impl Default for Settings {
             err_dy: [0.0; 6],
             galvo: GalvoSettings::default(),
             stepper: StepperSettings::default(),
+            gcode_junction_mm: 0.01,
         }
     }
 }

@@ -134,9 +134,16 @@ impl Running {
                 }
                 // A feed hold while homing stops it, as a stop does.
                 Either3::Third(
-                    StepperRequest::Stop | StepperRequest::Home | StepperRequest::Hold,
+                    StepperRequest::Stop
+                    | StepperRequest::Halt
+                    | StepperRequest::Home
+                    | StepperRequest::Hold,
                 ) => link.halt(),
-                Either3::Third(StepperRequest::Resume)
+                Either3::Third(
+                    StepperRequest::Resume
+                    | StepperRequest::FeedOverride { .. }
+                    | StepperRequest::Junction { .. },
+                )
                 | Either3::First(())
                 | Either3::Second(()) => {}
             }

@@ -10,7 +10,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
-use kinematics_core::stepper::{SegmentQueue, StepGenerator, StepTick};
+use kinematics_core::stepper::{SegmentQueue, StepBlock, StepGenerator, StepTick};
 
 use super::{DriverSignals, StepperConfig};
 
@@ -63,6 +63,8 @@ pub struct StepperLink {
     tripped: AtomicU8,
     /// The homing seek found its switch.
     seek_hit: AtomicBool,
+    /// A new feed override, % (0: none pending; the latest wins).
+    feed_percent: AtomicU8,
     /// Drivers energised (the stepper task decides, the step timer applies).
     pub(super) enabled: AtomicBool,
     /// A stepper task serves the link.
@@ -99,6 +101,7 @@ impl StepperLink {
             pressed: AtomicU8::new(0),
             tripped: AtomicU8::new(0),
             seek_hit: AtomicBool::new(false),
+            feed_percent: AtomicU8::new(0),
             enabled: AtomicBool::new(false),
             attached: AtomicBool::new(false),
             pulse_ns: AtomicU32::new(0),
@@ -140,6 +143,18 @@ impl StepperLink {
         self.halt.store(true, Ordering::Release);
         self.ready.signal(());
         self.drained.signal(());
+    }
+
+    /// A new feed override, % (the sequencer's shell: the latest wins, no
+    /// queue to overflow; the stepper task takes it within a refill
+    /// period).
+    pub fn set_feed_override(&self, percent: u8) {
+        self.feed_percent.store(percent, Ordering::Relaxed);
+    }
+
+    /// The feed override set since the last call, % (the stepper task).
+    pub(super) fn take_feed_override(&self) -> Option<u8> {
+        Some(self.feed_percent.swap(0, Ordering::Relaxed)).filter(|&p| p > 0)
     }
 
     /// Takes a pending halt (the stepper task's side): drops everything
@@ -247,6 +262,20 @@ impl StepperLink {
         f: impl FnOnce(&mut SegmentQueue<STEP_QUEUE_LEN>) -> R,
     ) -> R {
         self.core.lock(|core| f(&mut core.borrow_mut().queue))
+    }
+
+    /// Runs `f` on the prepared segments with the step generator's block
+    /// in progress and running segment's period (a hold takes the
+    /// prepared segments back and brakes from there), under the step
+    /// timer's lock.
+    pub(super) fn with_queue_executing<R>(
+        &self,
+        f: impl FnOnce(&mut SegmentQueue<STEP_QUEUE_LEN>, (StepBlock, Option<u32>)) -> R,
+    ) -> R {
+        self.core.lock(|core| {
+            let StepCore { queue, generator } = &mut *core.borrow_mut();
+            f(queue, generator.executing())
+        })
     }
 
     /// Whether a step may come at the next event (prepared segments or

@@ -11,7 +11,7 @@ use cut::{Curve, PieceCut};
 
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::JointAngles;
-use kinematics_core::stepper::{Planner, Segment, SegmentPrep, StepMove};
+use kinematics_core::stepper::{Planner, Segment, SegmentPrep, SegmentQueue, StepBlock, StepMove};
 
 use super::{MoveShape, SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
 use kinematics_core::numeric::clamp;
@@ -22,6 +22,8 @@ use kinematics_core::numeric::clamp;
 pub const LINE_TOLERANCE_MM: f64 = 0.05;
 /// Most pieces one line is cut into.
 const MAX_PIECES: u32 = 4096;
+/// The step timer's queue of prepared segments.
+pub type StepQueue = SegmentQueue<{ super::STEP_QUEUE_LEN }>;
 /// Look-ahead depth of the planner, blocks.
 const PLANNER_LEN: usize = 16;
 
@@ -46,6 +48,10 @@ pub struct StepperMotion {
     started: Option<u32>,
     /// The moves since the last rest, for a hold's resume.
     history: resume::History,
+    /// Feed override: moves at a feed run at feed × this.
+    feed_scale: f64,
+    /// A junction deviation (deg) to plan with once the planner is empty.
+    junction_pending: Option<f64>,
 }
 
 /// A move waiting behind the line being cut.
@@ -72,6 +78,8 @@ impl StepperMotion {
             next: None,
             started: None,
             history: resume::History::default(),
+            feed_scale: 1.0,
+            junction_pending: None,
         })
     }
 
@@ -112,6 +120,7 @@ impl StepperMotion {
         self.planner = planner;
         self.prep = prep;
         self.last_point = None;
+        self.junction_pending = None;
         Ok(())
     }
 
@@ -159,6 +168,7 @@ impl StepperMotion {
             return Err(StepperRefusal::Busy);
         }
         let end = self.steps_at(point)?;
+        self.apply_junction();
         let queued = match self
             .last_point
             .and_then(|from| Curve::of(from, point, shape))
@@ -221,18 +231,19 @@ impl StepperMotion {
             end[1].wrapping_sub(self.planned[1]),
         ];
         let mut mv = Self::step_move(&self.config, delta);
+        let mut feed_rate = 0.0;
         if let Some((speed_mm_s, length_mm)) = feed.filter(|f| f.1 > 0.0) {
             // Step events per mm of the piece, at the feed.
             let events = delta[0].unsigned_abs().max(delta[1].unsigned_abs());
-            let rate = speed_mm_s * f64::from(events) / length_mm;
+            feed_rate = speed_mm_s * f64::from(events) / length_mm;
             mv.nominal_rate_steps_per_s = clamp(
-                rate,
+                feed_rate * self.feed_scale,
                 kinematics_core::stepper::motion::MIN_RATE_STEPS_PER_S,
                 mv.nominal_rate_steps_per_s,
             );
         }
         self.planner
-            .push(&mv)
+            .push_feed(&mv, feed_rate)
             .map_err(|_| StepperRefusal::BadConfig)?;
         self.planned = end;
         Ok(())
@@ -279,20 +290,24 @@ impl StepperMotion {
         self.prep.next_segment(&mut self.planner)
     }
 
-    /// Decelerates to rest at the limit along the path; what is left of
-    /// the move is dropped.
-    pub fn stop(&mut self) {
-        self.hold();
+    /// Decelerates to rest at the limit along the path from where the
+    /// step generator is (`queue`, `executing`: see [`Self::hold`]); what
+    /// is left of the move is dropped.
+    pub fn stop(&mut self, queue: &mut StepQueue, executing: (StepBlock, Option<u32>)) {
+        self.hold(queue, executing);
         self.history.rest(None);
     }
 
     /// A feed hold: as [`Self::stop`], but the moves since the last rest
-    /// are kept for [`Self::resume`].
-    pub fn hold(&mut self) {
+    /// are kept for [`Self::resume`]. The segments prepared in the step
+    /// `queue` are taken back and the braking starts where the segment
+    /// the generator runs ends (`executing`: its block and period, from
+    /// [`kinematics_core::stepper::StepGenerator::executing`]).
+    pub fn hold(&mut self, queue: &mut StepQueue, executing: (StepBlock, Option<u32>)) {
         self.line = None;
         self.next = None;
         self.pending = None;
-        self.prep.hold(&mut self.planner);
+        self.prep.hold_now(&mut self.planner, executing, queue);
     }
 
     /// The steps were halted (or a stop came to rest) at `position`:
@@ -336,6 +351,42 @@ impl StepperMotion {
         ];
         self.last_point = None;
         Ok(())
+    }
+
+    /// G-code's feed override, % (10–200; others ignored): the queued
+    /// moves at a feed and the one being cut change speed now.
+    pub fn set_feed_percent(&mut self, percent: u8) {
+        if !(10..=200).contains(&percent) {
+            return;
+        }
+        self.feed_scale = f64::from(percent) / 100.0;
+        let max_rate = Self::step_move(&self.config, [1, 0]).nominal_rate_steps_per_s;
+        self.prep
+            .set_feed_scale(self.feed_scale, max_rate, &mut self.planner);
+    }
+
+    /// The junction deviation from now on, degrees of joint travel (in
+    /// use once the planner is next empty; refused values are ignored).
+    pub fn set_junction_deg(&mut self, deg: f64) {
+        if deg.is_finite() && deg >= 0.0 && deg != self.config.junction_deviation_deg {
+            self.junction_pending = Some(deg);
+            self.apply_junction();
+        }
+    }
+
+    /// Plans with the pending junction deviation when nothing is queued.
+    fn apply_junction(&mut self) {
+        let Some(deg) = self.junction_pending else {
+            return;
+        };
+        if !self.planner.is_empty() || self.prep.is_busy() {
+            return;
+        }
+        if let Ok(planner) = Planner::new(deg / self.config.deg_per_step()) {
+            self.planner = planner;
+            self.config.junction_deviation_deg = deg;
+        }
+        self.junction_pending = None;
     }
 
     /// Step position where the queued moves end.

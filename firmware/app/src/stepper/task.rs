@@ -144,6 +144,9 @@ impl Running {
             };
             link.events.send(event).await;
         }
+        if let Some(percent) = link.take_feed_override() {
+            self.motion.set_feed_percent(percent);
+        }
         self.refill(link);
         if let Some(seq) = self.motion.take_started() {
             link.events.send(StepperEvent::Taken { seq }).await;
@@ -216,10 +219,12 @@ impl Running {
                 self.deferred = Some(request);
             }
             StepperRequest::MoveTo { .. } => self.move_to(request, link).await,
+            StepperRequest::Halt => link.halt(),
             StepperRequest::Stop => {
-                self.motion.stop();
+                link.with_queue_executing(|q, e| self.motion.stop(q, e));
                 self.deferred = None;
                 self.stopping = true;
+                self.refill(link);
             }
             StepperRequest::Home => {
                 let event = match self.home(link).await {
@@ -229,9 +234,14 @@ impl Running {
                 link.events.send(event).await;
             }
             StepperRequest::Hold => {
-                self.motion.hold();
+                link.with_queue_executing(|q, e| self.motion.hold(q, e));
                 self.deferred = None;
                 self.stopping = true;
+                self.refill(link);
+            }
+            StepperRequest::FeedOverride { percent } => self.motion.set_feed_percent(percent),
+            StepperRequest::Junction { deviation_deg } => {
+                self.motion.set_junction_deg(deviation_deg)
             }
             StepperRequest::Resume => {
                 if let Err(e) = self.motion.resume(link.position_steps()) {

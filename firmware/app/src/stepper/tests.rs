@@ -196,7 +196,7 @@ fn stop_decelerates_to_rest_short_of_the_target() {
         }
         link.step_tick().unwrap();
     }
-    motion.stop();
+    link.with_queue_executing(|q, e| motion.stop(q, e));
     let positions = drain(&mut motion, link);
     let end = positions.last().unwrap()[0];
     let target = config

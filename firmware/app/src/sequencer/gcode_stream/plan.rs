@@ -82,7 +82,7 @@ impl Core {
     #[inline(never)]
     pub(super) fn stream_exit_speed(&self, current: &Block, cursor: &SpeedCursor) -> f64 {
         let motion = &self.gcode.motion;
-        let Ok(mut plan) = Lookahead::<PLAN_BLOCKS>::new(self.gcode.values.junction_mm) else {
+        let Ok(mut plan) = Lookahead::<PLAN_BLOCKS>::new(self.settings.gcode_junction_mm) else {
             return 0.0;
         };
         let left = cursor.block.length - cursor.done;

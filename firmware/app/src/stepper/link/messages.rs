@@ -26,6 +26,10 @@ pub enum StepperRequest {
     /// Decelerate to rest at the acceleration limit along the path, drop
     /// the rest.
     Stop,
+    /// Halt the steps at once (a G-code soft reset): the sequencer's
+    /// shell calls [`StepperLink::halt`](super::StepperLink::halt) itself,
+    /// so the step timer drops what is prepared at its next event.
+    Halt,
     /// Home the axes with switches: seek, back off, latch, set the zero,
     /// pull off.
     Home,
@@ -34,6 +38,22 @@ pub enum StepperRequest {
     /// After a hold came to rest: the kept moves again, from the rest
     /// point (the rest of the one it stopped in first).
     Resume,
+    /// G-code's feed override, % (10–200): moves at a feed run at feed ×
+    /// percent / 100 from now on, the one being cut too (within the
+    /// acceleration limit). The sequencer's shell hands it over through
+    /// [`StepperLink::set_feed_override`](super::StepperLink::set_feed_override)
+    /// (the latest wins), not the request queue.
+    FeedOverride {
+        /// Percent of the programmed feed.
+        percent: u8,
+    },
+    /// grbl's junction deviation for the moves from now on (G-code's
+    /// `$11`; the product's runs use `stepper.junction_deg`), degrees of
+    /// joint travel; takes effect when the planner is next empty.
+    Junction {
+        /// Junction deviation, degrees.
+        deviation_deg: f64,
+    },
 }
 
 /// How a move gets to its point.
