@@ -28,6 +28,7 @@ impl Core {
     /// The galvo stopped (`at`: where marking ended, if it marked): when a
     /// hold waits for it, what was marked is done and the hold is held
     /// (or, resumed meanwhile, goes on from the stop point).
+    #[inline(never)]
     pub(in crate::sequencer) fn gcode_galvo_stopped(
         &mut self,
         at: Option<MarkStop>,
@@ -47,12 +48,12 @@ impl Core {
         if let Some((at, start)) = piece {
             self.gcode_galvo_rest_at(start, at, out);
         }
+        // Held; `~` came while stopping: resumed at once.
         let motion = &mut self.gcode.motion;
-        match motion.hold {
-            Hold::Stopping => motion.hold = Hold::Held,
-            Hold::None if motion.current.is_some() => self.gcode_send_step(out),
-            Hold::None => self.grbl_advance(out),
-            Hold::Held => {}
+        let resumed = motion.hold == Hold::None;
+        motion.hold = Hold::Held;
+        if resumed {
+            self.grbl_resume(out);
         }
     }
 
