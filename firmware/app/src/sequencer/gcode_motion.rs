@@ -393,7 +393,7 @@ impl Core {
         if self.gcode.motion.clear() {
             self.ok(out);
         }
-        self.gcode.galvo = Default::default();
+        self.gcode_galvo_hold_dropped();
         self.grbl_sync_position();
     }
 }

@@ -25,6 +25,11 @@ impl Core {
         record.stopping
     }
 
+    /// A stop or reset dropped the hold: no report is awaited.
+    pub(in crate::sequencer) fn gcode_galvo_hold_dropped(&mut self) {
+        self.gcode.galvo.stopping = false;
+    }
+
     /// The galvo stopped (`at`: where marking ended, if it marked): when a
     /// hold waits for it, what was marked is done and the hold is held
     /// (or, resumed meanwhile, goes on from the stop point).
@@ -76,15 +81,14 @@ impl Core {
         for _ in 0..stop.pos {
             motion.queue.pop_front();
         }
-        (c.block, c.index, c.count, c.from) = (block, stop.index, count, point);
+        (c.block, c.index, c.count) = (block, stop.index, count);
         motion.position = point;
         if point.distance_to(point_at(&block, c.index, count)) < AT_END_MM {
             c.index += 1;
         }
         motion.current = (c.index <= c.count).then_some(c);
-        if stop.pos > 0 {
-            self.grbl_take_owed(out);
-        }
+        // The blocks left the queue: a line waiting for room is queued.
+        self.grbl_take_owed(out);
     }
 
     /// Step `line` (from 0) of the piece starting at `start` (index 0:
