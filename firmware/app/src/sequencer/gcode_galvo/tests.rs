@@ -234,3 +234,24 @@ fn a_hold_the_galvo_caught_before_marking_redoes_the_stroke() {
     let sent = strokes(&realtime(&mut core, 7, Realtime::CycleStart));
     assert_eq!(sent.first(), Some(&(4, [-1.0, -1.0])), "{sent:?}");
 }
+
+#[test]
+fn a_soft_reset_while_the_galvo_stops_is_alarm_3_and_its_late_report_is_ignored() {
+    let texts = |out: &[Action]| std::format!("{out:?}");
+    // Still braking (no report yet): motion was interrupted.
+    let mut core = Core::new(Instant::from_millis(0));
+    let (square, _) = square_in_flight(&mut core);
+    realtime(&mut core, 4, Realtime::FeedHold);
+    let out = realtime(&mut core, 5, Realtime::SoftReset);
+    assert!(texts(&out).contains("ALARM:3"), "{out:?}");
+    let out = stopped(&mut core, 6, square, 1, [10.0, 0.0]);
+    assert!(strokes(&out).is_empty(), "{out:?}");
+    assert!(!status(&mut core, 7).contains("MPos:10.000,0.000,"));
+    // Held (the report came): at rest, no alarm.
+    let mut core = Core::new(Instant::from_millis(0));
+    let (square, _) = square_in_flight(&mut core);
+    realtime(&mut core, 4, Realtime::FeedHold);
+    stopped(&mut core, 5, square, 1, [10.0, 0.0]);
+    let out = realtime(&mut core, 6, Realtime::SoftReset);
+    assert!(!texts(&out).contains("ALARM:3"), "{out:?}");
+}
