@@ -533,3 +533,28 @@ fn m4_power_on_the_stepper_follows_its_speed_through_the_ramps_and_m3_stays_cons
     let order: Vec<u16> = m3.recording.laser_power.iter().map(|l| l.1).collect();
     assert_eq!(order, [800, 0], "{:?}", m3.recording.laser_power);
 }
+
+#[test]
+fn status_reads_home_while_dollar_h_homes_the_stepper() {
+    let report = run_with_pan_switch(
+        "@type-ahead $H\nwait 500\n@realtime 0x3f\nG4 P0.1\nwait 500\n@realtime 0x3f\n",
+        30.0,
+    );
+    let (homed_at, _) = first_after(&report, "$H", |l| l.starts_with("[homed: stepper"));
+    let during: Vec<_> = report
+        .transcript
+        .lines
+        .iter()
+        .filter(|(t, l)| l.starts_with('<') && *t < homed_at)
+        .collect();
+    assert!(!during.is_empty(), "no status while homing");
+    assert!(
+        during.iter().all(|(_, l)| l.starts_with("<Home|")),
+        "{during:?}"
+    );
+    let after = statuses(&report);
+    assert!(
+        after.last().is_some_and(|l| l.starts_with("<Idle|")),
+        "{after:?}"
+    );
+}
