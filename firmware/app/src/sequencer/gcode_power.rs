@@ -81,21 +81,18 @@ impl Core {
         LaserPower::from_fraction(fraction)
     }
 
-    /// The stepper's speed over its block's cruise speed, ‰ (the shell,
-    /// before each event).
+    /// The stepper's speed over its block's cruise speed, ‰ (0..=1000,
+    /// the step generator's; the shell, before each event).
     pub(super) fn note_stepper_speed(&mut self, permille: u16) {
-        self.gcode.motion.stepper.speed_permille = permille.min(1000);
+        self.gcode.motion.stepper.speed_permille = permille;
     }
 
-    /// While M4 lights the stepper: the next time to follow its speed
-    /// (the stream tick after the last event), else `None`.
+    /// While G-code lights the stepper's moves: the next time M4 power
+    /// follows its speed (the stream tick after the last event; under M3
+    /// nothing changes then), else `None`.
     pub(super) fn gcode_stepper_power_tick(&self) -> Option<embassy_time::Instant> {
-        let m4 = self
-            .gcode_running_laser()
-            .is_some_and(|l| l.mode == SpindleMode::Dynamic);
         let lit = self.actuator.uses_stepper() && self.gcode_gimbal_lit();
-        (lit && m4 && self.gcode.values.laser_mode && self.gcode.motion.stepper_moving())
-            .then(|| self.inputs.now + STEPPER_POWER_TICK)
+        (lit && self.gcode.motion.stepper_moving()).then(|| self.inputs.now + STEPPER_POWER_TICK)
     }
 
     /// After a realtime command: when it changed an override (`before`
