@@ -352,8 +352,8 @@ mod tests {
             let g = f.board_to_global(BoardPoint::new(x, y)).unwrap();
             prop_assert_eq!(g.x_cm, oq + dx);
             // Rigid motion: the distance from the board origin is preserved.
-            let r_board = libm::hypot(x + xo, y + yo);
-            let r_global = libm::hypot(g.y_cm - dy, g.z_cm - dz);
+            let r_board = crate::numeric::hypot(x + xo, y + yo);
+            let r_global = crate::numeric::hypot(g.y_cm - dy, g.z_cm - dz);
             prop_assert!((r_board - r_global).abs() < 1e-12 * (1.0 + r_board));
             let b = f.global_to_board(g).unwrap();
             prop_assert!((b.x_cm - x).abs() < 1e-12 && (b.y_cm - y).abs() < 1e-12);

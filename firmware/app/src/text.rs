@@ -114,11 +114,47 @@ impl fmt::Write for Truncating {
     }
 }
 
+/// `text` without leading and trailing whitespace: `str::trim`'s result
+/// (the same Unicode `White_Space` set, tested against
+/// `char::is_whitespace`) without linking core's 256 B whitespace table.
+pub fn trim(text: &str) -> &str {
+    text.trim_matches(is_white_space)
+}
+
+/// Whether `c` has the Unicode `White_Space` property (as
+/// `char::is_whitespace`).
+fn is_white_space(c: char) -> bool {
+    matches!(
+        c,
+        '\t'..='\r'
+            | ' '
+            | '\u{85}'
+            | '\u{a0}'
+            | '\u{1680}'
+            | '\u{2000}'..='\u{200a}'
+            | '\u{2028}'
+            | '\u{2029}'
+            | '\u{202f}'
+            | '\u{205f}'
+            | '\u{3000}'
+    )
+}
+
 #[cfg(test)]
 mod tests {
     extern crate std;
     use super::*;
     use std::format;
+
+    #[test]
+    fn white_space_is_chars_whitespace() {
+        for c in (0..=0x10_ffff).filter_map(char::from_u32) {
+            assert_eq!(is_white_space(c), c.is_whitespace(), "{c:?}");
+        }
+        for text in ["", "  ", " help ", "\u{3000}x\u{a0}\t", "a b\n", "\u{2029}"] {
+            assert_eq!(trim(text), text.trim(), "{text:?}");
+        }
+    }
 
     #[test]
     fn fixed_rounds_to_its_decimals() {

@@ -37,7 +37,7 @@ impl C {
         )
     }
     fn abs(self) -> f64 {
-        libm::hypot(self.re, self.im)
+        kinematics_core::numeric::hypot(self.re, self.im)
     }
     /// `e^z − 1`, accurate for small |z|.
     fn exp_m1(self) -> C {

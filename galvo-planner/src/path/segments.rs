@@ -32,7 +32,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
     pub fn line_to(&mut self, p_mm: [f64; 2]) -> Result<(), Error> {
         let p = finite_point("p_mm", p_mm)?;
         let (dx, dy) = (p[0] - self.pen[0], p[1] - self.pen[1]);
-        let length = libm::hypot(dx, dy);
+        let length = kinematics_core::numeric::hypot(dx, dy);
         if length < 1e-9 {
             return Ok(());
         }
@@ -70,8 +70,8 @@ impl<const CAP: usize> PathPlanner<CAP> {
     ) -> Result<(), Error> {
         let end = finite_point("end_mm", end_mm)?;
         let c = finite_point("center_mm", center_mm)?;
-        let r0 = libm::hypot(self.pen[0] - c[0], self.pen[1] - c[1]);
-        let r1 = libm::hypot(end[0] - c[0], end[1] - c[1]);
+        let r0 = kinematics_core::numeric::hypot(self.pen[0] - c[0], self.pen[1] - c[1]);
+        let r1 = kinematics_core::numeric::hypot(end[0] - c[0], end[1] - c[1]);
         let tol = 0.005f64.max(1e-3 * r0);
         if r0 < 1e-6 || libm::fabs(r0 - r1) > tol {
             return Err(Error::ArcRadiusMismatch {

@@ -131,7 +131,7 @@ impl Qr {
             if ak == 0.0 {
                 continue;
             }
-            let h = libm::hypot(pivot, ak);
+            let h = crate::numeric::hypot(pivot, ak);
             let (c, s) = (pivot / h, ak / h);
             for (rj, aj) in rk.iter_mut().zip(a.iter_mut()).skip(k) {
                 let (x, y) = (*rj, *aj);

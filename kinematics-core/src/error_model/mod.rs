@@ -139,7 +139,7 @@ impl ErrorModel {
     pub fn compensate(&self, target: PointMm) -> Result<PointMm, Error> {
         self.check()?;
         target.check_finite()?;
-        let tol = COMPENSATION_TOL * libm::hypot(target.x_mm, target.y_mm).max(1.0);
+        let tol = COMPENSATION_TOL * crate::numeric::hypot(target.x_mm, target.y_mm).max(1.0);
         let mut c = target;
         for _ in 0..MAX_ITERATIONS {
             let ex = self.dx.value(c.x_mm, c.y_mm);
@@ -147,7 +147,7 @@ impl ErrorModel {
             // Residual of the current command.
             let rx = c.x_mm + ex - target.x_mm;
             let ry = c.y_mm + ey - target.y_mm;
-            let res = libm::hypot(rx, ry);
+            let res = crate::numeric::hypot(rx, ry);
             if !res.is_finite() {
                 return Err(Error::NotConverged);
             }
@@ -276,7 +276,7 @@ mod tests {
             let target = PointMm::new(x, y);
             let c = m.compensate(target).unwrap();
             let landed = m.predict(c).unwrap();
-            prop_assert!(libm::hypot(landed.x_mm - x, landed.y_mm - y) <= 1e-6);
+            prop_assert!(crate::numeric::hypot(landed.x_mm - x, landed.y_mm - y) <= 1e-6);
         }
 
         #[test]
@@ -285,7 +285,7 @@ mod tests {
         ) {
             let c = PointMm::new(x, y);
             let back = m.compensate(m.predict(c).unwrap()).unwrap();
-            prop_assert!(libm::hypot(back.x_mm - x, back.y_mm - y) <= 1e-6);
+            prop_assert!(crate::numeric::hypot(back.x_mm - x, back.y_mm - y) <= 1e-6);
         }
     }
 }

@@ -29,8 +29,8 @@ pub fn ik(ol_cm: f64, p: GlobalPoint) -> Result<JointAngles, Error> {
         return Err(Error::BehindGimbal);
     }
     let yaw_rad = libm::atan2(p.y_cm, p.x_cm);
-    let h_cm = libm::hypot(p.x_cm, p.y_cm);
-    let r_cm = libm::hypot(h_cm, p.z_cm);
+    let h_cm = crate::numeric::hypot(p.x_cm, p.y_cm);
+    let r_cm = crate::numeric::hypot(h_cm, p.z_cm);
     if r_cm <= ol_cm {
         return Err(Error::InsideOffsetCircle);
     }

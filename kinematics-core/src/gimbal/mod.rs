@@ -222,7 +222,7 @@ impl Gimbal {
         };
         let spot = exact.fk(j)?;
         Ok(finite(
-            libm::hypot(spot.x_cm - target.x_cm, spot.y_cm - target.y_cm),
+            crate::numeric::hypot(spot.x_cm - target.x_cm, spot.y_cm - target.y_cm),
             "pointing error",
         )?)
     }

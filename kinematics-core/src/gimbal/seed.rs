@@ -30,7 +30,7 @@ pub fn ik(ol_cm: f64, p: GlobalPoint) -> Result<JointAngles, Error> {
     }
     let yaw_rad = libm::atan2(p.y_cm, p.x_cm);
     let theta_rad = libm::atan2(p.z_cm, p.x_cm);
-    let op3_cm = libm::hypot(p.x_cm, p.z_cm);
+    let op3_cm = crate::numeric::hypot(p.x_cm, p.z_cm);
     if op3_cm <= ol_cm {
         return Err(Error::InsideOffsetCircle);
     }

@@ -122,7 +122,7 @@ impl<const N: usize> Lookahead<N> {
         accel: f64,
     ) -> Result<(), LookaheadError> {
         let positive = |v: f64| v.is_finite() && v > 0.0;
-        let is_unit = |u: [f64; 2]| libm::fabs(libm::hypot(u[0], u[1]) - 1.0) < 1e-6;
+        let is_unit = |u: [f64; 2]| libm::fabs(crate::numeric::hypot(u[0], u[1]) - 1.0) < 1e-6;
         let valid = positive(length) && positive(nominal_speed) && positive(accel);
         if !(valid && is_unit(unit_in) && is_unit(unit_out)) {
             return Err(LookaheadError::InvalidBlock);

@@ -108,8 +108,8 @@ impl ArcSteps {
             (end.x_cm - centre.x_cm) / step,
             (end.y_cm - centre.y_cm) / step,
         );
-        let r = libm::hypot(ax, ay);
-        if !r.is_finite() || !libm::hypot(bx, by).is_finite() {
+        let r = crate::numeric::hypot(ax, ay);
+        if !r.is_finite() || !crate::numeric::hypot(bx, by).is_finite() {
             return Err(Error::TooManySteps);
         }
         if r < 1.0 {
@@ -119,7 +119,7 @@ impl ArcSteps {
         if 8.0 * (r + 2.0) > f64::from(MAX_STEPS) {
             return Err(Error::TooManySteps);
         }
-        if (libm::hypot(bx, by) - r).abs() > 0.5 {
+        if (crate::numeric::hypot(bx, by) - r).abs() > 0.5 {
             return Err(Error::EndNotOnCircle);
         }
         let sweep = if start == end {

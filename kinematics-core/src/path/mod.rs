@@ -119,9 +119,9 @@ pub(crate) mod test_support {
             let ny = if y.abs() <= s { 0.0 } else { y.abs() - s };
             let fx = x.abs() + s;
             let fy = y.abs() + s;
-            libm::hypot(nx, ny) <= r && libm::hypot(fx, fy) >= r
+            crate::numeric::hypot(nx, ny) <= r && crate::numeric::hypot(fx, fy) >= r
         };
-        let (mut lo, mut hi) = (0.0f64, r + libm::hypot(x, y));
+        let (mut lo, mut hi) = (0.0f64, r + crate::numeric::hypot(x, y));
         for _ in 0..200 {
             let mid = 0.5 * (lo + hi);
             if meets(mid) {

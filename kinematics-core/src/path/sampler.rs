@@ -92,7 +92,7 @@ impl Shape {
                 let sweep = if start == end || a < 1e-12 { TAU } else { a };
                 Shape::Arc {
                     centre,
-                    radius_cm: libm::hypot(ax, ay),
+                    radius_cm: crate::numeric::hypot(ax, ay),
                     start_rad,
                     sweep_rad: rotation.sign() * sweep,
                 }
@@ -142,7 +142,7 @@ impl UniformSampler {
             Segment::Line { from, to } => {
                 from.check_finite()?;
                 to.check_finite()?;
-                let len = libm::hypot(to.x_cm - from.x_cm, to.y_cm - from.y_cm);
+                let len = crate::numeric::hypot(to.x_cm - from.x_cm, to.y_cm - from.y_cm);
                 (
                     Shape::Line { from, to },
                     from,
@@ -161,8 +161,8 @@ impl UniformSampler {
                 centre.check_finite()?;
                 let shape = Shape::of(segment);
                 let (r, r_end) = (
-                    libm::hypot(start.x_cm - centre.x_cm, start.y_cm - centre.y_cm),
-                    libm::hypot(end.x_cm - centre.x_cm, end.y_cm - centre.y_cm),
+                    crate::numeric::hypot(start.x_cm - centre.x_cm, start.y_cm - centre.y_cm),
+                    crate::numeric::hypot(end.x_cm - centre.x_cm, end.y_cm - centre.y_cm),
                 );
                 if !r.is_finite() || !r_end.is_finite() {
                     return Err(Error::TooManySteps);
@@ -247,7 +247,7 @@ mod tests {
     use std::vec::Vec;
 
     fn dist(a: BoardPoint, b: BoardPoint) -> f64 {
-        libm::hypot(a.x_cm - b.x_cm, a.y_cm - b.y_cm)
+        crate::numeric::hypot(a.x_cm - b.x_cm, a.y_cm - b.y_cm)
     }
 
     #[test]

@@ -190,7 +190,7 @@ impl<const N: usize> Planner<N> {
     /// Pushes a validated, non-empty move onto the plan.
     fn push_plan(plan: &mut Lookahead<N>, mv: &StepMove) -> Result<(), MotionError> {
         let event_count = validate_move(mv)?;
-        let norm = libm::hypot(f64::from(mv.steps[0]), f64::from(mv.steps[1]));
+        let norm = crate::numeric::hypot(f64::from(mv.steps[0]), f64::from(mv.steps[1]));
         let unit = [f64::from(mv.steps[0]) / norm, f64::from(mv.steps[1]) / norm];
         plan.push(
             f64::from(event_count),

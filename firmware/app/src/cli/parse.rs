@@ -20,7 +20,7 @@ const GRID_INDEX_LIMIT: i32 = 20;
 /// (they are acknowledged with `ok` and do nothing, so a file of commands
 /// with comments can be pasted into the terminal).
 pub fn parse_line(line: &str) -> Result<Option<Command>, CommandError> {
-    let text = line.trim();
+    let text = crate::text::trim(line);
     if text.is_empty() || text.starts_with('#') {
         return Ok(None);
     }

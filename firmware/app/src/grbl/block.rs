@@ -25,7 +25,7 @@ impl PointMm {
 
     /// Distance to `other`, mm.
     pub fn distance_to(self, other: PointMm) -> f64 {
-        libm::hypot(other.x_mm - self.x_mm, other.y_mm - self.y_mm)
+        kinematics_core::numeric::hypot(other.x_mm - self.x_mm, other.y_mm - self.y_mm)
     }
 }
 
@@ -103,7 +103,7 @@ impl Arc {
             from,
             to,
             centre,
-            radius_mm: libm::hypot(sx, sy),
+            radius_mm: kinematics_core::numeric::hypot(sx, sy),
             sweep_rad: sweep,
         }
     }

@@ -350,7 +350,7 @@ impl ParserState {
             }
             // Centre on the perpendicular bisector; grbl's sign rules: the
             // short arc for R > 0, the long one for R < 0.
-            let mut h = -libm::sqrt(h_squared) / libm::hypot(dx, dy);
+            let mut h = -libm::sqrt(h_squared) / kinematics_core::numeric::hypot(dx, dy);
             if !clockwise {
                 h = -h;
             }
@@ -374,10 +374,12 @@ impl ParserState {
             y_mm: from.y_mm + j,
         };
         check_point(centre)?;
-        let radius_error = libm::fabs(centre.distance_to(to) - libm::hypot(i, j));
+        let radius_error =
+            libm::fabs(centre.distance_to(to) - kinematics_core::numeric::hypot(i, j));
         if radius_error > ARC_RADIUS_SLACK_MM
             && (radius_error > ARC_RADIUS_MAX_ERROR_MM
-                || radius_error > ARC_RADIUS_MAX_ERROR_FRACTION * libm::hypot(i, j))
+                || radius_error
+                    > ARC_RADIUS_MAX_ERROR_FRACTION * kinematics_core::numeric::hypot(i, j))
         {
             return Err(GrblError::InvalidTarget);
         }

@@ -56,7 +56,9 @@ impl Curve {
             Shape::Line { from, to } => distance_to_segment_cm(p, from, to),
             Shape::Arc {
                 centre, radius_cm, ..
-            } => (libm::hypot(p.x_cm - centre.x_cm, p.y_cm - centre.y_cm) - radius_cm).abs(),
+            } => (kinematics_core::numeric::hypot(p.x_cm - centre.x_cm, p.y_cm - centre.y_cm)
+                - radius_cm)
+                .abs(),
         }
     }
 }
@@ -135,5 +137,5 @@ fn distance_to_segment_cm(p: BoardPoint, a: BoardPoint, b: BoardPoint) -> f64 {
     } else {
         0.0
     };
-    libm::hypot(p.x_cm - (a.x_cm + t * dx), p.y_cm - (a.y_cm + t * dy))
+    kinematics_core::numeric::hypot(p.x_cm - (a.x_cm + t * dx), p.y_cm - (a.y_cm + t * dy))
 }

@@ -69,7 +69,9 @@ impl History {
 /// within 0.05 mm of a line or an arc (a joint-space travel within 2 mm
 /// of its chord).
 fn short_of_end_on(from: BoardPoint, to: &Remembered, p: BoardPoint) -> bool {
-    let d = |a: BoardPoint, b: BoardPoint| 10.0 * libm::hypot(a.x_cm - b.x_cm, a.y_cm - b.y_cm);
+    let d = |a: BoardPoint, b: BoardPoint| {
+        10.0 * kinematics_core::numeric::hypot(a.x_cm - b.x_cm, a.y_cm - b.y_cm)
+    };
     let tol_mm = if to.shape == MoveShape::Travel {
         2.0
     } else {
