@@ -450,7 +450,7 @@ fn m4_on_the_stepper_lights_while_it_steps_and_is_dark_at_rest_and_in_dwells() {
         "two lit moves: {:?}",
         report.recording.laser_events
     );
-    assert!(levels.iter().all(|l| l.1 == 0 || l.1 == 600), "{levels:?}");
+    assert!(levels.iter().all(|l| l.1 <= 600), "{levels:?}");
     // Dark through the dwell between them (0.5 s).
     let dwell = system_tests::sent_at(&report, "G4 P0.5");
     let dark: u64 = report
@@ -462,4 +462,99 @@ fn m4_on_the_stepper_lights_while_it_steps_and_is_dark_at_rest_and_in_dwells() {
         .next()
         .expect("a dark stretch");
     assert!(dark >= 450_000, "{dark} µs dark in the dwell");
+}
+
+/// Pan step rate at `t_ns` (the interval of the steps around it),
+/// steps/s; 0 outside the steps.
+fn pan_rate_at(steps_ns: &[u64], t_ns: u64) -> f64 {
+    let k = steps_ns.partition_point(|&s| s <= t_ns);
+    match (
+        k.checked_sub(1).and_then(|i| steps_ns.get(i)),
+        steps_ns.get(k),
+    ) {
+        (Some(&a), Some(&b)) => 1e9 / (b - a) as f64,
+        _ => 0.0,
+    }
+}
+
+#[test]
+fn m4_power_on_the_stepper_follows_its_speed_through_the_ramps_and_m3_stays_constant() {
+    // Slow ramps (10 °/s²: about half a second to 20 mm/s) on a line
+    // along the pan axis.
+    let job = |mode: &str| {
+        run(&format!(
+            "$30=1000\n$31=0\nset stepper.accel_deg_s2 10\nG0 X-40 Y0\n\
+             G1 X40 F1200 {mode} S800\nG4 P0.5\nM5\n"
+        ))
+    };
+    let report = job("M4");
+    let levels = report.recording.laser_power.clone();
+    eprintln!("M4 levels (µs, ‰): {levels:?}");
+    // The G1's steps (from its first lit level on).
+    let start_ns = levels.first().expect("lit").0.saturating_sub(2_000) * 1000;
+    let steps: Vec<u64> = step_times_ns(&report, 0)
+        .into_iter()
+        .filter(|&t| t >= start_ns)
+        .collect();
+    let cruise = steps.windows(2).map(|w| w[1] - w[0]).min().expect("steps");
+    let cruise_rate = 1e9 / cruise as f64;
+    let (mut rising, mut falling) = (0, 0);
+    let lit: Vec<_> = levels.iter().filter(|l| l.1 > 0).collect();
+    for w in lit.windows(2) {
+        let (t, level) = *w[0];
+        let ratio = pan_rate_at(&steps, t * 1000) / cruise_rate;
+        let duty = f64::from(level) / 800.0;
+        eprintln!("{t} µs: duty/S {duty:.3}, speed/F {ratio:.3}");
+        assert!(level <= 800, "{levels:?}");
+        if (0.15..0.95).contains(&ratio) {
+            assert!(
+                (duty - ratio).abs() <= 0.1 * ratio,
+                "{t} µs: {duty} vs {ratio}"
+            );
+            if w[1].1 > level {
+                rising += 1;
+            } else {
+                falling += 1;
+            }
+        }
+    }
+    assert!(
+        rising >= 5 && falling >= 5,
+        "{rising} up, {falling} down: {levels:?}"
+    );
+    // Dark at rest: from the line's last step (within a tick) through
+    // the dwell after it.
+    let stopped = steps.last().expect("steps") / 1000;
+    for t in (stopped + 20_000..stopped + 450_000).step_by(10_000) {
+        assert_eq!(report.recording.power_at(t), 0, "lit at rest at {t} µs");
+    }
+    // M3: S from start to end.
+    let m3 = job("M3");
+    let order: Vec<u16> = m3.recording.laser_power.iter().map(|l| l.1).collect();
+    assert_eq!(order, [800, 0], "{:?}", m3.recording.laser_power);
+}
+
+#[test]
+fn status_reads_home_while_dollar_h_homes_the_stepper() {
+    let report = run_with_pan_switch(
+        "@type-ahead $H\nwait 500\n@realtime 0x3f\nG4 P0.1\nwait 500\n@realtime 0x3f\n",
+        30.0,
+    );
+    let (homed_at, _) = first_after(&report, "$H", |l| l.starts_with("[homed: stepper"));
+    let during: Vec<_> = report
+        .transcript
+        .lines
+        .iter()
+        .filter(|(t, l)| l.starts_with('<') && *t < homed_at)
+        .collect();
+    assert!(!during.is_empty(), "no status while homing");
+    assert!(
+        during.iter().all(|(_, l)| l.starts_with("<Home|")),
+        "{during:?}"
+    );
+    let after = statuses(&report);
+    assert!(
+        after.last().is_some_and(|l| l.starts_with("<Idle|")),
+        "{after:?}"
+    );
 }
