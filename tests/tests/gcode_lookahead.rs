@@ -298,7 +298,7 @@ fn a_hold_mid_job_decelerates_dark_and_resumes_on_the_path_on_the_stepper() {
     eprintln!("stepper hold: {fit:?}");
     assert!(fit.worst_lit_mm <= STEPPER_TOLERANCE_MM, "{fit:?}");
     // The stretch travelled dark between `!` and rest is the one gap:
-    // the stepper runs its prepared segments (8 × 1.5 ms, but at least
-    // one step each: ≈ 12 ms a step at 20 mm/s) before it brakes.
-    assert!(fit.worst_missed_mm <= 3.0, "{fit:?}");
+    // the hold takes the prepared segments back and brakes at once
+    // (measured 0.19 mm), so it stays within about a servo resolution.
+    assert!(fit.worst_missed_mm <= 0.5, "{fit:?}");
 }

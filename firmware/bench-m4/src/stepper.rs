@@ -36,6 +36,7 @@ fn segment(events: u32, starts_block: bool) -> Segment {
         starts_block,
         events,
         period_ticks: 20,
+        speed_permille: 1000,
     }
 }
 

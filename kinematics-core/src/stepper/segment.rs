@@ -33,6 +33,9 @@ pub struct Segment {
     pub events: u32,
     /// Timer ticks between events (≥ 1).
     pub period_ticks: u32,
+    /// The segment's rate over its block's cruise rate, ‰ (0..=1000; M4
+    /// laser power follows it).
+    pub speed_permille: u16,
 }
 
 /// A trapezoid velocity profile over `d` step events, rates in steps/s,
@@ -158,6 +161,7 @@ impl Segment {
         starts_block: false,
         events: 0,
         period_ticks: 0,
+        speed_permille: 0,
     };
 }
 
@@ -232,6 +236,9 @@ struct Cutting {
     fresh: bool,
     /// The block's feed before the override, steps/s (0: fixed rate).
     feed_rate: f64,
+    /// The block's cruise rate (feed override applied), steps/s (0: a
+    /// hold's taken-back stretch).
+    nominal: f64,
 }
 
 impl Cutting {
@@ -389,6 +396,7 @@ impl SegmentPrep {
             end: b.event_count,
             fresh: true,
             feed_rate: b.feed_rate_steps_per_s,
+            nominal: b.nominal_rate_steps_per_s,
         };
         if let Some(rate) = self.hold_rate {
             let exit = cutting.decelerate_from(rate);
@@ -420,12 +428,19 @@ impl SegmentPrep {
         // Saturating float→int conversion; at least one event.
         let events = (want as u32).max(1).min(c.end - c.done);
         let dt = c.profile.time_at(s0 + f64::from(events)) - c.profile.time_at(s0);
-        let ticks = libm::ceil(dt * self.timer_hz / f64::from(events));
+        let ticks = libm::ceil(dt * self.timer_hz / f64::from(events)).max(1.0);
+        let speed = if c.nominal > 0.0 {
+            clamp(self.timer_hz / ticks / c.nominal, 0.0, 1.0)
+        } else {
+            0.0
+        };
         let segment = Segment {
             block: c.block,
             starts_block: c.fresh,
             events,
-            period_ticks: (ticks as u32).max(1),
+            period_ticks: ticks as u32,
+            // In 0..=1000: the cast is exact.
+            speed_permille: libm::round(speed * 1000.0) as u16,
         };
         c.done += events;
         c.fresh = false;

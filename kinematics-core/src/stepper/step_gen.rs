@@ -28,6 +28,9 @@ pub struct StepGenerator {
     position: [i32; 2],
     /// Timer period of the segment being (or last) executed, ticks.
     period_ticks: u32,
+    /// [`Segment::speed_permille`] of the segment being (or last)
+    /// executed; 0 at rest.
+    speed_permille: u16,
 }
 
 impl Default for StepGenerator {
@@ -46,6 +49,7 @@ impl StepGenerator {
             left: 0,
             position: [0; 2],
             period_ticks: 0,
+            speed_permille: 0,
         }
     }
 
@@ -75,11 +79,18 @@ impl StepGenerator {
         )
     }
 
+    /// The running segment's rate over its block's cruise rate, ‰
+    /// (0..=1000; 0 at rest or after a halt).
+    pub fn speed_permille(&self) -> u16 {
+        self.speed_permille
+    }
+
     /// Drops the current segment (a hard stop: steps halt at once).
     pub fn halt(&mut self) {
         self.segment = None;
         self.left = 0;
         self.period_ticks = 0;
+        self.speed_permille = 0;
     }
 
     /// One timer interrupt: the next step event of the current segment,
@@ -87,8 +98,11 @@ impl StepGenerator {
     /// is prepared (the timer should stop).
     pub fn tick<const Q: usize>(&mut self, queue: &mut SegmentQueue<Q>) -> Option<StepTick> {
         if self.left == 0 {
-            let seg = queue.pop();
-            self.load(seg?);
+            let Some(seg) = queue.pop() else {
+                self.speed_permille = 0;
+                return None;
+            };
+            self.load(seg);
         }
         let seg = self.segment?;
         let mut step = [false; 2];
@@ -135,6 +149,7 @@ impl StepGenerator {
         }
         self.left = seg.events;
         self.period_ticks = seg.period_ticks;
+        self.speed_permille = seg.speed_permille;
         self.segment = (seg.events > 0).then_some(seg);
     }
 }

@@ -28,8 +28,6 @@ const PREP_PER_HALF: usize = 1;
 const JOB_QUEUE: usize = 4;
 /// Look-ahead blocks of the path planner (a stroke has at most 4).
 const MARK_BLOCKS: usize = galvo_planner::blocks::MARK_BLOCKS;
-/// GRBL's default junction deviation, mm.
-const JUNCTION_DEVIATION_MM: f64 = 0.01;
 
 /// Galvo loop parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +48,9 @@ pub struct GalvoConfig {
     pub mark_speed_mm_s: f64,
     /// Marking acceleration (and braking on stop), mm/s².
     pub mark_accel_mm_s2: f64,
+    /// Junction deviation of the marking path planner (grbl's `$11`,
+    /// the `gcode.junction_mm` setting), mm: larger corners faster.
+    pub junction_deviation_mm: f64,
 }
 
 /// Why the loop cannot be built or a job cannot run.

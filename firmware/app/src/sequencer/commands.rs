@@ -164,7 +164,8 @@ impl Core {
     ) {
         match checked {
             Ok(()) => {
-                if before.galvo != self.settings.galvo {
+                let junction = self.settings.gcode_junction_mm;
+                if before.galvo != self.settings.galvo || before.gcode_junction_mm != junction {
                     self.configure_galvo(out);
                 }
                 self.configure_stepper(out);

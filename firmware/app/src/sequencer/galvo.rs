@@ -16,8 +16,9 @@ use crate::text::Shortest;
 /// Dwell of a goto on the galvo: held until the next command, µs.
 const HOLD_US: u32 = u32::MAX;
 
-/// The loop configuration for the user's galvo parameters.
-pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
+/// The loop configuration for the user's galvo parameters and the
+/// junction deviation (`$11`, mm) its marking planner corners with.
+pub fn config_from(settings: &GalvoSettings, junction_deviation_mm: f64) -> GalvoConfig {
     GalvoConfig {
         sample_period_s: settings.sample_period_us * 1e-6,
         galvo: settings.galvo(),
@@ -36,6 +37,7 @@ pub fn config_from(settings: &GalvoSettings) -> GalvoConfig {
         laser_off_delay_us: settings.laser_off_delay_us as u32,
         mark_speed_mm_s: settings.mark_speed_mm_s,
         mark_accel_mm_s2: settings.mark_accel_mm_s2,
+        junction_deviation_mm,
     }
 }
 
@@ -44,7 +46,8 @@ impl Default for GalvoConfig {
     /// SPEC geometry and DAC span, reference mirror drive, time-optimal
     /// jumps, 100 µs laser delays, marking at 1 m/s.
     fn default() -> Self {
-        config_from(&GalvoSettings::default())
+        let defaults = crate::settings::Settings::default();
+        config_from(&defaults.galvo, defaults.gcode_junction_mm)
     }
 }
 
@@ -186,7 +189,9 @@ impl Core {
 
     /// Sends the galvo parameters to the loop (applied between points).
     pub(super) fn configure_galvo(&mut self, out: &mut dyn ActionSink) {
-        out.act(Action::ConfigureGalvo(config_from(&self.settings.galvo)));
+        let settings = &self.settings;
+        let config = config_from(&settings.galvo, settings.gcode_junction_mm);
+        out.act(Action::ConfigureGalvo(config));
         self.allow_galvo_laser(out);
     }
 

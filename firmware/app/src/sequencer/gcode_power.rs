@@ -17,6 +17,10 @@ use super::machine::Core;
 use crate::grbl::report::Overrides;
 use crate::grbl::{Block, Laser, SpindleMode};
 
+/// How often M4 power follows the stepper's speed (the gimbal's stream
+/// tick).
+const STEPPER_POWER_TICK: embassy_time::Duration = embassy_time::Duration::from_millis(20);
+
 /// Actual over programmed speed of a gimbal step that takes `interval_ms`
 /// where the programmed feed would take `by_feed_ms`: below 1 when the
 /// servos' speed limit stretches it, 0 for a step that does not move.
@@ -62,13 +66,12 @@ impl Core {
             // A streamed block moves while its cursor has speed.
             let streaming = self.gcode.motion.stream.speed_mm_s() > 0.0;
             let moving = streaming || c.is_some_and(|c| c.until.is_none() && c.servo_seq.is_some());
-            // The stepper: S while its steps run (no speed feedback from
-            // the step timer: ramps are not followed), 0 at rest.
+            // The stepper: its step generator's speed while its steps run.
             let stepping = self.actuator.uses_stepper()
                 && c.is_some_and(|c| c.until.is_none())
                 && self.gcode.motion.stepper_moving();
             fraction *= if stepping {
-                1.0
+                f32::from(self.gcode.motion.stepper.speed_permille) / 1000.0
             } else if moving {
                 self.gcode.step_speed_ratio
             } else {
@@ -76,6 +79,20 @@ impl Core {
             };
         }
         LaserPower::from_fraction(fraction)
+    }
+
+    /// The stepper's speed over its block's cruise speed, ‰ (0..=1000,
+    /// the step generator's; the shell, before each event).
+    pub(super) fn note_stepper_speed(&mut self, permille: u16) {
+        self.gcode.motion.stepper.speed_permille = permille;
+    }
+
+    /// While G-code lights the stepper's moves: the next time M4 power
+    /// follows its speed (the stream tick after the last event; under M3
+    /// nothing changes then), else `None`.
+    pub(super) fn gcode_stepper_power_tick(&self) -> Option<embassy_time::Instant> {
+        let lit = self.actuator.uses_stepper() && self.gcode_gimbal_lit();
+        (lit && self.gcode.motion.stepper_moving()).then(|| self.inputs.now + STEPPER_POWER_TICK)
     }
 
     /// After a realtime command: when it changed an override (`before`

@@ -54,6 +54,8 @@ impl Core {
         let g = &self.gcode;
         let motion = &g.motion;
         let state = match (g.mode, motion.hold) {
+            // A `$H` waiting for the stepper's homing (grbl's `Home`).
+            _ if g.homing => MachineState::Home,
             (GrblMode::Alarm, _) => MachineState::Alarm,
             (GrblMode::Check, _) => MachineState::Check,
             (_, Hold::Held) => MachineState::Hold {

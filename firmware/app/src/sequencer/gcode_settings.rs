@@ -95,9 +95,7 @@ impl Core {
                 self.settings
                     .set(param, value / k)
                     .map_err(|_| GrblError::InvalidStatement)?;
-                if n != 11 {
-                    self.configure_galvo(out);
-                }
+                self.configure_galvo(out);
             }
             // Fixed ones (and the board extent) take only their value.
             _ if setting.binding == Binding::Fixed || matches!(number, 130 | 131) => {

@@ -177,7 +177,9 @@ impl Core {
     /// `run_deadline` (a run's dwell), or when the G-code dwell or settle
     /// ends.
     pub(super) fn gcode_deadline_or(&self, run_deadline: Option<Instant>) -> Option<Instant> {
-        run_deadline.or(self.gcode.motion.current.and_then(|c| c.until))
+        run_deadline
+            .or(self.gcode.motion.current.and_then(|c| c.until))
+            .or_else(|| self.gcode_stepper_power_tick())
     }
 
     /// Whether G-code lights the gimbal laser now: a lit step or dwell

@@ -38,6 +38,9 @@ pub(super) struct StepperJob {
     /// The feed override the stepper task has, % (`None`: not sent since
     /// the last stop).
     feed_percent: Option<u8>,
+    /// The step generator's speed over the running block's cruise speed,
+    /// ‰ (the shell notes it before each event).
+    pub(super) speed_permille: u16,
 }
 
 /// The laser setting of a feed block (default for others).

@@ -258,6 +258,8 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 galvo_bisection: galvo.plans_bisection(),
                 stepper_attached: self.io.stepper.is_attached(),
             };
+            self.core
+                .note_stepper_speed(self.io.stepper.speed_permille());
             self.core.on(inputs, event, &mut self.io);
             let follow_up = core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing);
             if follow_up != FollowUp::Nothing {

@@ -295,6 +295,13 @@ impl StepperLink {
         })
     }
 
+    /// The running segment's speed over its block's cruise speed, ‰
+    /// (0 at rest): M4 laser power follows it.
+    pub fn speed_permille(&self) -> u16 {
+        self.core
+            .lock(|core| core.borrow().generator.speed_permille())
+    }
+
     /// Position counted from the emitted steps, microsteps `[pan, tilt]`.
     pub fn position_steps(&self) -> [i32; 2] {
         self.core

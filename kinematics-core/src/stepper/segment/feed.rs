@@ -44,6 +44,7 @@ impl SegmentPrep {
             ..PlannedBlock::default()
         });
         c.start = c.done;
+        c.nominal = nominal;
         planner.limit_head_entry(exit);
     }
 }

@@ -28,6 +28,7 @@ fn add_run(back: &mut SegmentQueue<TAKE_BACK>, block: StepBlock, events: u32, st
         starts_block: starts,
         events,
         period_ticks: 0,
+        speed_permille: 0,
     });
 }
 
@@ -103,6 +104,7 @@ impl SegmentPrep {
                 end: run.block.event_count,
                 fresh: run.starts_block,
                 feed_rate: 0.0,
+                nominal: 0.0,
             };
             let exit = cutting.decelerate_from(self.hold_rate.unwrap_or(0.0));
             self.hold_rate = Some(exit);

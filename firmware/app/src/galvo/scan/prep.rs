@@ -21,7 +21,7 @@ use galvo_planner::{
 };
 use kinematics_core::PointMm;
 
-use super::{GalvoError, GalvoLoop, INTEGRATOR_CAPACITY, JUNCTION_DEVIATION_MM, Job, MARK_BLOCKS};
+use super::{GalvoError, GalvoLoop, INTEGRATOR_CAPACITY, Job, MARK_BLOCKS};
 use crate::domain::{Rotation, Segment, Unit};
 use crate::galvo::DacStream;
 
@@ -346,7 +346,7 @@ impl GalvoLoop {
             // each marks at its own feed.
             speed_mm_s: self.config.mark_speed_mm_s,
             accel_mm_s2: self.config.mark_accel_mm_s2,
-            junction_deviation_mm: JUNCTION_DEVIATION_MM,
+            junction_deviation_mm: self.config.junction_deviation_mm,
             ts_s: self.config.sample_period_s,
         };
         let speed = self.marking_speed_mm_s(speed_mm_s);
