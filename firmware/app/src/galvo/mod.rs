@@ -207,6 +207,26 @@ pub enum GalvoEvent {
     Underrun(Underrun),
     /// New parameters were refused (the old ones stay).
     ConfigRefused(GalvoError),
+    /// A `Stop` (after a close of the gate) has taken effect and the
+    /// mirrors are at rest: where marking ended when the gate closed, if
+    /// a path was being marked then (`None`: nothing of one was lit).
+    Stopped(Option<MarkStop>),
+}
+
+/// Where a stop caught a marked path: on line `line` (from 0) of path
+/// `seq`'s stroke, at board point (`x_mm`, `y_mm`), the end of the last
+/// half buffer the DAC output lit (within one half buffer of the close).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MarkStop {
+    /// Request number of the path.
+    pub seq: u32,
+    /// Line of its stroke, from 0.
+    pub line: u8,
+    /// Board x, mm.
+    pub x_mm: f32,
+    /// Board y, mm.
+    pub y_mm: f32,
 }
 
 /// Depth of the galvo request queue.

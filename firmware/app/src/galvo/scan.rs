@@ -174,6 +174,8 @@ pub struct GalvoLoop {
     /// A continuation stroke joined to the running one, its `Done` due
     /// when the sampler reaches its blocks ([`join`]).
     joining: Option<join::Joining>,
+    /// Where marking was after each of the last halves, newest first.
+    trace: trace::Trace,
 }
 
 impl GalvoLoop {
@@ -256,6 +258,7 @@ impl GalvoLoop {
                 generation = now;
             }
             self.take_requests(link);
+            self.report_stopped(link);
             if let Some(config) = link.config.try_take() {
                 self.configure(config);
             }
@@ -279,6 +282,7 @@ impl GalvoLoop {
             self.prep_up_to(PREP_PER_HALF);
             let out = &mut half[..n];
             let computed = self.refill(out, |event| hold_done(&mut drawing, link, event));
+            self.trace_half();
             link.publish(self.phase(), self.queue.len());
             if !link.laser_allowed() {
                 // `laser off`: the mirrors still move, dark.
@@ -383,3 +387,4 @@ mod runs;
 mod samples;
 #[cfg(test)]
 mod tests;
+mod trace;

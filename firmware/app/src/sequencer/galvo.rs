@@ -177,6 +177,7 @@ impl Core {
                 );
                 self.stop("galvo underrun", out);
             }
+            GalvoEvent::Stopped(at) => self.gcode_galvo_stopped(at, out),
             GalvoEvent::ConfigRefused(error) => {
                 self.notify(
                     out,

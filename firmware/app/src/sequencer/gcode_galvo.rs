@@ -23,15 +23,23 @@
 //! finishes its blocks, then the next piece (already sent) is the one in
 //! flight.
 //!
-//! Feed hold during a stroke: the galvo brakes along it, dark, as for a
-//! single block; `~` marks the stroke again from its start (today's rule
-//! for the step in flight, which for a joined stroke is its first block).
+//! Feed hold during a stroke ([`hold`]): the gate closes (dark at once),
+//! the galvo drops the pieces sent ahead, brakes along the stroke and
+//! reports where marking stopped ([`GalvoEvent::Stopped`]: the piece, its
+//! line, the point). The hold is stopping (`Hold:1`) until then; the
+//! blocks (arc chords) marked by then finish as on `done`, the block in
+//! progress stays in flight from the stop point (`MPos`, `Hold:0`), and
+//! `~` sends the rest of the contour from there as a new stroke, so
+//! nothing marked before the hold is lit again. A report that names no
+//! piece of it (nothing lit yet) redoes the step in flight.
 //! `target both` keeps one step per request: the gimbal cannot follow a
 //! galvo stroke.
 
 use super::gcode_motion::{block_point, cm, point_at};
 use super::machine::{ActionSink, Core};
 use crate::domain::{Figure, StrokeCm};
+#[cfg(doc)]
+use crate::galvo::GalvoEvent;
 use crate::galvo::GalvoRequest;
 use crate::grbl::{Block, PointMm};
 
@@ -73,6 +81,8 @@ pub(super) struct GalvoStroke {
     ahead: [Option<ahead::Ahead>; AHEAD],
     /// The piece after a finished one, in flight from the next step.
     adopt: Option<ahead::Ahead>,
+    /// A feed hold waits for the galvo to report where it stopped.
+    stopping: bool,
 }
 
 /// A piece built: the stroke, its feed (the slowest, mm/min), its cover.
@@ -310,5 +320,6 @@ fn feed_of(block: &Block) -> Option<f64> {
 }
 
 mod ahead;
+mod hold;
 #[cfg(test)]
 mod tests;

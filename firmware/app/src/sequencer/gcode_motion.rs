@@ -12,8 +12,10 @@
 //!   alone, consecutive lit blocks are joined into one stroke
 //!   ([`super::gcode_galvo`]).
 //!
-//! Feed hold stops after the step in flight (the galvo at once, braking
-//! along its stroke), laser dark; `~` goes on from there.
+//! Feed hold stops after the step in flight, laser dark; `~` goes on
+//! from there. The galvo stops at once, braking along its stroke, and
+//! the hold waits (`Hold:1`) for it to report where marking stopped: `~`
+//! goes on from that point ([`super::gcode_galvo`]).
 
 use embassy_time::{Duration, Instant};
 use heapless::Deque;
@@ -46,7 +48,8 @@ const MAX_STEPS: u32 = 100_000;
 pub(super) enum Hold {
     /// Running.
     None,
-    /// Stopping after the step in flight (laser already dark).
+    /// Stopping after the step in flight, or until the galvo reports
+    /// where it stopped marking (laser already dark).
     Stopping,
     /// Stopped; `~` resumes.
     Held,
@@ -317,7 +320,8 @@ impl Core {
     }
 
     /// `!`: laser dark at once; the gimbal stops after the step in
-    /// flight, the galvo brakes along its stroke.
+    /// flight, the galvo brakes along its stroke (held where it reports
+    /// marking stopped).
     pub(super) fn grbl_hold(&mut self, out: &mut dyn ActionSink) {
         let motion = &self.gcode.motion;
         if motion.hold != Hold::None || motion.is_idle() || self.gcode_stepper_hold(out) {
@@ -326,15 +330,23 @@ impl Core {
         let motion = &mut self.gcode.motion;
         motion.gimbal_lit = false;
         let galvo_in_flight = motion.current.is_some_and(|c| c.galvo_seq.is_some());
+        // A galvo stroke: held where the galvo reports it stopped marking.
+        let stroke = self.gcode_galvo_hold();
+        let motion = &mut self.gcode.motion;
         if let Some(c) = motion.current.as_mut() {
-            // The galvo's step is redone from its start on resume.
+            // Its `done` no longer counts: a galvo step (not a stroke) is
+            // redone from its start on resume.
             c.galvo_seq = None;
         }
         // A dwell runs to its end, dark; a servo move to its point.
         let waiting = motion
             .current
             .is_some_and(|c| c.servo_seq.is_some() || c.until.is_some());
-        motion.hold = if waiting { Hold::Stopping } else { Hold::Held };
+        motion.hold = if waiting || stroke {
+            Hold::Stopping
+        } else {
+            Hold::Held
+        };
         if galvo_in_flight {
             // Closing the gate also darkens the samples the DAC holds.
             self.close_gate(out);
@@ -381,6 +393,7 @@ impl Core {
         if self.gcode.motion.clear() {
             self.ok(out);
         }
+        self.gcode_galvo_hold_dropped();
         self.grbl_sync_position();
     }
 }

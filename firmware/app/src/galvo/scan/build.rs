@@ -115,6 +115,7 @@ impl GalvoLoop {
             off_delay_samples: samples_for(config.laser_off_delay_us, ts),
             jump_planning: planning,
             joining: None,
+            trace: super::trace::Trace::default(),
             config,
         }))
     }

@@ -175,6 +175,7 @@ impl GalvoLoop {
     /// jump in flight lands, a stroke being marked brakes along the path,
     /// and the mirrors hold.
     pub fn stop(&mut self) {
+        self.trace_stop();
         self.queue.clear();
         self.joining = None;
         self.steps.clear();

@@ -129,6 +129,11 @@ impl GalvoLoop {
         true
     }
 
+    /// Planner blocks of the continuation joined and not reached yet.
+    pub(super) fn joined_blocks(&self) -> usize {
+        self.joining.map_or(0, |j| usize::from(j.blocks))
+    }
+
     /// After marking samples: when the sampler has reached the joined
     /// continuation's blocks (`left` blocks remain in the planner), the
     /// running job is done and the continuation runs on as the job. Out
