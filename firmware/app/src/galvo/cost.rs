@@ -80,9 +80,9 @@ pub struct CostModel {
 /// The STM32F407's loop, fitted to `cargo xtask bench-m4` (each field's
 /// source row below; see the module doc).
 pub const M4_COST: CostModel = CostModel {
-    // `loop.holding.refill` (a whole holding half: 1 400) less its 128
+    // `loop.holding.refill` (a whole holding half: 1 680) less its 128
     // held samples.
-    refill: 1_400 - 128 * 10,
+    refill: 1_680 - 128 * 10,
     // `loop.holding.refill` / 128, rounded down (the rest is `refill`).
     held: 10,
     // `loop.jump.steady`.
