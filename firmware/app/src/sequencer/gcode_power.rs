@@ -12,14 +12,11 @@
 //! it is 0 and M4 is dark.
 
 use super::gcode_motion::Hold;
+use super::gcode_stream::STREAM_PERIOD_MS;
 use super::laser::LaserPower;
 use super::machine::Core;
 use crate::grbl::report::Overrides;
 use crate::grbl::{Block, Laser, SpindleMode};
-
-/// How often M4 power follows the stepper's speed (the gimbal's stream
-/// tick).
-const STEPPER_POWER_TICK: embassy_time::Duration = embassy_time::Duration::from_millis(20);
 
 /// Actual over programmed speed of a gimbal step that takes `interval_ms`
 /// where the programmed feed would take `by_feed_ms`: below 1 when the
@@ -88,11 +85,12 @@ impl Core {
     }
 
     /// While G-code lights the stepper's moves: the next time M4 power
-    /// follows its speed (the stream tick after the last event; under M3
+    /// follows its speed (the gimbal's stream period after the last event; under M3
     /// nothing changes then), else `None`.
     pub(super) fn gcode_stepper_power_tick(&self) -> Option<embassy_time::Instant> {
         let lit = self.actuator.uses_stepper() && self.gcode_gimbal_lit();
-        (lit && self.gcode.motion.stepper_moving()).then(|| self.inputs.now + STEPPER_POWER_TICK)
+        (lit && self.gcode.motion.stepper_moving())
+            .then(|| self.inputs.now + embassy_time::Duration::from_millis(STREAM_PERIOD_MS))
     }
 
     /// After a realtime command: when it changed an override (`before`
