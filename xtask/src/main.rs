@@ -6,6 +6,7 @@ mod calib;
 mod fuzz;
 mod json_out;
 mod kin;
+mod path_remap;
 mod plan;
 mod qemu;
 mod scenario;
@@ -59,6 +60,12 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if builds_for_the_target(&cli.command)
+        && let Err(err) = path_remap::apply()
+    {
+        eprintln!("xtask: error: {err:#}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Test => toolchain::test().map(|()| ExitCode::SUCCESS),
         Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
@@ -95,4 +102,18 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Commands that build for the firmware target (their panic paths are
+/// remapped so the image size does not depend on the machine).
+fn builds_for_the_target(command: &Command) -> bool {
+    matches!(
+        command,
+        Command::Test
+            | Command::Build
+            | Command::BenchM4
+            | Command::Flash
+            | Command::Size
+            | Command::Qemu(_)
+    )
 }
