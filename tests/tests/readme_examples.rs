@@ -25,7 +25,8 @@ fn script_files(text: &str) -> Vec<String> {
 
 #[test]
 fn script_files_are_found_in_readme_text() {
-    let text = "run `cargo xtask sim --script a/b.txt --until-idle`.\n`cargo xtask sim --script\nc.nc`";
+    let text =
+        "run `cargo xtask sim --script a/b.txt --until-idle`.\n`cargo xtask sim --script\nc.nc`";
     assert_eq!(script_files(text), vec!["a/b.txt", "c.nc"]);
 }
 

@@ -296,5 +296,11 @@ fn the_readme_example_measurements_fit() {
     let written = std::fs::read_to_string(&out).unwrap();
     std::fs::remove_file(&out).ok();
     assert_eq!(json["dx"]["n"].as_u64(), Some(121));
-    assert_eq!(written.lines().filter(|l| l.starts_with("set err.")).count(), 12);
+    assert_eq!(
+        written
+            .lines()
+            .filter(|l| l.starts_with("set err."))
+            .count(),
+        12
+    );
 }
