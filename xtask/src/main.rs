@@ -3,6 +3,7 @@
 
 mod bench_m4;
 mod calib;
+mod doctor;
 mod fuzz;
 mod json_out;
 mod kin;
@@ -10,6 +11,7 @@ mod path_remap;
 mod plan;
 mod qemu;
 mod scenario;
+mod serial;
 mod sim;
 mod size_gcode;
 mod size_stack;
@@ -32,6 +34,10 @@ enum Command {
     Test,
     /// Build the release firmware for thumbv7em-none-eabihf.
     Build,
+    /// Check this machine for the first hour with a board: toolchain,
+    /// flip-link, probe-rs, udev rules, probes, the board's console (and
+    /// with --port, that the firmware answers and matches this checkout).
+    Doctor(doctor::DoctorArgs),
     /// The hot paths on the Cortex-M4F ISA (QEMU mps2-an386, -icount): instruction counts, µs, budgets.
     BenchM4,
     /// Build the release firmware and flash it with `probe-rs run` (streams defmt logs).
@@ -69,6 +75,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Test => toolchain::test().map(|()| ExitCode::SUCCESS),
         Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
+        Command::Doctor(args) => doctor::run(args),
         Command::BenchM4 => bench_m4::bench_m4().map(|_table| ExitCode::SUCCESS),
         Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
