@@ -200,6 +200,7 @@ impl fmt::Debug for Command {
             Command::Set { param, value } => write!(f, "set {} {}", param.name, Shortest(*value)),
             Command::Get(param) => write!(f, "get {}", param.name),
             Command::Grbl(line) => f.write_str(line.as_str()),
+            Command::Trace(on) => f.write_str(if *on { "trace on" } else { "trace off" }),
             other => f.write_str(other.name()),
         }
     }
@@ -229,6 +230,7 @@ impl PartialEq for Command {
             }
             (Command::Get(a), Command::Get(b)) => a.name == b.name,
             (Command::Grbl(a), Command::Grbl(b)) => a == b,
+            (Command::Trace(a), Command::Trace(b)) => a == b,
             (a, b) => core::mem::discriminant(a) == core::mem::discriminant(b),
         }
     }
