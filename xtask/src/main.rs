@@ -5,6 +5,7 @@ mod bench_m4;
 mod calib;
 mod doctor;
 mod fuzz;
+mod hil;
 mod json_out;
 mod kin;
 mod path_remap;
@@ -44,6 +45,9 @@ enum Command {
     Flash,
     /// Print the release firmware's size (text/data/bss) against the budget.
     Size,
+    /// The hardware acceptance run: the shared scenarios against a board
+    /// over its serial console, a pass/fail table and a JSON report.
+    Hil(hil::HilArgs),
     /// Run the firmware tasks on the host against simulated servos (virtual time).
     Sim(sim::SimArgs),
     /// Run the firmware on QEMU's mps2-an386 (Cortex-M4F) against the simulator's servos.
@@ -80,6 +84,7 @@ fn main() -> ExitCode {
         Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => sim::run_sim(args),
+        Command::Hil(args) => hil::run(args),
         Command::Qemu(args) => qemu::run(args),
         Command::Kin(args) => kin::run(args),
         Command::Calib(args) => calib::run(args),

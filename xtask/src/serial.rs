@@ -61,6 +61,11 @@ impl Console {
     pub fn send_line(&mut self, line: &str) -> Result<()> {
         let mut bytes = line.as_bytes().to_vec();
         bytes.push(b'\n');
+        self.send_bytes(&bytes)
+    }
+
+    /// Writes `bytes` as they are (e.g. a grbl realtime byte).
+    pub fn send_bytes(&mut self, bytes: &[u8]) -> Result<()> {
         let deadline = Instant::now() + Duration::from_secs(5);
         let mut written = 0;
         while written < bytes.len() {
