@@ -325,3 +325,6 @@ impl StepperJob {
         *self = Self::default();
     }
 }
+
+#[cfg(test)]
+mod tests;

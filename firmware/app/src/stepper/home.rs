@@ -3,9 +3,10 @@
 //! it closes (at most the soft-limit span plus two pull-offs), back off
 //! the pull-off distance, approach again at the latch speed until it
 //! closes, take that step as the switch's joint angle (the zero), pull
-//! off. The step timer halts the steps before the first step event that
-//! finds the switch closed, so the latch point is the first microstep
-//! inside the switch.
+//! off (a switch not found: the axis goes back to where its seek
+//! began, so the position stays known). The step timer halts the steps
+//! before the first step event that finds the switch closed, so the
+//! latch point is the first microstep inside the switch.
 
 use embassy_futures::select::{Either3, select, select3};
 use embassy_time::Timer;
@@ -65,9 +66,9 @@ impl Running {
             let travel = steps(config.max_deg[axis] - config.min_deg[axis] + 2.0 * h.pulloff_deg)?;
             let pull = steps(h.pulloff_deg)?;
             let seek = LimitMode::Seek(axis as u8);
-            let not_found = HomingFailure::NotFound(axis as u8);
+            let start = link.position_steps()[axis];
             if let Jogged::Done = self.jog(link, axis, travel, h.seek_deg_s, seek).await? {
-                return Err(not_found);
+                return Err(self.not_found(link, axis, start, h.seek_deg_s).await);
             }
             self.jog(link, axis, -pull, h.seek_deg_s, LimitMode::Ignore)
                 .await?;
@@ -75,7 +76,7 @@ impl Running {
                 return Err(HomingFailure::StillPressed(axis as u8));
             }
             if let Jogged::Done = self.jog(link, axis, 2 * pull, h.latch_deg_s, seek).await? {
-                return Err(not_found);
+                return Err(self.not_found(link, axis, start, h.seek_deg_s).await);
             }
             // The latch step is the first inside the switch: the switch
             // closed within the step before it, at half a step back on
@@ -92,6 +93,28 @@ impl Running {
             log::info!("stepper: axis {} homed", axis);
         }
         Ok(())
+    }
+
+    /// Axis `axis`'s switch was not found: back to `start` (its steps
+    /// before the seek) at `speed_deg_s`, so the axes end where the cycle
+    /// found them (a failed `$H` repeated does not wind the axis round);
+    /// why it failed.
+    async fn not_found(
+        &mut self,
+        link: &StepperLink,
+        axis: usize,
+        start: i32,
+        speed_deg_s: f64,
+    ) -> HomingFailure {
+        let not_found = HomingFailure::NotFound(axis as u8);
+        let back = start.wrapping_sub(link.position_steps()[axis]);
+        if back == 0 {
+            return not_found;
+        }
+        match self.jog(link, axis, back, speed_deg_s, LimitMode::Ignore).await {
+            Ok(_) => not_found,
+            Err(why) => why,
+        }
     }
 
     /// Moves axis `axis` by `steps` at `speed_deg_s` with the limit check
