@@ -111,7 +111,10 @@ impl Running {
         if back == 0 {
             return not_found;
         }
-        match self.jog(link, axis, back, speed_deg_s, LimitMode::Ignore).await {
+        match self
+            .jog(link, axis, back, speed_deg_s, LimitMode::Ignore)
+            .await
+        {
             Ok(_) => not_found,
             Err(why) => why,
         }

@@ -172,7 +172,9 @@ impl StepperMotion {
         self.apply_junction();
         // After power-up, a stop or a halt the line starts where the
         // counted steps are.
-        let from = self.last_point.or_else(|| self.board_point_of(self.planned));
+        let from = self
+            .last_point
+            .or_else(|| self.board_point_of(self.planned));
         let queued = match from.and_then(|from| Curve::of(from, point, shape)) {
             Some(curve) => Queued::Cut(PieceCut {
                 curve,

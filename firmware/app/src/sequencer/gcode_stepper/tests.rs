@@ -97,7 +97,10 @@ fn the_first_lit_move_after_power_up_is_a_line_at_its_feed_lit() {
         panic!("one line: {:?}", moves(&out));
     };
     assert_eq!(feed, 10.0, "600 mm/min");
-    assert!(core.laser_on(), "lit from its start: the position is counted");
+    assert!(
+        core.laser_on(),
+        "lit from its start: the position is counted"
+    );
 }
 
 #[test]
@@ -112,13 +115,20 @@ fn a_failed_home_leaves_the_counted_position_in_mpos_and_status_says_homing() {
     let steps = [300, 0];
     let why = HomingFailure::Interrupted;
     let out = stepper(&mut core, 7000, StepperEvent::HomingFailed { why, steps });
-    assert!(texts(&out).iter().any(|t| t == "ALARM:6"), "{:?}", texts(&out));
+    assert!(
+        texts(&out).iter().any(|t| t == "ALARM:6"),
+        "{:?}",
+        texts(&out)
+    );
     assert_eq!(core.status().activity, Activity::Idle);
     let config = core.stepper_config();
     let spot = config.gimbal.fk(config.joints_of(steps).unwrap()).unwrap();
     let report = status(&mut core, 7001);
     let mpos = std::format!("MPos:{:.3},{:.3},", spot.x_cm * 10.0, spot.y_cm * 10.0);
-    assert!(report.starts_with("<Alarm|") && report.contains(&mpos), "{report} vs {mpos}");
+    assert!(
+        report.starts_with("<Alarm|") && report.contains(&mpos),
+        "{report} vs {mpos}"
+    );
     // Unlocked, G0 X0 Y0 goes back from there.
     line(&mut core, 7002, "$X");
     assert_eq!(moves(&line(&mut core, 7003, "G0 X0 Y0")).len(), 1);
