@@ -620,3 +620,15 @@ fn the_first_g1_after_power_up_a_reset_or_target_stepper_is_lit_at_its_feed() {
         assert!(dist(end, [x1, 0.0]) < 0.6, "{case}: ended at {end:?}");
     }
 }
+
+#[test]
+fn a_line_typed_ahead_of_target_stepper_runs_to_its_end() {
+    // The stop of `target stepper` came to rest after the line's move
+    // was sent; its report used to drop the move (stuck in `Run`).
+    let report = run(
+        "G0 X10\nwait 1000\n@type-ahead target stepper\n@type-ahead G1 X20 F600\nwait 3000\n?\n",
+    );
+    let status = statuses(&report).pop().expect("a status report");
+    assert!(status.starts_with("<Idle|"), "{status}");
+    assert!(dist(mpos(status), [20.0, 0.0]) < 0.01, "{status}");
+}

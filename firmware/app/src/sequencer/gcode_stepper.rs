@@ -205,6 +205,11 @@ impl Core {
             }
             StepperEvent::Stopped { steps } => {
                 let braked = core::mem::take(&mut motion.stepper.braking);
+                if !braked && !motion.is_idle() {
+                    // The rest of a stop from before the job (`target
+                    // stepper` typed ahead of it): its moves run on.
+                    return false;
+                }
                 self.gcode_stepper_at(steps);
                 let motion = &mut self.gcode.motion;
                 motion.stepper.held |= braked;

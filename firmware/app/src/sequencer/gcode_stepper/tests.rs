@@ -133,3 +133,19 @@ fn a_failed_home_leaves_the_counted_position_in_mpos_and_status_says_homing() {
     line(&mut core, 7002, "$X");
     assert_eq!(moves(&line(&mut core, 7003, "G0 X0 Y0")).len(), 1);
 }
+
+#[test]
+fn the_rest_of_a_stop_from_before_the_job_does_not_lose_its_move() {
+    let mut core = stepper_core();
+    // `target stepper` (a stop) typed ahead of the line: the stepper's
+    // rest report comes after the line's move was sent.
+    let [(seq, MoveShape::Line, _)] = moves(&line(&mut core, 1, "G1 X20 F600"))[..] else {
+        panic!("one line");
+    };
+    stepper(&mut core, 2, StepperEvent::Stopped { steps: [0, 0] });
+    assert!(status(&mut core, 3).starts_with("<Run|"));
+    let steps = [-81, 0];
+    stepper(&mut core, 2000, StepperEvent::Arrived { seq, steps });
+    let report = status(&mut core, 2001);
+    assert!(report.starts_with("<Idle|MPos:20.000,0.000,"), "{report}");
+}
