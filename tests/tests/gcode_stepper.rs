@@ -632,3 +632,25 @@ fn a_line_typed_ahead_of_target_stepper_runs_to_its_end() {
     assert!(status.starts_with("<Idle|"), "{status}");
     assert!(dist(mpos(status), [20.0, 0.0]) < 0.01, "{status}");
 }
+
+#[test]
+fn a_line_from_axes_beyond_their_soft_limits_is_refused_with_alarm_2_dark() {
+    // Pan at 13.5°, then its limit set to 10°: no board line
+    // starts there; the job ends in a soft-limit alarm, nothing lit moves.
+    let report =
+        run("G0 X-60\nwait 1000\nset stepper.pan.max_deg 10\nM3 S1000\nG1 X0 F600\nwait 2000\n?\n");
+    let lines = terminal_lines(&report);
+    assert!(
+        lines.contains(&"[MSG:stepper: move refused: Unreachable]") && lines.contains(&"ALARM:2"),
+        "{lines:?}"
+    );
+    let status = statuses(&report).pop().expect("a status report");
+    assert!(status.starts_with("<Alarm|"), "{status}");
+    let g1_us = sent_at(&report, "G1 X0 F600");
+    let moved_lit = gimbal_spot_mm(&report)
+        .iter()
+        .filter(|s| s.2 && s.0 >= g1_us)
+        .any(|s| dist(s.1, [-60.0, 0.0]) > 0.5);
+    assert!(!moved_lit, "lit off the start");
+    assert!(dist(spot_mm_at(&report, report.end_time_us), [-60.0, 0.0]) < 0.5);
+}

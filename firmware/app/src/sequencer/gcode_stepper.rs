@@ -203,6 +203,13 @@ impl Core {
                 }
                 true
             }
+            StepperEvent::Refused { seq, why } if motion.stepper.inflight == Some(seq) => {
+                // The checks before it passed, the stepper refused it
+                // (its axes beyond their soft limits): as on the galvo.
+                self.notify(out, format_args!("MSG:stepper: move refused: {why:?}"));
+                self.grbl_alarm(Alarm::SoftLimit, out);
+                true
+            }
             StepperEvent::Stopped { steps } => {
                 let braked = core::mem::take(&mut motion.stepper.braking);
                 if !braked && !motion.is_idle() {

@@ -149,3 +149,20 @@ fn the_rest_of_a_stop_from_before_the_job_does_not_lose_its_move() {
     let report = status(&mut core, 2001);
     assert!(report.starts_with("<Idle|MPos:20.000,0.000,"), "{report}");
 }
+
+#[test]
+fn a_move_the_stepper_refuses_raises_a_soft_limit_alarm_and_ends_the_job() {
+    let mut core = stepper_core();
+    let [(seq, MoveShape::Line, _)] = moves(&line(&mut core, 1, "G1 X20 F600"))[..] else {
+        panic!("one line");
+    };
+    let why = crate::stepper::StepperRefusal::Unreachable;
+    let out = stepper(&mut core, 2, StepperEvent::Refused { seq, why });
+    assert!(
+        texts(&out).iter().any(|t| t == "ALARM:2"),
+        "{:?}",
+        texts(&out)
+    );
+    assert!(status(&mut core, 3).starts_with("<Alarm|"));
+    assert!(!core.laser_on());
+}
