@@ -40,8 +40,12 @@ impl Running {
         let _ = link.take_halt();
         self.stopping = false;
         self.deferred = None;
-        self.motion.rest_at(link.position_steps());
-        let result = self.home_axes(&config, link).await;
+        let start = link.position_steps();
+        self.motion.rest_at(start);
+        let mut result = self.home_axes(&config, link).await;
+        if let Err(HomingFailure::NotFound(axis)) = result {
+            result = self.back_to(link, usize::from(axis), start, &config).await;
+        }
         link.set_limit_mode(LimitMode::Guard);
         self.motion.rest_at(link.position_steps());
         result.map(|()| link.position_steps())
@@ -66,9 +70,9 @@ impl Running {
             let travel = steps(config.max_deg[axis] - config.min_deg[axis] + 2.0 * h.pulloff_deg)?;
             let pull = steps(h.pulloff_deg)?;
             let seek = LimitMode::Seek(axis as u8);
-            let start = link.position_steps()[axis];
+            let not_found = HomingFailure::NotFound(axis as u8);
             if let Jogged::Done = self.jog(link, axis, travel, h.seek_deg_s, seek).await? {
-                return Err(self.not_found(link, axis, start, h.seek_deg_s).await);
+                return Err(not_found);
             }
             self.jog(link, axis, -pull, h.seek_deg_s, LimitMode::Ignore)
                 .await?;
@@ -76,7 +80,7 @@ impl Running {
                 return Err(HomingFailure::StillPressed(axis as u8));
             }
             if let Jogged::Done = self.jog(link, axis, 2 * pull, h.latch_deg_s, seek).await? {
-                return Err(self.not_found(link, axis, start, h.seek_deg_s).await);
+                return Err(not_found);
             }
             // The latch step is the first inside the switch: the switch
             // closed within the step before it, at half a step back on
@@ -95,29 +99,24 @@ impl Running {
         Ok(())
     }
 
-    /// Axis `axis`'s switch was not found: back to `start` (its steps
-    /// before the seek) at `speed_deg_s`, so the axes end where the cycle
-    /// found them (a failed `$H` repeated does not wind the axis round);
-    /// why it failed.
-    async fn not_found(
+    /// Axis `axis`'s switch was not found: back to its steps at the
+    /// start of the cycle (`start`; its seek began there: an axis before
+    /// it moves only itself) at the seek speed, so the axes end where the
+    /// cycle found them (a failed `$H` repeated does not wind the axis
+    /// round). Returns the failure to report.
+    async fn back_to(
         &mut self,
         link: &StepperLink,
         axis: usize,
-        start: i32,
-        speed_deg_s: f64,
-    ) -> HomingFailure {
-        let not_found = HomingFailure::NotFound(axis as u8);
-        let back = start.wrapping_sub(link.position_steps()[axis]);
-        if back == 0 {
-            return not_found;
+        start: [i32; 2],
+        config: &StepperConfig,
+    ) -> Result<(), HomingFailure> {
+        let back = start[axis & 1].wrapping_sub(link.position_steps()[axis & 1]);
+        if back != 0 {
+            let speed = config.homing.seek_deg_s;
+            self.jog(link, axis, back, speed, LimitMode::Ignore).await?;
         }
-        match self
-            .jog(link, axis, back, speed_deg_s, LimitMode::Ignore)
-            .await
-        {
-            Ok(_) => not_found,
-            Err(why) => why,
-        }
+        Err(HomingFailure::NotFound(axis as u8))
     }
 
     /// Moves axis `axis` by `steps` at `speed_deg_s` with the limit check
