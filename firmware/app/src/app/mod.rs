@@ -16,7 +16,6 @@
 
 mod board;
 mod tasks;
-pub mod trace;
 
 pub use self::board::{
     Board, Console, Indicators, Leds, NoGalvoDac, NoStepper, Parts, StopButton, Watchdog,

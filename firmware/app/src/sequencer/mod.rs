@@ -28,6 +28,7 @@ mod machine;
 mod report;
 mod run;
 mod stepper;
+mod trace;
 
 use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
@@ -322,8 +323,11 @@ impl<L: LaserSwitch, S: SettingsStore> Io<'_, L, S> {
         let lit = on && self.gate.open(self.generation);
         self.refused |= on && !lit;
         if lit != self.lit {
-            self.laser
-                .set(if lit { self.power } else { LaserPower::OFF });
+            let power = if lit { self.power } else { LaserPower::OFF };
+            self.laser.set(power);
+            if self.link.tracing() {
+                trace::laser(self.link, Instant::now().as_micros(), power);
+            }
             self.lit = lit;
             log::info!("laser {}", if lit { "on" } else { "off" });
         }
@@ -331,9 +335,13 @@ impl<L: LaserSwitch, S: SettingsStore> Io<'_, L, S> {
 
     /// The gimbal laser's power while lit (applied at once when it is).
     fn set_power(&mut self, power: LaserPower) {
+        let changed = self.power != power;
         self.power = power;
         if self.lit {
             self.laser.set(power);
+            if changed && self.link.tracing() {
+                trace::laser(self.link, Instant::now().as_micros(), power);
+            }
         }
     }
 }
@@ -375,7 +383,12 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
             }
             Action::GimbalLaser(on) => self.set_laser(on),
             Action::GimbalPower(power) => self.set_power(power),
-            Action::Note(event) => self.laser.note(event),
+            Action::Note(event) => {
+                self.laser.note(event);
+                if self.link.tracing() {
+                    trace::event(self.link, Instant::now().as_micros(), event);
+                }
+            }
             Action::Line(line) => {
                 let outbound = &self.link.outbound;
                 let _ = match &line {
