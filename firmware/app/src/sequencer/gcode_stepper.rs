@@ -317,3 +317,6 @@ impl StepperJob {
         *self = Self::default();
     }
 }
+
+#[cfg(test)]
+mod tests;
