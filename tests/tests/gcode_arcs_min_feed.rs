@@ -6,7 +6,7 @@
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::SpotMm;
 use system_tests::gcode_toolpath::{galvo_spot_mm, gimbal_spot_mm};
-use system_tests::run_with;
+use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with};
 
 /// The lit stretches of a spot timeline: (first t, last t, samples).
 fn lit_runs(samples: &[SpotMm]) -> Vec<(u64, u64, Vec<[f64; 2]>)> {
@@ -143,6 +143,7 @@ fn stepper_arcs_end_at_their_end_points_in_their_planned_time() {
         "the arcs did not all end: {:?}",
         report.end
     );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     let runs = lit_runs(&gimbal_spot_mm(&report));
     assert_eq!(runs.len(), arcs.len(), "one lit stretch per arc");
     for (arc, (first_us, last_us, spots)) in arcs.iter().zip(&runs) {
@@ -183,13 +184,15 @@ fn tiny_feed_line(target: &str, length_mm: f64) -> SimReport {
         "target {target}\nG0 X-5 Y0\nM3 S1000\nG1 X{} F0.0000001\nM5\n",
         length_mm - 5.0
     );
-    run_with(
+    let report = run_with(
         &script,
         SimOptions {
             max_time_ms: 45_000,
             ..SimOptions::default()
         },
-    )
+    );
+    assert_safe_allowing(&report, UNTIL_STEP_FIXES);
+    report
 }
 
 /// The `length_mm` line ran lit from its start to its end at 1 mm/min,

@@ -104,7 +104,7 @@ fn off_path(session: &Session, spot: Spot, samples: &[(u64, [f64; 2], bool)]) ->
     let mut episode: Option<(u64, u64, u32, f64, [f64; 2])> = None;
     let mut cursor = 0usize;
     for &(t, p, _) in samples.iter().filter(|s| s.2) {
-        let known = lit.partition_point(|m| m.accepted_us <= t);
+        let known = lit.partition_point(|m| m.sent_us <= t);
         let near = |k: usize| lit[k].piece.distance_mm(p);
         let nearest = (cursor..known.min(cursor + 4))
             .find(|&k| near(k) <= tol)
@@ -186,7 +186,7 @@ fn late(session: &Session, spot: Spot, samples: &Samples, end: u64) -> Vec<Viola
         }
         previous = d;
         let to = m.piece.end();
-        let arrived = window(samples, m.accepted_us, d.saturating_add(1))
+        let arrived = window(samples, m.sent_us, d.saturating_add(1))
             .iter()
             .any(|s| dist(s.1, to) <= tol);
         if !arrived {

@@ -121,7 +121,10 @@ pub(super) fn dist(p: [f64; 2], q: [f64; 2]) -> f64 {
 /// One commanded motion (or lit dwell) of the model.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Motion {
-    /// When its line was accepted (`ok`), µs.
+    /// When its line was sent, µs (it may run from then on: the host
+    /// reads the `ok` later).
+    pub(super) sent_us: u64,
+    /// When its line was accepted (`ok` read by the host), µs.
     pub(super) accepted_us: u64,
     pub(super) piece: Piece,
     /// Lit: G1–G3 (or a G4 after one) with M3/M4 and S > 0 (M4: not a
@@ -270,8 +273,8 @@ impl Interpreter<'_> {
         }
     }
 
-    /// An accepted G-code line.
-    fn gcode(&mut self, t: u64, words: &[(char, f64)]) {
+    /// An accepted G-code line, sent at `sent`.
+    fn gcode(&mut self, sent: u64, t: u64, words: &[(char, f64)]) {
         let (mut x, mut y, mut i, mut j, mut r, mut p) = (None, None, None, None, None, None);
         let mut dwell = false;
         for &(letter, v) in words {
@@ -310,13 +313,16 @@ impl Interpreter<'_> {
                 return;
             };
             let lit = lit_mode && self.dwell_lit;
-            self.push(t, Piece::Point(at), lit, Some(s));
+            self.push(sent, t, Piece::Point(at), lit, Some(s));
             return;
         }
         if x.is_none() && y.is_none() {
             return;
         }
         let Some(from) = self.at.or_else(|| (self.spot_at)(self.spot, t)) else {
+            // No sample yet to start from: the path is unknown, its end
+            // too unless absolute on both axes.
+            self.at = x.zip(y).filter(|_| !self.relative).map(|(x, y)| [x, y]);
             return;
         };
         let axis = |v: Option<f64>, k: usize| match v {
@@ -336,15 +342,16 @@ impl Interpreter<'_> {
         let planned_s = (self.motion != 0)
             .then(|| piece.length_mm() / (self.feed.max(MIN_FEED_MM_MIN) / 60.0));
         if self.motion == 0 || piece.length_mm() > 0.0 {
-            self.push(t, piece, lit_mode, planned_s);
+            self.push(sent, t, piece, lit_mode, planned_s);
         }
     }
 
-    fn push(&mut self, t: u64, piece: Piece, lit: bool, planned_s: Option<f64>) {
+    fn push(&mut self, sent: u64, t: u64, piece: Piece, lit: bool, planned_s: Option<f64>) {
         if self.suspended {
             return;
         }
-        self.session(t).motions.push(Motion {
+        self.session(sent).motions.push(Motion {
+            sent_us: sent,
             accepted_us: t,
             piece,
             lit,
@@ -430,7 +437,7 @@ pub(super) fn sessions(
         })
         .collect();
     let mut next_stop = 0;
-    let mut pending: std::collections::VecDeque<&str> = Default::default();
+    let mut pending: std::collections::VecDeque<(u64, &str)> = Default::default();
     for (t, line) in &transcript.lines {
         let t = *t;
         while next_stop < stops.len() && stops[next_stop] <= t {
@@ -438,7 +445,7 @@ pub(super) fn sessions(
             next_stop += 1;
         }
         if let Some(sent) = line.strip_prefix("> ") {
-            pending.push_back(sent);
+            pending.push_back((t, sent));
         } else if let Some(byte) = line.strip_prefix(">> 0x") {
             match u8::from_str_radix(byte, 16).unwrap_or(0) {
                 0x18 => {
@@ -455,14 +462,14 @@ pub(super) fn sessions(
                 _ => {}
             }
         } else if line == "ok" || line.starts_with("error:") {
-            let Some(sent) = pending.pop_front() else {
+            let Some((sent_us, sent)) = pending.pop_front() else {
                 continue;
             };
             if line != "ok" {
                 continue;
             }
             match words(sent) {
-                Some(w) => it.gcode(t, &w),
+                Some(w) => it.gcode(sent_us, t, &w),
                 None => it.command(t, sent),
             }
         }
