@@ -157,7 +157,11 @@ fn stepper_arcs_end_at_their_end_points_in_their_planned_time() {
         let sweep = arc.sweep();
         for &p in spots {
             let off = (dist(p, arc.centre) - arc.radius()).abs();
-            assert!(off <= STEPPER_TOLERANCE_MM, "{}: {off} mm off the circle", arc.line);
+            assert!(
+                off <= STEPPER_TOLERANCE_MM,
+                "{}: {off} mm off the circle",
+                arc.line
+            );
             // On the programmed part of the circle (a full circle: all).
             let beyond = (arc.progress(p) - sweep) * arc.radius();
             let before_start = (std::f64::consts::TAU - arc.progress(p)) * arc.radius();
@@ -205,7 +209,9 @@ fn assert_runs_at_the_minimum_feed(
     tolerance_mm: f64,
 ) {
     let runs = lit_runs(spots);
-    let (first, last, lit) = runs.first().unwrap_or_else(|| panic!("{target}: never lit"));
+    let (first, last, lit) = runs
+        .first()
+        .unwrap_or_else(|| panic!("{target}: never lit"));
     assert_eq!(runs.len(), 1, "{target}: one lit stretch");
     let took_s = (last - first) as f64 / t_per_s;
     let planned_s = 60.0 * length_mm;
@@ -215,7 +221,10 @@ fn assert_runs_at_the_minimum_feed(
     );
     let (start, end) = (lit[0], *lit.last().expect("lit"));
     let to = [length_mm - 5.0, 0.0];
-    assert!(dist(start, [-5.0, 0.0]) <= tolerance_mm, "{target}: starts at {start:?}");
+    assert!(
+        dist(start, [-5.0, 0.0]) <= tolerance_mm,
+        "{target}: starts at {start:?}"
+    );
     assert!(dist(end, to) <= tolerance_mm, "{target}: ends at {end:?}");
 }
 
@@ -235,7 +244,11 @@ fn a_feed_below_the_minimum_runs_at_one_mm_per_minute_on_the_galvo() {
         .map(|p| [(p[0] * 1e4).round() as i64, (p[1] * 1e4).round() as i64])
         .collect();
     codes.dedup();
-    assert!(codes.len() >= 5, "the spot crept over {} codes", codes.len());
+    assert!(
+        codes.len() >= 5,
+        "the spot crept over {} codes",
+        codes.len()
+    );
 }
 
 #[test]
@@ -267,5 +280,8 @@ fn a_feed_below_the_minimum_ends_lit_at_its_end_point_on_the_stepper() {
     let took_s = (last - first) as f64 * 1e-6;
     assert!((1.0..=6.0).contains(&took_s), "lit {took_s:.3} s");
     let end = *lit.last().expect("lit");
-    assert!(dist(end, [-4.0, 0.0]) <= STEPPER_TOLERANCE_MM, "ends at {end:?}");
+    assert!(
+        dist(end, [-4.0, 0.0]) <= STEPPER_TOLERANCE_MM,
+        "ends at {end:?}"
+    );
 }

@@ -50,8 +50,8 @@ use crate::recorder::{EventRecord, ServoSample, SpotSample};
 use crate::usb_host::Transcript;
 use crate::world::SimReport;
 
-pub use conformance::{DURATION_SLACK_S, RAPID_MIN_MM_S};
 use conformance::gcode_conformance;
+pub use conformance::{DURATION_SLACK_S, RAPID_MIN_MM_S};
 use dark::dark_after_stops;
 use moving::{galvo_jumps_dark, gimbal_dwell_mode, gimbal_travel_dark};
 use replies::one_reply_per_line;

@@ -68,7 +68,13 @@ fn window(samples: &Samples, from: u64, until: u64) -> &[(u64, [f64; 2], bool)] 
 /// (e) and (f) on every G-code session of the run.
 pub(super) fn gcode_conformance(inputs: &SafetyInputs<'_>) -> (Vec<Violation>, Vec<Violation>) {
     let (pointing, galvo) = samples(inputs);
-    let of = |spot: Spot| if spot == Spot::Galvo { &galvo } else { &pointing };
+    let of = |spot: Spot| {
+        if spot == Spot::Galvo {
+            &galvo
+        } else {
+            &pointing
+        }
+    };
     let spot_at = |spot: Spot, t: u64| {
         let s = of(spot);
         let k = s.partition_point(|x| x.0 <= t);
@@ -109,7 +115,11 @@ fn off_path(session: &Session, spot: Spot, samples: &[(u64, [f64; 2], bool)]) ->
         let nearest = (cursor..known.min(cursor + 4))
             .find(|&k| near(k) <= tol)
             .map(|k| (k, near(k)))
-            .or_else(|| (0..known).map(|k| (k, near(k))).min_by(|a, b| a.1.total_cmp(&b.1)));
+            .or_else(|| {
+                (0..known)
+                    .map(|k| (k, near(k)))
+                    .min_by(|a, b| a.1.total_cmp(&b.1))
+            });
         match nearest {
             Some((k, d)) if d <= tol => {
                 cursor = k;
@@ -190,20 +200,31 @@ fn late(session: &Session, spot: Spot, samples: &Samples, end: u64) -> Vec<Viola
             .iter()
             .any(|s| dist(s.1, to) <= tol);
         if !arrived {
+            // The closest it came before the next stop, for the report.
+            let closest = window(samples, m.sent_us, end)
+                .iter()
+                .map(|s| (dist(s.1, to), s.0))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .unwrap_or((f64::INFINITY, 0));
             found.push(Violation {
                 kind: ViolationKind::LateMotion,
                 t_us: d,
                 detail: format!(
-                    "{spot:?} spot not at ({:.2}, {:.2}) mm by {:.3} ms, the end of its motion's bound ({:.3} s planned)",
+                    "{spot:?} spot not at ({:.2}, {:.2}) mm by {:.3} ms, the end of its motion's bound ({:.3} s planned; closest {:.2} mm at {:.3} ms)",
                     to[0],
                     to[1],
                     d as f64 / 1000.0,
-                    m.planned_s.unwrap_or(0.0)
+                    m.planned_s.unwrap_or(0.0),
+                    closest.0,
+                    closest.1 as f64 / 1000.0
                 ),
             });
             break;
         }
-        let next = session.motions.get(k + 1).map_or(end, |n| n.accepted_us.min(end));
+        let next = session
+            .motions
+            .get(k + 1)
+            .map_or(end, |n| n.accepted_us.min(end));
         let strays = window(samples, d, next)
             .iter()
             .find(|s| s.2 && dist(s.1, to) > tol);

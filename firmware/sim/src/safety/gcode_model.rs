@@ -98,7 +98,8 @@ impl Piece {
                 sweep_rad,
             } => {
                 let ang = (p[1] - centre[1]).atan2(p[0] - centre[0]);
-                let along = (sweep_rad.signum() * (ang - start_rad)).rem_euclid(std::f64::consts::TAU);
+                let along =
+                    (sweep_rad.signum() * (ang - start_rad)).rem_euclid(std::f64::consts::TAU);
                 if along <= sweep_rad.abs() {
                     (dist(p, centre) - radius).abs()
                 } else {
@@ -170,7 +171,9 @@ fn words(line: &str) -> Option<Vec<(char, f64)>> {
             return None;
         }
         let tail = &rest[1..];
-        let end = tail.find(|c: char| c.is_ascii_alphabetic()).unwrap_or(tail.len());
+        let end = tail
+            .find(|c: char| c.is_ascii_alphabetic())
+            .unwrap_or(tail.len());
         out.push((letter, tail[..end].parse::<f64>().ok()?));
         rest = &tail[end..];
     }
@@ -309,7 +312,8 @@ impl Interpreter<'_> {
         }
         let lit_mode = self.laser_on && self.power > 0.0 && (1..=3).contains(&self.motion);
         if dwell {
-            let (Some(at), Some(s)) = (self.at, p) else {
+            let here = self.at.or_else(|| (self.spot_at)(self.spot, t));
+            let (Some(at), Some(s)) = (here, p) else {
                 return;
             };
             let lit = lit_mode && self.dwell_lit;
@@ -339,8 +343,8 @@ impl Interpreter<'_> {
             },
             _ => Piece::Line { a: from, b: to },
         };
-        let planned_s = (self.motion != 0)
-            .then(|| piece.length_mm() / (self.feed.max(MIN_FEED_MM_MIN) / 60.0));
+        let planned_s =
+            (self.motion != 0).then(|| piece.length_mm() / (self.feed.max(MIN_FEED_MM_MIN) / 60.0));
         if self.motion == 0 || piece.length_mm() > 0.0 {
             self.push(sent, t, piece, lit_mode, planned_s);
         }
@@ -430,7 +434,9 @@ pub(super) fn sessions(
     let stops: Vec<u64> = events
         .iter()
         .filter_map(|e| match &e.event {
-            SequencerEvent::Stopped { why } if why != "pattern complete" && why != "G-code started" => {
+            SequencerEvent::Stopped { why }
+                if why != "pattern complete" && why != "G-code started" =>
+            {
                 Some(e.t_us)
             }
             _ => None,
@@ -485,7 +491,15 @@ mod tests {
     #[test]
     fn arcs_follow_grbl_and_distances_measure_the_programmed_part() {
         // G2 X0 Y-10 I-10 J0 from (10, 0): a quarter, clockwise.
-        let q = arc([10.0, 0.0], [0.0, -10.0], Some(-10.0), Some(0.0), None, true).unwrap();
+        let q = arc(
+            [10.0, 0.0],
+            [0.0, -10.0],
+            Some(-10.0),
+            Some(0.0),
+            None,
+            true,
+        )
+        .unwrap();
         assert!((q.length_mm() - 5.0 * std::f64::consts::PI).abs() < 1e-9);
         assert!(q.distance_mm([10.0f64.sqrt() * 5.0f64.sqrt(), -50f64.sqrt()]) < 1e-9);
         // The rest of the circle is off it: (-10, 0) is 14.1 mm from both ends.
@@ -494,7 +508,9 @@ mod tests {
         let full = arc([5.0, 5.0], [5.0, 5.0], Some(5.0), Some(-5.0), None, true).unwrap();
         assert!((full.length_mm() - 2.0 * std::f64::consts::PI * 50f64.sqrt()).abs() < 1e-6);
         let long = arc([0.0, 0.0], [30.0, 30.0], None, None, Some(-30.0), false).unwrap();
-        let Piece::Arc { centre, .. } = long else { panic!() };
+        let Piece::Arc { centre, .. } = long else {
+            panic!()
+        };
         assert!(dist(centre, [30.0, 0.0]) < 1e-9, "{centre:?}");
         assert!((long.length_mm() - 45.0 * std::f64::consts::PI).abs() < 1e-6);
         assert!(dist(long.end(), [30.0, 30.0]) < 1e-9);
@@ -502,8 +518,18 @@ mod tests {
 
     #[test]
     fn only_g_code_lines_have_words() {
-        assert_eq!(words("G1 X1.5 y-2 (c) ; x"), Some(vec![('G', 1.0), ('X', 1.5), ('Y', -2.0)]));
-        for line in ["status", "stop", "goto 1 2", "set dwell_ms 3", "$X", "target galvo"] {
+        assert_eq!(
+            words("G1 X1.5 y-2 (c) ; x"),
+            Some(vec![('G', 1.0), ('X', 1.5), ('Y', -2.0)])
+        );
+        for line in [
+            "status",
+            "stop",
+            "goto 1 2",
+            "set dwell_ms 3",
+            "$X",
+            "target galvo",
+        ] {
             assert_eq!(words(line), None, "{line}");
         }
     }
