@@ -36,7 +36,11 @@ fn command(core: &mut Core, ms: u64, command: Command) -> Vec<Action> {
 }
 
 fn line(core: &mut Core, ms: u64, text: &str) -> Vec<Action> {
-    command(core, ms, Command::Grbl(GrblLine::new(text).expect("short line")))
+    command(
+        core,
+        ms,
+        Command::Grbl(GrblLine::new(text).expect("short line")),
+    )
 }
 
 /// The stepper moves requested: (seq, shape).
@@ -68,7 +72,10 @@ fn take_and_arrive(core: &mut Core, ms: u64, seq: u32) -> Vec<Action> {
 #[test]
 fn an_arc_is_one_stepper_move_and_ends_at_its_arrival() {
     let mut core = Core::new(Instant::from_millis(0));
-    assert_eq!(closers(&command(&mut core, 0, Command::Target(Actuator::Stepper))), 1);
+    assert_eq!(
+        closers(&command(&mut core, 0, Command::Target(Actuator::Stepper))),
+        1
+    );
     line(&mut core, 1, "$X");
     let rapid = moves(&line(&mut core, 2, "G0 X10 Y0"));
     assert_eq!(rapid.len(), 1, "{rapid:?}");
