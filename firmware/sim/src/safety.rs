@@ -36,6 +36,7 @@
 mod conformance;
 mod dark;
 mod gcode_model;
+mod gcode_piece;
 mod moving;
 mod replies;
 mod steps;

@@ -11,13 +11,13 @@
 //! G30/G38/G43/G53/G92/G93, patterns, gotos, grids) make it stop judging
 //! until the next stop or reset, or forget the position, as noted.
 
+use super::gcode_piece::arc;
+pub(super) use super::gcode_piece::{Piece, dist};
 use crate::recorder::{EventRecord, SequencerEvent};
 use crate::usb_host::Transcript;
 
 /// grbl's `MINIMUM_FEED_RATE`, mm/min.
 const MIN_FEED_MM_MIN: f64 = 1.0;
-/// grbl's `ARC_ANGULAR_TRAVEL_EPSILON`, rad.
-const FULL_CIRCLE_EPSILON_RAD: f64 = 5e-7;
 
 /// Which spot a G-code session moves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,93 +30,6 @@ pub(super) enum Spot {
     Galvo,
     /// The gimbal's and the galvo's (`target both`).
     Both,
-}
-
-/// The board path of one commanded motion, mm.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) enum Piece {
-    /// A straight line (G0, G1).
-    Line { a: [f64; 2], b: [f64; 2] },
-    /// An arc about `centre` from angle `start_rad`, `sweep_rad` signed
-    /// (positive counter-clockwise).
-    Arc {
-        centre: [f64; 2],
-        radius: f64,
-        start_rad: f64,
-        sweep_rad: f64,
-    },
-    /// Standing at a point (G4).
-    Point([f64; 2]),
-}
-
-impl Piece {
-    /// Length, mm.
-    pub(super) fn length_mm(&self) -> f64 {
-        match *self {
-            Piece::Line { a, b } => dist(a, b),
-            Piece::Arc {
-                radius, sweep_rad, ..
-            } => radius * sweep_rad.abs(),
-            Piece::Point(_) => 0.0,
-        }
-    }
-
-    /// Where it ends, mm.
-    pub(super) fn end(&self) -> [f64; 2] {
-        match *self {
-            Piece::Line { b, .. } => b,
-            Piece::Arc {
-                centre,
-                radius,
-                start_rad,
-                sweep_rad,
-            } => {
-                let a = start_rad + sweep_rad;
-                [centre[0] + radius * a.cos(), centre[1] + radius * a.sin()]
-            }
-            Piece::Point(p) => p,
-        }
-    }
-
-    /// Distance of `p` from the piece, mm.
-    pub(super) fn distance_mm(&self, p: [f64; 2]) -> f64 {
-        match *self {
-            Piece::Line { a, b } => {
-                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-                let len2 = dx * dx + dy * dy;
-                let t = if len2 > 0.0 {
-                    (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                dist(p, [a[0] + t * dx, a[1] + t * dy])
-            }
-            Piece::Arc {
-                centre,
-                radius,
-                start_rad,
-                sweep_rad,
-            } => {
-                let ang = (p[1] - centre[1]).atan2(p[0] - centre[0]);
-                let along =
-                    (sweep_rad.signum() * (ang - start_rad)).rem_euclid(std::f64::consts::TAU);
-                if along <= sweep_rad.abs() {
-                    (dist(p, centre) - radius).abs()
-                } else {
-                    let s = [
-                        centre[0] + radius * start_rad.cos(),
-                        centre[1] + radius * start_rad.sin(),
-                    ];
-                    dist(p, s).min(dist(p, self.end()))
-                }
-            }
-            Piece::Point(q) => dist(p, q),
-        }
-    }
-}
-
-pub(super) fn dist(p: [f64; 2], q: [f64; 2]) -> f64 {
-    (p[0] - q[0]).hypot(p[1] - q[1])
 }
 
 /// One commanded motion (or lit dwell) of the model.
@@ -364,50 +277,6 @@ impl Interpreter<'_> {
     }
 }
 
-/// The arc of a G2 (`cw`)/G3 from `from` to `to` by I/J offsets or R, as
-/// grbl computes it (`None`: grbl refuses it).
-fn arc(
-    from: [f64; 2],
-    to: [f64; 2],
-    i: Option<f64>,
-    j: Option<f64>,
-    r: Option<f64>,
-    cw: bool,
-) -> Option<Piece> {
-    let centre = match r {
-        Some(r) => {
-            let (x, y) = (to[0] - from[0], to[1] - from[1]);
-            let h2 = 4.0 * r * r - x * x - y * y;
-            if h2 < 0.0 || (x == 0.0 && y == 0.0) {
-                return None;
-            }
-            let mut h = -h2.sqrt() / x.hypot(y);
-            if !cw {
-                h = -h;
-            }
-            if r < 0.0 {
-                h = -h;
-            }
-            [from[0] + 0.5 * (x - y * h), from[1] + 0.5 * (y + x * h)]
-        }
-        None => [from[0] + i.unwrap_or(0.0), from[1] + j.unwrap_or(0.0)],
-    };
-    let (sx, sy) = (from[0] - centre[0], from[1] - centre[1]);
-    let (ex, ey) = (to[0] - centre[0], to[1] - centre[1]);
-    let mut sweep = (sx * ey - sy * ex).atan2(sx * ex + sy * ey);
-    if cw && sweep >= -FULL_CIRCLE_EPSILON_RAD {
-        sweep -= std::f64::consts::TAU;
-    } else if !cw && sweep <= FULL_CIRCLE_EPSILON_RAD {
-        sweep += std::f64::consts::TAU;
-    }
-    Some(Piece::Arc {
-        centre,
-        radius: sx.hypot(sy),
-        start_rad: sy.atan2(sx),
-        sweep_rad: sweep,
-    })
-}
-
 /// The G-code sessions of a run, from its transcript and the sequencer's
 /// stops; `spot_at(spot, t)` gives where a spot was at `t` (µs, mm), for
 /// the start of the first motion after a stop.
@@ -485,52 +354,4 @@ pub(super) fn sessions(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn arcs_follow_grbl_and_distances_measure_the_programmed_part() {
-        // G2 X0 Y-10 I-10 J0 from (10, 0): a quarter, clockwise.
-        let q = arc(
-            [10.0, 0.0],
-            [0.0, -10.0],
-            Some(-10.0),
-            Some(0.0),
-            None,
-            true,
-        )
-        .unwrap();
-        assert!((q.length_mm() - 5.0 * std::f64::consts::PI).abs() < 1e-9);
-        assert!(q.distance_mm([10.0f64.sqrt() * 5.0f64.sqrt(), -50f64.sqrt()]) < 1e-9);
-        // The rest of the circle is off it: (-10, 0) is 14.1 mm from both ends.
-        assert!((q.distance_mm([-10.0, 0.0]) - 200f64.sqrt()).abs() < 1e-9);
-        // A full circle by I/J only; R < 0 takes the long way.
-        let full = arc([5.0, 5.0], [5.0, 5.0], Some(5.0), Some(-5.0), None, true).unwrap();
-        assert!((full.length_mm() - 2.0 * std::f64::consts::PI * 50f64.sqrt()).abs() < 1e-6);
-        let long = arc([0.0, 0.0], [30.0, 30.0], None, None, Some(-30.0), false).unwrap();
-        let Piece::Arc { centre, .. } = long else {
-            panic!()
-        };
-        assert!(dist(centre, [30.0, 0.0]) < 1e-9, "{centre:?}");
-        assert!((long.length_mm() - 45.0 * std::f64::consts::PI).abs() < 1e-6);
-        assert!(dist(long.end(), [30.0, 30.0]) < 1e-9);
-    }
-
-    #[test]
-    fn only_g_code_lines_have_words() {
-        assert_eq!(
-            words("G1 X1.5 y-2 (c) ; x"),
-            Some(vec![('G', 1.0), ('X', 1.5), ('Y', -2.0)])
-        );
-        for line in [
-            "status",
-            "stop",
-            "goto 1 2",
-            "set dwell_ms 3",
-            "$X",
-            "target galvo",
-        ] {
-            assert_eq!(words(line), None, "{line}");
-        }
-    }
-}
+mod tests;
