@@ -42,10 +42,7 @@ impl Piece {
                 radius,
                 start_rad,
                 sweep_rad,
-            } => {
-                let a = start_rad + sweep_rad;
-                [centre[0] + radius * a.cos(), centre[1] + radius * a.sin()]
-            }
+            } => on_circle(centre, radius, start_rad + sweep_rad),
             Piece::Point(p) => p,
         }
     }
@@ -75,16 +72,21 @@ impl Piece {
                 if along <= sweep_rad.abs() {
                     (dist(p, centre) - radius).abs()
                 } else {
-                    let s = [
-                        centre[0] + radius * start_rad.cos(),
-                        centre[1] + radius * start_rad.sin(),
-                    ];
+                    let s = on_circle(centre, radius, start_rad);
                     dist(p, s).min(dist(p, self.end()))
                 }
             }
             Piece::Point(q) => dist(p, q),
         }
     }
+}
+
+/// The point at `angle` (rad) on the circle about `centre`, mm.
+fn on_circle(centre: [f64; 2], radius: f64, angle: f64) -> [f64; 2] {
+    [
+        centre[0] + radius * angle.cos(),
+        centre[1] + radius * angle.sin(),
+    ]
 }
 
 pub(super) fn dist(p: [f64; 2], q: [f64; 2]) -> f64 {
