@@ -15,7 +15,7 @@ use crate::galvo::ScanPhase;
 use crate::grbl::realtime::{OverrideStep, Realtime};
 use crate::servo::task::{ServoOutcome, ServoRequest};
 
-const READINGS: Readings = Readings {
+pub(crate) const READINGS: Readings = Readings {
     galvo: GalvoReadout {
         phase: ScanPhase::Idle,
         queued: 0,
