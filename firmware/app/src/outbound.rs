@@ -54,6 +54,11 @@ pub const NOTICE_LIMIT: usize = OUTBOUND_BYTES - CLOSER_ROOM;
 /// for four notices and the closer).
 pub const DATA_LIMIT: usize = NOTICE_LIMIT - 4 * (LINE_ENTRY_MAX + MARKER_ENTRY);
 
+/// Room a line's reply is given before the line is taken while the host
+/// reads, bytes (grbl's longest, `$$`, stores about 700; the product's
+/// long replies wait for the queue to drain instead).
+pub const REPLY_ROOM: usize = 1024;
+
 /// What a queued line is; decides how it is printed and its priority.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -352,6 +357,13 @@ impl Outbound {
     /// what notices may fill: the console dispatches a line only then.
     pub fn has_closer_room(&self) -> bool {
         self.queued_bytes() <= OUTBOUND_BYTES - CLOSER_ROOM
+    }
+
+    /// Whether the reply of a line (up to [`REPLY_ROOM`] bytes of data
+    /// lines and its closer) fits: the console waits for it while the host
+    /// reads before it takes the next line.
+    pub fn has_reply_room(&self) -> bool {
+        self.queued_bytes() + REPLY_ROOM <= DATA_LIMIT
     }
 
     /// Lines dropped and not yet reported.
