@@ -58,3 +58,68 @@ fn a_move_typed_with_the_soft_reset_runs_after_it() {
         "the move ran: {status}\n{lines:#?}"
     );
 }
+
+/// Lines of the transcript after the last `@open`.
+fn after_reopen(lines: &[(u64, String)]) -> &[(u64, String)] {
+    let open = lines
+        .iter()
+        .rposition(|(_, l)| l == "@open")
+        .expect("the port was opened again");
+    &lines[open + 1..]
+}
+
+#[test]
+fn a_host_that_flooded_closed_and_opened_the_port_again_is_answered_at_once() {
+    // Issue 25, defect 8: a host typed far more than it read, stopped
+    // reading, closed the port and opened it again: `stop` and `version`
+    // were not answered within 15 s. A new connection is a new session:
+    // the old one's input and replies are gone, the new lines answered.
+    for flood in ["version", "params", "$G", "G1 X1 Y1 F6000"] {
+        let mut script = String::from("@stall-read 60000\n");
+        for _ in 0..400 {
+            script += &format!("@type-ahead {flood}\n");
+        }
+        script += "wait 1000\n@close\nwait 200\n@open\nstop\nversion\nwait 500\n";
+        let report = run_with(&script, SimOptions::default());
+        assert!(report.transcript.script_done, "{flood}");
+        let lines = after_reopen(&report.transcript.lines);
+        let texts: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
+        assert_eq!(texts.first(), Some(&"> stop"), "{flood}: {texts:#?}");
+        assert_eq!(texts.get(1), Some(&"ok"), "{flood}: {texts:#?}");
+        assert_eq!(texts.get(2), Some(&"> version"), "{flood}: {texts:#?}");
+        assert!(
+            texts.get(3).is_some_and(|l| l.starts_with("laser-pointer")),
+            "{flood}: {texts:#?}"
+        );
+        assert_eq!(texts.get(4), Some(&"ok"), "{flood}: {texts:#?}");
+        let opened_at = lines[0].0;
+        let answered_at = lines[4].0;
+        assert!(
+            answered_at - opened_at < 1_000_000,
+            "{flood}: answered {} µs after the port opened",
+            answered_at - opened_at
+        );
+    }
+}
+
+#[test]
+fn a_job_line_waiting_for_room_when_the_host_left_is_stopped_for_the_next_host() {
+    // The last host left a G-code line waiting for room in the motion
+    // queue (its `ok` would come only when a block ends): the new host
+    // is answered at once, and the old job does not run on unattended.
+    let mut script = String::from("M3 S1000\n");
+    for i in 0..20 {
+        script += &format!("@type-ahead G1 X{} Y0 F60\n", i % 2 * 10);
+    }
+    script += "wait 500\n@close\nwait 100\n@open\nversion\n@realtime ?\nwait 100\n";
+    let report = run_with(&script, SimOptions::default());
+    let lines = after_reopen(&report.transcript.lines);
+    let texts: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
+    assert_eq!(texts.first(), Some(&"> version"), "{texts:#?}");
+    assert!(texts.get(1).is_some_and(|l| l.starts_with("laser-pointer")), "{texts:#?}");
+    assert_eq!(texts.get(2), Some(&"ok"), "{texts:#?}");
+    assert!(lines[2].0 - lines[0].0 < 1_000_000, "{texts:#?}");
+    let status = texts.iter().find(|l| l.starts_with('<')).expect("a status report");
+    assert!(status.starts_with("<Idle|"), "the old job stopped: {status}");
+    assert!(report.idle_at_end);
+}
