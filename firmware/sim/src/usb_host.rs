@@ -172,6 +172,16 @@ impl UsbHost {
         self.port_changed.signal(());
     }
 
+    /// Whether the port is open.
+    pub fn port_is_open(&self) -> bool {
+        self.open.get()
+    }
+
+    /// The number of the current (or last) connection.
+    pub fn connection(&self) -> u32 {
+        self.connection.get()
+    }
+
     /// Waits until the port is open; returns its connection number.
     pub async fn port_opened(&self) -> u32 {
         while !self.open.get() {
