@@ -2,6 +2,8 @@
 //! implements one of `laser-app`'s board traits
 //! ([`laser_app::app::Board`] and friends) over the HAL.
 
+use core::sync::atomic::{AtomicBool, Ordering};
+use embassy_futures::select::{Either, select};
 use embassy_stm32::Peri;
 use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::gpio::OutputType;
@@ -16,8 +18,6 @@ use embassy_stm32::timer::{Ch1, Ch2};
 use embassy_stm32::usb::Driver;
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_time::{Duration, Instant, Timer};
-use core::sync::atomic::{AtomicBool, Ordering};
-use embassy_futures::select::{Either, select};
 use embassy_usb::class::cdc_acm::{BufferedReceiver, ControlChanged, Sender};
 use embedded_io_async::Read;
 use laser_app::app::{

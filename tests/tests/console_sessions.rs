@@ -116,10 +116,19 @@ fn a_job_line_waiting_for_room_when_the_host_left_is_stopped_for_the_next_host()
     let lines = after_reopen(&report.transcript.lines);
     let texts: Vec<&str> = lines.iter().map(|(_, l)| l.as_str()).collect();
     assert_eq!(texts.first(), Some(&"> version"), "{texts:#?}");
-    assert!(texts.get(1).is_some_and(|l| l.starts_with("laser-pointer")), "{texts:#?}");
+    assert!(
+        texts.get(1).is_some_and(|l| l.starts_with("laser-pointer")),
+        "{texts:#?}"
+    );
     assert_eq!(texts.get(2), Some(&"ok"), "{texts:#?}");
     assert!(lines[2].0 - lines[0].0 < 1_000_000, "{texts:#?}");
-    let status = texts.iter().find(|l| l.starts_with('<')).expect("a status report");
-    assert!(status.starts_with("<Idle|"), "the old job stopped: {status}");
+    let status = texts
+        .iter()
+        .find(|l| l.starts_with('<'))
+        .expect("a status report");
+    assert!(
+        status.starts_with("<Idle|"),
+        "the old job stopped: {status}"
+    );
     assert!(report.idle_at_end);
 }

@@ -275,7 +275,11 @@ fn a_host_that_reads_with_short_pauses_gets_every_typed_ahead_line_run() {
         let answers = lines.iter().filter(|(_, l)| l.starts_with(data)).count();
         assert_eq!(refused, 0, "{line}: lines refused to a host that reads");
         assert_eq!((closers, answers), (600, 600), "{line}");
-        let dropped = report.transcript.notices.iter().filter(|(_, n)| n.contains("dropped"));
+        let dropped = report
+            .transcript
+            .notices
+            .iter()
+            .filter(|(_, n)| n.contains("dropped"));
         assert_eq!(dropped.count(), 0, "{line}: replies dropped");
     }
 }

@@ -84,3 +84,48 @@ impl OwedClosers {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::outbound::LineKind;
+
+    #[test]
+    fn a_host_counts_as_not_reading_until_the_writer_takes_a_line() {
+        let out = Outbound::new();
+        let mut reading = HostReading::default();
+        assert!(!reading.not_reading(&out));
+        out.push(LineKind::Ok, "");
+        out.push(LineKind::Ok, "");
+        reading.stalled(&out);
+        assert!(reading.not_reading(&out));
+        out.push(LineKind::Ok, "");
+        assert!(reading.not_reading(&out), "queuing is not reading");
+        assert!(out.take().is_some());
+        assert!(!reading.not_reading(&out), "the host read a line");
+        assert!(!reading.not_reading(&out));
+    }
+
+    #[test]
+    fn owed_closers_are_paid_in_order_as_runs() {
+        let link = CommandLink::new();
+        let mut owed = OwedClosers::default();
+        for ok in [false, false, true, false] {
+            assert!(owed.owe(ok));
+        }
+        owed.pay(&link);
+        assert!(owed.is_empty());
+        let kinds: [Option<LineKind>; 5] =
+            core::array::from_fn(|_| link.outbound.take().map(|l| l.kind));
+        assert_eq!(
+            kinds,
+            [
+                Some(LineKind::Error),
+                Some(LineKind::Error),
+                Some(LineKind::Ok),
+                Some(LineKind::Error),
+                None
+            ]
+        );
+    }
+}

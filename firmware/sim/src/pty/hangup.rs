@@ -40,8 +40,14 @@ impl PtyBridge {
     /// the caller sends an empty chunk on `to_host` once it has ended the
     /// closed session (its output before that is dropped).
     pub fn start_with_hangups(pty: &mut Pty) -> Result<Self> {
-        let mut reader = pty.master.try_clone().context("cannot clone the PTY master")?;
-        let mut writer = pty.master.try_clone().context("cannot clone the PTY master")?;
+        let mut reader = pty
+            .master
+            .try_clone()
+            .context("cannot clone the PTY master")?;
+        let mut writer = pty
+            .master
+            .try_clone()
+            .context("cannot clone the PTY master")?;
         pty._slave = None;
         let path = pty.path.clone();
         let closes = Arc::new(AtomicU32::new(0));

@@ -208,14 +208,23 @@ fn jog_while_not_idle_is_refused_with_grbls_error_8() {
     let out = line(&mut core, 1, "G1 X20 F300");
     assert_eq!(closers(&out), 1);
     assert!(status(&mut core, 2).starts_with("<Run|"));
-    assert_eq!(grbl_error_code(&line(&mut core, 3, "$J=G91 X1 F600")), Some(8));
+    assert_eq!(
+        grbl_error_code(&line(&mut core, 3, "$J=G91 X1 F600")),
+        Some(8)
+    );
     realtime(&mut core, 4, Realtime::SoftReset);
     assert!(status(&mut core, 5).starts_with("<Alarm|"));
-    assert_eq!(grbl_error_code(&line(&mut core, 6, "$J=G91 X1 F600")), Some(8));
+    assert_eq!(
+        grbl_error_code(&line(&mut core, 6, "$J=G91 X1 F600")),
+        Some(8)
+    );
     assert_eq!(grbl_error_code(&line(&mut core, 7, "G0 X1")), Some(9));
     assert_eq!(grbl_error_code(&line(&mut core, 8, "$X")), None);
     assert_eq!(grbl_error_code(&line(&mut core, 9, "$C")), None);
-    assert_eq!(grbl_error_code(&line(&mut core, 10, "$J=G91 X1 F600")), Some(8));
+    assert_eq!(
+        grbl_error_code(&line(&mut core, 10, "$J=G91 X1 F600")),
+        Some(8)
+    );
 }
 
 #[test]
