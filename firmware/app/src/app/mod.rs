@@ -16,6 +16,7 @@
 
 mod board;
 mod tasks;
+pub mod trace;
 
 pub use self::board::{
     Board, Console, HostPresence, Indicators, Leds, NoGalvoDac, NoHangUp, NoStepper, Parts,

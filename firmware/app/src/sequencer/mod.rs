@@ -35,7 +35,7 @@ use embassy_time::{Duration, Instant, Timer};
 pub use self::galvo::config_from;
 pub use self::laser::{LaserEvent, LaserPower, LaserSwitch, laser_wanted};
 pub use self::machine::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
-use crate::command::CommandLink;
+use crate::command::{Command, CommandLink};
 use crate::galvo::{GalvoLink, GalvoRequest};
 use crate::laser_gate::LaserGate;
 use crate::log;
@@ -235,6 +235,9 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             Either4::First(Either::First(request)) => Event::Realtime(request),
             Either4::First(Either::Second(Either::First(command))) => {
                 log::debug!("command: {:?}", command);
+                if let Command::Trace(on) = command {
+                    io.link.set_tracing(on);
+                }
                 Event::Command {
                     command,
                     readings: io.readings(),
