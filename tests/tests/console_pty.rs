@@ -6,55 +6,24 @@
 
 use std::fs::{File, OpenOptions};
 use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::path::Path;
 use std::sync::mpsc::{Receiver, channel};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use laser_sim::pty::PtyOptions;
-use laser_sim::world::{SimOptions, SimReport, run};
+use laser_sim::on_pty::SimOnPty;
+use laser_sim::world::SimOptions;
 
 /// Ends a run that hangs.
 const GUARD: Duration = Duration::from_secs(120);
 
-/// A simulation serving its console on a PTY.
-struct PtySim {
-    path: PathBuf,
-    stop: Arc<AtomicBool>,
-    run: JoinHandle<SimReport>,
-}
-
-impl PtySim {
-    fn start(name: &str) -> Self {
-        let path = std::env::temp_dir().join(format!("laser-pty-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_file(&path);
-        let stop = Arc::new(AtomicBool::new(false));
-        let options = SimOptions {
-            pty: Some(PtyOptions {
-                link: Some(path.clone()),
-                stop: stop.clone(),
-            }),
-            realtime: true,
-            max_time_ms: GUARD.as_millis() as u64,
-            ..SimOptions::default()
-        };
-        let run = std::thread::spawn(move || run(options));
-        let started = Instant::now();
-        while std::fs::read_link(&path).is_err() {
-            assert!(started.elapsed() < GUARD, "no PTY");
-            std::thread::sleep(Duration::from_millis(10));
-        }
-        Self { path, stop, run }
-    }
-
-    fn finish(self) -> SimReport {
-        self.stop.store(true, Ordering::Relaxed);
-        let report = self.run.join().expect("the simulation ran");
-        let _ = std::fs::remove_file(&self.path);
-        report
-    }
+/// Starts the simulator with its console on a PTY named after `name`.
+fn start(name: &str) -> SimOnPty {
+    let link = std::env::temp_dir().join(format!("laser-pty-{name}-{}", std::process::id()));
+    let options = SimOptions {
+        max_time_ms: GUARD.as_millis() as u64,
+        ..SimOptions::default()
+    };
+    SimOnPty::start(link, options).expect("the simulator's PTY")
 }
 
 /// Opens the port (the host's side).
@@ -112,8 +81,8 @@ fn a_reading_host_typing_ahead_on_the_pty_gets_every_line_run() {
     // Issue 25, defect 7: with a thread reading everything, 49 821 of
     // 50 000 typed-ahead `version` lines were refused as "not reading".
     const LINES: usize = 5_000;
-    let sim = PtySim::start("typeahead");
-    let port = open_port(&sim.path);
+    let sim = start("typeahead");
+    let port = open_port(&sim.link);
     let lines = read_lines(&port);
     let mut writer = port.try_clone().expect("clone");
     let typing = std::thread::spawn(move || {
@@ -151,8 +120,8 @@ fn a_host_that_flooded_and_closed_the_pty_is_followed_by_one_answered_at_once() 
     // Issue 25, defect 8: 711 414 lines written in 8 s without reading,
     // the port closed and opened again: `stop` and `version` were not
     // answered within 15 s.
-    let sim = PtySim::start("reopen");
-    let mut port = open_port(&sim.path);
+    let sim = start("reopen");
+    let mut port = open_port(&sim.link);
     let flood = "version\r\n".repeat(2_000);
     // The host's writes stop when nothing more fits (back-pressure): write
     // from a thread and close the port with what is still unwritten.
@@ -167,7 +136,7 @@ fn a_host_that_flooded_and_closed_the_pty_is_followed_by_one_answered_at_once() 
     // the console has taken its lines (each refused or answered).
     flooding.join().expect("flooded");
     std::thread::sleep(Duration::from_millis(200));
-    let mut port = open_port(&sim.path);
+    let mut port = open_port(&sim.link);
     let lines = read_lines(&port);
     port.write_all(b"stop\r\nversion\r\n").expect("typed");
     let seen = lines_until(&lines, |l| l.starts_with("laser-pointer"));
@@ -198,8 +167,8 @@ fn a_host_that_flooded_and_closed_the_pty_is_followed_by_one_answered_at_once() 
 fn an_unlock_written_with_the_soft_reset_on_the_pty_unlocks_after_it() {
     // Issue 25, defect 5: `\x18$X\n` in one write answered `ok` to `$X`
     // before ALARM:3 and the banner (5 of 5 on a PTY).
-    let sim = PtySim::start("reset");
-    let mut port = open_port(&sim.path);
+    let sim = start("reset");
+    let mut port = open_port(&sim.link);
     let lines = read_lines(&port);
     port.write_all(b"G1 X20 Y0 F300\r\n").expect("typed");
     lines_until(&lines, |l| l == "ok");
