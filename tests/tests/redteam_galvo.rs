@@ -145,3 +145,36 @@ fn an_idle_galvo_loop_never_underruns_after_a_job_however_slow() {
         );
     }
 }
+
+#[test]
+fn an_underrun_is_told_with_the_stop_it_makes_never_after_it() {
+    // Issue 25, defect 9: at 15 µs of compute per sample the pattern
+    // underran and stopped (told), then the parked loop underran again
+    // and a second notice said "stopped" of a pattern stopped before.
+    let report = run_with_galvo_cost(
+        "target galvo\npattern tuning\nwait 500\nstop\nwait 500\npattern tuning\nwait 500\n",
+        15_000,
+    );
+    assert!(
+        report.galvo_underruns >= 3,
+        "the loop underran while parked too: {}",
+        report.galvo_underruns
+    );
+    let told: Vec<u64> = report
+        .transcript
+        .notices
+        .iter()
+        .filter(|(_, n)| n.contains("galvo underrun"))
+        .map(|(t, _)| *t)
+        .collect();
+    let second_start = report
+        .transcript
+        .lines
+        .iter()
+        .filter(|(_, l)| l == "> pattern tuning")
+        .nth(1)
+        .map(|(t, _)| *t)
+        .expect("the pattern was started twice");
+    assert_eq!(told.len(), 2, "one notice per pattern stopped: {told:?}");
+    assert!(told[0] < 500_000 && told[1] >= second_start, "{told:?}");
+}

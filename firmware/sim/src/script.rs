@@ -5,8 +5,10 @@
 //! long (the script goes on, so lines can be typed during the stall),
 //! `@type-ahead <line>` types a line without waiting for its reply,
 //! `@realtime <byte>` sends one of grbl's realtime bytes (`?`, `!`, `~`
-//! or hex: `0x18`, `0x9b`, …; no line, no reply awaited) and `@button`
-//! presses the board's stop button.
+//! or hex: `0x18`, `0x9b`, …; no line, no reply awaited), `@button`
+//! presses the board's stop button, and `@close` / `@open` close the
+//! console port (unplug: what was not read yet is lost) and open it
+//! again (a new session).
 
 use anyhow::{Context, Result, bail};
 
@@ -27,6 +29,11 @@ pub enum Step {
     StopButton,
     /// Send one grbl realtime byte (no line end, no reply awaited).
     Realtime(u8),
+    /// The host closes the port (DTR drops): replies not read yet are
+    /// lost, as are lines still awaiting them.
+    ClosePort,
+    /// The host opens the port again (a new session).
+    OpenPort,
 }
 
 /// The byte of `@realtime <byte>`: one of grbl's realtime commands, as
@@ -91,11 +98,13 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
                 steps.push(Step::SendAhead(typed.to_owned()));
             }
             Some("@button") if line == "@button" => steps.push(Step::StopButton),
+            Some("@close") if line == "@close" => steps.push(Step::ClosePort),
+            Some("@open") if line == "@open" => steps.push(Step::OpenPort),
             Some("@realtime") => steps.push(Step::Realtime(realtime_byte(words.next(), number)?)),
             Some(directive) if directive.starts_with('@') => {
                 bail!(
                     "script line {number}: unknown directive {directive:?} \
-                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button)"
+                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, @close, @open)"
                 );
             }
             _ => steps.push(Step::Send(line.to_owned())),

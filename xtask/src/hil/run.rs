@@ -220,6 +220,9 @@ pub fn run_scenario(
             BoardStep::Script(Step::StopButton) => {
                 bail!("the stop button cannot be pressed over the console")
             }
+            BoardStep::Script(Step::ClosePort | Step::OpenPort) => {
+                bail!("@close/@open: the harness keeps its port open")
+            }
             BoardStep::Reset => {
                 session.pump(REPLY_LIMIT, |s| s.owed == 0)?;
                 let Some(reset) = reset else {

@@ -77,6 +77,9 @@ pub fn run_step(machine: &mut Machine, step: &BoardStep, deadline: Instant) -> R
         }
         BoardStep::Script(Step::StopButton) => machine.press_button()?,
         BoardStep::Script(Step::Realtime(byte)) => machine.send_realtime(*byte)?,
+        BoardStep::Script(Step::ClosePort | Step::OpenPort) => {
+            anyhow::bail!("@close/@open: the QEMU board's console is a UART (no port to close)")
+        }
     }
     Ok(true)
 }

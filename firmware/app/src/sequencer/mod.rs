@@ -30,7 +30,7 @@ mod run;
 mod stepper;
 mod trace;
 
-use embassy_futures::select::{Either, Either4, select, select4};
+use embassy_futures::select::{Either, Either3, Either4, select, select3, select4};
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::galvo::config_from;
@@ -214,21 +214,27 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 None => core::future::pending::<()>().await,
             }
         };
-        let command = select(io.link.commands.receive(), io.link.stop_request.wait());
+        // Realtime bytes first: the console sends them before the lines
+        // that follow them in the host's input, so a line typed after a
+        // soft reset (even in the same write) runs in the new session.
+        let command = select(
+            io.link.realtime.receive(),
+            select(io.link.commands.receive(), io.link.stop_request.wait()),
+        );
         let event = select4(
             command,
             io.servo.outcomes.receive(),
             timer,
-            select4(
+            select3(
                 Timer::at(housekeeping),
                 io.galvo.events.receive(),
-                io.link.realtime.receive(),
                 io.stepper.events.receive(),
             ),
         )
         .await;
         match event {
-            Either4::First(Either::First(command)) => {
+            Either4::First(Either::First(request)) => Event::Realtime(request),
+            Either4::First(Either::Second(Either::First(command))) => {
                 log::debug!("command: {:?}", command);
                 if let Command::Trace(on) = command {
                     io.link.set_tracing(on);
@@ -238,13 +244,12 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                     readings: io.readings(),
                 }
             }
-            Either4::First(Either::Second(())) => Event::StopRequest,
+            Either4::First(Either::Second(Either::Second(()))) => Event::StopRequest,
             Either4::Second(outcome) => Event::Servo(outcome),
             Either4::Third(()) => Event::DwellEnded,
-            Either4::Fourth(Either4::First(())) => Event::Tick,
-            Either4::Fourth(Either4::Second(event)) => Event::Galvo(event),
-            Either4::Fourth(Either4::Third(request)) => Event::Realtime(request),
-            Either4::Fourth(Either4::Fourth(event)) => Event::Stepper(event),
+            Either4::Fourth(Either3::First(())) => Event::Tick,
+            Either4::Fourth(Either3::Second(event)) => Event::Galvo(event),
+            Either4::Fourth(Either3::Third(event)) => Event::Stepper(event),
         }
     }
 

@@ -168,6 +168,10 @@ fn word_and_modal_errors_follow_grbl() {
     for (line, code) in [
         ("10", 1),
         ("G1 X", 2),
+        ("X", 2),
+        ("S nan", 2),
+        ("S NaN", 2),
+        ("F inf", 2),
         ("X1.2.3", 2),
         ("F-1", 4),
         ("S-1", 4),
