@@ -279,6 +279,30 @@ pub const ROWS: &[Row] = &[
         budget: None,
     },
     Row {
+        id: "sweep.plan.xy",
+        what: "two-axis time-optimal jump plan (f32, as the loop plans it), worst of a seeded sweep: anywhere, tiny, tiny at the edge",
+        unit: "jump",
+        budget: Some((100.0, "100 µs per two-axis jump", PLANNING)),
+    },
+    Row {
+        id: "sweep.stroke.steady",
+        what: "loop, marking: worst half of a seeded sweep of strokes with close corners, hairpins, arc chords, reversals",
+        unit: "sample",
+        budget: Some((0.20 * SAMPLE_US, "20 % of the 10 µs sample", LOOP)),
+    },
+    Row {
+        id: "sweep.stroke.refill",
+        what: "refill: worst half of the stroke sweep",
+        unit: "half",
+        budget: half_refill_budget(REFILL),
+    },
+    Row {
+        id: "sweep.stroke.prep",
+        what: "prep: worst step of the stroke sweep (stroke setup or joined piece)",
+        unit: "step",
+        budget: prep_budget(PREP),
+    },
+    Row {
         id: "plan.xy.optimal.1lsb",
         what: "two-axis time-optimal jump plan, 1 LSB",
         unit: "jump",
