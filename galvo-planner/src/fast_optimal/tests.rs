@@ -75,3 +75,52 @@ fn few_newton_iterations() {
         assert!(free <= 4 && fixed <= 4, "{k}°: {free} + {fixed} iterations");
     }
 }
+
+#[test]
+#[ignore]
+fn scan_iterations() {
+    let d = rigid(10e-6);
+    let lsb_deg = 12.5 / 2047.5;
+    let mut k = 0.5;
+    let mut rows = std::vec::Vec::new();
+    let mut dump = std::vec::Vec::new();
+    while k < 4000.0 {
+        ITERATIONS.with(|c| c.set(0));
+        let p = plan_jump(&d, 0.0, k * lsb_deg * DEG, Method::TimeOptimal, 100_000).expect("plan");
+        let count = ITERATIONS.with(|c| c.get());
+        let (free, fixed) = (count % 100, count / 100);
+        rows.push((free + fixed, k, p.samples(), free, fixed));
+        dump.push(std::format!("{k:.6} {} {:?}", p.samples(), p.info()));
+        k *= 1.002;
+    }
+    std::fs::write(std::env::var("DUMP").unwrap(), dump.join("\n")).unwrap();
+    rows.sort_by(|a, b| b.0.cmp(&a.0));
+    for r in rows.iter().take(25) {
+        println!("{:.3} codes: {} samples, Newton {} + {}", r.1, r.2, r.3, r.4);
+    }
+    let hist = rows.iter().fold([0u32; 30], |mut h, r| { h[(r.0 as usize).min(29)] += 1; h });
+    println!("{hist:?}");
+}
+
+#[test]
+#[ignore]
+fn trace_one() {
+    let d = rigid(10e-6);
+    let lsb_deg = 12.5 / 2047.5;
+    super::newton::TRACE.with(|t| t.set(true));
+    let p = plan_jump(&d, 0.0, 1.34 * lsb_deg * DEG, Method::TimeOptimal, 100_000).expect("plan");
+    println!("{} {:?}", p.samples(), p.info());
+}
+
+#[test]
+#[ignore]
+fn sizes() {
+    println!(
+        "disc {} plan {} xy {} law {} info {}",
+        core::mem::size_of::<Discrete<3>>(),
+        core::mem::size_of::<JumpPlan<3>>(),
+        core::mem::size_of::<crate::plan::XyJump<3>>(),
+        core::mem::size_of::<InputLaw<3>>(),
+        core::mem::size_of::<PlanInfo>()
+    );
+}
