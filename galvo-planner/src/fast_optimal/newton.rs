@@ -21,11 +21,6 @@ std::thread_local! {
     pub(crate) static ITERATIONS: core::cell::Cell<u32> = const { core::cell::Cell::new(0) };
 }
 
-#[cfg(test)]
-std::thread_local! {
-    pub(crate) static TRACE: core::cell::Cell<bool> = const { core::cell::Cell::new(false) };
-}
-
 /// Newton iterations per solve (piecewise linear: exact after the switch
 /// samples settle; 2–5 in practice).
 const MAX_NEWTON: u32 = 24;
@@ -67,10 +62,6 @@ pub(super) fn newton(
         let dbase = if fixed_n.is_some() { 2.0 } else { 0.0 };
         let (r, jac) = modal_residual(modes, &mut caches, &g_fixed, m, fixed_n, (n, dn), s);
         let cells = (n as i32, s.sigma1 as i32, s.sigma2 as i32);
-        #[cfg(test)]
-        if TRACE.with(|t| t.get()) {
-            std::eprintln!("fixed {fixed_n:?} n {n} s {s:?} r {r:?} jac {jac:?}");
-        }
         let [[mut a, mut b], [mut c, mut d]] = jac;
         let mut det = a * d - b * c;
         let exact_jacobian = det != 0.0;

@@ -76,51 +76,26 @@ fn few_newton_iterations() {
     }
 }
 
+/// Issue 25: every move from one LSB to the full 4 095-LSB field (every
+/// 0.2 %) settles in a bounded number of Newton iterations. A fixed-N
+/// solve whose solution a bound (`σ2 ≥ 1`) pinned outside its samples
+/// used to run to MAX_NEWTON: 1.336-1.344 LSB took 2 + 26 iterations
+/// (10 000 M4 instructions for one axis) before the next N planned it.
 #[test]
-#[ignore]
-fn scan_iterations() {
+fn newton_iterations_bounded_from_one_lsb_to_full_field() {
     let d = rigid(10e-6);
     let lsb_deg = 12.5 / 2047.5;
-    let mut k = 0.5;
-    let mut rows = std::vec::Vec::new();
-    let mut dump = std::vec::Vec::new();
-    while k < 4000.0 {
+    let mut worst = (0, 0.0);
+    let mut lsb = 1.0;
+    while lsb <= 4095.0 {
         ITERATIONS.with(|c| c.set(0));
-        let p = plan_jump(&d, 0.0, k * lsb_deg * DEG, Method::TimeOptimal, 100_000).expect("plan");
+        plan_jump(&d, 0.0, lsb * lsb_deg * DEG, Method::TimeOptimal, 100_000).expect("plan");
         let count = ITERATIONS.with(|c| c.get());
-        let (free, fixed) = (count % 100, count / 100);
-        rows.push((free + fixed, k, p.samples(), free, fixed));
-        dump.push(std::format!("{k:.6} {} {:?}", p.samples(), p.info()));
-        k *= 1.002;
+        let total = count % 100 + count / 100;
+        if total > worst.0 {
+            worst = (total, lsb);
+        }
+        lsb *= 1.002;
     }
-    std::fs::write(std::env::var("DUMP").unwrap(), dump.join("\n")).unwrap();
-    rows.sort_by(|a, b| b.0.cmp(&a.0));
-    for r in rows.iter().take(25) {
-        println!("{:.3} codes: {} samples, Newton {} + {}", r.1, r.2, r.3, r.4);
-    }
-    let hist = rows.iter().fold([0u32; 30], |mut h, r| { h[(r.0 as usize).min(29)] += 1; h });
-    println!("{hist:?}");
-}
-
-#[test]
-#[ignore]
-fn trace_one() {
-    let d = rigid(10e-6);
-    let lsb_deg = 12.5 / 2047.5;
-    super::newton::TRACE.with(|t| t.set(true));
-    let p = plan_jump(&d, 0.0, 1.34 * lsb_deg * DEG, Method::TimeOptimal, 100_000).expect("plan");
-    println!("{} {:?}", p.samples(), p.info());
-}
-
-#[test]
-#[ignore]
-fn sizes() {
-    println!(
-        "disc {} plan {} xy {} law {} info {}",
-        core::mem::size_of::<Discrete<3>>(),
-        core::mem::size_of::<JumpPlan<3>>(),
-        core::mem::size_of::<crate::plan::XyJump<3>>(),
-        core::mem::size_of::<InputLaw<3>>(),
-        core::mem::size_of::<PlanInfo>()
-    );
+    assert!(worst.0 <= 10, "{} iterations at {:.3} LSB", worst.0, worst.1);
 }

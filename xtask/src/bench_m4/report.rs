@@ -164,6 +164,7 @@ fn measured(id: &str, instructions: f64) -> Measured {
         inputs_tried: None,
         status: budget.map(|(_, _, e)| match e {
             Enforcement::Enforced => "enforced".to_owned(),
+            Enforcement::Pending(work) => format!("reported, not yet met ({work})"),
         }),
         over_budget: budget.is_some_and(|(b, _, e)| e == Enforcement::Enforced && us > b),
     }
