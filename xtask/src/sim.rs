@@ -218,10 +218,11 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
             stop,
         }
     });
-    let report = run(SimOptions {
+    let realtime = args.realtime || args.interactive || args.pty.is_some();
+    let options = SimOptions {
         script,
         pty,
-        realtime: args.realtime || args.interactive || args.pty.is_some(),
+        realtime,
         interactive: args.interactive,
         until_idle,
         faults,
@@ -230,7 +231,24 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
         echo: true,
         galvo_cost_ns_per_sample: args.galvo_cost_ns,
         ..SimOptions::default()
-    });
+    };
+    // A scripted run is deterministic in virtual time: with
+    // `--check-safety` a long task step must recur in every run, so host
+    // load alone cannot fail it (re-run at most twice, only when a step
+    // was long). A real-time or terminal session runs once.
+    let report = if args.check_safety && !realtime {
+        let mut runs = 0;
+        laser_sim::safety::steady_steps(|| {
+            runs += 1;
+            // The transcript is echoed once.
+            run(SimOptions {
+                echo: runs == 1,
+                ..options.clone()
+            })
+        })
+    } else {
+        run(options)
+    };
     write_outputs(&args, svg.as_deref(), &report)?;
     print_summary(&report);
     let unsafe_run = args.check_safety && !safety_holds(&report);
