@@ -218,7 +218,12 @@ fn a_sweep_reports_its_worst_input_and_is_enforced_on_it() {
     let r = parse(&over).unwrap();
     let plan = r.rows.iter().find(|m| m.id == "sweep.plan.xy").unwrap();
     assert!(plan.share.unwrap() > 1.0 && !plan.over_budget);
-    assert!(plan.status.as_deref().unwrap().starts_with("reported, not yet met"));
+    assert!(
+        plan.status
+            .as_deref()
+            .unwrap()
+            .starts_with("reported, not yet met")
+    );
     assert!(check(&r).is_ok());
     // 1100 ticks per half: 343.75 instructions per sample, over the
     // 25 % (323) allowed for corners; enforced, with the input named.
@@ -227,20 +232,31 @@ fn a_sweep_reports_its_worst_input_and_is_enforced_on_it() {
         "bench sweep.stroke.steady 1100 128",
     );
     let err = check(&parse(&over).unwrap()).unwrap_err().to_string();
-    assert!(err.contains("sweep.stroke.steady") && err.contains("input 58"), "{err}");
+    assert!(
+        err.contains("sweep.stroke.steady") && err.contains("input 58"),
+        "{err}"
+    );
     // So is the refill of the sweep's worst half (20 000 ticks, 1.2 ms).
     let over = OUT.replace(
         "bench sweep.stroke.refill 800 1",
         "bench sweep.stroke.refill 20000 1",
     );
     let err = check(&parse(&over).unwrap()).unwrap_err().to_string();
-    assert!(err.contains("sweep.stroke.refill") && err.contains("input 58"), "{err}");
+    assert!(
+        err.contains("sweep.stroke.refill") && err.contains("input 58"),
+        "{err}"
+    );
     // A sweep without its worst input is not a report.
     let bare = OUT.replace(
         "worst sweep.plan.xy 3000 (-80.109,136.229)->(-80.261,140.839) mm\n",
         "",
     );
-    assert!(parse(&bare).unwrap_err().to_string().contains("worst input"));
+    assert!(
+        parse(&bare)
+            .unwrap_err()
+            .to_string()
+            .contains("worst input")
+    );
 }
 
 #[test]

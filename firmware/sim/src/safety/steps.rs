@@ -61,6 +61,19 @@ pub fn steady_steps(mut run: impl FnMut() -> SimReport) -> SimReport {
         runs.push(run().task_steps);
         let kept = recurring_steps(&runs);
         let done = !long(&kept);
+        let count = |steps: &[TaskSteps]| -> u64 {
+            steps
+                .iter()
+                .filter(|t| t.kind == TaskKind::Firmware)
+                .map(|t| t.long_step_count)
+                .sum()
+        };
+        eprintln!(
+            "steady_steps: run {} of {NOISE_RUNS}: {} long firmware steps in run 1, {} recur",
+            runs.len(),
+            runs.first().map_or(0, |r| count(r)),
+            count(&kept)
+        );
         report.task_steps = kept;
         if done {
             break;
