@@ -97,5 +97,10 @@ fn newton_iterations_bounded_from_one_lsb_to_full_field() {
         }
         lsb *= 1.002;
     }
-    assert!(worst.0 <= 10, "{} iterations at {:.3} LSB", worst.0, worst.1);
+    assert!(
+        worst.0 <= 10,
+        "{} iterations at {:.3} LSB",
+        worst.0,
+        worst.1
+    );
 }
