@@ -175,5 +175,5 @@ fn only_long_steps_that_recur_in_every_run_count() {
     assert_eq!(kept[0].max_cpu_ns, LONG_STEP_NS);
     // One run is itself.
     let one = vec![steps_with(&[(50_000, 2_500_000)], 2_500_000)];
-    assert_eq!(recurring_steps(&[one.clone()]), one);
+    assert_eq!(recurring_steps(std::slice::from_ref(&one)), one);
 }
