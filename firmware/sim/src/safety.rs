@@ -57,6 +57,7 @@ use dark::dark_after_stops;
 use moving::{galvo_jumps_dark, gimbal_dwell_mode, gimbal_travel_dark};
 use replies::one_reply_per_line;
 use steps::short_steps;
+pub use steps::{NOISE_RUNS, steady_steps};
 use timeline::SettingsTimeline;
 
 /// Time after a stop (fault, button, underrun, …) within which every
