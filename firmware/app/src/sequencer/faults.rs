@@ -11,6 +11,7 @@
 //! whatever the laser mode.
 
 use super::machine::{ActionSink, Core};
+use super::drivers::Driver;
 use crate::command::Command;
 use crate::servo::task::{ServoFault, ServoIdSet};
 use crate::settings::Settings;
@@ -107,7 +108,7 @@ impl Core {
         // What a fault says about the servo is never stale: it is dead
         // until it answers again.
         self.faults.mark_dead(id);
-        let gimbal_run = self.actuator.uses_gimbal() && self.run.is_some();
+        let gimbal_run = self.drivers().any(Driver::needs_servos) && self.run.is_some();
         // A fault of an older, superseded move: the current move finds out
         // itself (the laser is dark meanwhile: the servo is marked dead).
         if gimbal_run
@@ -140,7 +141,7 @@ impl Core {
         let moves_gimbal = matches!(
             command,
             Command::Goto(_) | Command::Grid { .. } | Command::Pattern { .. }
-        ) && self.actuator.uses_gimbal();
+        ) && self.drivers().any(Driver::needs_servos);
         if !moves_gimbal {
             return None;
         }

@@ -7,6 +7,7 @@
 use super::gcode_galvo::GalvoStroke;
 use super::gcode_motion::{Hold, Motion, PLANNER_BLOCKS};
 use super::gcode_settings::GrblValues;
+use super::drivers::Driver;
 use super::machine::{Action, ActionSink, Core, Line};
 use crate::command::RealtimeRequest;
 use crate::grbl::classify::{LineKind, classify};
@@ -236,7 +237,7 @@ impl Core {
         if !idle || self.gcode.mode == GrblMode::Check {
             return self.grbl_error(out, GrblError::NotIdle);
         }
-        if self.actuator.uses_stepper() {
+        if self.drivers().any(Driver::homes_with_switches) {
             // The reply waits for the end of homing (grbl's `$H`): a
             // sender's next lines wait with it.
             return match self.start_homing(out) {
@@ -314,11 +315,9 @@ impl Core {
     /// interrupted motion.
     fn grbl_reset(&mut self, out: &mut dyn ActionSink) {
         let moving = self.gcode.motion.current.is_some() && self.gcode.motion.hold != Hold::Held;
-        if self.actuator.uses_stepper() {
-            // grbl's reset kills the steps at once (the position is then
-            // uncertain: ALARM:3); `stop` would brake at the limit.
-            out.act(Action::Stepper(crate::stepper::StepperRequest::Halt));
-        }
+        // grbl's reset kills the motion at once where a driver can (the
+        // position is then uncertain: ALARM:3); `stop` would brake.
+        self.drivers_reset(out);
         self.stop("grbl soft reset", out);
         self.gcode.parser.soft_reset();
         self.grbl_sync_position();

@@ -104,7 +104,7 @@ impl Core {
         lit: bool,
         out: &mut dyn ActionSink,
     ) -> Option<u32> {
-        let strokes = lit && !self.actuator.uses_gimbal();
+        let strokes = lit && !self.drivers().lockstep();
         if let Some(next) = self.gcode.galvo.adopt.take() {
             if strokes && let Some(seq) = self.gcode_galvo_adopt(from, next) {
                 return Some(seq);

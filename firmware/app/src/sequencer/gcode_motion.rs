@@ -22,6 +22,7 @@ use heapless::Deque;
 
 use super::gcode_stepper::StepperJob;
 use super::gcode_stream::{Stream, planned_length};
+use super::drivers::Driver;
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
 use crate::domain::PointCm;
@@ -212,11 +213,7 @@ impl Core {
         let reachable = |p: PointMm| {
             let on_board = libm::fabs(p.x_mm) <= half_width_mm + 1e-9
                 && libm::fabs(p.y_mm) <= half_height_mm + 1e-9;
-            let p = cm(p);
-            on_board
-                && (!self.actuator.uses_gimbal() || self.aimer.aim(p).is_ok())
-                && (!self.actuator.uses_galvo() || self.aimer.galvo_in_range(p))
-                && (!self.actuator.uses_stepper() || self.stepper_reaches(p))
+            on_board && self.drivers_reach(cm(p))
         };
         match block {
             Block::Arc { .. } => (0..=16).all(|k| reachable(point_at(block, k, 16))),
@@ -227,7 +224,7 @@ impl Core {
     /// Steps `block` is split into on the current actuator(s).
     fn step_count(&self, block: &Block) -> u32 {
         let step_mm = (self.aimer.path_step_cm() * 10.0).max(0.01);
-        let gimbal = self.actuator.uses_gimbal();
+        let gimbal = self.drivers().any(Driver::steps_lines);
         let steps =
             |length_mm: f64| libm::ceil(length_mm / step_mm).clamp(1.0, MAX_STEPS as f64) as u32;
         match *block {

@@ -13,6 +13,7 @@
 
 use super::gcode_motion::Hold;
 use super::gcode_stream::STREAM_PERIOD_MS;
+use super::drivers::Driver;
 use super::laser::LaserPower;
 use super::machine::Core;
 use crate::grbl::report::Overrides;
@@ -64,7 +65,7 @@ impl Core {
             let streaming = self.gcode.motion.stream.speed_mm_s() > 0.0;
             let moving = streaming || c.is_some_and(|c| c.until.is_none() && c.servo_seq.is_some());
             // The stepper: its step generator's speed while its steps run.
-            let stepping = self.actuator.uses_stepper()
+            let stepping = self.drivers().any(Driver::polls_speed)
                 && c.is_some_and(|c| c.until.is_none())
                 && self.gcode.motion.stepper_moving();
             fraction *= if stepping {
@@ -88,7 +89,7 @@ impl Core {
     /// follows its speed (the gimbal's stream period after the last event; under M3
     /// nothing changes then), else `None`.
     pub(super) fn gcode_stepper_power_tick(&self) -> Option<embassy_time::Instant> {
-        let lit = self.actuator.uses_stepper() && self.gcode_gimbal_lit();
+        let lit = self.drivers().any(Driver::polls_speed) && self.gcode_gimbal_lit();
         (lit && self.gcode.motion.stepper_moving())
             .then(|| self.inputs.now + embassy_time::Duration::from_millis(STREAM_PERIOD_MS))
     }
@@ -107,7 +108,7 @@ impl Core {
     /// elsewhere the level the laser output runs at now (0 when dark).
     pub(super) fn gcode_reported_power(&self) -> f64 {
         let v = &self.gcode.values;
-        let fraction = if self.actuator.uses_galvo() {
+        let fraction = if self.drivers().any(Driver::reports_programmed_power) {
             self.gcode_running_laser()
                 .map_or(0.0, |l| l.fraction(v.s_min, v.s_max))
         } else if self.laser_on && self.gcode_gimbal_lit() {

@@ -68,10 +68,8 @@ impl Core {
         };
         let (mut feed, _) = motion.feed_and_power(&g.overrides);
         let power = self.gcode_reported_power();
-        if self.actuator.uses_galvo() {
-            // The galvo marks at most at its marking speed.
-            feed = feed.min(self.settings.galvo.mark_speed_mm_s * 60.0);
-        }
+        // A driver may mark at most at its marking speed.
+        feed = feed.min(self.drivers().feed_cap_mm_min(&self.settings));
         let mask = g.values.report_mask;
         let free_blocks = (PLANNER_BLOCKS - motion.queue.len()) as u16;
         let status = Status {

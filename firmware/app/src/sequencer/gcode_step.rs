@@ -7,6 +7,7 @@ use embassy_time::{Duration, Instant};
 
 use super::gcode_motion::{CORNER_DEADBAND_TENTHS, CORNER_SETTLE_MS, Hold, cm, point_at};
 use super::laser::LaserEvent;
+use super::drivers::{Arrival, DriverStep};
 use super::machine::{Action, ActionSink, Core};
 use crate::domain::Target;
 use crate::grbl::{Block, PointMm};
@@ -19,7 +20,7 @@ impl Core {
             // The gimbal follows its planned profile.
             return self.stream_tick(out);
         }
-        if self.actuator.uses_stepper() {
+        if self.drivers().hands_over_blocks() {
             return self.gcode_stepper_send(out);
         }
         let motion = &self.gcode.motion;
@@ -39,25 +40,30 @@ impl Core {
         };
         let lit = lit && motion.hold == Hold::None;
         let from = motion.position;
+        let step = DriverStep {
+            from,
+            to,
+            feed,
+            lit,
+            // The last step of a block ends at a corner: it must arrive
+            // within the driver's resolution, or the next block's first
+            // step would cut the corner by up to the arrival deadband.
+            corner: current.index >= current.count,
+        };
         let mut servo_seq = None;
         let mut galvo_seq = None;
-        if self.actuator.uses_gimbal() {
-            // The last step of a block ends at a corner: it must arrive
-            // within the servo resolution, or the next block's first step
-            // would cut the corner by up to the arrival deadband.
-            let corner = current.index >= current.count;
-            servo_seq = self.gcode_servo_move(from, to, feed, corner, out);
-            if servo_seq.is_none() {
-                return;
-            }
-            // Dark until the gimbal has arrived once since the start.
-            self.gcode.motion.gimbal_lit = lit && self.gcode.motion.arrived;
-        }
-        if self.actuator.uses_galvo() {
-            let Some(seq) = self.gcode_galvo_send(from, to, feed, lit, out) else {
+        for driver in self.drivers().iter() {
+            let Some(seq) = self.driver_step(driver, step, out) else {
                 return;
             };
-            galvo_seq = Some(seq);
+            match driver.arrival() {
+                Arrival::Move => servo_seq = Some(seq),
+                Arrival::Job => galvo_seq = Some(seq),
+            }
+            if driver.carries_laser_pin() {
+                // Dark until it has arrived once since the start.
+                self.gcode.motion.gimbal_lit = lit && self.gcode.motion.arrived;
+            }
         }
         if let Some(c) = self.gcode.motion.current.as_mut() {
             c.from = from;
@@ -79,7 +85,7 @@ impl Core {
 
     /// A servo move to `to` at `feed` mm/min (rapid: servo speed);
     /// returns its request number.
-    fn gcode_servo_move(
+    pub(super) fn gcode_servo_move(
         &mut self,
         from: PointMm,
         to: PointMm,

@@ -130,8 +130,9 @@ impl Core {
     #[inline(never)]
     pub(super) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
         let percent = self.gcode.overrides.feed;
+        let stepping = self.drivers().hands_over_blocks();
         let job = &mut self.gcode.motion.stepper;
-        if self.actuator.uses_stepper() && job.feed_percent != Some(percent) {
+        if stepping && job.feed_percent != Some(percent) {
             job.feed_percent = Some(percent);
             out.act(Action::Stepper(StepperRequest::FeedOverride { percent }));
         }
@@ -282,8 +283,9 @@ impl Core {
     /// `false` when nothing moves there.
     #[inline(never)]
     pub(super) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
+        let stepping = self.drivers().hands_over_blocks();
         let motion = &mut self.gcode.motion;
-        if !self.actuator.uses_stepper() || motion.stepper.inflight.is_none() {
+        if !stepping || motion.stepper.inflight.is_none() {
             return false;
         }
         motion.gimbal_lit = false;

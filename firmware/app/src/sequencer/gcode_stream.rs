@@ -83,7 +83,7 @@ impl Core {
     /// gimbal alone).
     #[inline(never)]
     pub(super) fn gcode_streams(&self) -> bool {
-        self.actuator.uses_gimbal() && !self.actuator.uses_galvo()
+        self.drivers().gimbal_streams()
     }
 
     /// Starts following `block` (already popped from the motion queue):

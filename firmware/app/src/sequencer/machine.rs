@@ -22,6 +22,7 @@ use embassy_time::Instant;
 
 use super::faults::ServoFaults;
 use super::laser::laser_wanted;
+use super::drivers::Driver;
 use super::run::Run;
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::log;
@@ -240,9 +241,10 @@ impl Core {
         // (a galvo underrun) until the run is stopped or restarted.
         // The stepper pan/tilt carries the gimbal's laser; no servo
         // blocks it.
-        let servo_blocked =
-            !self.actuator.uses_stepper() && self.faults.gimbal_laser_blocked(yaw, pitch, phase);
-        let wanted = (self.actuator.uses_gimbal() || self.actuator.uses_stepper())
+        let drivers = self.drivers();
+        let servo_blocked = drivers.any(Driver::needs_servos)
+            && self.faults.gimbal_laser_blocked(yaw, pitch, phase);
+        let wanted = drivers.any(Driver::carries_laser_pin)
             && (laser_wanted(self.settings.laser_mode, phase, servo_blocked)
                 || self.gcode_gimbal_lit())
             && !self.gate_lost;

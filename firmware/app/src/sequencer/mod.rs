@@ -12,6 +12,7 @@
 //! view on the [`StatusBoard`].
 
 mod commands;
+mod drivers;
 mod faults;
 mod galvo;
 mod gcode;

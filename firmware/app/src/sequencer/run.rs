@@ -4,6 +4,7 @@
 use embassy_time::{Duration, Instant};
 
 use super::faults;
+use super::drivers::{Arrival, PathRun};
 use super::laser::LaserEvent;
 use super::machine::{Action, ActionSink, Core};
 use crate::domain::{Aim, AimModel, GridPattern, PathCursor, Pattern, Target};
@@ -175,18 +176,19 @@ impl Core {
         }
         // The stepper traces paths exactly; with `model seed` it keeps the
         // seed's point-by-point method (for comparison), as the gimbal.
-        if self.actuator.uses_stepper() && self.model == AimModel::Exact {
-            return Self::traced(pattern, once);
+        match self.drivers().path_run(self.model == AimModel::Exact) {
+            PathRun::Traced => Self::traced(pattern, once),
+            PathRun::Marked => Some(RunKind::Marked { pattern, once }),
+            PathRun::Refused => None,
+            PathRun::Points => {
+                let cursor = self.path_cursor(&pattern)?;
+                Some(RunKind::Path {
+                    pattern,
+                    once,
+                    cursor,
+                })
+            }
         }
-        if self.actuator.uses_galvo() {
-            return (!self.actuator.uses_gimbal()).then_some(RunKind::Marked { pattern, once });
-        }
-        let cursor = self.path_cursor(&pattern)?;
-        Some(RunKind::Path {
-            pattern,
-            once,
-            cursor,
-        })
     }
 
     /// The cursor at the first point of a pass of `pattern` (`None` when
@@ -240,14 +242,15 @@ impl Core {
         let holds = matches!(run.kind, RunKind::Goto(_));
         let closed = run.pass > 0 && self.last_aim.is_some_and(|(t, _)| t.point == target.point);
         let approach = holds || (run.index == 0 && !closed);
-        let (gimbal, galvo) = (self.actuator.uses_gimbal(), self.actuator.uses_galvo());
-        let stepper = self.actuator.uses_stepper();
-        let gimbal_started = !gimbal || self.begin_gimbal_move(target, out);
-        let stepper_started =
-            gimbal_started && (!stepper || self.begin_stepper_move(target, approach, out));
-        let galvo_started = stepper_started && (!galvo || self.begin_galvo_point(target, out));
-        if !(gimbal_started && stepper_started && galvo_started) {
-            return;
+        let (mut moves, mut jobs) = (false, false);
+        for driver in self.drivers().iter() {
+            if !self.driver_aim(driver, target, approach, out) {
+                return;
+            }
+            match driver.arrival() {
+                Arrival::Move => moves = true,
+                Arrival::Job => jobs = true,
+            }
         }
         if let Some(run) = self.run.as_mut() {
             run.phase = if approach {
@@ -256,17 +259,17 @@ impl Core {
                 Phase::Moving
             };
             run.dwell_until = None;
-            run.gimbal_busy = gimbal || stepper;
+            run.gimbal_busy = moves;
             // A goto's galvo holds the point, laser on, until the next
             // command: nothing to wait for.
-            run.galvo_busy = galvo && !holds;
+            run.galvo_busy = jobs && !holds;
         }
         self.point_finished_if_done(out);
     }
 
     /// Aims the gimbal at `target` and sends the servo move; on an
     /// unreachable target stops with an error notice.
-    fn begin_gimbal_move(&mut self, target: Target, out: &mut dyn ActionSink) -> bool {
+    pub(super) fn begin_gimbal_move(&mut self, target: Target, out: &mut dyn ActionSink) -> bool {
         let aim = match self.aimer.aim(target.point) {
             Ok(aim) => aim,
             Err(e) => {

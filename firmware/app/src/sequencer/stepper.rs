@@ -12,6 +12,7 @@ use kinematics_core::gimbal::{Gimbal, GimbalModel};
 
 use super::machine::{Action, ActionSink, Core};
 use super::run::RunKind;
+use super::drivers::Driver;
 use crate::domain::{Aim, Pattern, PointCm, Segment, Target, Unit};
 use crate::log;
 use crate::stepper::{HomingFailure, MoveShape, StepperConfig, StepperEvent, StepperRequest};
@@ -56,7 +57,7 @@ impl Core {
 
     /// Decelerates the stepper to rest (when it draws).
     pub(super) fn stop_stepper(&self, out: &mut dyn ActionSink) {
-        if self.actuator.uses_stepper() {
+        if self.drivers().hands_over_blocks() {
             out.act(Action::Stepper(StepperRequest::Stop));
         }
     }
@@ -239,7 +240,7 @@ impl Core {
     /// Errors: not the stepper, or no switches (nothing changes; the
     /// power-up position stays step 0).
     pub(super) fn start_homing(&mut self, out: &mut dyn ActionSink) -> Result<(), &'static str> {
-        if !self.actuator.uses_stepper() {
+        if !self.drivers().any(Driver::homes_with_switches) {
             return Err("home: only with target stepper");
         }
         let s = &self.settings.stepper;

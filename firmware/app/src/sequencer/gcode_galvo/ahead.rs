@@ -43,7 +43,7 @@ impl Core {
         let in_flight = motion
             .current
             .is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == self.gcode.galvo.seq);
-        if !in_flight || motion.hold != Hold::None || self.actuator.uses_gimbal() {
+        if !in_flight || motion.hold != Hold::None || self.drivers().lockstep() {
             return;
         }
         loop {

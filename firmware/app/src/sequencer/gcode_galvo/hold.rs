@@ -18,9 +18,10 @@ impl Core {
     /// it does.
     pub(in crate::sequencer) fn gcode_galvo_hold(&mut self) -> bool {
         let c = self.gcode.motion.current;
+        let lockstep = self.drivers().lockstep();
         let record = &mut self.gcode.galvo;
         // (Still waiting after a `!`, `~` before the report, `!`.)
-        record.stopping |= !self.actuator.uses_gimbal()
+        record.stopping |= !lockstep
             && c.is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == record.seq);
         record.stopping
     }
