@@ -1,26 +1,16 @@
 //! Command handling: each command gets exactly one closing reply, and
 //! changes state only when it is accepted.
 
-use super::machine::{Action, ActionSink, AfterCheck, Core, Pending, Readings};
-use super::run::{RunKind, Start};
-use super::drivers::Drivers;
 use crate::command::Command;
-use crate::domain::{
-    AimModel, Pattern, PatternCheck, PatternError, Target, check_target,
-};
+use crate::domain::{AimModel, Pattern, PatternCheck, PatternError, Target, check_target};
 use crate::galvo::GalvoError;
+use crate::sequencer::drivers::{Drivers, NO_GALVO};
+use crate::sequencer::machine::{
+    Action, ActionSink, AfterCheck, CHECKS_PER_STEP, Core, Pending, Readings,
+};
+use crate::sequencer::run::{RunKind, Start};
 use crate::settings::JumpPlanner;
 use crate::settings::{PARAMS, ParamLine, ParamSpec};
-
-/// Points a pattern check aims at per executor step. One gimbal IK point
-/// is ~170 µs of soft-float on the target; with the first point of the
-/// run aimed in the last step, a step aims at no more than four (~0.7 ms).
-pub(super) const CHECKS_PER_STEP: usize = 3;
-
-/// The reply to galvo commands when no galvo loop serves the link.
-pub(super) const NO_GALVO: &str = "this build has no galvo output";
-/// The reply to `target stepper` when no stepper task serves the link.
-pub(super) const NO_STEPPER: &str = "this build has no stepper output";
 
 impl Core {
     /// Runs `command` (`readings`: what the shell read from the links).

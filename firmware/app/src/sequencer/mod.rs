@@ -14,26 +14,17 @@
 mod commands;
 mod drivers;
 mod faults;
-mod galvo;
 mod gcode;
-mod gcode_galvo;
-mod gcode_motion;
-mod gcode_power;
-mod gcode_report;
-mod gcode_settings;
-mod gcode_step;
-mod gcode_stepper;
-mod gcode_stream;
+mod io;
 mod laser;
 mod machine;
 mod report;
 mod run;
-mod stepper;
 
 use embassy_futures::select::{Either, Either4, select, select4};
 use embassy_time::{Duration, Instant, Timer};
 
-pub use self::galvo::config_from;
+pub use self::drivers::galvo::config_from;
 pub use self::laser::{LaserEvent, LaserPower, LaserSwitch, laser_wanted};
 pub use self::machine::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::CommandLink;

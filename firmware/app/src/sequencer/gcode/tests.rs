@@ -3,17 +3,15 @@
 
 extern crate std;
 
-use std::string::String;
-use std::vec::Vec;
-
-use embassy_time::Instant;
-
-use super::super::gcode_motion::PLANNER_BLOCKS;
-use super::super::machine::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::{Command, GrblLine, RealtimeRequest};
 use crate::galvo::ScanPhase;
 use crate::grbl::realtime::{OverrideStep, Realtime};
+use crate::sequencer::gcode::queue::PLANNER_BLOCKS;
+use crate::sequencer::machine::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::servo::task::{ServoOutcome, ServoRequest};
+use embassy_time::Instant;
+use std::string::String;
+use std::vec::Vec;
 
 const READINGS: Readings = Readings {
     galvo: GalvoReadout {

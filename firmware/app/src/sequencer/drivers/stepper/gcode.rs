@@ -1,82 +1,21 @@
-//! G-code on the stepper pan/tilt (`target stepper`): each block goes to
-//! the stepper task as a move along its board line or arc (G0 as joint
-//! travel), cut there within the stepper's line tolerance and planned by
-//! its look-ahead planner. A block is handed on as soon as the stepper
-//! has taken the one before ([`StepperEvent::Taken`]), so the planner
-//! joins them at speed; the block before a change of the laser (dark ↔
-//! lit, or of its M3/M4 and S), a dwell, a pause or the end waits for
-//! rest, so the laser switches where the spot is (the stepper runs
-//! several blocks ahead of the one the sequencer hands over). A feed hold decelerates along the path at the
-//! limit (laser dark at once); `~` goes on from the point it stopped at:
-//! the rest of the block it stopped in, then the queue.
+//! The stepper driver's G-code stage: blocks handed over whole to its task.
 
-use kinematics_core::Rotation;
-use kinematics_core::frames::BoardPoint;
-
-use super::gcode::GrblMode;
-use super::gcode_motion::{Hold, cm};
-use super::gcode_stream::planned_length;
-use super::machine::{Action, ActionSink, Core};
 use crate::domain::PointCm;
-use crate::grbl::{Alarm, GrblError, Laser};
-use crate::grbl::{Block, PointMm};
+use crate::grbl::Laser;
+use crate::grbl::{Alarm, Block, GrblError, PointMm};
+use crate::sequencer::gcode::GrblMode;
+use crate::sequencer::gcode::queue::cm;
+use crate::sequencer::gcode::queue::{Hold, planned_length};
+use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
 use crate::text::reply_text;
-
-/// What the stepper has of the G-code job.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct StepperJob {
-    /// The last move handed over and not yet at rest.
-    inflight: Option<u32>,
-    /// The laser of the blocks handed over: lit, and with what setting.
-    lit: bool,
-    laser: Laser,
-    /// The current block waits for rest before it is handed over.
-    waiting: bool,
-    /// A hold came to rest: `~` asks the stepper to go on with its moves.
-    held: bool,
-    /// The feed override the stepper task has, % (`None`: not sent since
-    /// the last stop).
-    feed_percent: Option<u8>,
-    /// The step generator's speed over the running block's cruise speed,
-    /// ‰ (the shell notes it before each event).
-    pub(super) speed_permille: u16,
-}
-
-/// The laser setting of a feed block (default for others).
-fn block_laser(block: &Block) -> Laser {
-    match *block {
-        Block::Line { laser, .. } | Block::Arc { laser, .. } => laser,
-        _ => Laser::default(),
-    }
-}
-
-/// The stepper move of a motion block: end point (cm) and shape.
-fn stepper_move(block: &Block) -> Option<(BoardPoint, MoveShape)> {
-    let board = |p: PointMm| {
-        let p = cm(p);
-        BoardPoint::new(p.x_cm, p.y_cm)
-    };
-    Some(match *block {
-        Block::Rapid { to, .. } => (board(to), MoveShape::Travel),
-        Block::Line { to, .. } | Block::Jog { to, .. } => (board(to), MoveShape::Line),
-        Block::Arc { arc, .. } => {
-            let rotation = if arc.sweep_rad < 0.0 {
-                Rotation::Cw
-            } else {
-                Rotation::Ccw
-            };
-            let centre = board(arc.centre);
-            (board(arc.to), MoveShape::Arc { centre, rotation })
-        }
-        _ => return None,
-    })
-}
+use kinematics_core::Rotation;
+use kinematics_core::frames::BoardPoint;
 
 impl Core {
     /// Hands the current block to the stepper (or waits for rest first).
     #[inline(never)]
-    pub(super) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
         let Some(current) = self.gcode.motion.current else {
             return;
         };
@@ -128,7 +67,7 @@ impl Core {
     /// Tells the stepper task the feed override when it changed (it
     /// applies it on the fly, to the move being cut too).
     #[inline(never)]
-    pub(super) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
         let percent = self.gcode.overrides.feed;
         let stepping = self.drivers().hands_over_blocks();
         let job = &mut self.gcode.motion.stepper;
@@ -177,7 +116,7 @@ impl Core {
 
     /// The G-code side of a stepper report: `true` when it was the job's.
     #[inline(never)]
-    pub(super) fn gcode_stepper_event(
+    pub(in crate::sequencer) fn gcode_stepper_event(
         &mut self,
         event: &StepperEvent,
         out: &mut dyn ActionSink,
@@ -237,7 +176,7 @@ impl Core {
     /// MPos where homing left the spot, at `steps`) or, as grbl, `ALARM:N`
     /// (locked) and then `ok`; parameters that allow no homing: `error:5`.
     #[inline(never)]
-    pub(super) fn gcode_homing_done(
+    pub(in crate::sequencer) fn gcode_homing_done(
         &mut self,
         homed: Result<[i32; 2], HomingFailure>,
         out: &mut dyn ActionSink,
@@ -282,7 +221,7 @@ impl Core {
     /// `!` on the stepper: decelerate along the path, dark at once.
     /// `false` when nothing moves there.
     #[inline(never)]
-    pub(super) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
+    pub(in crate::sequencer) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
         let stepping = self.drivers().hands_over_blocks();
         let motion = &mut self.gcode.motion;
         if !stepping || motion.stepper.inflight.is_none() {
@@ -296,7 +235,7 @@ impl Core {
 
     /// Whether the stepper reaches board point `p` within its soft limits.
     #[inline(never)]
-    pub(super) fn stepper_reaches(&self, p: PointCm) -> bool {
+    pub(in crate::sequencer) fn stepper_reaches(&self, p: PointCm) -> bool {
         let config = self.stepper_config();
         config
             .gimbal
@@ -305,17 +244,39 @@ impl Core {
     }
 }
 
-impl super::gcode_motion::Motion {
+impl crate::sequencer::gcode::queue::Motion {
     /// Whether the stepper runs a move of the job.
-    pub(super) fn stepper_moving(&self) -> bool {
+    pub(in crate::sequencer) fn stepper_moving(&self) -> bool {
         self.stepper.inflight.is_some()
     }
 }
 
-impl StepperJob {
-    /// Forgets the job (a stop, a reset).
-    #[inline(never)]
-    pub(super) fn clear(&mut self) {
-        *self = Self::default();
+/// The laser setting of a feed block (default for others).
+fn block_laser(block: &Block) -> Laser {
+    match *block {
+        Block::Line { laser, .. } | Block::Arc { laser, .. } => laser,
+        _ => Laser::default(),
     }
+}
+
+/// The stepper move of a motion block: end point (cm) and shape.
+fn stepper_move(block: &Block) -> Option<(BoardPoint, MoveShape)> {
+    let board = |p: PointMm| {
+        let p = cm(p);
+        BoardPoint::new(p.x_cm, p.y_cm)
+    };
+    Some(match *block {
+        Block::Rapid { to, .. } => (board(to), MoveShape::Travel),
+        Block::Line { to, .. } | Block::Jog { to, .. } => (board(to), MoveShape::Line),
+        Block::Arc { arc, .. } => {
+            let rotation = if arc.sweep_rad < 0.0 {
+                Rotation::Cw
+            } else {
+                Rotation::Ccw
+            };
+            let centre = board(arc.centre);
+            (board(arc.to), MoveShape::Arc { centre, rotation })
+        }
+        _ => return None,
+    })
 }

@@ -2,25 +2,29 @@
 //! [`super`]): sending them as far as lit blocks are queued, and the
 //! next one taking over when the piece in flight is done.
 
-use super::super::gcode_motion::Hold;
-use super::super::machine::{ActionSink, Core};
-use super::{AHEAD, AHEAD_LINES, Cover, Cursor};
 use crate::grbl::PointMm;
+use crate::sequencer::drivers::galvo::{AHEAD, AHEAD_LINES, Cover, Cursor};
+use crate::sequencer::gcode::queue::Hold;
+use crate::sequencer::machine::{ActionSink, Core};
 
 /// A piece sent ahead of the one in flight.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Ahead {
-    pub(super) seq: u32,
+pub(in crate::sequencer) struct Ahead {
+    pub(in crate::sequencer) seq: u32,
     pub(super) start: Cursor,
     pub(super) cover: Cover,
-    pub(super) lines: u8,
+    pub(in crate::sequencer) lines: u8,
 }
 
 impl Core {
     /// The piece `next`, sent ahead, becomes the one in flight: it starts
     /// at the block in flight now. Its number, or `None` when it does not
     /// start here.
-    pub(super) fn gcode_galvo_adopt(&mut self, from: PointMm, next: Ahead) -> Option<u32> {
+    pub(in crate::sequencer) fn gcode_galvo_adopt(
+        &mut self,
+        from: PointMm,
+        next: Ahead,
+    ) -> Option<u32> {
         let start = Cursor { pos: 0, index: 0 };
         let piece = self.gcode_galvo_piece(from, start, usize::from(next.lines), true)?;
         if piece.stroke.segments() != usize::from(next.lines) || piece.cover != next.cover {

@@ -1,18 +1,22 @@
 //! What the grbl session reports: status reports (`?`), `$$`, `$#`,
 //! `$G`, `$I`, `$N` and `$` help, formatted by [`crate::grbl::report`].
 
-use super::gcode::{GrblMode, RX_BUFFER_BYTES};
-use super::gcode_motion::{Hold, PLANNER_BLOCKS};
-use super::machine::{ActionSink, Core};
 use crate::grbl::ParserState;
 use crate::grbl::report::{self, MachineState, Status};
 use crate::grbl::system::SystemCommand;
+use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
+use crate::sequencer::gcode::{GrblMode, RX_BUFFER_BYTES};
+use crate::sequencer::machine::{ActionSink, Core};
 use crate::text::reply_text;
 
 impl Core {
     /// The `$` commands that only report (`$`, `$$`, `$#`, `$G`, `$I`,
     /// `$N`): their data lines.
-    pub(super) fn grbl_info(&mut self, command: SystemCommand<'_>, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn grbl_info(
+        &mut self,
+        command: SystemCommand<'_>,
+        out: &mut dyn ActionSink,
+    ) {
         match command {
             SystemCommand::Help => {
                 self.grbl_data(out, reply_text(format_args!("{}", report::HELP)))
@@ -50,7 +54,11 @@ impl Core {
     }
 
     /// `?`: one status report, whatever the state.
-    pub(super) fn grbl_status(&mut self, rx_free_bytes: u16, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn grbl_status(
+        &mut self,
+        rx_free_bytes: u16,
+        out: &mut dyn ActionSink,
+    ) {
         let g = &self.gcode;
         let motion = &g.motion;
         let state = match (g.mode, motion.hold) {

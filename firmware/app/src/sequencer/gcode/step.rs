@@ -3,19 +3,20 @@
 //! actuator: add one here), and reports it done (servo arrival, galvo
 //! job done, dwell end); then the next step, block or hold follows.
 
-use embassy_time::{Duration, Instant};
-
-use super::gcode_motion::{CORNER_DEADBAND_TENTHS, CORNER_SETTLE_MS, Hold, cm, point_at};
-use super::laser::LaserEvent;
-use super::drivers::{Arrival, DriverStep};
-use super::machine::{Action, ActionSink, Core};
 use crate::domain::Target;
 use crate::grbl::{Block, PointMm};
+use crate::sequencer::drivers::{Arrival, DriverStep};
+use crate::sequencer::gcode::queue::{
+    CORNER_DEADBAND_TENTHS, CORNER_SETTLE_MS, Hold, cm, point_at,
+};
+use crate::sequencer::laser::LaserEvent;
+use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::servo::task::ServoOutcome;
+use embassy_time::{Duration, Instant};
 
 impl Core {
     /// Sends the current step to every actuator that draws.
-    pub(super) fn gcode_send_step(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn gcode_send_step(&mut self, out: &mut dyn ActionSink) {
         if self.gcode.motion.stream.is_following() {
             // The gimbal follows its planned profile.
             return self.stream_tick(out);
@@ -78,14 +79,14 @@ impl Core {
     /// The galvo's marking feed for programmed feed `feed_mm_min`: the feed
     /// override applied, capped by the galvo's marking speed
     /// (`galvo.mark_speed_mm_s`), mm/min.
-    pub(super) fn gcode_galvo_feed_mm_min(&self, feed_mm_min: f64) -> f64 {
+    pub(in crate::sequencer) fn gcode_galvo_feed_mm_min(&self, feed_mm_min: f64) -> f64 {
         let feed = self.gcode.overrides.feed_mm_min(feed_mm_min);
         feed.min(self.settings.galvo.mark_speed_mm_s * 60.0)
     }
 
     /// A servo move to `to` at `feed` mm/min (rapid: servo speed);
     /// returns its request number.
-    pub(super) fn gcode_servo_move(
+    pub(in crate::sequencer) fn gcode_servo_move(
         &mut self,
         from: PointMm,
         to: PointMm,
@@ -104,7 +105,8 @@ impl Core {
             60_000.0 * from.distance_to(to) / f.max(1e-3)
         });
         let interval_ms = libm::fmax(f64::from(by_servo), by_feed).min(f64::from(u16::MAX)) as u16;
-        self.gcode.step_speed_ratio = super::gcode_power::speed_ratio(by_feed, interval_ms);
+        self.gcode.step_speed_ratio =
+            crate::sequencer::gcode::power::speed_ratio(by_feed, interval_ms);
         let deadband_tenths = if corner {
             CORNER_DEADBAND_TENTHS
         } else {
@@ -144,7 +146,11 @@ impl Core {
 
     /// The galvo loop finished job `seq`; `true` when it was the G-code
     /// step's.
-    pub(super) fn gcode_galvo_done(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
+    pub(in crate::sequencer) fn gcode_galvo_done(
+        &mut self,
+        seq: u32,
+        out: &mut dyn ActionSink,
+    ) -> bool {
         let Some(c) = self.gcode.motion.current.as_mut() else {
             return false;
         };
@@ -182,7 +188,10 @@ impl Core {
 
     /// `run_deadline` (a run's dwell), or when the G-code dwell or settle
     /// ends.
-    pub(super) fn gcode_deadline_or(&self, run_deadline: Option<Instant>) -> Option<Instant> {
+    pub(in crate::sequencer) fn gcode_deadline_or(
+        &self,
+        run_deadline: Option<Instant>,
+    ) -> Option<Instant> {
         run_deadline
             .or(self.gcode.motion.current.and_then(|c| c.until))
             .or_else(|| self.gcode_stepper_power_tick())
@@ -191,19 +200,19 @@ impl Core {
     /// Whether G-code lights the gimbal laser now: a lit step or dwell
     /// runs, and the laser mode (`laser auto`) still allows it (`laser off`
     /// mid-step darkens at once).
-    pub(super) fn gcode_gimbal_lit(&self) -> bool {
+    pub(in crate::sequencer) fn gcode_gimbal_lit(&self) -> bool {
         self.gcode.motion.gimbal_lit && self.settings.laser_mode == crate::settings::LaserMode::Auto
     }
 
     /// The dwell deadline passed: a run's dwell, or the G-code step's.
-    pub(super) fn dwell_ended(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn dwell_ended(&mut self, out: &mut dyn ActionSink) {
         self.dwell_finished(out);
         self.gcode_dwell_check(out);
     }
 
     /// Every actuator finished the step in flight: the next step, the next
     /// block, or the hold.
-    pub(super) fn gcode_step_done(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn gcode_step_done(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         let Some(mut c) = motion.current else { return };
         let stepper = c.stepper_seq.is_some();
@@ -236,7 +245,7 @@ impl Core {
     /// The G-code side of a servo report: an arrival of the step in flight
     /// moves on; `true` for a fault of it (the caller stops, after its own
     /// fault handling).
-    pub(super) fn gcode_servo_outcome(
+    pub(in crate::sequencer) fn gcode_servo_outcome(
         &mut self,
         outcome: &ServoOutcome,
         out: &mut dyn ActionSink,
@@ -260,7 +269,7 @@ impl Core {
     }
 
     /// Whether the G-code step waits for galvo job `seq`.
-    pub(super) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
+    pub(in crate::sequencer) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
         self.gcode
             .motion
             .current

@@ -3,11 +3,11 @@
 //! chords) marked by then are finished, the block in progress is left at
 //! the stop point, so `~` marks only what is left of the contour.
 
-use super::super::gcode_motion::{Hold, point_at};
-use super::super::machine::{ActionSink, Core};
-use super::Cursor;
 use crate::galvo::MarkStop;
 use crate::grbl::PointMm;
+use crate::sequencer::drivers::galvo::Cursor;
+use crate::sequencer::gcode::queue::{Hold, point_at};
+use crate::sequencer::machine::{ActionSink, Core};
 
 /// A stop closer than this to the end of its step (mm) ends the step.
 const AT_END_MM: f64 = 1e-3;
@@ -21,8 +21,8 @@ impl Core {
         let lockstep = self.drivers().lockstep();
         let record = &mut self.gcode.galvo;
         // (Still waiting after a `!`, `~` before the report, `!`.)
-        record.stopping |= !lockstep
-            && c.is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == record.seq);
+        record.stopping |=
+            !lockstep && c.is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == record.seq);
         record.stopping
     }
 
