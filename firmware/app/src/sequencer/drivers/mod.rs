@@ -10,10 +10,10 @@
 //! laser it carries and how that follows its speed, and how fast it may
 //! mark. Enum dispatch: a [`Driver`] is one byte, each question one
 //! `match`, nothing allocated. What a driver does itself lives in its
-//! files (gimbal: `run.rs` point moves, `gcode_step.rs`/`gcode_stream`;
-//! galvo: `galvo.rs`, `gcode_galvo`; stepper: `stepper.rs`,
-//! `gcode_stepper.rs`). A new actuator is a new variant here, its
-//! answers in these `match`es, its files, and its link in the shell.
+//! files (gimbal: `run/points.rs` point moves, `gcode/step.rs` steps,
+//! `gimbal/` its stream; galvo: `galvo/`; stepper: `stepper/`). A new
+//! actuator is a new variant here, its answers in these `match`es, its
+//! files, and its link in the shell (ARCHITECTURE.md, "Adding a driver").
 
 use crate::domain::Actuator;
 use crate::grbl::PointMm;
