@@ -4,6 +4,8 @@
 mod bench_m4;
 mod calib;
 mod fuzz;
+#[cfg(test)]
+mod import_cycles;
 mod json_out;
 mod kin;
 mod plan;
