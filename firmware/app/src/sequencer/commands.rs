@@ -9,8 +9,7 @@ use crate::sequencer::machine::{
     Action, ActionSink, AfterCheck, CHECKS_PER_STEP, Core, Pending, Readings,
 };
 use crate::sequencer::run::{RunKind, Start};
-use crate::settings::JumpPlanner;
-use crate::settings::{PARAMS, ParamLine, ParamSpec};
+use crate::settings::{JumpPlanner, PARAMS, ParamLine, ParamSpec};
 
 impl Core {
     /// Runs `command` (`readings`: what the shell read from the links).

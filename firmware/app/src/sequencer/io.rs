@@ -2,8 +2,6 @@
 //! [`Readings`]) and what comes out of it ([`Action`]s into an
 //! [`ActionSink`], console [`Line`]s).
 
-use embassy_time::Instant;
-
 use crate::command::Command;
 use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, RefillTime, ScanPhase};
 use crate::sequencer::laser::LaserEvent;
@@ -11,6 +9,7 @@ use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{LoadedRecord, RecordError};
 use crate::stepper::{StepperConfig, StepperEvent, StepperRequest};
 use crate::text::ReplyText;
+use embassy_time::Instant;
 
 /// Something that happened, for the core to act on.
 #[derive(Debug, Clone, Copy)]

@@ -18,19 +18,17 @@
 //! in between; should something else arrive, a pending check is finished
 //! at once first, so every command still gets exactly one reply.
 
-use embassy_time::Instant;
-
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::log;
 use crate::sequencer::drivers::Driver;
 use crate::sequencer::faults::ServoFaults;
+pub use crate::sequencer::io::{Action, ActionSink, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::sequencer::laser::laser_wanted;
 use crate::sequencer::run::Run;
 use crate::settings::{LoadedRecord, RecordError, Settings};
 use crate::status::{Activity, Snapshot};
 use crate::text::reply_text;
-
-pub use crate::sequencer::io::{Action, ActionSink, Event, GalvoReadout, Inputs, Line, Readings};
+use embassy_time::Instant;
 
 /// Points a pattern check aims at per executor step. One gimbal IK point
 /// is ~170 µs of soft-float on the target; with the first point of the

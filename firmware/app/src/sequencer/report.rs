@@ -2,8 +2,7 @@
 //! core's state (and, for `status`, what the shell read from the links).
 
 use crate::build_info;
-use crate::command::Command;
-use crate::command::HELP_LINES;
+use crate::command::{Command, HELP_LINES};
 use crate::domain::{AimModel, PointCm};
 use crate::sequencer::machine::{ActionSink, Core, Readings};
 use crate::status::{Activity, Phase, Snapshot};

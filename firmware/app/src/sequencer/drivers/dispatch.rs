@@ -1,10 +1,9 @@
 //! The driver interface's dispatch: each question to the driver(s) that draw.
 
 use crate::domain::{PointCm, Target};
-use crate::sequencer::drivers::Arrival;
-use crate::sequencer::drivers::Driver;
-use crate::sequencer::drivers::DriverStep;
-use crate::sequencer::drivers::Drivers;
+use crate::grbl::Block;
+use crate::sequencer::drivers::{Arrival, Driver, DriverStep, Drivers};
+use crate::sequencer::gcode::queue::planned_length;
 use crate::sequencer::machine::{ActionSink, Core};
 
 impl Core {
@@ -61,6 +60,40 @@ impl Core {
                 crate::stepper::StepperRequest::Halt,
             ));
         }
+    }
+
+    /// Offers `block`, just taken from the motion queue, to a driver that
+    /// plans whole blocks itself (the gimbal alone streams them through
+    /// its look-ahead plan); `true` when it took it (it is then the
+    /// current block).
+    pub(in crate::sequencer) fn drivers_take_block(
+        &mut self,
+        block: &Block,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        if !(self.gcode_streams() && planned_length(block).is_some()) {
+            return false;
+        }
+        self.gcode.motion.current = Some(self.new_current(*block, 1));
+        self.stream_begin(block, out)
+    }
+
+    /// Hands the current G-code step to a driver with a stage of its own
+    /// (the gimbal following its planned profile, the stepper taking
+    /// blocks whole); `false` when the drivers take it step by step
+    /// ([`Core::driver_step`]).
+    pub(in crate::sequencer) fn drivers_send_in_own_stage(
+        &mut self,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        if self.gcode.motion.stream.is_following() {
+            self.stream_tick(out);
+        } else if self.drivers().hands_over_blocks() {
+            self.gcode_stepper_send(out);
+        } else {
+            return false;
+        }
+        true
     }
 
     /// Sends the G-code step from `from` to `to` (`feed` mm/min, `None`:

@@ -3,14 +3,12 @@
 use crate::command::RealtimeRequest;
 use crate::grbl::classify::{LineKind, classify};
 use crate::grbl::realtime::Realtime;
-use crate::grbl::report::{self};
+use crate::grbl::report;
 use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError};
 use crate::sequencer::drivers::Driver;
-use crate::sequencer::gcode::GrblMode;
-use crate::sequencer::gcode::GrblValues;
-use crate::sequencer::gcode::NO_OVERRIDES;
 use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
+use crate::sequencer::gcode::{GrblMode, GrblValues, NO_OVERRIDES};
 use crate::sequencer::machine::{Action, ActionSink, Core, Line};
 use crate::settings::Settings;
 use crate::text::{ReplyText, reply_text};

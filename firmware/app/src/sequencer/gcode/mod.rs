@@ -6,7 +6,7 @@
 
 use crate::grbl::ParserState;
 use crate::grbl::report::Overrides;
-use crate::grbl::settings_map::{self};
+use crate::grbl::settings_map;
 use crate::sequencer::drivers::galvo::GalvoStroke;
 use crate::sequencer::gcode::queue::Motion;
 

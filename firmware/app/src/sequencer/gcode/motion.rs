@@ -2,13 +2,7 @@
 
 use crate::grbl::{Block, PointMm, SpindleMode};
 use crate::sequencer::drivers::Driver;
-use crate::sequencer::gcode::queue::Current;
-use crate::sequencer::gcode::queue::Hold;
-use crate::sequencer::gcode::queue::MAX_STEPS;
-use crate::sequencer::gcode::queue::block_end;
-use crate::sequencer::gcode::queue::cm;
-use crate::sequencer::gcode::queue::planned_length;
-use crate::sequencer::gcode::queue::point_at;
+use crate::sequencer::gcode::queue::{Current, Hold, MAX_STEPS, block_end, cm, point_at};
 use crate::sequencer::laser::LaserEvent;
 use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::settings::LaserMode;
@@ -96,11 +90,8 @@ impl Core {
                     }
                 }
                 _ => {
-                    if self.gcode_streams() && planned_length(&block).is_some() {
-                        self.gcode.motion.current = Some(self.new_current(block, 1));
-                        if self.stream_begin(&block, out) {
-                            continue;
-                        }
+                    if self.drivers_take_block(&block, out) {
+                        continue;
                     }
                     let count = self.step_count(&block);
                     self.gcode.motion.current = Some(self.new_current(block, count));

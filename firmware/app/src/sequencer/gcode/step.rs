@@ -17,12 +17,8 @@ use embassy_time::{Duration, Instant};
 impl Core {
     /// Sends the current step to every actuator that draws.
     pub(in crate::sequencer) fn gcode_send_step(&mut self, out: &mut dyn ActionSink) {
-        if self.gcode.motion.stream.is_following() {
-            // The gimbal follows its planned profile.
-            return self.stream_tick(out);
-        }
-        if self.drivers().hands_over_blocks() {
-            return self.gcode_stepper_send(out);
+        if self.drivers_send_in_own_stage(out) {
+            return;
         }
         let motion = &self.gcode.motion;
         let Some(current) = motion.current else {

@@ -5,11 +5,7 @@ use crate::domain::{Figure, StrokeCm};
 use crate::galvo::GalvoEvent;
 use crate::galvo::GalvoRequest;
 use crate::grbl::{Block, PointMm};
-use crate::sequencer::drivers::galvo::Cover;
-use crate::sequencer::drivers::galvo::Cursor;
-use crate::sequencer::drivers::galvo::GalvoStroke;
-use crate::sequencer::drivers::galvo::MAX_ARC_CHORDS;
-use crate::sequencer::drivers::galvo::Piece;
+use crate::sequencer::drivers::galvo::{Cover, Cursor, GalvoStroke, MAX_ARC_CHORDS, Piece};
 use crate::sequencer::gcode::queue::{block_point, cm, point_at};
 use crate::sequencer::machine::{ActionSink, Core};
 

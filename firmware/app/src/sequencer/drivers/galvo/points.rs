@@ -3,8 +3,7 @@
 use crate::domain::{Pattern, Target};
 use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoEvent, GalvoRequest};
 use crate::log;
-use crate::sequencer::drivers::galvo::HOLD_US;
-use crate::sequencer::drivers::galvo::config_from;
+use crate::sequencer::drivers::galvo::{HOLD_US, config_from};
 use crate::sequencer::machine::{Action, ActionSink, Core, GalvoReadout};
 use crate::sequencer::run::RunKind;
 use crate::settings::LaserMode;

@@ -2,10 +2,10 @@
 
 use crate::domain::Target;
 use crate::grbl::{Block, PointMm};
-use crate::sequencer::drivers::gimbal::MIN_TICK_MS;
-use crate::sequencer::drivers::gimbal::STREAM_PERIOD_MS;
-use crate::sequencer::gcode::queue::planned_length;
-use crate::sequencer::gcode::queue::{CORNER_DEADBAND_TENTHS, Hold, block_point, cm, point_at};
+use crate::sequencer::drivers::gimbal::{MIN_TICK_MS, STREAM_PERIOD_MS};
+use crate::sequencer::gcode::queue::{
+    CORNER_DEADBAND_TENTHS, Hold, block_point, cm, planned_length, point_at,
+};
 use crate::sequencer::machine::{ActionSink, Core};
 use embassy_time::Duration;
 use kinematics_core::lookahead::{LookaheadBlock, SpeedCursor};

@@ -1,11 +1,9 @@
 //! The stepper driver's G-code stage: blocks handed over whole to its task.
 
 use crate::domain::PointCm;
-use crate::grbl::Laser;
-use crate::grbl::{Alarm, Block, GrblError, PointMm};
+use crate::grbl::{Alarm, Block, GrblError, Laser, PointMm};
 use crate::sequencer::gcode::GrblMode;
-use crate::sequencer::gcode::queue::cm;
-use crate::sequencer::gcode::queue::{Hold, planned_length};
+use crate::sequencer::gcode::queue::{Hold, cm, planned_length};
 use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
 use crate::text::reply_text;
