@@ -99,6 +99,8 @@ pub struct Core {
     pub(super) inputs: Inputs,
     /// The grbl session: G-code parser, motion queue, grbl settings.
     pub(super) gcode: crate::sequencer::gcode::Gcode,
+    /// What each actuator driver keeps of the G-code job.
+    pub(super) jobs: crate::sequencer::drivers::DriverJobs,
 }
 
 impl Core {
@@ -128,6 +130,7 @@ impl Core {
                 stepper_attached: false,
             },
             gcode: crate::sequencer::gcode::Gcode::new(),
+            jobs: crate::sequencer::drivers::DriverJobs::new(),
         }
     }
 

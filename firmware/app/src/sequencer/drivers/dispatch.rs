@@ -86,7 +86,7 @@ impl Core {
         &mut self,
         out: &mut dyn ActionSink,
     ) -> bool {
-        if self.gcode.motion.stream.is_following() {
+        if self.jobs.gimbal.is_following() {
             self.stream_tick(out);
         } else if self.drivers().hands_over_blocks() {
             self.gcode_stepper_send(out);

@@ -189,6 +189,29 @@ impl Drivers {
     }
 }
 
+/// What each driver keeps of the G-code job: its own state, which only
+/// its files change.
+#[derive(Debug, Clone)]
+pub(in crate::sequencer) struct DriverJobs {
+    /// The gimbal's look-ahead plan and the block it follows.
+    pub(in crate::sequencer) gimbal: gimbal::Stream,
+    /// The galvo stroke in flight (several blocks joined).
+    pub(in crate::sequencer) galvo: galvo::GalvoStroke,
+    /// What the stepper has of the job.
+    pub(in crate::sequencer) stepper: stepper::StepperJob,
+}
+
+impl DriverJobs {
+    /// Nothing in flight (power-up).
+    pub(in crate::sequencer) fn new() -> Self {
+        Self {
+            gimbal: gimbal::Stream::new(),
+            galvo: galvo::GalvoStroke::default(),
+            stepper: stepper::StepperJob::default(),
+        }
+    }
+}
+
 /// One G-code step for a driver that takes blocks step by step.
 #[derive(Debug, Clone, Copy)]
 pub(in crate::sequencer) struct DriverStep {

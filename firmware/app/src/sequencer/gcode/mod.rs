@@ -7,7 +7,6 @@
 use crate::grbl::ParserState;
 use crate::grbl::report::Overrides;
 use crate::grbl::settings_map;
-use crate::sequencer::drivers::galvo::GalvoStroke;
 use crate::sequencer::gcode::queue::Motion;
 
 /// grbl's RX buffer as `$I` advertises it, bytes.
@@ -45,8 +44,6 @@ pub(in crate::sequencer) struct Gcode {
     pub(in crate::sequencer) motion: Motion,
     /// Status reports sent (grbl adds `WCO:` / `Ov:` every few).
     pub(in crate::sequencer) reports: u32,
-    /// The galvo stroke in flight (several blocks joined).
-    pub(in crate::sequencer) galvo: GalvoStroke,
     /// Actual over programmed speed of the gimbal step in flight, 0..=1
     /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
     pub(in crate::sequencer) step_speed_ratio: f32,
@@ -67,7 +64,6 @@ impl Gcode {
             overrides: NO_OVERRIDES,
             motion: Motion::new(),
             reports: 0,
-            galvo: GalvoStroke::default(),
             step_speed_ratio: 0.0,
             homing: false,
             stepper_junction_deg: None,

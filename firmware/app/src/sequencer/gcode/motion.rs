@@ -193,6 +193,8 @@ impl Core {
     /// A stop from anywhere (`stop`, the button, a fault, a reset, an
     /// alarm): the queue is dropped; a line waiting for room is answered.
     pub(in crate::sequencer) fn gcode_abort(&mut self, out: &mut dyn ActionSink) {
+        self.jobs.gimbal.clear();
+        self.jobs.stepper.clear();
         if self.gcode.motion.clear() {
             self.ok(out);
         }

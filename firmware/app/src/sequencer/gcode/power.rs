@@ -62,14 +62,14 @@ impl Core {
         if laser.mode == SpindleMode::Dynamic && v.laser_mode {
             let c = self.gcode.motion.current;
             // A streamed block moves while its cursor has speed.
-            let streaming = self.gcode.motion.stream.speed_mm_s() > 0.0;
+            let streaming = self.jobs.gimbal.speed_mm_s() > 0.0;
             let moving = streaming || c.is_some_and(|c| c.until.is_none() && c.servo_seq.is_some());
             // The stepper: its step generator's speed while its steps run.
             let stepping = self.drivers().any(Driver::polls_speed)
                 && c.is_some_and(|c| c.until.is_none())
-                && self.gcode.motion.stepper_moving();
+                && self.jobs.stepper.is_moving();
             fraction *= if stepping {
-                f32::from(self.gcode.motion.stepper.speed_permille) / 1000.0
+                f32::from(self.jobs.stepper.speed_permille) / 1000.0
             } else if moving {
                 self.gcode.step_speed_ratio
             } else {
@@ -82,7 +82,7 @@ impl Core {
     /// The stepper's speed over its block's cruise speed, ‰ (0..=1000,
     /// the step generator's; the shell, before each event).
     pub(in crate::sequencer) fn note_stepper_speed(&mut self, permille: u16) {
-        self.gcode.motion.stepper.speed_permille = permille;
+        self.jobs.stepper.speed_permille = permille;
     }
 
     /// While G-code lights the stepper's moves: the next time M4 power
@@ -90,7 +90,7 @@ impl Core {
     /// nothing changes then), else `None`.
     pub(in crate::sequencer) fn gcode_stepper_power_tick(&self) -> Option<embassy_time::Instant> {
         let lit = self.drivers().any(Driver::polls_speed) && self.gcode_gimbal_lit();
-        (lit && self.gcode.motion.stepper_moving())
+        (lit && self.jobs.stepper.is_moving())
             .then(|| self.inputs.now + embassy_time::Duration::from_millis(STREAM_PERIOD_MS))
     }
 

@@ -21,7 +21,6 @@ use crate::domain::PointCm;
 use crate::grbl::report::Overrides;
 use crate::grbl::{Block, Blocks, PointMm};
 use crate::sequencer::drivers::gimbal::Stream;
-use crate::sequencer::drivers::stepper::StepperJob;
 use embassy_time::Instant;
 use heapless::Deque;
 
@@ -89,10 +88,6 @@ pub(in crate::sequencer) struct Motion {
     pub(in crate::sequencer) arrived: bool,
     /// The gimbal laser should be lit.
     pub(in crate::sequencer) gimbal_lit: bool,
-    /// The gimbal's look-ahead plan and the block it follows.
-    pub(in crate::sequencer) stream: Stream,
-    /// What the stepper has of the job.
-    pub(in crate::sequencer) stepper: StepperJob,
 }
 
 impl Motion {
@@ -106,8 +101,6 @@ impl Motion {
             started: false,
             arrived: false,
             gimbal_lit: false,
-            stream: Stream::new(),
-            stepper: StepperJob::default(),
         }
     }
 
@@ -123,14 +116,19 @@ impl Motion {
     }
 
     /// Feed (mm/min) and laser power S of what runs, after overrides.
-    pub(in crate::sequencer) fn feed_and_power(&self, ov: &Overrides) -> (f64, f64) {
+    /// `stream`: the gimbal's.
+    pub(in crate::sequencer) fn feed_and_power(
+        &self,
+        ov: &Overrides,
+        stream: &Stream,
+    ) -> (f64, f64) {
         let Some(current) = self.current.filter(|_| self.hold == Hold::None) else {
             return (0.0, 0.0);
         };
         let scale = |v: f64, percent: u8| v * f64::from(percent) / 100.0;
         // The gimbal's speed on its planned profile, when it streams.
-        let feed = |f: f64| match self.stream.is_following() {
-            true => self.stream.speed_mm_s() * 60.0,
+        let feed = |f: f64| match stream.is_following() {
+            true => stream.speed_mm_s() * 60.0,
             false => scale(f, ov.feed),
         };
         match current.block {
@@ -153,8 +151,6 @@ impl Motion {
         self.started = false;
         self.arrived = false;
         self.gimbal_lit = false;
-        self.stream.clear();
-        self.stepper.clear();
         self.owed.take().is_some()
     }
 }

@@ -74,7 +74,7 @@ impl Core {
             _ if motion.is_idle() => MachineState::Idle,
             _ => MachineState::Run,
         };
-        let (mut feed, _) = motion.feed_and_power(&g.overrides);
+        let (mut feed, _) = motion.feed_and_power(&g.overrides, &self.jobs.gimbal);
         let power = self.gcode_reported_power();
         // A driver may mark at most at its marking speed.
         feed = feed.min(self.drivers().feed_cap_mm_min(&self.settings));

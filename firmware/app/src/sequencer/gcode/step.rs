@@ -168,7 +168,7 @@ impl Core {
         };
         if c.until.is_some_and(|until| until <= now) {
             c.until = None;
-            if self.gcode.motion.stream.is_following() {
+            if self.jobs.gimbal.is_following() {
                 // The streaming tick: the next point, or the next block.
                 c.servo_seq = None;
                 return if c.index > 0 {

@@ -316,7 +316,7 @@ fn follow(core: &mut Core, ms: u64) -> Vec<(f64, [f64; 2])> {
             break;
         }
         let p = core.gcode.motion.position;
-        trace.push((core.gcode.motion.stream.speed_mm_s(), [p.x_mm, p.y_mm]));
+        trace.push((core.jobs.gimbal.speed_mm_s(), [p.x_mm, p.y_mm]));
     }
     trace
 }

@@ -30,7 +30,7 @@ impl Core {
         if piece.stroke.segments() != usize::from(next.lines) || piece.cover != next.cover {
             return None;
         }
-        let record = &mut self.gcode.galvo;
+        let record = &mut self.jobs.galvo;
         record.seq = Some(next.seq);
         record.cover = piece.cover;
         for a in record.ahead.iter_mut().flatten() {
@@ -46,12 +46,12 @@ impl Core {
         let motion = &self.gcode.motion;
         let in_flight = motion
             .current
-            .is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == self.gcode.galvo.seq);
+            .is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == self.jobs.galvo.seq);
         if !in_flight || motion.hold != Hold::None || self.drivers().lockstep() {
             return;
         }
         loop {
-            let record = self.gcode.galvo;
+            let record = self.jobs.galvo;
             let sent = record.ahead.iter().flatten().count();
             // One request slot stays free (for the stroke after).
             let room = self.inputs.galvo_room.is_some_and(|room| room > 1);
@@ -79,7 +79,7 @@ impl Core {
             if !self.send_galvo(request, out) {
                 return;
             }
-            if let Some(slot) = self.gcode.galvo.ahead.get_mut(sent) {
+            if let Some(slot) = self.jobs.galvo.ahead.get_mut(sent) {
                 *slot = Some(ahead);
             }
         }
@@ -90,14 +90,14 @@ impl Core {
     /// brakes dark, rather than left to be marked behind the sequencer's
     /// back.
     pub(in crate::sequencer) fn gcode_galvo_drop_unadopted(&mut self, out: &mut dyn ActionSink) {
-        if self.gcode.galvo.adopt.take().is_some() {
+        if self.jobs.galvo.adopt.take().is_some() {
             self.stop_galvo(out);
         }
     }
 
     /// Whether `seq` is a piece sent ahead of the stroke in flight.
     pub(in crate::sequencer) fn gcode_galvo_ahead_is(&self, seq: u32) -> bool {
-        let g = &self.gcode.galvo;
+        let g = &self.jobs.galvo;
         g.ahead
             .iter()
             .chain([&g.adopt])

@@ -22,7 +22,7 @@ impl Core {
         out: &mut dyn ActionSink,
     ) -> Option<u32> {
         let strokes = lit && !self.drivers().lockstep();
-        if let Some(next) = self.gcode.galvo.adopt.take() {
+        if let Some(next) = self.jobs.galvo.adopt.take() {
             if strokes && let Some(seq) = self.gcode_galvo_adopt(from, next) {
                 return Some(seq);
             }
@@ -38,7 +38,7 @@ impl Core {
             .flatten();
         let request = match (piece, lit) {
             (Some(piece), _) => {
-                self.gcode.galvo = GalvoStroke {
+                self.jobs.galvo = GalvoStroke {
                     seq: Some(seq),
                     cover: piece.cover,
                     ..GalvoStroke::default()
@@ -186,13 +186,13 @@ impl Core {
         seq: u32,
         out: &mut dyn ActionSink,
     ) {
-        let record = core::mem::take(&mut self.gcode.galvo);
+        let record = core::mem::take(&mut self.jobs.galvo);
         if record.seq != Some(seq) {
             return;
         }
         let [first, second] = record.ahead;
-        self.gcode.galvo.adopt = first;
-        self.gcode.galvo.ahead = [second, None];
+        self.jobs.galvo.adopt = first;
+        self.jobs.galvo.ahead = [second, None];
         let motion = &mut self.gcode.motion;
         let Some(c) = motion.current.as_mut() else {
             return;

@@ -19,7 +19,7 @@ impl Core {
     pub(in crate::sequencer) fn gcode_galvo_hold(&mut self) -> bool {
         let c = self.gcode.motion.current;
         let lockstep = self.drivers().lockstep();
-        let record = &mut self.gcode.galvo;
+        let record = &mut self.jobs.galvo;
         // (Still waiting after a `!`, `~` before the report, `!`.)
         record.stopping |=
             !lockstep && c.is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == record.seq);
@@ -28,7 +28,7 @@ impl Core {
 
     /// A stop or reset dropped the hold: no report is awaited.
     pub(in crate::sequencer) fn gcode_galvo_hold_dropped(&mut self) {
-        self.gcode.galvo.stopping = false;
+        self.jobs.galvo.stopping = false;
     }
 
     /// The galvo stopped (`at`: where marking ended, if it marked): when a
@@ -40,11 +40,11 @@ impl Core {
         at: Option<MarkStop>,
         out: &mut dyn ActionSink,
     ) {
-        if !self.gcode.galvo.stopping {
+        if !self.jobs.galvo.stopping {
             return;
         }
         // The galvo dropped the pieces sent ahead.
-        let record = core::mem::take(&mut self.gcode.galvo);
+        let record = core::mem::take(&mut self.jobs.galvo);
         let piece = at.and_then(|at| match record.seq == Some(at.seq) {
             true => Some((at, Cursor { pos: 0, index: 0 })),
             false => (record.ahead.iter().flatten())

@@ -37,7 +37,7 @@ impl Core {
             accel,
             ..LookaheadBlock::default()
         };
-        let stream = &mut self.gcode.motion.stream;
+        let stream = &mut self.jobs.gimbal;
         stream.cursor = Some(match stream.cursor {
             Some(mut c) => {
                 c.continue_into(planned, 0.0);
@@ -59,16 +59,15 @@ impl Core {
     #[inline(never)]
     pub(in crate::sequencer) fn stream_tick(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
-        let (Some(current), Some(mut cursor)) = (motion.current, motion.stream.cursor) else {
+        let (Some(current), Some(mut cursor)) = (motion.current, self.jobs.gimbal.cursor) else {
             return;
         };
         let braking = motion.hold != Hold::None || current.cancelled;
         // The exit: the next block's entry while it joins at speed.
         cursor.block.exit_speed = self.stream_exit_speed(&current.block, &cursor);
         let joins = cursor.block.exit_speed > 0.0;
-        let motion = &self.gcode.motion;
         let ov = f64::from(self.gcode.overrides.feed) / 100.0;
-        let scale = ov.min(motion.stream.cap_mm_s / cursor.block.nominal_speed.max(1e-9));
+        let scale = ov.min(self.jobs.gimbal.cap_mm_s / cursor.block.nominal_speed.max(1e-9));
         let dt_ms = STREAM_PERIOD_MS as f64;
         let left = cursor.block.length - cursor.done;
         let over = cursor.advance(dt_ms / 1000.0, scale, braking);
@@ -76,7 +75,7 @@ impl Core {
         let tick_ms = over.map_or(dt_ms, |over| {
             (dt_ms * left / (left + over).max(1e-12)).max(MIN_TICK_MS)
         });
-        self.gcode.motion.stream.cursor = Some(cursor);
+        self.jobs.gimbal.cursor = Some(cursor);
         let to = block_point(&current.block, cursor.fraction());
         let at_end = over.is_some();
         let final_move = at_end && !joins;
@@ -96,7 +95,7 @@ impl Core {
         if final_move {
             // The last move of the burst waits for arrival and settles
             // (`gcode_servo_arrived`); what follows starts from rest.
-            motion.stream.cursor = None;
+            self.jobs.gimbal.cursor = None;
             return;
         }
         c.until = Some(
@@ -126,7 +125,7 @@ impl Core {
                 }
             }
             None => {
-                self.gcode.motion.stream.cursor = None;
+                self.jobs.gimbal.cursor = None;
                 self.grbl_advance(out);
             }
         }
@@ -176,7 +175,7 @@ impl Core {
             }
             _ => return 0.0,
         };
-        let ratio = self.gcode.motion.stream.speed_mm_s() / programmed.max(1e-9);
+        let ratio = self.jobs.gimbal.speed_mm_s() / programmed.max(1e-9);
         kinematics_core::numeric::clamp(ratio, 0.0, 1.0) as f32
     }
 
@@ -214,7 +213,7 @@ impl Core {
         }
         if cancelled {
             motion.current = None;
-            motion.stream.clear();
+            self.jobs.gimbal.clear();
             self.grbl_sync_position();
             self.grbl_advance(out);
             return;
@@ -227,7 +226,7 @@ impl Core {
     #[inline(never)]
     pub(in crate::sequencer) fn stream_arrived(&mut self, seq: u32) -> bool {
         let motion = &mut self.gcode.motion;
-        let on_the_way = motion.stream.is_following()
+        let on_the_way = self.jobs.gimbal.is_following()
             && motion.current.is_some_and(|c| c.servo_seq == Some(seq));
         if on_the_way {
             motion.arrived = true;

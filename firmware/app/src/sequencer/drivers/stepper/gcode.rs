@@ -2,6 +2,7 @@
 
 use crate::domain::PointCm;
 use crate::grbl::{Alarm, Block, GrblError, Laser, PointMm};
+use crate::sequencer::drivers::stepper::StepperJob;
 use crate::sequencer::gcode::GrblMode;
 use crate::sequencer::gcode::queue::{Hold, cm, planned_length};
 use crate::sequencer::machine::{Action, ActionSink, Core};
@@ -19,7 +20,7 @@ impl Core {
         };
         let lit = self.lights(&current.block) && self.gcode.motion.hold == Hold::None;
         let laser = block_laser(&current.block);
-        let job = &mut self.gcode.motion.stepper;
+        let job = &mut self.jobs.stepper;
         if job.inflight.is_some() && (lit != job.lit || (lit && laser != job.laser)) {
             job.waiting = true;
             return;
@@ -45,8 +46,8 @@ impl Core {
         if let Some(c) = motion.current.as_mut() {
             c.stepper_seq = Some(seq);
         }
-        motion.stepper.lit = lit;
-        motion.stepper.laser = laser;
+        self.jobs.stepper.lit = lit;
+        self.jobs.stepper.laser = laser;
         motion.gimbal_lit = lit && motion.arrived;
     }
 
@@ -68,7 +69,7 @@ impl Core {
     pub(in crate::sequencer) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
         let percent = self.gcode.overrides.feed;
         let stepping = self.drivers().hands_over_blocks();
-        let job = &mut self.gcode.motion.stepper;
+        let job = &mut self.jobs.stepper;
         if stepping && job.feed_percent != Some(percent) {
             job.feed_percent = Some(percent);
             out.act(Action::Stepper(StepperRequest::FeedOverride { percent }));
@@ -92,7 +93,7 @@ impl Core {
             shape,
             feed_mm_s,
         }));
-        self.gcode.motion.stepper.inflight = Some(seq);
+        self.jobs.stepper.inflight = Some(seq);
         seq
     }
 
@@ -102,7 +103,7 @@ impl Core {
     #[inline(never)]
     fn stepper_joins_next(&self) -> bool {
         let motion = &self.gcode.motion;
-        let job = &motion.stepper;
+        let job = &self.jobs.stepper;
         let same_laser =
             |b: &Block| self.lights(b) == job.lit && (!job.lit || block_laser(b) == job.laser);
         motion.hold == Hold::None
@@ -128,12 +129,12 @@ impl Core {
                 self.gcode_stepper_done(out);
                 true
             }
-            StepperEvent::Arrived { seq, .. } if motion.stepper.inflight == Some(seq) => {
-                motion.stepper.inflight = None;
+            StepperEvent::Arrived { seq, .. } if self.jobs.stepper.inflight == Some(seq) => {
+                self.jobs.stepper.inflight = None;
                 motion.arrived = true;
                 if ours(seq) {
                     self.gcode_stepper_done(out);
-                } else if motion.stepper.waiting {
+                } else if self.jobs.stepper.waiting {
                     self.gcode_stepper_send(out);
                 }
                 true
@@ -143,7 +144,7 @@ impl Core {
                 let motion = &mut self.gcode.motion;
                 if motion.hold == Hold::Stopping {
                     motion.hold = Hold::Held;
-                    motion.stepper.held = true;
+                    self.jobs.stepper.held = true;
                 }
                 self.grbl_sync_position();
                 false
@@ -161,7 +162,7 @@ impl Core {
             .joints_of(steps)
             .and_then(|j| config.gimbal.fk(j).ok());
         let motion = &mut self.gcode.motion;
-        motion.stepper.inflight = None;
+        self.jobs.stepper.inflight = None;
         if let Some(p) = at {
             motion.position = PointMm {
                 x_mm: p.x_cm * 10.0,
@@ -222,7 +223,7 @@ impl Core {
     pub(in crate::sequencer) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
         let stepping = self.drivers().hands_over_blocks();
         let motion = &mut self.gcode.motion;
-        if !stepping || motion.stepper.inflight.is_none() {
+        if !stepping || self.jobs.stepper.inflight.is_none() {
             return false;
         }
         motion.gimbal_lit = false;
@@ -242,10 +243,10 @@ impl Core {
     }
 }
 
-impl crate::sequencer::gcode::queue::Motion {
+impl StepperJob {
     /// Whether the stepper runs a move of the job.
-    pub(in crate::sequencer) fn stepper_moving(&self) -> bool {
-        self.stepper.inflight.is_some()
+    pub(in crate::sequencer) fn is_moving(&self) -> bool {
+        self.inflight.is_some()
     }
 }
 
