@@ -1,18 +1,14 @@
-//! The G-code step in flight: each actuator that draws gets it
-//! ([`Core::gcode_send_step`], the one place that dispatches per
-//! actuator: add one here), and reports it done (servo arrival, galvo
-//! job done, dwell end); then the next step, block or hold follows.
+//! The G-code step in flight: the drivers that draw get it through the
+//! driver interface ([`Core::gcode_send_step`]: a driver's own stage, or
+//! [`Core::driver_step`] for each), and report it done (servo arrival,
+//! galvo job done, dwell end; each driver's side in `drivers/`); then the
+//! next step, block or hold follows.
 
-use crate::domain::Target;
-use crate::grbl::{Block, PointMm};
+use crate::grbl::Block;
 use crate::sequencer::drivers::{Arrival, DriverStep};
-use crate::sequencer::gcode::queue::{
-    CORNER_DEADBAND_TENTHS, CORNER_SETTLE_MS, Hold, cm, point_at,
-};
-use crate::sequencer::laser::LaserEvent;
-use crate::sequencer::machine::{Action, ActionSink, Core};
-use crate::servo::task::ServoOutcome;
-use embassy_time::{Duration, Instant};
+use crate::sequencer::gcode::queue::{Hold, point_at};
+use crate::sequencer::machine::{ActionSink, Core};
+use embassy_time::Instant;
 
 impl Core {
     /// Sends the current step to every actuator that draws.
@@ -70,94 +66,6 @@ impl Core {
         if galvo_seq.is_some() {
             self.gcode_galvo_send_ahead(out);
         }
-    }
-
-    /// The galvo's marking feed for programmed feed `feed_mm_min`: the feed
-    /// override applied, capped by the galvo's marking speed
-    /// (`galvo.mark_speed_mm_s`), mm/min.
-    pub(in crate::sequencer) fn gcode_galvo_feed_mm_min(&self, feed_mm_min: f64) -> f64 {
-        let feed = self.gcode.overrides.feed_mm_min(feed_mm_min);
-        feed.min(self.settings.galvo.mark_speed_mm_s * 60.0)
-    }
-
-    /// A servo move to `to` at `feed` mm/min (rapid: servo speed);
-    /// returns its request number.
-    pub(in crate::sequencer) fn gcode_servo_move(
-        &mut self,
-        from: PointMm,
-        to: PointMm,
-        feed: Option<f64>,
-        corner: bool,
-        out: &mut dyn ActionSink,
-    ) -> Option<u32> {
-        let point = cm(to);
-        let Ok(aim) = self.aimer.aim(point) else {
-            self.grbl_alarm(crate::grbl::Alarm::SoftLimit, out);
-            return None;
-        };
-        let by_servo = self.move_interval_ms(&aim);
-        let by_feed = feed.map_or(0.0, |f| {
-            let f = self.gcode.overrides.feed_mm_min(f);
-            60_000.0 * from.distance_to(to) / f.max(1e-3)
-        });
-        let interval_ms = libm::fmax(f64::from(by_servo), by_feed).min(f64::from(u16::MAX)) as u16;
-        self.gcode.step_speed_ratio =
-            crate::sequencer::gcode::power::speed_ratio(by_feed, interval_ms);
-        let deadband_tenths = if corner {
-            CORNER_DEADBAND_TENTHS
-        } else {
-            (self.settings.deadband_deg * 10.0) as u16
-        };
-        let seq = self.send_gimbal_move(&aim, interval_ms, deadband_tenths, out);
-        self.last_aim = Some((Target { point, grid: None }, aim));
-        Some(seq)
-    }
-
-    /// The servo task reports move `seq` arrived; `true` when it was the
-    /// G-code step's.
-    fn gcode_servo_arrived(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
-        if self.stream_arrived(seq) {
-            out.act(Action::Note(LaserEvent::GimbalArrived));
-            return true;
-        }
-        let Some(c) = self.gcode.motion.current.as_mut() else {
-            return false;
-        };
-        if c.servo_seq != Some(seq) {
-            return false;
-        }
-        c.servo_seq = None;
-        if c.index >= c.count && c.count > 0 {
-            c.until = Some(
-                self.inputs
-                    .now
-                    .saturating_add(Duration::from_millis(CORNER_SETTLE_MS)),
-            );
-        }
-        self.gcode.motion.arrived = true;
-        out.act(Action::Note(LaserEvent::GimbalArrived));
-        self.gcode_step_done(out);
-        true
-    }
-
-    /// The galvo loop finished job `seq`; `true` when it was the G-code
-    /// step's.
-    pub(in crate::sequencer) fn gcode_galvo_done(
-        &mut self,
-        seq: u32,
-        out: &mut dyn ActionSink,
-    ) -> bool {
-        let Some(c) = self.gcode.motion.current.as_mut() else {
-            return false;
-        };
-        if c.galvo_seq != Some(seq) {
-            return false;
-        }
-        c.galvo_seq = None;
-        self.gcode_galvo_stroke_done(seq, out);
-        self.gcode_step_done(out);
-        self.gcode_galvo_drop_unadopted(out);
-        true
     }
 
     /// When the dwell deadline passed: the dwell block is done.
@@ -237,39 +145,4 @@ impl Core {
     }
 }
 
-impl Core {
-    /// The G-code side of a servo report: an arrival of the step in flight
-    /// moves on; `true` for a fault of it (the caller stops, after its own
-    /// fault handling).
-    pub(in crate::sequencer) fn gcode_servo_outcome(
-        &mut self,
-        outcome: &ServoOutcome,
-        out: &mut dyn ActionSink,
-    ) -> bool {
-        match *outcome {
-            ServoOutcome::Arrived { seq, .. } => {
-                self.gcode_servo_arrived(seq, out);
-                false
-            }
-            ServoOutcome::Fault { seq, .. } => self.gcode_awaits_servo(seq),
-            _ => false,
-        }
-    }
-
-    /// Whether the G-code step waits for servo move `seq`.
-    fn gcode_awaits_servo(&self, seq: u32) -> bool {
-        self.gcode
-            .motion
-            .current
-            .is_some_and(|c| c.servo_seq == Some(seq))
-    }
-
-    /// Whether the G-code step waits for galvo job `seq`.
-    pub(in crate::sequencer) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
-        self.gcode
-            .motion
-            .current
-            .is_some_and(|c| c.galvo_seq == Some(seq))
-            || self.gcode_galvo_ahead_is(seq)
-    }
-}
+impl Core {}

@@ -239,3 +239,42 @@ fn feed_of(block: &Block) -> Option<f64> {
         _ => None,
     }
 }
+
+impl Core {
+    /// The galvo's marking feed for programmed feed `feed_mm_min`: the feed
+    /// override applied, capped by the galvo's marking speed
+    /// (`galvo.mark_speed_mm_s`), mm/min.
+    pub(in crate::sequencer) fn gcode_galvo_feed_mm_min(&self, feed_mm_min: f64) -> f64 {
+        let feed = self.gcode.overrides.feed_mm_min(feed_mm_min);
+        feed.min(self.settings.galvo.mark_speed_mm_s * 60.0)
+    }
+
+    /// The galvo loop finished job `seq`; `true` when it was the G-code
+    /// step's.
+    pub(in crate::sequencer) fn gcode_galvo_done(
+        &mut self,
+        seq: u32,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        let Some(c) = self.gcode.motion.current.as_mut() else {
+            return false;
+        };
+        if c.galvo_seq != Some(seq) {
+            return false;
+        }
+        c.galvo_seq = None;
+        self.gcode_galvo_stroke_done(seq, out);
+        self.gcode_step_done(out);
+        self.gcode_galvo_drop_unadopted(out);
+        true
+    }
+
+    /// Whether the G-code step waits for galvo job `seq`.
+    pub(in crate::sequencer) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
+        self.gcode
+            .motion
+            .current
+            .is_some_and(|c| c.galvo_seq == Some(seq))
+            || self.gcode_galvo_ahead_is(seq)
+    }
+}

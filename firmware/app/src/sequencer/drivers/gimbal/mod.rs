@@ -67,4 +67,5 @@ impl Stream {
 }
 
 mod plan;
+mod step;
 mod stream;
