@@ -101,6 +101,8 @@ pub struct Core {
     pub(super) gcode: crate::sequencer::gcode::Gcode,
     /// What each actuator driver keeps of the G-code job.
     pub(super) jobs: crate::sequencer::drivers::DriverJobs,
+    /// The stepper task homes (`home` or `$H` sent, its end not reported).
+    pub(super) stepper_homing: bool,
 }
 
 impl Core {
@@ -131,6 +133,7 @@ impl Core {
             },
             gcode: crate::sequencer::gcode::Gcode::new(),
             jobs: crate::sequencer::drivers::DriverJobs::new(),
+            stepper_homing: false,
         }
     }
 
@@ -183,6 +186,7 @@ impl Core {
         Snapshot {
             activity: match run {
                 None if !self.gcode.motion.is_idle() => Activity::Gcode,
+                None if self.stepper_homing => Activity::Homing,
                 None => Activity::Idle,
                 Some(r) => match r.kind.pattern() {
                     Some(p) => Activity::Pattern(p),

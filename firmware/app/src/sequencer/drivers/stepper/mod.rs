@@ -24,6 +24,8 @@ pub(in crate::sequencer) struct StepperJob {
     waiting: bool,
     /// A hold came to rest: `~` asks the stepper to go on with its moves.
     held: bool,
+    /// A hold was asked and the stepper has not reported rest yet.
+    braking: bool,
     /// The feed override the stepper task has, % (`None`: not sent since
     /// the last stop).
     feed_percent: Option<u8>,
@@ -42,3 +44,6 @@ impl StepperJob {
 
 mod gcode;
 mod points;
+
+#[cfg(test)]
+mod tests;

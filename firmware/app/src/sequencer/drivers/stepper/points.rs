@@ -172,6 +172,9 @@ impl Core {
         event: StepperEvent,
         out: &mut dyn ActionSink,
     ) {
+        if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
+            self.stepper_homing = false;
+        }
         if self.gcode_stepper_event(&event, out) {
             return;
         }
@@ -221,9 +224,9 @@ impl Core {
                         Fixed::<3>(j.pitch_deg)
                     ),
                 );
-                self.gcode_homing_done(Ok(steps), out);
+                self.gcode_homing_done(steps, None, out);
             }
-            StepperEvent::HomingFailed(why) => {
+            StepperEvent::HomingFailed { why, steps } => {
                 let text = match why {
                     HomingFailure::NoSwitches => "no homing switches configured",
                     HomingFailure::NotFound(0) => "pan switch not found within the travel",
@@ -233,7 +236,7 @@ impl Core {
                     HomingFailure::BadConfig => "parameters refused for the homing moves",
                 };
                 self.notify(out, format_args!("error: home failed: {text}; not homed"));
-                self.gcode_homing_done(Err(why), out);
+                self.gcode_homing_done(steps, Some(why), out);
             }
         }
     }
@@ -259,6 +262,7 @@ impl Core {
         }
         self.stop("home", out);
         out.act(Action::Stepper(StepperRequest::Home));
+        self.stepper_homing = true;
         Ok(())
     }
 
