@@ -6,8 +6,8 @@ use std::vec::Vec;
 
 use embassy_time::Instant;
 
-use super::super::gcode::tests::{READINGS, closers};
-use super::super::machine::{Action, Core, Event, Inputs};
+use crate::sequencer::gcode::tests::{READINGS, closers};
+use crate::sequencer::machine::{Action, Core, Event, Inputs};
 use crate::command::{Command, GrblLine};
 use crate::domain::Actuator;
 use crate::stepper::{MoveShape, StepperEvent, StepperRequest};

@@ -2,31 +2,35 @@
 //! [`super`]): sending them as far as lit blocks are queued, and the
 //! next one taking over when the piece in flight is done.
 
-use super::super::gcode_motion::Hold;
-use super::super::machine::{ActionSink, Core};
-use super::{AHEAD, AHEAD_LINES, Cover, Cursor};
 use crate::grbl::PointMm;
+use crate::sequencer::drivers::galvo::{AHEAD, AHEAD_LINES, Cover, Cursor};
+use crate::sequencer::gcode::queue::Hold;
+use crate::sequencer::machine::{ActionSink, Core};
 
 /// A piece sent ahead of the one in flight.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Ahead {
-    pub(super) seq: u32,
+pub(in crate::sequencer) struct Ahead {
+    pub(in crate::sequencer) seq: u32,
     pub(super) start: Cursor,
     pub(super) cover: Cover,
-    pub(super) lines: u8,
+    pub(in crate::sequencer) lines: u8,
 }
 
 impl Core {
     /// The piece `next`, sent ahead, becomes the one in flight: it starts
     /// at the block in flight now. Its number, or `None` when it does not
     /// start here.
-    pub(super) fn gcode_galvo_adopt(&mut self, from: PointMm, next: Ahead) -> Option<u32> {
+    pub(in crate::sequencer) fn gcode_galvo_adopt(
+        &mut self,
+        from: PointMm,
+        next: Ahead,
+    ) -> Option<u32> {
         let start = Cursor { pos: 0, index: 0 };
         let piece = self.gcode_galvo_piece(from, start, usize::from(next.lines), true)?;
         if piece.stroke.segments() != usize::from(next.lines) || piece.cover != next.cover {
             return None;
         }
-        let record = &mut self.gcode.galvo;
+        let record = &mut self.jobs.galvo;
         record.seq = Some(next.seq);
         record.cover = piece.cover;
         for a in record.ahead.iter_mut().flatten() {
@@ -42,12 +46,12 @@ impl Core {
         let motion = &self.gcode.motion;
         let in_flight = motion
             .current
-            .is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == self.gcode.galvo.seq);
-        if !in_flight || motion.hold != Hold::None || self.actuator.uses_gimbal() {
+            .is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == self.jobs.galvo.seq);
+        if !in_flight || motion.hold != Hold::None || self.drivers().lockstep() {
             return;
         }
         loop {
-            let record = self.gcode.galvo;
+            let record = self.jobs.galvo;
             let sent = record.ahead.iter().flatten().count();
             // One request slot stays free (for the stroke after).
             let room = self.inputs.galvo_room.is_some_and(|room| room > 1);
@@ -75,7 +79,7 @@ impl Core {
             if !self.send_galvo(request, out) {
                 return;
             }
-            if let Some(slot) = self.gcode.galvo.ahead.get_mut(sent) {
+            if let Some(slot) = self.jobs.galvo.ahead.get_mut(sent) {
                 *slot = Some(ahead);
             }
         }
@@ -86,14 +90,14 @@ impl Core {
     /// brakes dark, rather than left to be marked behind the sequencer's
     /// back.
     pub(in crate::sequencer) fn gcode_galvo_drop_unadopted(&mut self, out: &mut dyn ActionSink) {
-        if self.gcode.galvo.adopt.take().is_some() {
+        if self.jobs.galvo.adopt.take().is_some() {
             self.stop_galvo(out);
         }
     }
 
     /// Whether `seq` is a piece sent ahead of the stroke in flight.
     pub(in crate::sequencer) fn gcode_galvo_ahead_is(&self, seq: u32) -> bool {
-        let g = &self.gcode.galvo;
+        let g = &self.jobs.galvo;
         g.ahead
             .iter()
             .chain([&g.adopt])

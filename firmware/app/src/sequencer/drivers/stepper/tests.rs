@@ -7,10 +7,10 @@ use std::vec::Vec;
 
 use embassy_time::Instant;
 
-use super::super::gcode::tests::{line, on, realtime, status, texts};
-use super::super::machine::{Action, Core, Event};
 use crate::domain::Actuator;
 use crate::grbl::realtime::Realtime;
+use crate::sequencer::gcode::tests::{line, on, realtime, status, texts};
+use crate::sequencer::machine::{Action, Core, Event};
 use crate::status::Activity;
 use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
 

@@ -1,61 +1,20 @@
-//! The core's side of the galvo: points and paths to the galvo loop, its
-//! events back, its parameters (built here from the settings: the galvo
-//! loop knows nothing of them), and its laser permission.
+//! The galvo driver's points: a pattern's points, goto and marked paths, its configuration.
 
-use galvo_planner::{Method, RigidParams};
-
-use super::machine::{Action, ActionSink, Core, GalvoReadout};
-use super::run::RunKind;
 use crate::domain::{Pattern, Target};
-use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoConfig, GalvoEvent, GalvoRequest};
+use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoEvent, GalvoRequest};
 use crate::log;
-use crate::settings::{GalvoSettings, JumpPlanner, LaserMode};
+use crate::sequencer::drivers::galvo::{HOLD_US, config_from};
+use crate::sequencer::machine::{Action, ActionSink, Core, GalvoReadout};
+use crate::sequencer::run::RunKind;
+use crate::settings::LaserMode;
 use crate::status::Phase;
 use crate::text::Shortest;
-
-/// Dwell of a goto on the galvo: held until the next command, µs.
-const HOLD_US: u32 = u32::MAX;
-
-/// The loop configuration for the user's galvo parameters and the
-/// junction deviation (`$11`, mm) its marking planner corners with.
-pub fn config_from(settings: &GalvoSettings, junction_deviation_mm: f64) -> GalvoConfig {
-    GalvoConfig {
-        sample_period_s: settings.sample_period_us * 1e-6,
-        galvo: settings.galvo(),
-        mirrors: RigidParams {
-            kt_nm_per_a: settings.kt_nm_per_a,
-            j_kg_m2: settings.j_kg_m2,
-            l_h: settings.l_h,
-            r_ohm: settings.r_ohm,
-            u_max_v: settings.u_max_v,
-        },
-        method: match settings.planner {
-            JumpPlanner::Optimal => Method::TimeOptimal,
-            JumpPlanner::Seed => Method::BISECTION,
-        },
-        laser_on_delay_us: settings.laser_on_delay_us as u32,
-        laser_off_delay_us: settings.laser_off_delay_us as u32,
-        mark_speed_mm_s: settings.mark_speed_mm_s,
-        mark_accel_mm_s2: settings.mark_accel_mm_s2,
-        junction_deviation_mm,
-    }
-}
-
-impl Default for GalvoConfig {
-    /// The default galvo parameters ([`GalvoSettings::default`]): 100 kHz,
-    /// SPEC geometry and DAC span, reference mirror drive, time-optimal
-    /// jumps, 100 µs laser delays, marking at 1 m/s.
-    fn default() -> Self {
-        let defaults = crate::settings::Settings::default();
-        config_from(&defaults.galvo, defaults.gcode_junction_mm)
-    }
-}
 
 impl Core {
     /// Tells the galvo loop to stop (drop its jobs, laser off, clear an
     /// underrun latch). Never lost: the requests it has not taken yet are
     /// dropped first, so there is room.
-    pub(super) fn stop_galvo(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn stop_galvo(&mut self, out: &mut dyn ActionSink) {
         out.act(Action::Galvo(GalvoRequest::Stop));
         if self.inputs.galvo_room.is_some() {
             self.inputs.galvo_room = Some(GALVO_REQUEST_DEPTH - 1);
@@ -64,7 +23,11 @@ impl Core {
 
     /// Queues a job for the galvo loop; `false` (with an error notice,
     /// everything stopped) when the loop does not keep up.
-    pub(super) fn send_galvo(&mut self, request: GalvoRequest, out: &mut dyn ActionSink) -> bool {
+    pub(in crate::sequencer) fn send_galvo(
+        &mut self,
+        request: GalvoRequest,
+        out: &mut dyn ActionSink,
+    ) -> bool {
         let Some(room) = self.inputs.galvo_room.filter(|room| *room > 0) else {
             log::warning!("galvo: request queue full");
             self.notify(out, format_args!("error: galvo not responding; stopped"));
@@ -96,7 +59,11 @@ impl Core {
 
     /// Sends the current grid or goto point to the galvo (board cm →
     /// galvo mm). Paths go whole, through [`Self::begin_galvo_path`].
-    pub(super) fn begin_galvo_point(&mut self, target: Target, out: &mut dyn ActionSink) -> bool {
+    pub(in crate::sequencer) fn begin_galvo_point(
+        &mut self,
+        target: Target,
+        out: &mut dyn ActionSink,
+    ) -> bool {
         self.allow_galvo_laser(out);
         let Some(run) = self.run else { return false };
         let dwell_us = match run.kind {
@@ -122,7 +89,11 @@ impl Core {
     }
 
     /// Sends path `pattern` of the run to the galvo as one job.
-    pub(super) fn begin_galvo_path(&mut self, pattern: Pattern, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn begin_galvo_path(
+        &mut self,
+        pattern: Pattern,
+        out: &mut dyn ActionSink,
+    ) {
         self.allow_galvo_laser(out);
         let Some(path) = pattern.figure() else {
             self.stop("not a path", out);
@@ -148,7 +119,11 @@ impl Core {
     }
 
     /// Handles an event of the galvo loop.
-    pub(super) fn galvo_event(&mut self, event: GalvoEvent, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn galvo_event(
+        &mut self,
+        event: GalvoEvent,
+        out: &mut dyn ActionSink,
+    ) {
         match event {
             GalvoEvent::Done { seq } if self.gcode_galvo_done(seq, out) => {}
             GalvoEvent::Refused { seq, error } if self.gcode_awaits_galvo(seq) => {
@@ -194,7 +169,7 @@ impl Core {
     }
 
     /// Sends the galvo parameters to the loop (applied between points).
-    pub(super) fn configure_galvo(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn configure_galvo(&mut self, out: &mut dyn ActionSink) {
         let settings = &self.settings;
         let config = config_from(&settings.galvo, settings.gcode_junction_mm);
         out.act(Action::ConfigureGalvo(config));
@@ -209,7 +184,7 @@ impl Core {
     /// again after `laser auto`.
     /// `laser dwell` lights only dwells: a marked path (which has none)
     /// stays dark, like the gimbal's.
-    pub(super) fn allow_galvo_laser(&self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn allow_galvo_laser(&self, out: &mut dyn ActionSink) {
         let marking = self
             .run
             .is_some_and(|r| r.kind.pattern().is_some_and(|p| p.is_path()));
@@ -226,7 +201,11 @@ impl Core {
     }
 
     /// `galvo status` lines.
-    pub(super) fn report_galvo_status(&self, galvo: &GalvoReadout, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn report_galvo_status(
+        &self,
+        galvo: &GalvoReadout,
+        out: &mut dyn ActionSink,
+    ) {
         let g = &self.settings.galvo;
         let (phase, queued) = (galvo.phase, galvo.queued);
         self.data(

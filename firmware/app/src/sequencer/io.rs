@@ -2,15 +2,14 @@
 //! [`Readings`]) and what comes out of it ([`Action`]s into an
 //! [`ActionSink`], console [`Line`]s).
 
-use embassy_time::Instant;
-
-use super::super::laser::LaserEvent;
 use crate::command::Command;
 use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, RefillTime, ScanPhase};
+use crate::sequencer::laser::LaserEvent;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{LoadedRecord, RecordError};
 use crate::stepper::{StepperConfig, StepperEvent, StepperRequest};
 use crate::text::ReplyText;
+use embassy_time::Instant;
 
 /// Something that happened, for the core to act on.
 #[derive(Debug, Clone, Copy)]
@@ -32,7 +31,7 @@ pub enum Event {
     Galvo(GalvoEvent),
     /// The stepper task's report.
     Stepper(StepperEvent),
-    /// The dwell deadline ([`Core::dwell_deadline`](super::Core::dwell_deadline)) passed.
+    /// The dwell deadline ([`Core::dwell_deadline`](crate::sequencer::machine::Core::dwell_deadline)) passed.
     DwellEnded,
     /// The housekeeping tick (liveness for the watchdog).
     Tick,
@@ -122,13 +121,13 @@ pub enum Action {
     /// The power the gimbal laser runs at while lit (sent before the
     /// [`Action::GimbalLaser`] that lights it, and whenever it changes
     /// while lit).
-    GimbalPower(super::super::LaserPower),
+    GimbalPower(crate::sequencer::laser::LaserPower),
     /// Tell the laser switch about an event that decides when a laser may
-    /// be lit ([`super::super::LaserSwitch::note`]).
+    /// be lit ([`crate::sequencer::laser::LaserSwitch::note`]).
     Note(LaserEvent<'static>),
     /// A line to the console.
     Line(Line),
-    /// Save the settings ([`Core::settings`](super::Core::settings)); answer with
+    /// Save the settings ([`Core::settings`](crate::sequencer::machine::Core::settings)); answer with
     /// [`Event::Saved`].
     Save,
     /// Let the other tasks run, then send [`Event::CheckStep`].

@@ -2,24 +2,11 @@
 //! acceleration on the gimbal, and the exit speed the look-ahead plan
 //! allows the block running.
 
-use kinematics_core::lookahead::{Lookahead, SpeedCursor};
-
-use super::super::gcode_motion::{block_point, cm, point_at};
-use super::super::machine::Core;
-use super::{GIMBAL_ACCEL_DEG_S2, MIN_LENGTH_MM, PLAN_BLOCKS};
 use crate::grbl::{Block, PointMm};
-
-/// Length of a motion block, mm (`None`: not a motion, or nothing to move).
-pub(in crate::sequencer) fn planned_length(block: &Block) -> Option<f64> {
-    let length = match *block {
-        Block::Rapid { from, to } | Block::Line { from, to, .. } | Block::Jog { from, to, .. } => {
-            from.distance_to(to)
-        }
-        Block::Arc { arc, .. } => arc.length_mm(),
-        _ => return None,
-    };
-    (length.is_finite() && length > MIN_LENGTH_MM).then_some(length)
-}
+use crate::sequencer::drivers::gimbal::{GIMBAL_ACCEL_DEG_S2, PLAN_BLOCKS};
+use crate::sequencer::gcode::queue::{MIN_LENGTH_MM, block_point, cm, planned_length, point_at};
+use crate::sequencer::machine::Core;
+use kinematics_core::lookahead::{Lookahead, SpeedCursor};
 
 /// Unit directions at the start and at the end of a motion block of
 /// `length` mm.
@@ -43,7 +30,7 @@ impl Core {
     /// within [`GIMBAL_ACCEL_DEG_S2`], through the joint degrees per mm
     /// along the block.
     #[inline(never)]
-    pub(super) fn stream_limits(&self, block: &Block, length: f64) -> (f64, f64) {
+    pub(in crate::sequencer) fn stream_limits(&self, block: &Block, length: f64) -> (f64, f64) {
         let s = &self.settings;
         let deg_per_mm = self.joint_deg_per_mm(block, length).max(1e-6);
         let cap = (s.servo_speed_deg_s / deg_per_mm).min(s.galvo.mark_speed_mm_s);
@@ -80,7 +67,11 @@ impl Core {
     /// (none queued, a dwell, pause or end, a dark → lit change, or the
     /// gimbal has not arrived anywhere yet: dark until it has).
     #[inline(never)]
-    pub(super) fn stream_exit_speed(&self, current: &Block, cursor: &SpeedCursor) -> f64 {
+    pub(in crate::sequencer) fn stream_exit_speed(
+        &self,
+        current: &Block,
+        cursor: &SpeedCursor,
+    ) -> f64 {
         let motion = &self.gcode.motion;
         let Ok(mut plan) = Lookahead::<PLAN_BLOCKS>::new(self.settings.gcode_junction_mm) else {
             return 0.0;

@@ -8,10 +8,10 @@ use std::vec::Vec;
 
 use embassy_time::Instant;
 
-use super::super::gcode::tests::{closers, line, move_seq, pump, realtime, status};
-use super::super::laser::LaserPower;
-use super::super::machine::{Action, Core};
 use crate::grbl::realtime::{OverrideStep, Realtime};
+use crate::sequencer::gcode::tests::{closers, line, move_seq, pump, realtime, status};
+use crate::sequencer::laser::LaserPower;
+use crate::sequencer::machine::{Action, Core};
 
 /// The last power level `actions` set for the gimbal laser.
 fn power(actions: &[Action]) -> Option<u16> {

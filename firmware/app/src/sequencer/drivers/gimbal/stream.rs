@@ -1,96 +1,32 @@
-//! G-code on the gimbal through grbl's look-ahead planner: every period
-//! the block running (what is left of it, entered at the speed it has)
-//! and the motion blocks queued behind it (up to [`PLAN_BLOCKS`], to the
-//! first that must start from rest) are planned by
-//! [`kinematics_core::lookahead::Lookahead`] in board mm (cruise at F —
-//! G0 at the rate limit — capped by `$110` and the servo speed;
-//! acceleration `$120` capped by the servos' [`GIMBAL_ACCEL_DEG_S2`];
-//! junctions by `$11`): the plan gives the running block's exit speed.
-//! Planned afresh each period, nothing of it stays in the sequencer's
-//! state (its stack copies of it are what the 14 KiB ceiling counts). The
-//! block running is
-//! followed at [`STREAM_PERIOD_MS`] by a [`SpeedCursor`]: every period
-//! one servo move to the next point of the planned profile, timed to the
-//! period (each move supersedes the one before, so the servos never stop
-//! between points). A tick that reaches a block's end goes exactly to it
-//! (corners are not cut) and the next block goes on at the junction speed;
-//! only a block ending at rest (queue empty, dwell, pause, end, a
-//! reversal) waits for arrival within 0.1° and the settle. A feed hold
-//! brakes along the path at the limit (dark) and `~` goes on from the
-//! point it stopped at; the feed override scales the cruise on the fly.
+//! The gimbal driver's stream: one point of the planned profile every period.
 
-use embassy_time::Duration;
-use kinematics_core::lookahead::{LookaheadBlock, SpeedCursor};
-
-use super::gcode_motion::{CORNER_DEADBAND_TENTHS, Hold, block_point, cm, point_at};
-use super::machine::{ActionSink, Core};
 use crate::domain::Target;
 use crate::grbl::{Block, PointMm};
-
-mod plan;
-
-pub(super) use plan::planned_length;
-
-/// The streaming period, ms (the servos' shortest move ramp).
-pub(super) const STREAM_PERIOD_MS: u64 = 20;
-/// Joint acceleration the servos follow, °/s² (their speed within 0.1 s).
-pub(super) const GIMBAL_ACCEL_DEG_S2: f64 = 2000.0;
-/// Blocks planned each period: the block running and those behind it.
-const PLAN_BLOCKS: usize = 8;
-/// Shorter blocks are not planned (nothing to move).
-const MIN_LENGTH_MM: f64 = 1e-4;
-/// Shortest tick, ms (a block end just past the previous tick).
-const MIN_TICK_MS: f64 = 2.0;
-
-/// The block being followed.
-#[derive(Debug, Clone)]
-pub(super) struct Stream {
-    /// Following the running block (`None`: at rest, or its final move).
-    cursor: Option<SpeedCursor>,
-    /// Highest cruise of the running block (servo speed, `$110`), mm/s.
-    cap_mm_s: f64,
-}
-
-impl Stream {
-    pub(super) const fn new() -> Self {
-        Self {
-            cursor: None,
-            cap_mm_s: 0.0,
-        }
-    }
-
-    /// Forgets the block followed (a stop, a reset, an alarm).
-    #[inline(never)]
-    pub(super) fn clear(&mut self) {
-        self.cursor = None;
-    }
-
-    /// Whether a block is being followed.
-    #[inline(never)]
-    pub(super) fn is_following(&self) -> bool {
-        self.cursor.is_some()
-    }
-
-    /// Speed now, mm/s (0 at rest).
-    #[inline(never)]
-    pub(super) fn speed_mm_s(&self) -> f64 {
-        self.cursor.map_or(0.0, |c| c.speed)
-    }
-}
+use crate::sequencer::drivers::gimbal::{MIN_TICK_MS, STREAM_PERIOD_MS};
+use crate::sequencer::gcode::queue::{
+    CORNER_DEADBAND_TENTHS, Hold, block_point, cm, planned_length, point_at,
+};
+use crate::sequencer::machine::{ActionSink, Core};
+use embassy_time::Duration;
+use kinematics_core::lookahead::{LookaheadBlock, SpeedCursor};
 
 impl Core {
     /// Whether G-code on this actuator streams through the planner (the
     /// gimbal alone).
     #[inline(never)]
-    pub(super) fn gcode_streams(&self) -> bool {
-        self.actuator.uses_gimbal() && !self.actuator.uses_galvo()
+    pub(in crate::sequencer) fn gcode_streams(&self) -> bool {
+        self.drivers().gimbal_streams()
     }
 
     /// Starts following `block` (already popped from the motion queue):
     /// from rest, or on from the block before at the speed reached.
     /// `false` when it has nothing to move (it then runs step by step).
     #[inline(never)]
-    pub(super) fn stream_begin(&mut self, block: &Block, out: &mut dyn ActionSink) -> bool {
+    pub(in crate::sequencer) fn stream_begin(
+        &mut self,
+        block: &Block,
+        out: &mut dyn ActionSink,
+    ) -> bool {
         let Some(length) = planned_length(block) else {
             return false;
         };
@@ -101,7 +37,7 @@ impl Core {
             accel,
             ..LookaheadBlock::default()
         };
-        let stream = &mut self.gcode.motion.stream;
+        let stream = &mut self.jobs.gimbal;
         stream.cursor = Some(match stream.cursor {
             Some(mut c) => {
                 c.continue_into(planned, 0.0);
@@ -121,18 +57,17 @@ impl Core {
     /// profile to the servos, the next tick scheduled — or the block's end
     /// reached (the next block, or the final move), or a hold at rest.
     #[inline(never)]
-    pub(super) fn stream_tick(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn stream_tick(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
-        let (Some(current), Some(mut cursor)) = (motion.current, motion.stream.cursor) else {
+        let (Some(current), Some(mut cursor)) = (motion.current, self.jobs.gimbal.cursor) else {
             return;
         };
         let braking = motion.hold != Hold::None || current.cancelled;
         // The exit: the next block's entry while it joins at speed.
         cursor.block.exit_speed = self.stream_exit_speed(&current.block, &cursor);
         let joins = cursor.block.exit_speed > 0.0;
-        let motion = &self.gcode.motion;
         let ov = f64::from(self.gcode.overrides.feed) / 100.0;
-        let scale = ov.min(motion.stream.cap_mm_s / cursor.block.nominal_speed.max(1e-9));
+        let scale = ov.min(self.jobs.gimbal.cap_mm_s / cursor.block.nominal_speed.max(1e-9));
         let dt_ms = STREAM_PERIOD_MS as f64;
         let left = cursor.block.length - cursor.done;
         let over = cursor.advance(dt_ms / 1000.0, scale, braking);
@@ -140,7 +75,7 @@ impl Core {
         let tick_ms = over.map_or(dt_ms, |over| {
             (dt_ms * left / (left + over).max(1e-12)).max(MIN_TICK_MS)
         });
-        self.gcode.motion.stream.cursor = Some(cursor);
+        self.jobs.gimbal.cursor = Some(cursor);
         let to = block_point(&current.block, cursor.fraction());
         let at_end = over.is_some();
         let final_move = at_end && !joins;
@@ -160,7 +95,7 @@ impl Core {
         if final_move {
             // The last move of the burst waits for arrival and settles
             // (`gcode_servo_arrived`); what follows starts from rest.
-            motion.stream.cursor = None;
+            self.jobs.gimbal.cursor = None;
             return;
         }
         c.until = Some(
@@ -173,7 +108,7 @@ impl Core {
     /// The tick reached the end of a block that joins the next at speed:
     /// the next block (queued, planned) goes on from here, hold or not.
     #[inline(never)]
-    pub(super) fn stream_block_done(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn stream_block_done(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         if let Some(c) = motion.current.take() {
             motion.position = point_at(&c.block, 1, 1);
@@ -190,7 +125,7 @@ impl Core {
                 }
             }
             None => {
-                self.gcode.motion.stream.cursor = None;
+                self.jobs.gimbal.cursor = None;
                 self.grbl_advance(out);
             }
         }
@@ -240,7 +175,7 @@ impl Core {
             }
             _ => return 0.0,
         };
-        let ratio = self.gcode.motion.stream.speed_mm_s() / programmed.max(1e-9);
+        let ratio = self.jobs.gimbal.speed_mm_s() / programmed.max(1e-9);
         kinematics_core::numeric::clamp(ratio, 0.0, 1.0) as f32
     }
 
@@ -255,7 +190,7 @@ impl Core {
 
     /// Whether `block` lights the laser (a lit G1/G2/G3).
     #[inline(never)]
-    pub(super) fn lights(&self, block: &Block) -> bool {
+    pub(in crate::sequencer) fn lights(&self, block: &Block) -> bool {
         match *block {
             Block::Line { laser, .. } | Block::Arc { laser, .. } => {
                 self.gcode_lit(laser.mode, laser.power)
@@ -278,7 +213,7 @@ impl Core {
         }
         if cancelled {
             motion.current = None;
-            motion.stream.clear();
+            self.jobs.gimbal.clear();
             self.grbl_sync_position();
             self.grbl_advance(out);
             return;
@@ -289,9 +224,9 @@ impl Core {
     /// The servo task confirmed streamed move `seq`: `true` when it was
     /// a point on the way (the block goes on at its own pace).
     #[inline(never)]
-    pub(super) fn stream_arrived(&mut self, seq: u32) -> bool {
+    pub(in crate::sequencer) fn stream_arrived(&mut self, seq: u32) -> bool {
         let motion = &mut self.gcode.motion;
-        let on_the_way = motion.stream.is_following()
+        let on_the_way = self.jobs.gimbal.is_following()
             && motion.current.is_some_and(|c| c.servo_seq == Some(seq));
         if on_the_way {
             motion.arrived = true;

@@ -1,102 +1,19 @@
-//! G-code on the galvo alone: consecutive lit feed moves are marked as
-//! one stroke ([`Figure::Stroke`]) by the galvo's look-ahead path planner
-//! — one jump, one laser-on delay, corners at the planner's junction
-//! speed with the laser on through them, one laser-off delay — instead of
-//! one stroke per block.
-//!
-//! A stroke takes what is left of the block in flight and then whole lit
-//! G1/G2/G3 blocks waiting at the front of the queue, up to
-//! [`StrokeCm::MAX_SEGMENTS`] lines: a G1 is a line, a G2/G3 its chords
-//! within `$12` (exact arcs cost the galvo's prep stage too much, see
-//! [`StrokeCm`]). It is marked at the slowest of its
-//! blocks' feeds (F × feed override, capped by `galvo.mark_speed_mm_s`).
-//! The galvo reports it done once; then its blocks leave the queue
-//! together (their slots free, a line waiting for room is answered) and
-//! the position moves to its end.
-//!
-//! A contour longer than one stroke is sent in pieces that continue it
-//! ([`StrokeCm::continuing`], up to [`AHEAD_LINES`] lines each, up to
-//! [`AHEAD`] of them ahead of the piece in flight): the galvo loop joins
-//! each to the stroke it is marking, so the whole contour is one stroke
-//! (one laser on/off pair, no stop at the joints); a piece that comes too
-//! late is marked as a stroke of its own. Each piece's `Done` still
-//! finishes its blocks, then the next piece (already sent) is the one in
-//! flight.
-//!
-//! Feed hold during a stroke ([`hold`]): the gate closes (dark at once),
-//! the galvo drops the pieces sent ahead, brakes along the stroke and
-//! reports where marking stopped ([`GalvoEvent::Stopped`]: the piece, its
-//! line, the point). The hold is stopping (`Hold:1`) until then; the
-//! blocks (arc chords) marked by then finish as on `done`, the block in
-//! progress stays in flight from the stop point (`MPos`, `Hold:0`), and
-//! `~` sends the rest of the contour from there as a new stroke, so
-//! nothing marked before the hold is lit again. A report that names no
-//! piece of it (nothing lit yet) redoes the step in flight.
-//! `target both` keeps one step per request: the gimbal cannot follow a
-//! galvo stroke.
+//! The galvo driver's G-code stage: lit blocks joined into strokes, pieces sent ahead.
 
-use super::gcode_motion::{block_point, cm, point_at};
-use super::machine::{ActionSink, Core};
 use crate::domain::{Figure, StrokeCm};
 #[cfg(doc)]
 use crate::galvo::GalvoEvent;
 use crate::galvo::GalvoRequest;
 use crate::grbl::{Block, PointMm};
-
-/// Most chords of an arc counted when joining it (more never fit).
-const MAX_ARC_CHORDS: u32 = 100_000;
-/// Lines of a piece sent ahead: half the loop's path planner, so it joins
-/// while the piece before it still has blocks there.
-pub(super) const AHEAD_LINES: usize = StrokeCm::MAX_SEGMENTS / 2;
-/// Pieces sent ahead of the one in flight.
-const AHEAD: usize = 2;
-
-/// Where a piece starts: step `index` of block `pos` (0: the block in
-/// flight; k: the k-th queued one).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct Cursor {
-    pos: usize,
-    index: u32,
-}
-
-/// What a piece covers from its start cursor.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct Cover {
-    /// Last step of its first block it marks.
-    last_index: u32,
-    /// Whole blocks after that one it marks.
-    joined: u8,
-    /// Where it ends, mm.
-    end: PointMm,
-}
-
-/// The stroke in flight on the galvo: what its "done" completes.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct GalvoStroke {
-    /// Its galvo request number.
-    seq: Option<u32>,
-    /// What it covers from the block in flight.
-    cover: Cover,
-    /// Pieces sent ahead, continuing it, oldest first.
-    ahead: [Option<ahead::Ahead>; AHEAD],
-    /// The piece after a finished one, in flight from the next step.
-    adopt: Option<ahead::Ahead>,
-    /// A feed hold waits for the galvo to report where it stopped.
-    stopping: bool,
-}
-
-/// A piece built: the stroke, its feed (the slowest, mm/min), its cover.
-struct Piece {
-    stroke: StrokeCm,
-    feed: f64,
-    cover: Cover,
-}
+use crate::sequencer::drivers::galvo::{Cover, Cursor, GalvoStroke, MAX_ARC_CHORDS, Piece};
+use crate::sequencer::gcode::queue::{block_point, cm, point_at};
+use crate::sequencer::machine::{ActionSink, Core};
 
 impl Core {
     /// The galvo's request for the G-code step from `from` to `to` at
     /// `feed` (mm/min), `lit` or dark, with its number; `None` when it
     /// could not be sent (the sequencer stopped).
-    pub(super) fn gcode_galvo_send(
+    pub(in crate::sequencer) fn gcode_galvo_send(
         &mut self,
         from: PointMm,
         to: PointMm,
@@ -104,8 +21,8 @@ impl Core {
         lit: bool,
         out: &mut dyn ActionSink,
     ) -> Option<u32> {
-        let strokes = lit && !self.actuator.uses_gimbal();
-        if let Some(next) = self.gcode.galvo.adopt.take() {
+        let strokes = lit && !self.drivers().lockstep();
+        if let Some(next) = self.jobs.galvo.adopt.take() {
             if strokes && let Some(seq) = self.gcode_galvo_adopt(from, next) {
                 return Some(seq);
             }
@@ -121,7 +38,7 @@ impl Core {
             .flatten();
         let request = match (piece, lit) {
             (Some(piece), _) => {
-                self.gcode.galvo = GalvoStroke {
+                self.jobs.galvo = GalvoStroke {
                     seq: Some(seq),
                     cover: piece.cover,
                     ..GalvoStroke::default()
@@ -149,7 +66,7 @@ impl Core {
         self.send_galvo(request, out).then_some(seq)
     }
 
-    fn gcode_galvo_stroke_request(&self, seq: u32, piece: Piece) -> GalvoRequest {
+    pub(super) fn gcode_galvo_stroke_request(&self, seq: u32, piece: Piece) -> GalvoRequest {
         GalvoRequest::Path {
             seq,
             path: Figure::Stroke(piece.stroke),
@@ -158,7 +75,7 @@ impl Core {
     }
 
     /// The block at `pos` (0: the block in flight), its steps on the galvo.
-    fn gcode_galvo_block(&self, pos: usize) -> Option<(Block, u32)> {
+    pub(super) fn gcode_galvo_block(&self, pos: usize) -> Option<(Block, u32)> {
         let motion = &self.gcode.motion;
         let c = motion.current?;
         if pos == 0 {
@@ -175,7 +92,7 @@ impl Core {
     }
 
     /// Where the piece after one starting at `start` with `cover` starts.
-    fn gcode_galvo_after(&self, start: Cursor, cover: Cover) -> Cursor {
+    pub(super) fn gcode_galvo_after(&self, start: Cursor, cover: Cover) -> Cursor {
         let count = self.gcode_galvo_block(start.pos).map_or(0, |(_, n)| n);
         if cover.joined == 0 && cover.last_index < count {
             Cursor {
@@ -194,7 +111,7 @@ impl Core {
     /// (index 0: the block in flight's current step) through whole lit
     /// blocks queued after it, up to `max_lines`: `None` when its first
     /// block is not a lit feed move (the block in flight: not a feed move).
-    fn gcode_galvo_piece(
+    pub(super) fn gcode_galvo_piece(
         &self,
         from: PointMm,
         start: Cursor,
@@ -264,14 +181,18 @@ impl Core {
     /// the blocks joined to it leave the queue (the last one becomes the
     /// block in flight, at its end); the next piece sent ahead is in
     /// flight from the next step. The caller then finishes the step.
-    pub(super) fn gcode_galvo_stroke_done(&mut self, seq: u32, out: &mut dyn ActionSink) {
-        let record = core::mem::take(&mut self.gcode.galvo);
+    pub(in crate::sequencer) fn gcode_galvo_stroke_done(
+        &mut self,
+        seq: u32,
+        out: &mut dyn ActionSink,
+    ) {
+        let record = core::mem::take(&mut self.jobs.galvo);
         if record.seq != Some(seq) {
             return;
         }
         let [first, second] = record.ahead;
-        self.gcode.galvo.adopt = first;
-        self.gcode.galvo.ahead = [second, None];
+        self.jobs.galvo.adopt = first;
+        self.jobs.galvo.ahead = [second, None];
         let motion = &mut self.gcode.motion;
         let Some(c) = motion.current.as_mut() else {
             return;
@@ -319,7 +240,41 @@ fn feed_of(block: &Block) -> Option<f64> {
     }
 }
 
-mod ahead;
-mod hold;
-#[cfg(test)]
-mod tests;
+impl Core {
+    /// The galvo's marking feed for programmed feed `feed_mm_min`: the feed
+    /// override applied, capped by the galvo's marking speed
+    /// (`galvo.mark_speed_mm_s`), mm/min.
+    pub(in crate::sequencer) fn gcode_galvo_feed_mm_min(&self, feed_mm_min: f64) -> f64 {
+        let feed = self.gcode.overrides.feed_mm_min(feed_mm_min);
+        feed.min(self.settings.galvo.mark_speed_mm_s * 60.0)
+    }
+
+    /// The galvo loop finished job `seq`; `true` when it was the G-code
+    /// step's.
+    pub(in crate::sequencer) fn gcode_galvo_done(
+        &mut self,
+        seq: u32,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        let Some(c) = self.gcode.motion.current.as_mut() else {
+            return false;
+        };
+        if c.galvo_seq != Some(seq) {
+            return false;
+        }
+        c.galvo_seq = None;
+        self.gcode_galvo_stroke_done(seq, out);
+        self.gcode_step_done(out);
+        self.gcode_galvo_drop_unadopted(out);
+        true
+    }
+
+    /// Whether the G-code step waits for galvo job `seq`.
+    pub(in crate::sequencer) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
+        self.gcode
+            .motion
+            .current
+            .is_some_and(|c| c.galvo_seq == Some(seq))
+            || self.gcode_galvo_ahead_is(seq)
+    }
+}

@@ -1,90 +1,26 @@
-//! G-code on the stepper pan/tilt (`target stepper`): each block goes to
-//! the stepper task as a move along its board line or arc (G0 as joint
-//! travel), cut there within the stepper's line tolerance and planned by
-//! its look-ahead planner. A block is handed on as soon as the stepper
-//! has taken the one before ([`StepperEvent::Taken`]), so the planner
-//! joins them at speed; the block before a change of the laser (dark ↔
-//! lit, or of its M3/M4 and S), a dwell, a pause or the end waits for
-//! rest, so the laser switches where the spot is (the stepper runs
-//! several blocks ahead of the one the sequencer hands over). A feed hold decelerates along the path at the
-//! limit (laser dark at once); `~` goes on from the point it stopped at:
-//! the rest of the block it stopped in, then the queue.
+//! The stepper driver's G-code stage: blocks handed over whole to its task.
 
-use kinematics_core::Rotation;
-use kinematics_core::frames::BoardPoint;
-
-use super::gcode::GrblMode;
-use super::gcode_motion::{Hold, cm};
-use super::gcode_stream::planned_length;
-use super::machine::{Action, ActionSink, Core};
 use crate::domain::PointCm;
-use crate::grbl::{Alarm, GrblError, Laser};
-use crate::grbl::{Block, PointMm};
+use crate::grbl::{Alarm, Block, GrblError, Laser, PointMm};
+use crate::sequencer::drivers::stepper::StepperJob;
+use crate::sequencer::gcode::GrblMode;
+use crate::sequencer::gcode::queue::{Hold, cm, planned_length};
+use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
 use crate::text::reply_text;
-
-/// What the stepper has of the G-code job.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct StepperJob {
-    /// The last move handed over and not yet at rest.
-    inflight: Option<u32>,
-    /// The laser of the blocks handed over: lit, and with what setting.
-    lit: bool,
-    laser: Laser,
-    /// The current block waits for rest before it is handed over.
-    waiting: bool,
-    /// A hold came to rest: `~` asks the stepper to go on with its moves.
-    held: bool,
-    /// A hold was asked and the stepper has not reported rest yet.
-    braking: bool,
-    /// The feed override the stepper task has, % (`None`: not sent since
-    /// the last stop).
-    feed_percent: Option<u8>,
-    /// The step generator's speed over the running block's cruise speed,
-    /// ‰ (the shell notes it before each event).
-    pub(super) speed_permille: u16,
-}
-
-/// The laser setting of a feed block (default for others).
-fn block_laser(block: &Block) -> Laser {
-    match *block {
-        Block::Line { laser, .. } | Block::Arc { laser, .. } => laser,
-        _ => Laser::default(),
-    }
-}
-
-/// The stepper move of a motion block: end point (cm) and shape.
-fn stepper_move(block: &Block) -> Option<(BoardPoint, MoveShape)> {
-    let board = |p: PointMm| {
-        let p = cm(p);
-        BoardPoint::new(p.x_cm, p.y_cm)
-    };
-    Some(match *block {
-        Block::Rapid { to, .. } => (board(to), MoveShape::Travel),
-        Block::Line { to, .. } | Block::Jog { to, .. } => (board(to), MoveShape::Line),
-        Block::Arc { arc, .. } => {
-            let rotation = if arc.sweep_rad < 0.0 {
-                Rotation::Cw
-            } else {
-                Rotation::Ccw
-            };
-            let centre = board(arc.centre);
-            (board(arc.to), MoveShape::Arc { centre, rotation })
-        }
-        _ => return None,
-    })
-}
+use kinematics_core::Rotation;
+use kinematics_core::frames::BoardPoint;
 
 impl Core {
     /// Hands the current block to the stepper (or waits for rest first).
     #[inline(never)]
-    pub(super) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
         let Some(current) = self.gcode.motion.current else {
             return;
         };
         let lit = self.lights(&current.block) && self.gcode.motion.hold == Hold::None;
         let laser = block_laser(&current.block);
-        let job = &mut self.gcode.motion.stepper;
+        let job = &mut self.jobs.stepper;
         if job.inflight.is_some() && (lit != job.lit || (lit && laser != job.laser)) {
             job.waiting = true;
             return;
@@ -109,8 +45,8 @@ impl Core {
         if let Some(c) = motion.current.as_mut() {
             c.stepper_seq = Some(seq);
         }
-        motion.stepper.lit = lit;
-        motion.stepper.laser = laser;
+        self.jobs.stepper.lit = lit;
+        self.jobs.stepper.laser = laser;
         // Unlike a servo's, the stepper's position is known from the
         // start (its counted steps): the first move is cut from there.
         motion.gimbal_lit = lit;
@@ -131,10 +67,11 @@ impl Core {
     /// Tells the stepper task the feed override when it changed (it
     /// applies it on the fly, to the move being cut too).
     #[inline(never)]
-    pub(super) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
         let percent = self.gcode.overrides.feed;
-        let job = &mut self.gcode.motion.stepper;
-        if self.actuator.uses_stepper() && job.feed_percent != Some(percent) {
+        let stepping = self.drivers().hands_over_blocks();
+        let job = &mut self.jobs.stepper;
+        if stepping && job.feed_percent != Some(percent) {
             job.feed_percent = Some(percent);
             out.act(Action::Stepper(StepperRequest::FeedOverride { percent }));
         }
@@ -157,7 +94,7 @@ impl Core {
             shape,
             feed_mm_s,
         }));
-        self.gcode.motion.stepper.inflight = Some(seq);
+        self.jobs.stepper.inflight = Some(seq);
         seq
     }
 
@@ -167,7 +104,7 @@ impl Core {
     #[inline(never)]
     fn stepper_joins_next(&self) -> bool {
         let motion = &self.gcode.motion;
-        let job = &motion.stepper;
+        let job = &self.jobs.stepper;
         let same_laser =
             |b: &Block| self.lights(b) == job.lit && (!job.lit || block_laser(b) == job.laser);
         motion.hold == Hold::None
@@ -179,7 +116,7 @@ impl Core {
 
     /// The G-code side of a stepper report: `true` when it was the job's.
     #[inline(never)]
-    pub(super) fn gcode_stepper_event(
+    pub(in crate::sequencer) fn gcode_stepper_event(
         &mut self,
         event: &StepperEvent,
         out: &mut dyn ActionSink,
@@ -193,17 +130,17 @@ impl Core {
                 self.gcode_stepper_done(out);
                 true
             }
-            StepperEvent::Arrived { seq, .. } if motion.stepper.inflight == Some(seq) => {
-                motion.stepper.inflight = None;
+            StepperEvent::Arrived { seq, .. } if self.jobs.stepper.inflight == Some(seq) => {
+                self.jobs.stepper.inflight = None;
                 motion.arrived = true;
                 if ours(seq) {
                     self.gcode_stepper_done(out);
-                } else if motion.stepper.waiting {
+                } else if self.jobs.stepper.waiting {
                     self.gcode_stepper_send(out);
                 }
                 true
             }
-            StepperEvent::Refused { seq, why } if motion.stepper.inflight == Some(seq) => {
+            StepperEvent::Refused { seq, why } if self.jobs.stepper.inflight == Some(seq) => {
                 // The checks before it passed, the stepper refused it
                 // (its axes beyond their soft limits): as on the galvo.
                 self.notify(out, format_args!("MSG:stepper: move refused: {why:?}"));
@@ -211,7 +148,7 @@ impl Core {
                 true
             }
             StepperEvent::Stopped { steps } => {
-                let braked = core::mem::take(&mut motion.stepper.braking);
+                let braked = core::mem::take(&mut self.jobs.stepper.braking);
                 if !braked && !motion.is_idle() {
                     // The rest of a stop from before the job (`target
                     // stepper` typed ahead of it): its moves run on.
@@ -219,7 +156,7 @@ impl Core {
                 }
                 self.gcode_stepper_at(steps);
                 let motion = &mut self.gcode.motion;
-                motion.stepper.held |= braked;
+                self.jobs.stepper.held |= braked;
                 match motion.hold {
                     Hold::Stopping if braked => motion.hold = Hold::Held,
                     // `~` came while it braked: it goes on now it is at
@@ -243,7 +180,7 @@ impl Core {
             .joints_of(steps)
             .and_then(|j| config.gimbal.fk(j).ok());
         let motion = &mut self.gcode.motion;
-        motion.stepper.inflight = None;
+        self.jobs.stepper.inflight = None;
         if let Some(p) = at {
             motion.position = PointMm {
                 x_mm: p.x_cm * 10.0,
@@ -258,7 +195,7 @@ impl Core {
     /// grbl, `ALARM:N` (locked) and then `ok`; parameters that allow no
     /// homing: `error:5`.
     #[inline(never)]
-    pub(super) fn gcode_homing_done(
+    pub(in crate::sequencer) fn gcode_homing_done(
         &mut self,
         steps: [i32; 2],
         failed: Option<HomingFailure>,
@@ -300,21 +237,22 @@ impl Core {
     /// `!` on the stepper: decelerate along the path, dark at once.
     /// `false` when nothing moves there.
     #[inline(never)]
-    pub(super) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
+    pub(in crate::sequencer) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
+        let stepping = self.drivers().hands_over_blocks();
         let motion = &mut self.gcode.motion;
-        if !self.actuator.uses_stepper() || motion.stepper.inflight.is_none() {
+        if !stepping || self.jobs.stepper.inflight.is_none() {
             return false;
         }
         motion.gimbal_lit = false;
         motion.hold = Hold::Stopping;
-        motion.stepper.braking = true;
+        self.jobs.stepper.braking = true;
         out.act(Action::Stepper(StepperRequest::Hold));
         true
     }
 
     /// Whether the stepper reaches board point `p` within its soft limits.
     #[inline(never)]
-    pub(super) fn stepper_reaches(&self, p: PointCm) -> bool {
+    pub(in crate::sequencer) fn stepper_reaches(&self, p: PointCm) -> bool {
         let config = self.stepper_config();
         config
             .gimbal
@@ -323,22 +261,39 @@ impl Core {
     }
 }
 
-impl super::gcode_motion::Motion {
-    /// Whether the stepper runs a move of the job.
-    pub(super) fn stepper_moving(&self) -> bool {
-        self.stepper.inflight.is_some()
-    }
-}
-
 impl StepperJob {
-    /// Forgets the job (a stop, a reset).
-    #[inline(never)]
-    pub(super) fn clear(&mut self) {
-        *self = Self::default();
+    /// Whether the stepper runs a move of the job.
+    pub(in crate::sequencer) fn is_moving(&self) -> bool {
+        self.inflight.is_some()
     }
 }
 
-#[cfg(test)]
-mod arc_tests;
-#[cfg(test)]
-mod tests;
+/// The laser setting of a feed block (default for others).
+fn block_laser(block: &Block) -> Laser {
+    match *block {
+        Block::Line { laser, .. } | Block::Arc { laser, .. } => laser,
+        _ => Laser::default(),
+    }
+}
+
+/// The stepper move of a motion block: end point (cm) and shape.
+fn stepper_move(block: &Block) -> Option<(BoardPoint, MoveShape)> {
+    let board = |p: PointMm| {
+        let p = cm(p);
+        BoardPoint::new(p.x_cm, p.y_cm)
+    };
+    Some(match *block {
+        Block::Rapid { to, .. } => (board(to), MoveShape::Travel),
+        Block::Line { to, .. } | Block::Jog { to, .. } => (board(to), MoveShape::Line),
+        Block::Arc { arc, .. } => {
+            let rotation = if arc.sweep_rad < 0.0 {
+                Rotation::Cw
+            } else {
+                Rotation::Ccw
+            };
+            let centre = board(arc.centre);
+            (board(arc.to), MoveShape::Arc { centre, rotation })
+        }
+        _ => return None,
+    })
+}

@@ -1,18 +1,22 @@
 //! What the grbl session reports: status reports (`?`), `$$`, `$#`,
 //! `$G`, `$I`, `$N` and `$` help, formatted by [`crate::grbl::report`].
 
-use super::gcode::{GrblMode, RX_BUFFER_BYTES};
-use super::gcode_motion::{Hold, PLANNER_BLOCKS};
-use super::machine::{ActionSink, Core};
 use crate::grbl::ParserState;
 use crate::grbl::report::{self, MachineState, Status};
 use crate::grbl::system::SystemCommand;
+use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
+use crate::sequencer::gcode::{GrblMode, RX_BUFFER_BYTES};
+use crate::sequencer::machine::{ActionSink, Core};
 use crate::text::reply_text;
 
 impl Core {
     /// The `$` commands that only report (`$`, `$$`, `$#`, `$G`, `$I`,
     /// `$N`): their data lines.
-    pub(super) fn grbl_info(&mut self, command: SystemCommand<'_>, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn grbl_info(
+        &mut self,
+        command: SystemCommand<'_>,
+        out: &mut dyn ActionSink,
+    ) {
         match command {
             SystemCommand::Help => {
                 self.grbl_data(out, reply_text(format_args!("{}", report::HELP)))
@@ -50,7 +54,11 @@ impl Core {
     }
 
     /// `?`: one status report, whatever the state.
-    pub(super) fn grbl_status(&mut self, rx_free_bytes: u16, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn grbl_status(
+        &mut self,
+        rx_free_bytes: u16,
+        out: &mut dyn ActionSink,
+    ) {
         let g = &self.gcode;
         let motion = &g.motion;
         let state = match (g.mode, motion.hold) {
@@ -66,12 +74,10 @@ impl Core {
             _ if motion.is_idle() => MachineState::Idle,
             _ => MachineState::Run,
         };
-        let (mut feed, _) = motion.feed_and_power(&g.overrides);
+        let (mut feed, _) = motion.feed_and_power(&g.overrides, &self.jobs.gimbal);
         let power = self.gcode_reported_power();
-        if self.actuator.uses_galvo() {
-            // The galvo marks at most at its marking speed.
-            feed = feed.min(self.settings.galvo.mark_speed_mm_s * 60.0);
-        }
+        // A driver may mark at most at its marking speed.
+        feed = feed.min(self.drivers().feed_cap_mm_min(&self.settings));
         let mask = g.values.report_mask;
         let free_blocks = (PLANNER_BLOCKS - motion.queue.len()) as u16;
         let status = Status {

@@ -3,11 +3,11 @@
 //! chords) marked by then are finished, the block in progress is left at
 //! the stop point, so `~` marks only what is left of the contour.
 
-use super::super::gcode_motion::{Hold, point_at};
-use super::super::machine::{ActionSink, Core};
-use super::Cursor;
 use crate::galvo::MarkStop;
 use crate::grbl::PointMm;
+use crate::sequencer::drivers::galvo::Cursor;
+use crate::sequencer::gcode::queue::{Hold, point_at};
+use crate::sequencer::machine::{ActionSink, Core};
 
 /// A stop closer than this to the end of its step (mm) ends the step.
 const AT_END_MM: f64 = 1e-3;
@@ -18,16 +18,17 @@ impl Core {
     /// it does.
     pub(in crate::sequencer) fn gcode_galvo_hold(&mut self) -> bool {
         let c = self.gcode.motion.current;
-        let record = &mut self.gcode.galvo;
+        let lockstep = self.drivers().lockstep();
+        let record = &mut self.jobs.galvo;
         // (Still waiting after a `!`, `~` before the report, `!`.)
-        record.stopping |= !self.actuator.uses_gimbal()
-            && c.is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == record.seq);
+        record.stopping |=
+            !lockstep && c.is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == record.seq);
         record.stopping
     }
 
     /// A stop or reset dropped the hold: no report is awaited.
     pub(in crate::sequencer) fn gcode_galvo_hold_dropped(&mut self) {
-        self.gcode.galvo.stopping = false;
+        self.jobs.galvo.stopping = false;
     }
 
     /// The galvo stopped (`at`: where marking ended, if it marked): when a
@@ -39,11 +40,11 @@ impl Core {
         at: Option<MarkStop>,
         out: &mut dyn ActionSink,
     ) {
-        if !self.gcode.galvo.stopping {
+        if !self.jobs.galvo.stopping {
             return;
         }
         // The galvo dropped the pieces sent ahead.
-        let record = core::mem::take(&mut self.gcode.galvo);
+        let record = core::mem::take(&mut self.jobs.galvo);
         let piece = at.and_then(|at| match record.seq == Some(at.seq) {
             true => Some((at, Cursor { pos: 0, index: 0 })),
             false => (record.ahead.iter().flatten())

@@ -7,21 +7,21 @@
 //! [`Core::stop`] closes the gate first). The stop button halts the steps
 //! at once through the link itself.
 
-use kinematics_core::frames::BoardPoint;
-use kinematics_core::gimbal::{Gimbal, GimbalModel};
-
-use super::machine::{Action, ActionSink, Core};
-use super::run::RunKind;
 use crate::domain::{Aim, Pattern, PointCm, Segment, Target, Unit};
 use crate::log;
+use crate::sequencer::drivers::Driver;
+use crate::sequencer::machine::{Action, ActionSink, Core};
+use crate::sequencer::run::RunKind;
 use crate::stepper::{HomingFailure, MoveShape, StepperConfig, StepperEvent, StepperRequest};
 use crate::text::Fixed;
+use kinematics_core::frames::BoardPoint;
+use kinematics_core::gimbal::{Gimbal, GimbalModel};
 
 impl Core {
     /// The stepper parameters from the settings (`stepper.*`), on the
     /// board placed as the settings say (OQ, offsets, pose), exact model,
     /// OL = 0 (the pan/tilt's axes meet at the beam).
-    pub(super) fn stepper_config(&self) -> StepperConfig {
+    pub(in crate::sequencer) fn stepper_config(&self) -> StepperConfig {
         let mut geometry = self
             .settings
             .gimbal(crate::domain::AimModel::Exact)
@@ -36,7 +36,7 @@ impl Core {
 
     /// Sends the stepper task its parameters (applied at rest; the
     /// junction deviation the product's, `stepper.junction_deg`).
-    pub(super) fn configure_stepper(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn configure_stepper(&mut self, out: &mut dyn ActionSink) {
         self.gcode.stepper_junction_deg = None;
         out.act(Action::ConfigureStepper(self.stepper_config()));
     }
@@ -44,7 +44,7 @@ impl Core {
     /// The stepper plans with the junction deviation of `gcode` (grbl's
     /// `$11`, mm at the board, as joint degrees at its centre) or of the
     /// product (`stepper.junction_deg`); told when it changes.
-    pub(super) fn stepper_junction(&mut self, gcode: bool, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn stepper_junction(&mut self, gcode: bool, out: &mut dyn ActionSink) {
         let want = gcode
             .then(|| (self.settings.gcode_junction_mm / (self.settings.oq_cm * 10.0)).to_degrees());
         if want != self.gcode.stepper_junction_deg {
@@ -55,8 +55,8 @@ impl Core {
     }
 
     /// Decelerates the stepper to rest (when it draws).
-    pub(super) fn stop_stepper(&self, out: &mut dyn ActionSink) {
-        if self.actuator.uses_stepper() {
+    pub(in crate::sequencer) fn stop_stepper(&self, out: &mut dyn ActionSink) {
+        if self.drivers().hands_over_blocks() {
             out.act(Action::Stepper(StepperRequest::Stop));
         }
     }
@@ -64,7 +64,7 @@ impl Core {
     /// Sends the current point to the stepper task: travel (`approach`,
     /// grid and goto points) straight in joint space, a path's next point
     /// along the board line.
-    pub(super) fn begin_stepper_move(
+    pub(in crate::sequencer) fn begin_stepper_move(
         &mut self,
         target: Target,
         approach: bool,
@@ -88,7 +88,9 @@ impl Core {
             shape,
             feed_mm_s: None,
         }));
-        out.act(Action::Note(super::laser::LaserEvent::GimbalMoveSent));
+        out.act(Action::Note(
+            crate::sequencer::laser::LaserEvent::GimbalMoveSent,
+        ));
         log::info!(
             "stepper target ({}, {}) cm ({})",
             target.point.x_cm,
@@ -113,7 +115,7 @@ impl Core {
 
     /// How a traced run of `pattern` runs (`None`: a figure of more than
     /// one stroke, which the stepper does not trace).
-    pub(super) fn traced(pattern: Pattern, once: bool) -> Option<RunKind> {
+    pub(in crate::sequencer) fn traced(pattern: Pattern, once: bool) -> Option<RunKind> {
         let Pattern::Path(figure) = pattern else {
             return None;
         };
@@ -124,7 +126,7 @@ impl Core {
 
     /// Point `index` of a traced pass: the stroke's start, then each
     /// segment's end (`None` past the last).
-    pub(super) fn traced_target(pattern: &Pattern, index: usize) -> Option<Target> {
+    pub(in crate::sequencer) fn traced_target(pattern: &Pattern, index: usize) -> Option<Target> {
         let Pattern::Path(figure) = pattern else {
             return None;
         };
@@ -165,7 +167,11 @@ impl Core {
     }
 
     /// The stepper task's report.
-    pub(super) fn stepper_event(&mut self, event: StepperEvent, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn stepper_event(
+        &mut self,
+        event: StepperEvent,
+        out: &mut dyn ActionSink,
+    ) {
         if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
             self.stepper_homing = false;
         }
@@ -241,8 +247,11 @@ impl Core {
     ///
     /// Errors: not the stepper, or no switches (nothing changes; the
     /// power-up position stays step 0).
-    pub(super) fn start_homing(&mut self, out: &mut dyn ActionSink) -> Result<(), &'static str> {
-        if !self.actuator.uses_stepper() {
+    pub(in crate::sequencer) fn start_homing(
+        &mut self,
+        out: &mut dyn ActionSink,
+    ) -> Result<(), &'static str> {
+        if !self.drivers().any(Driver::homes_with_switches) {
             return Err("home: only with target stepper");
         }
         let s = &self.settings.stepper;

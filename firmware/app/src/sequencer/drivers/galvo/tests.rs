@@ -4,16 +4,14 @@
 
 extern crate std;
 
-use std::vec::Vec;
-
-use embassy_time::Instant;
-
-use super::super::gcode::tests::{closers, line, on, realtime, status};
-use super::super::gcode_motion::PLANNER_BLOCKS;
-use super::super::machine::{Action, Core, Event};
 use crate::domain::{Actuator, Figure};
 use crate::galvo::{GalvoEvent, GalvoRequest, MarkStop};
 use crate::grbl::realtime::Realtime;
+use crate::sequencer::gcode::queue::PLANNER_BLOCKS;
+use crate::sequencer::gcode::tests::{closers, line, on, realtime, status};
+use crate::sequencer::machine::{Action, Core, Event};
+use embassy_time::Instant;
+use std::vec::Vec;
 
 /// The galvo requests in `actions`: (seq, stroke segments or `None` for
 /// another request, marking speed).

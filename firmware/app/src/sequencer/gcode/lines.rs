@@ -1,91 +1,22 @@
-//! The grbl side of the sequencer: G-code and `$` lines from the console
-//! (through [`crate::grbl`]'s parser into the motion queue of
-//! [`super::gcode_motion`]), grbl's realtime commands, and every reply a
-//! sender expects (`ok` once a line's motion is queued, `error:N`,
-//! `ALARM:N`, status reports).
+//! G-code and `$` lines and realtime commands of the session.
 
-use super::gcode_galvo::GalvoStroke;
-use super::gcode_motion::{Hold, Motion, PLANNER_BLOCKS};
-use super::gcode_settings::GrblValues;
-use super::machine::{Action, ActionSink, Core, Line};
 use crate::command::RealtimeRequest;
 use crate::grbl::classify::{LineKind, classify};
 use crate::grbl::realtime::Realtime;
-use crate::grbl::report::{self, Overrides};
+use crate::grbl::report;
 use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
-use crate::grbl::{Alarm, Block, Blocks, GrblError, ParserState};
+use crate::grbl::{Alarm, Block, Blocks, GrblError};
+use crate::sequencer::drivers::Driver;
+use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
+use crate::sequencer::gcode::{GrblMode, GrblValues, NO_OVERRIDES};
+use crate::sequencer::machine::{Action, ActionSink, Core, Line};
 use crate::settings::Settings;
 use crate::text::{ReplyText, reply_text};
-
-/// grbl's RX buffer as `$I` advertises it, bytes.
-pub(super) const RX_BUFFER_BYTES: u16 = crate::grbl::RX_BUFFER_BYTES as u16;
-
-/// Overrides at power-up and after a reset: 100 %.
-const NO_OVERRIDES: Overrides = Overrides {
-    feed: 100,
-    rapid: 100,
-    spindle: 100,
-};
-
-/// Whether G-code runs, is only checked, or is locked by an alarm.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum GrblMode {
-    /// Lines are queued and run.
-    Normal,
-    /// `$C`: lines are parsed and answered, nothing moves.
-    Check,
-    /// Locked until `$X`, `$H` or a reset.
-    Alarm,
-}
-
-/// The grbl session's state.
-#[derive(Debug, Clone)]
-pub(super) struct Gcode {
-    /// Modal state of the lines accepted so far.
-    pub(super) parser: ParserState,
-    pub(super) mode: GrblMode,
-    /// grbl-only settings (`$10`, `$11`, `$12`, `$30`–`$32`).
-    pub(super) values: GrblValues,
-    /// Feed / rapid / laser power overrides, %.
-    pub(super) overrides: Overrides,
-    /// The motion queue and what runs.
-    pub(super) motion: Motion,
-    /// Status reports sent (grbl adds `WCO:` / `Ov:` every few).
-    pub(super) reports: u32,
-    /// The galvo stroke in flight (several blocks joined).
-    pub(super) galvo: GalvoStroke,
-    /// Actual over programmed speed of the gimbal step in flight, 0..=1
-    /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
-    pub(super) step_speed_ratio: f32,
-    /// A `$H` on the stepper waits for homing to end for its reply.
-    pub(super) homing: bool,
-    /// The junction deviation the stepper plans with when G-code set it
-    /// (`$11` in joint degrees; `None`: the product's, from its settings).
-    pub(super) stepper_junction_deg: Option<f64>,
-}
-
-impl Gcode {
-    /// Power-up state.
-    pub(super) fn new() -> Self {
-        Self {
-            parser: ParserState::new(),
-            mode: GrblMode::Normal,
-            values: GrblValues::default(),
-            overrides: NO_OVERRIDES,
-            motion: Motion::new(),
-            reports: 0,
-            galvo: GalvoStroke::default(),
-            step_speed_ratio: 0.0,
-            homing: false,
-            stepper_junction_deg: None,
-        }
-    }
-}
 
 impl Core {
     /// A G-code or `$` line from the console: closed with `ok` (for a
     /// motion, once it is queued) or `error:N`.
-    pub(super) fn grbl_line(&mut self, line: &str, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn grbl_line(&mut self, line: &str, out: &mut dyn ActionSink) {
         match classify(line) {
             LineKind::System => self.grbl_system(line, out),
             _ => self.grbl_gcode(line, out),
@@ -93,17 +24,17 @@ impl Core {
     }
 
     /// Closes the current reply with `error:N`.
-    pub(super) fn grbl_error(&self, out: &mut dyn ActionSink, error: GrblError) {
+    pub(in crate::sequencer) fn grbl_error(&self, out: &mut dyn ActionSink, error: GrblError) {
         out.act(Action::Line(Line::GrblError(error)));
     }
 
     /// A data line in grbl's form (no decoration).
-    pub(super) fn grbl_data(&self, out: &mut dyn ActionSink, text: ReplyText) {
+    pub(in crate::sequencer) fn grbl_data(&self, out: &mut dyn ActionSink, text: ReplyText) {
         out.act(Action::Line(Line::Data(text)));
     }
 
     /// `ALARM:N`, the machine locked; motion stopped, laser dark.
-    pub(super) fn grbl_alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn grbl_alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
         self.stop("grbl alarm", out);
         self.gcode.mode = GrblMode::Alarm;
         self.grbl_data(
@@ -144,7 +75,7 @@ impl Core {
 
     /// Moves the blocks of the line waiting for room into the queue when
     /// they fit, and answers it.
-    pub(super) fn grbl_take_owed(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn grbl_take_owed(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         let Some(blocks) = motion.owed.as_ref() else {
             return;
@@ -236,7 +167,7 @@ impl Core {
         if !idle || self.gcode.mode == GrblMode::Check {
             return self.grbl_error(out, GrblError::NotIdle);
         }
-        if self.actuator.uses_stepper() {
+        if self.drivers().any(Driver::homes_with_switches) {
             // The reply waits for the end of homing (grbl's `$H`): a
             // sender's next lines wait with it.
             return match self.start_homing(out) {
@@ -284,14 +215,18 @@ impl Core {
 
     /// The parser continues from where the spot is (after a stop, a
     /// reset or a jog cancel).
-    pub(super) fn grbl_sync_position(&mut self) {
+    pub(in crate::sequencer) fn grbl_sync_position(&mut self) {
         if self.gcode.motion.is_idle() {
             self.gcode.parser.position = self.gcode.motion.position;
         }
     }
 
     /// A realtime command from the console.
-    pub(super) fn grbl_realtime(&mut self, request: RealtimeRequest, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn grbl_realtime(
+        &mut self,
+        request: RealtimeRequest,
+        out: &mut dyn ActionSink,
+    ) {
         let before = self.gcode.overrides;
         let ov = &mut self.gcode.overrides;
         match request.command {
@@ -316,11 +251,9 @@ impl Core {
     /// interrupted motion.
     fn grbl_reset(&mut self, out: &mut dyn ActionSink) {
         let moving = self.gcode.motion.current.is_some() && self.gcode.motion.hold != Hold::Held;
-        if self.actuator.uses_stepper() {
-            // grbl's reset kills the steps at once (the position is then
-            // uncertain: ALARM:3); `stop` would brake at the limit.
-            out.act(Action::Stepper(crate::stepper::StepperRequest::Halt));
-        }
+        // grbl's reset kills the motion at once where a driver can (the
+        // position is then uncertain: ALARM:3); `stop` would brake.
+        self.drivers_reset(out);
         self.stop("grbl soft reset", out);
         self.gcode.parser.soft_reset();
         self.grbl_sync_position();
@@ -344,6 +277,3 @@ impl Core {
         }
     }
 }
-
-#[cfg(test)]
-pub(super) mod tests;

@@ -2,7 +2,7 @@
 //! override applied to S first and the result clamped (as grbl), M3
 //! constant, M4 (with `$32=1`) scaled by the actual over the programmed
 //! speed. The gimbal's laser output takes the level
-//! ([`super::LaserPower`], PWM on the STM32); the galvo's laser is
+//! ([`crate::sequencer::laser::LaserPower`], PWM on the STM32); the galvo's laser is
 //! switched per sample, so there S > 0 means on.
 //!
 //! "Actual speed" on the gimbal: each G-code step is one servo move timed
@@ -11,17 +11,18 @@
 //! over its time; at rest (the settle at a block's end, a dwell, a hold)
 //! it is 0 and M4 is dark.
 
-use super::gcode_motion::Hold;
-use super::gcode_stream::STREAM_PERIOD_MS;
-use super::laser::LaserPower;
-use super::machine::Core;
 use crate::grbl::report::Overrides;
 use crate::grbl::{Block, Laser, SpindleMode};
+use crate::sequencer::drivers::Driver;
+use crate::sequencer::drivers::gimbal::STREAM_PERIOD_MS;
+use crate::sequencer::gcode::queue::Hold;
+use crate::sequencer::laser::LaserPower;
+use crate::sequencer::machine::Core;
 
 /// Actual over programmed speed of a gimbal step that takes `interval_ms`
 /// where the programmed feed would take `by_feed_ms`: below 1 when the
 /// servos' speed limit stretches it, 0 for a step that does not move.
-pub(super) fn speed_ratio(by_feed_ms: f64, interval_ms: u16) -> f32 {
+pub(in crate::sequencer) fn speed_ratio(by_feed_ms: f64, interval_ms: u16) -> f32 {
     if by_feed_ms <= 0.0 {
         return 0.0;
     }
@@ -49,7 +50,7 @@ impl Core {
     /// The gimbal laser's power: full for the product's own runs; while
     /// G-code lights it, S with the override, × the step's speed ratio
     /// under M4 in laser mode (0 at rest: dark).
-    pub(super) fn gcode_gimbal_power(&self) -> LaserPower {
+    pub(in crate::sequencer) fn gcode_gimbal_power(&self) -> LaserPower {
         if !self.gcode_gimbal_lit() {
             return LaserPower::FULL;
         }
@@ -61,14 +62,14 @@ impl Core {
         if laser.mode == SpindleMode::Dynamic && v.laser_mode {
             let c = self.gcode.motion.current;
             // A streamed block moves while its cursor has speed.
-            let streaming = self.gcode.motion.stream.speed_mm_s() > 0.0;
+            let streaming = self.jobs.gimbal.speed_mm_s() > 0.0;
             let moving = streaming || c.is_some_and(|c| c.until.is_none() && c.servo_seq.is_some());
             // The stepper: its step generator's speed while its steps run.
-            let stepping = self.actuator.uses_stepper()
+            let stepping = self.drivers().any(Driver::polls_speed)
                 && c.is_some_and(|c| c.until.is_none())
-                && self.gcode.motion.stepper_moving();
+                && self.jobs.stepper.is_moving();
             fraction *= if stepping {
-                f32::from(self.gcode.motion.stepper.speed_permille) / 1000.0
+                f32::from(self.jobs.stepper.speed_permille) / 1000.0
             } else if moving {
                 self.gcode.step_speed_ratio
             } else {
@@ -80,23 +81,23 @@ impl Core {
 
     /// The stepper's speed over its block's cruise speed, ‰ (0..=1000,
     /// the step generator's; the shell, before each event).
-    pub(super) fn note_stepper_speed(&mut self, permille: u16) {
-        self.gcode.motion.stepper.speed_permille = permille;
+    pub(in crate::sequencer) fn note_stepper_speed(&mut self, permille: u16) {
+        self.jobs.stepper.speed_permille = permille;
     }
 
     /// While G-code lights the stepper's moves: the next time M4 power
     /// follows its speed (the gimbal's stream period after the last event; under M3
     /// nothing changes then), else `None`.
-    pub(super) fn gcode_stepper_power_tick(&self) -> Option<embassy_time::Instant> {
-        let lit = self.actuator.uses_stepper() && self.gcode_gimbal_lit();
-        (lit && self.gcode.motion.stepper_moving())
+    pub(in crate::sequencer) fn gcode_stepper_power_tick(&self) -> Option<embassy_time::Instant> {
+        let lit = self.drivers().any(Driver::polls_speed) && self.gcode_gimbal_lit();
+        (lit && self.jobs.stepper.is_moving())
             .then(|| self.inputs.now + embassy_time::Duration::from_millis(STREAM_PERIOD_MS))
     }
 
     /// After a realtime command: when it changed an override (`before`
     /// the old values), the next status report carries `Ov:` (as grbl's
     /// report counter reset).
-    pub(super) fn grbl_report_changed_overrides(&mut self, before: Overrides) {
+    pub(in crate::sequencer) fn grbl_report_changed_overrides(&mut self, before: Overrides) {
         if self.gcode.overrides != before {
             self.gcode.reports = 1;
         }
@@ -105,9 +106,9 @@ impl Core {
     /// The power `FS:` reports, in S units: on the galvo the running S
     /// with the override, clamped to `$31`..`$30` (its output is on/off);
     /// elsewhere the level the laser output runs at now (0 when dark).
-    pub(super) fn gcode_reported_power(&self) -> f64 {
+    pub(in crate::sequencer) fn gcode_reported_power(&self) -> f64 {
         let v = &self.gcode.values;
-        let fraction = if self.actuator.uses_galvo() {
+        let fraction = if self.drivers().any(Driver::reports_programmed_power) {
             self.gcode_running_laser()
                 .map_or(0.0, |l| l.fraction(v.s_min, v.s_max))
         } else if self.laser_on && self.gcode_gimbal_lit() {
