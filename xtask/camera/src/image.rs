@@ -23,6 +23,30 @@ impl GrayImage {
         }
     }
 
+    /// The pixel-wise mean of `frames` (same size), rounded: averaging
+    /// N exposures of a still scene divides the sensor noise by √N.
+    pub fn mean(frames: &[GrayImage]) -> Result<Self, String> {
+        let first = frames.first().ok_or("no frames to average")?;
+        if frames
+            .iter()
+            .any(|f| (f.width, f.height) != (first.width, first.height))
+        {
+            return Err("frames to average differ in size".into());
+        }
+        let n = frames.len() as u32;
+        let pixels = (0..first.pixels.len())
+            .map(|i| {
+                let sum: u32 = frames.iter().map(|f| u32::from(f.pixels[i])).sum();
+                ((sum + n / 2) / n) as u8
+            })
+            .collect();
+        Ok(Self {
+            width: first.width,
+            height: first.height,
+            pixels,
+        })
+    }
+
     /// Value at column `x`, row `y` (`None` outside).
     pub fn get(&self, x: usize, y: usize) -> Option<u8> {
         (x < self.width)

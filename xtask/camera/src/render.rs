@@ -195,6 +195,20 @@ impl VirtualCamera {
         }
     }
 
+    /// The mean of `n` exposures (different noise) of `scene` with `spots` lit.
+    pub fn averaged_frame(
+        &self,
+        scene: &Scene,
+        spots: &[LaserSpot],
+        n: usize,
+        seed: u64,
+    ) -> GrayImage {
+        let frames: Vec<GrayImage> = (0..n.max(1) as u64)
+            .map(|k| self.frame(scene, spots, seed.wrapping_mul(31).wrapping_add(k)))
+            .collect();
+        GrayImage::mean(&frames).unwrap_or_else(|_| self.frame(scene, spots, seed))
+    }
+
     /// Scene and one frame in one call.
     pub fn render(&self, spots: &[LaserSpot], seed: u64) -> GrayImage {
         self.frame(&self.scene(), spots, seed)

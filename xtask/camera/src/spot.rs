@@ -181,7 +181,7 @@ pub fn detect_spot(
     let Some(main) = blobs.first() else {
         return Err(SpotError::NoSpot);
     };
-    let centroid_of = |b: &Blob| centroid(b, w, &diff, low, noise, &frame.pixels).0;
+    let centroid_of = |b: &Blob| centroid(b, frame, background, low, noise).0;
     if let Some(second) = blobs
         .get(1)
         .filter(|s| s.light >= SECOND_SPOT_RATIO * main.light)
@@ -190,7 +190,7 @@ pub fn detect_spot(
             at: [centroid_of(main), centroid_of(second)],
         });
     }
-    let (image_px, sigma_px) = centroid(main, w, &diff, low, noise, &frame.pixels);
+    let (image_px, sigma_px) = centroid(main, frame, background, low, noise);
     Ok(SpotMeasurement {
         image_px,
         sigma_px,
@@ -204,39 +204,56 @@ pub fn detect_spot(
     })
 }
 
-/// Intensity-weighted centroid (weights: difference above `floor`) and
-/// its 1-σ error from `noise` DN per pixel. Saturated pixels all weigh
-/// the same (the largest difference among them): their true brightness
-/// is unknown, and clipping at 255 over a textured print would otherwise
-/// weigh the core by the print's darkness.
+/// Intensity-weighted centroid over the blob's bounding box (+2 px) and
+/// its 1-σ error from `noise` DN per pixel. The difference is
+/// flat-fielded by the background (divided by the print's reflectance
+/// relative to white paper, at most 10×), so a spot half on a printed
+/// line is not pulled off it, and clipped at the paper's saturation
+/// level: saturated pixels all weigh the same, a symmetric profile.
 fn centroid(
     b: &Blob,
-    w: usize,
-    diff: &impl Fn(usize) -> f64,
+    frame: &GrayImage,
+    background: &GrayImage,
     floor: f64,
     noise: f64,
-    frame: &[u8],
 ) -> ([f64; 2], f64) {
-    let saturated = |i: usize| frame.get(i) == Some(&255);
-    let core = b
-        .pixels
-        .iter()
-        .filter(|&&i| saturated(i))
-        .map(|&i| diff(i))
-        .fold(0.0, f64::max);
-    let (mut sw, mut sx, mut sy) = (0.0, 0.0, 0.0);
+    let w = frame.width;
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
     for &i in &b.pixels {
-        let d = if saturated(i) { core } else { diff(i) };
-        let wgt = (d - floor).max(0.0);
-        sw += wgt;
-        sx += wgt * (i % w) as f64;
-        sy += wgt * (i / w) as f64;
+        let (x, y) = (i % w, i / w);
+        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+    }
+    let (x0, y0) = (x0.saturating_sub(2), y0.saturating_sub(2));
+    let (x1, y1) = ((x1 + 2).min(w - 1), (y1 + 2).min(frame.height - 1));
+    let at = |img: &GrayImage, x: usize, y: usize| f64::from(img.pixels[y * w + x]);
+    let paper = (y0..=y1)
+        .flat_map(|y| (x0..=x1).map(move |x| (x, y)))
+        .map(|(x, y)| at(background, x, y))
+        .fold(1.0, f64::max);
+    let clip = 255.0 - paper;
+    let (mut sw, mut sx, mut sy, mut sg2) = (0.0, 0.0, 0.0, Vec::new());
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let gain = paper / at(background, x, y).max(paper / 10.0);
+            let f = if at(frame, x, y) >= 255.0 {
+                clip
+            } else {
+                ((at(frame, x, y) - at(background, x, y)) * gain).min(clip)
+            };
+            let wgt = (f - floor).max(0.0);
+            if wgt > 0.0 {
+                sw += wgt;
+                sx += wgt * x as f64;
+                sy += wgt * y as f64;
+                sg2.push((x, y, gain));
+            }
+        }
     }
     let c = [sx / sw, sy / sw];
     let (mut vx, mut vy) = (0.0, 0.0);
-    for &i in &b.pixels {
-        vx += ((i % w) as f64 - c[0]).powi(2);
-        vy += ((i / w) as f64 - c[1]).powi(2);
+    for (x, y, g) in sg2 {
+        vx += (g * (x as f64 - c[0])).powi(2);
+        vy += (g * (y as f64 - c[1])).powi(2);
     }
     (c, noise * vx.max(vy).sqrt() / sw)
 }

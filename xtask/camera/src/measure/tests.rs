@@ -46,7 +46,8 @@ fn spots_on_rendered_frames_are_measured_to_a_twentieth_of_a_millimetre() {
     let vc = reference_camera(0.0);
     assert!(vc.camera.pose.off_normal_deg() >= 20.0);
     let scene = vc.scene();
-    let background = vc.frame(&scene, &[], 1);
+    // 8 laser-off exposures, 4 per point (a 1 s dwell has 30).
+    let background = vc.averaged_frame(&scene, &[], 8, 1);
     let mut det = MarkerDetector::new(background.width, background.height).unwrap();
     let view = locate_board(&mut det, &background, &vc.layout, None).unwrap();
     assert_eq!(view.markers.len(), 14);
@@ -62,7 +63,7 @@ fn spots_on_rendered_frames_are_measured_to_a_twentieth_of_a_millimetre() {
             g[0] + 3.0 * ((k as f64) * 0.7).sin(),
             g[1] + 3.0 * ((k as f64) * 1.3).cos(),
         ];
-        let frame = vc.frame(&scene, &[LaserSpot::at(truth)], 100 + k as u64);
+        let frame = vc.averaged_frame(&scene, &[LaserSpot::at(truth)], 4, 100 + k as u64);
         let m = view.measure(&background, &frame).unwrap();
         let e = (m.board_mm[0] - truth[0]).hypot(m.board_mm[1] - truth[1]);
         assert!(m.sigma_mm > 0.0 && m.sigma_mm < 0.1, "{m:?}");

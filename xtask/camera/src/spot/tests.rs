@@ -1,8 +1,9 @@
 use super::*;
 use crate::noise::Noise;
 
-/// A 200 × 150 textured background and the same with Gaussian spots
-/// (centre px, σ px, peak DN) added, then clipped: both with noise.
+/// A 200 × 150 printed pattern (white 160 DN, grey 120 DN) and the same
+/// with Gaussian spots (centre px, σ px, peak DN on white) scattered by
+/// the print, then clipped: both with noise.
 fn frames(spots: &[([f64; 2], f64, f64)], seed: u64) -> (GrayImage, GrayImage) {
     let (w, h) = (200, 150);
     let base: Vec<f64> = (0..w * h)
@@ -20,12 +21,13 @@ fn frames(spots: &[([f64; 2], f64, f64)], seed: u64) -> (GrayImage, GrayImage) {
         .enumerate()
         .map(|(i, &v)| {
             let (x, y) = ((i % w) as f64, (i / w) as f64);
-            let add: f64 = spots
-                .iter()
-                .map(|(c, s, p)| {
-                    p * (-((x - c[0]).powi(2) + (y - c[1]).powi(2)) / (2.0 * s * s)).exp()
-                })
-                .sum();
+            let add: f64 = v / 160.0
+                * spots
+                    .iter()
+                    .map(|(c, s, p)| {
+                        p * (-((x - c[0]).powi(2) + (y - c[1]).powi(2)) / (2.0 * s * s)).exp()
+                    })
+                    .sum::<f64>();
             noisy(v + add)
         })
         .collect();
