@@ -186,7 +186,7 @@ fn axis_summary(axis: &str, f: &AxisFit) -> String {
     )
 }
 
-mod camera;
+pub(crate) mod camera;
 mod frames;
 
 #[cfg(test)]

@@ -56,6 +56,28 @@ pub struct CameraArgs {
     pitch_mm: f64,
 }
 
+impl CameraArgs {
+    /// Arguments writing every output, for the tests.
+    #[cfg(test)]
+    pub(super) fn for_test(
+        images: &Path,
+        points: &Path,
+        output: &Path,
+        report: &Path,
+        svg: &Path,
+    ) -> Self {
+        Self {
+            images: images.into(),
+            points: points.into(),
+            background: None,
+            output: Some(output.into()),
+            report: Some(report.into()),
+            svg: Some(svg.into()),
+            pitch_mm: 19.16,
+        }
+    }
+}
+
 /// Worst and RMS error of a point set, mm.
 #[derive(Serialize, Debug, PartialEq)]
 pub struct ErrorStats {
@@ -146,7 +168,7 @@ fn residuals(report: &FitReport, points: &[MeasuredPoint]) -> Result<Vec<(f64, f
         .collect()
 }
 
-pub(super) fn camera_command(a: &CameraArgs) -> Result<String, String> {
+pub(crate) fn camera_command(a: &CameraArgs) -> Result<String, String> {
     let text = std::fs::read_to_string(&a.points)
         .map_err(|e| format!("cannot read {}: {e}", a.points.display()))?;
     let rows = read_frame_list(&text).map_err(|e| format!("{}: {e}", a.points.display()))?;

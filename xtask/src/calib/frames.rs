@@ -114,7 +114,8 @@ pub(super) fn frames_command(a: &FramesArgs) -> Result<String, String> {
         img.write_png(std::io::BufWriter::new(file))
             .map_err(|e| format!("{}: {e}", path.display()))
     };
-    save("background.png", &vc.frame(&scene, &[], 1))?;
+    // As the camera loop captures: 8 laser-off exposures averaged, 4 per point.
+    save("background.png", &vc.averaged_frame(&scene, &[], 8, 1))?;
     let mut csv = String::from(
         "# commanded board point of each frame, mm (written by `cargo xtask calib frames`)\nimage,x,y\n",
     );
