@@ -90,7 +90,7 @@ fn normaliser(points: impl Iterator<Item = [f64; 2]> + Clone) -> Option<Matrix3<
         .fold((0.0, 0.0), |(a, b), p| (a + p[0], b + p[1]));
     let (mx, my) = (sx / n, sy / n);
     let mean_dist = points.map(|p| (p[0] - mx).hypot(p[1] - my)).sum::<f64>() / n;
-    if !(mean_dist > 1e-12) {
+    if mean_dist.is_nan() || mean_dist <= 1e-12 {
         return None;
     }
     let s = std::f64::consts::SQRT_2 / mean_dist;
@@ -190,7 +190,7 @@ fn dlt(norm: &[([f64; 2], [f64; 2])]) -> Result<Matrix3<f64>, HomographyError> {
     let (smallest, next) = (eig.eigenvalues[order[0]], eig.eigenvalues[order[1]]);
     // A unique solution needs a one-dimensional null space: with
     // collinear points a second eigenvalue is (near) zero too.
-    if !(next > 1e-9 * eig.eigenvalues.max()) || !smallest.is_finite() {
+    if next.is_nan() || next <= 1e-9 * eig.eigenvalues.max() || !smallest.is_finite() {
         return Err(HomographyError::Degenerate);
     }
     let h = eig.eigenvectors.column(order[0]);

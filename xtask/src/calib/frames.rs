@@ -54,6 +54,9 @@ pub fn scaled_camera(scale: f64, distortion_percent: f64) -> Camera {
     cam
 }
 
+/// A dwell's commanded point and where the spot really was, mm.
+pub type CommandedAndReal = ([f64; 2], [f64; 2]);
+
 /// Commanded and real spot positions (mm) of the grid on a build with
 /// the board rolled `roll_deg` and the yaw servo off by `yaw_zero_deg`,
 /// after the `setup` command lines.
@@ -61,7 +64,7 @@ pub fn grid_dwells(
     roll_deg: f64,
     yaw_zero_deg: f64,
     setup: &str,
-) -> Result<Vec<([f64; 2], [f64; 2])>, String> {
+) -> Result<Vec<CommandedAndReal>, String> {
     let mut physical = PhysicalGimbal::default();
     physical.gimbal.geometry.frame.pose.roll_deg = roll_deg;
     physical.gimbal.geometry.yaw.zero_deg = yaw_zero_deg;
