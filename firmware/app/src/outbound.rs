@@ -175,6 +175,20 @@ struct Queue {
     dropped: Dropped,
     /// A command was dispatched and has not been closed yet.
     awaiting_close: bool,
+    /// The command in flight is quiet (see [`Outbound::begin_quiet_command`]).
+    quiet: bool,
+    /// The reply of the last quiet command, kept from the host.
+    quiet_reply: QuietReply,
+}
+
+/// The reply of a quiet command (sent by another task than the console):
+/// its first data line and how it closed.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct QuietReply {
+    /// First data line (empty when there was none).
+    pub data: ReplyText,
+    /// `Some(true)` once closed with `ok`, `Some(false)` with an error.
+    pub closed: Option<bool>,
 }
 
 impl Queue {
@@ -186,7 +200,30 @@ impl Queue {
                 notices: 0,
             },
             awaiting_close: false,
+            quiet: false,
+            quiet_reply: QuietReply {
+                data: ReplyText::new(),
+                closed: None,
+            },
         }
+    }
+
+    /// Keeps a line of the quiet command in flight from the host; `false`
+    /// when the line is not part of one (notices never are).
+    fn keep_quiet(&mut self, kind: LineKind, text: &str) -> bool {
+        if !self.quiet || kind == LineKind::Notice {
+            return false;
+        }
+        if kind.is_closer() {
+            self.quiet = false;
+            self.quiet_reply.closed = Some(kind == LineKind::Ok);
+        } else if self.quiet_reply.data.is_empty() {
+            let _ = self
+                .quiet_reply
+                .data
+                .push_str(text.get(..REPLY_LINE_LEN).unwrap_or(text));
+        }
+        true
     }
 
     fn push_bytes(&mut self, bytes: &[u8]) {
@@ -301,12 +338,20 @@ impl Outbound {
     /// counted) because its share of the queue is full. A closer also ends
     /// the command in flight.
     pub fn push(&self, kind: LineKind, text: &str) -> bool {
+        let mut quiet = false;
         let queued = self.with(|q| {
             if kind.is_closer() {
                 q.awaiting_close = false;
             }
-            q.push(kind, text)
+            quiet = q.keep_quiet(kind, text);
+            quiet || q.push(kind, text)
         });
+        if quiet {
+            if kind.is_closer() {
+                self.freed.signal(());
+            }
+            return true;
+        }
         if queued {
             self.queued.signal(());
         } else {
@@ -361,6 +406,31 @@ impl Outbound {
     /// Marks a command as dispatched: its closer is awaited.
     pub fn begin_command(&self) {
         self.with(|q| q.awaiting_close = true);
+    }
+
+    /// Marks a command from another task than the console (the PELCO
+    /// port) as dispatched, when no command is in flight: its data lines
+    /// and closer are kept from the host ([`Outbound::take_quiet_reply`]),
+    /// and the console waits for its closer like for one of its own.
+    /// `false` (nothing marked) while another command is in flight.
+    pub fn begin_quiet_command(&self) -> bool {
+        self.with(|q| {
+            if q.awaiting_close {
+                return false;
+            }
+            q.awaiting_close = true;
+            q.quiet = true;
+            q.quiet_reply = QuietReply::default();
+            true
+        })
+    }
+
+    /// The reply of the last quiet command once it is closed (taken once).
+    pub fn take_quiet_reply(&self) -> Option<QuietReply> {
+        self.with(|q| {
+            q.quiet_reply.closed?;
+            Some(core::mem::take(&mut q.quiet_reply))
+        })
     }
 
     /// Whether a dispatched command has not been closed yet.

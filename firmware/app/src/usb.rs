@@ -259,6 +259,8 @@ async fn dispatch_grbl<R: Read>(
         link.grbl_error(GrblError::LineOverflow);
         return Ok(Filled::Bytes);
     };
+    // A quiet command (the PELCO port's) may be in flight.
+    out.wait_until(|o| !o.awaiting_close()).await;
     out.begin_command();
     if link.commands.try_send(Command::Grbl(line)).is_err() {
         link.error("busy: the command queue is full");
@@ -334,6 +336,11 @@ impl OwedClosers {
 /// not necessarily written). `host_not_reading`: see [`HOST_STALL`].
 async fn dispatch(line: &str, link: &CommandLink, host_not_reading: &mut bool) {
     let out = &link.outbound;
+    if line.split_whitespace().eq(["pelco", "status"]) {
+        // Answered here: the port's counters are the console's to read.
+        link.pelco.report(|args| link.data(args));
+        return link.ok();
+    }
     let command = match parse_line(line) {
         Ok(Some(command)) => command,
         Ok(None) => return link.ok(),
@@ -352,6 +359,8 @@ async fn dispatch(line: &str, link: &CommandLink, host_not_reading: &mut bool) {
             *host_not_reading = true;
         }
     }
+    // A quiet command (the PELCO port's) may be in flight.
+    out.wait_until(|o| !o.awaiting_close()).await;
     // No await between marking and sending: a console cancelled by a
     // disconnect cannot leave a command marked but unsent.
     out.begin_command();
