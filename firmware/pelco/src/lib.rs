@@ -11,8 +11,8 @@
 //!   keeps the frames for its own address and counts the rest
 //!   ([`Counters`]).
 //!
-//! PELCO-D: `FF addr cmd1 cmd2 data1 data2 sum`, sum = (addr + cmd1 + cmd2
-//! + data1 + data2) mod 256. PELCO-P: `A0 addr d1 d2 d3 d4 AF xor`, xor =
+//! PELCO-D: `FF addr cmd1 cmd2 data1 data2 sum`, the sum of addr, cmd1,
+//! cmd2, data1 and data2 mod 256. PELCO-P: `A0 addr d1 d2 d3 d4 AF xor`,
 //! the XOR of the seven bytes before it. Both carry the same four bytes
 //! (PELCO-P's d1..d4 sit where PELCO-D's cmd1, cmd2, data1, data2 do), so
 //! one [`Command`] table serves both.
