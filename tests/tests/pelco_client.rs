@@ -43,7 +43,11 @@ fn run_client(replies: &str) -> serde_json::Value {
         .env("PYTHONPATH", &dir)
         .output()
         .expect("driver runs");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8(out.stdout).unwrap();
     serde_json::from_str(stdout.trim()).expect("one JSON line")
 }
@@ -71,14 +75,31 @@ fn pyptzcontroller_frames_drive_the_session_and_read_its_replies() {
         decoder.decode(&hex_bytes(hex), |f| frames.push(f));
     }
     let counters = decoder.counters();
-    assert_eq!(counters.frames as usize, written.len(), "every frame decodes");
+    assert_eq!(
+        counters.frames as usize,
+        written.len(),
+        "every frame decodes"
+    );
     assert_eq!((counters.bad_checksums, counters.other_addresses), (0, 0));
     let names: Vec<&str> = frames.iter().map(|f| Pelco::of(f).name()).collect();
     assert_eq!(
         names,
         [
-            "move", "move", "move", "move", "stop", "set-preset", "goto-preset", "clear-preset",
-            "set-aux", "clear-aux", "set-pan", "set-tilt", "set-pan", "set-tilt", "query-pan",
+            "move",
+            "move",
+            "move",
+            "move",
+            "stop",
+            "set-preset",
+            "goto-preset",
+            "clear-preset",
+            "set-aux",
+            "clear-aux",
+            "set-pan",
+            "set-tilt",
+            "set-pan",
+            "set-tilt",
+            "query-pan",
             "query-tilt",
         ]
     );
@@ -106,13 +127,27 @@ fn pyptzcontroller_frames_drive_the_session_and_read_its_replies() {
     // 7.5° up (each keeps the spot's other angle: the spot does not move
     // in this replay).
     assert_eq!(gotos.len(), 5);
-    assert_eq!(gotos[0], spot);
+    // Presets are kept in f32 cm: 10 nm at this distance.
+    let recalled = gotos[0];
+    assert!((recalled.x_cm - spot.x_cm).abs() < 1e-5 && (recalled.y_cm - spot.y_cm).abs() < 1e-5);
     let angle = |p: PointCm| angles_deg(p, OQ_CM);
     let close = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
     assert!(close(angle(gotos[1]), [25.5, 4.5]), "{:?}", angle(gotos[1]));
-    assert!(close(angle(gotos[2]), [-12.0, -10.0]), "{:?}", angle(gotos[2]));
-    assert!(close(angle(gotos[3]), [12.25, 4.5]), "{:?}", angle(gotos[3]));
-    assert!(close(angle(gotos[4]), [-12.0, 7.5]), "{:?}", angle(gotos[4]));
+    assert!(
+        close(angle(gotos[2]), [-12.0, -10.0]),
+        "{:?}",
+        angle(gotos[2])
+    );
+    assert!(
+        close(angle(gotos[3]), [12.25, 4.5]),
+        "{:?}",
+        angle(gotos[3])
+    );
+    assert!(
+        close(angle(gotos[4]), [-12.0, 7.5]),
+        "{:?}",
+        angle(gotos[4])
+    );
     let laser: Vec<LaserMode> = requests
         .iter()
         .filter_map(|(_, r)| match r {
@@ -126,13 +161,23 @@ fn pyptzcontroller_frames_drive_the_session_and_read_its_replies() {
         .filter(|(_, r)| matches!(r, Request::Command(Product::Grbl(_))))
         .count();
     assert!(jogs >= 2, "the moves queue jogs");
-    assert!(requests.iter().any(|(n, r)| *n == "stop" && *r == Request::JogCancel));
+    assert!(
+        requests
+            .iter()
+            .any(|(n, r)| *n == "stop" && *r == Request::JogCancel)
+    );
 
     // The replies to the two queries, back through the library.
     let replies: String = requests
         .iter()
         .filter_map(|(_, r)| match r {
-            Request::Reply(f) => Some(f.encode().as_slice().iter().map(|b| format!("{b:02x}")).collect::<String>()),
+            Request::Reply(f) => Some(
+                f.encode()
+                    .as_slice()
+                    .iter()
+                    .map(|b| format!("{b:02x}"))
+                    .collect::<String>(),
+            ),
             _ => None,
         })
         .collect();
