@@ -16,7 +16,7 @@
 //! | stepper ENABLE (both)   | PE13 (polarity a parameter; released = the idle level) |
 //! | stepper limit switches  | PE7 pan, PE8 tilt (pull-up inputs, normally-open switch to GND: low = pressed) |
 //!
-//! Flash: the image in sectors 0–5 (≤ 256 KiB), the saved settings in
+//! Flash: the image in sectors 0–6 (≤ 384 KiB), the saved settings in
 //! sectors 10 and 11 (`settings_flash`, `memory.x`).
 //!
 //! DMA: DAC1 channel 1's request is DMA1 stream 5, where USART2's receive

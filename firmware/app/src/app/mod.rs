@@ -16,6 +16,7 @@
 
 mod board;
 mod tasks;
+pub mod trace;
 
 pub use self::board::{
     Board, Console, Indicators, Leds, NoGalvoDac, NoStepper, Parts, StopButton, Watchdog,
