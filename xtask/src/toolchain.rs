@@ -22,6 +22,7 @@ const HOST_PACKAGES: [&str; 10] = [
     "kinematics-core",
     "galvo-planner",
     "fashionstar",
+    "pelco",
     "laser-app",
     "galvo-dma",
     "laser-sim",
@@ -31,10 +32,11 @@ const HOST_PACKAGES: [&str; 10] = [
     "fuzz-props",
 ];
 /// `no_std` crates that must also build for the target.
-const TARGET_LIBRARIES: [&str; 5] = [
+const TARGET_LIBRARIES: [&str; 6] = [
     "kinematics-core",
     "galvo-planner",
     "fashionstar",
+    "pelco",
     "laser-app",
     "galvo-dma",
 ];

@@ -6,10 +6,10 @@ use std::vec::Vec;
 
 use embassy_time::Instant;
 
-use crate::sequencer::gcode::tests::{READINGS, closers};
-use crate::sequencer::machine::{Action, Core, Event, Inputs};
 use crate::command::{Command, GrblLine};
 use crate::domain::Actuator;
+use crate::sequencer::gcode::tests::{READINGS, closers};
+use crate::sequencer::machine::{Action, Core, Event, Inputs};
 use crate::stepper::{MoveShape, StepperEvent, StepperRequest};
 
 fn on(core: &mut Core, ms: u64, event: Event) -> Vec<Action> {

@@ -46,6 +46,6 @@ mod gcode;
 mod points;
 
 #[cfg(test)]
-mod tests;
-#[cfg(test)]
 mod arc_tests;
+#[cfg(test)]
+mod tests;
