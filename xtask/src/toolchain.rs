@@ -18,7 +18,7 @@ pub const RAM_BUDGET_BYTES: u64 = 96 * 1024;
 /// rustup components the project uses (llvm-tools provides `llvm-size`).
 const COMPONENTS: [&str; 3] = ["rustfmt", "clippy", "llvm-tools"];
 /// Crates that build for the host (everything but the firmware binary).
-const HOST_PACKAGES: [&str; 10] = [
+const HOST_PACKAGES: &[&str] = &[
     "kinematics-core",
     "galvo-planner",
     "fashionstar",
@@ -32,7 +32,7 @@ const HOST_PACKAGES: [&str; 10] = [
     "fuzz-props",
 ];
 /// `no_std` crates that must also build for the target.
-const TARGET_LIBRARIES: [&str; 6] = [
+const TARGET_LIBRARIES: &[&str] = &[
     "kinematics-core",
     "galvo-planner",
     "fashionstar",

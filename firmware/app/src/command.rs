@@ -18,9 +18,11 @@ use embassy_sync::signal::Signal;
 use crate::domain::{Actuator, AimModel, Pattern, PointCm};
 use crate::grbl::realtime::Realtime;
 use crate::outbound::{LineKind, Outbound};
-use crate::pelco::PelcoStatus;
+
+mod pelco_status;
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
 use crate::text::{ReplyText, Shortest};
+pub use pelco_status::PelcoStatus;
 
 /// One line per command for `help` (the command reference; the console
 /// parser in `cli::parse` accepts exactly these).

@@ -125,6 +125,14 @@ impl DacStream for NoGalvoDac {
 #[derive(Debug)]
 pub enum NoStepper {}
 
+impl crate::stepper::StepPulseTask<NoStepper> {
+    /// A board without stepper outputs never gets a step timer task:
+    /// its spawner's `step_pulses` hook is this.
+    pub fn unreachable(self) -> ! {
+        match self.drive {}
+    }
+}
+
 impl StepperDrive for NoStepper {
     fn set_enabled(&mut self, _enabled: bool) {
         match *self {}

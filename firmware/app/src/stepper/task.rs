@@ -23,14 +23,6 @@ pub struct StepPulseTask<D> {
     pub(crate) link: &'static StepperLink,
 }
 
-impl StepPulseTask<crate::app::NoStepper> {
-    /// A board without stepper outputs never gets a step timer task:
-    /// its spawner's `step_pulses` hook is this.
-    pub fn unreachable(self) -> ! {
-        match self.drive {}
-    }
-}
-
 impl<D: StepperDrive> StepPulseTask<D> {
     /// Steps whatever is prepared; sleeps when nothing is.
     pub async fn run(mut self) -> ! {
