@@ -48,6 +48,7 @@ impl Core {
                 self.stop("stop command", out);
                 self.ok(out);
             }
+            Command::Arm => self.arm(out),
             Command::Home => match self.start_homing(out) {
                 Ok(()) => self.ok(out),
                 Err(reason) => self.error(out, reason),

@@ -97,6 +97,8 @@ pub struct Core {
     pub(super) inputs: Inputs,
     /// The grbl session: G-code parser, motion queue, grbl settings.
     pub(super) gcode: super::gcode::Gcode,
+    /// The laser controls' state (`None`: the board has none).
+    pub(super) controls: Option<crate::laser_controls::ControlsView>,
 }
 
 impl Core {
@@ -126,6 +128,7 @@ impl Core {
                 stepper_attached: false,
             },
             gcode: super::gcode::Gcode::new(),
+            controls: None,
         }
     }
 

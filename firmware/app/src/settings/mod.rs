@@ -16,6 +16,7 @@
 //! [`SettingsError`]s; the command line prints them as they are.
 
 mod error;
+mod controls;
 mod gcode;
 mod geometry;
 mod legacy;
@@ -224,6 +225,9 @@ pub struct Settings {
     pub stepper: StepperSettings,
     /// G-code's junction deviation (grbl's `$11`), mm.
     pub gcode_junction_mm: f64,
+    /// The laser controls' emission indicator lead: on this long after
+    /// `arm` before the laser may emit, s.
+    pub emission_delay_s: f64,
 }
 
 impl Default for Settings {
@@ -258,6 +262,7 @@ impl Default for Settings {
             galvo: GalvoSettings::default(),
             stepper: StepperSettings::default(),
             gcode_junction_mm: 0.01,
+            emission_delay_s: controls::DEFAULT_EMISSION_DELAY_S,
         }
     }
 }
