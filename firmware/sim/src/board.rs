@@ -12,18 +12,20 @@
 //! | galvo DAC     | the simulated double-buffered DAC ([`SimDac`]), or none |
 //! | stepper STEP/DIR/ENABLE | the driver models ([`SimStepperDrive`]), or none |
 //! | LEDs, button, watchdog | recorded models ([`crate::panel`])       |
+//! | interlock, key, emission indicator | script-set inputs, recorded indicator ([`crate::controls`]), or none |
 
 use std::convert::Infallible;
 use std::rc::Rc;
 
 use embassy_executor::Spawner;
 use laser_app::app::{
-    Board, Console, ConsoleTask, GalvoTask, IndicatorTask, Parts, SequencerTask, ServoBusTask,
-    Spawn, StopButtonTask, WatchdogTask,
+    Board, Console, ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, Parts,
+    SequencerTask, ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::stepper::{StepPulseTask, StepperTask};
 
+use crate::controls::SimLaserControls;
 use crate::dac::SimDac;
 use crate::executor::{TaskKind, spawn_task};
 use crate::panel::{SimLeds, SimStopButton, SimWatchdog};
@@ -53,6 +55,8 @@ pub struct SimBoard {
     pub stop_button: SimStopButton,
     /// The watchdog.
     pub watchdog: SimWatchdog,
+    /// The laser controls, if the board has them.
+    pub laser_controls: Option<SimLaserControls>,
 }
 
 impl Board for SimBoard {
@@ -66,6 +70,7 @@ impl Board for SimBoard {
     type Indicators = SimLeds;
     type StopButton = SimStopButton;
     type Watchdog = SimWatchdog;
+    type LaserControls = SimLaserControls;
 
     fn into_parts(self) -> Parts<Self> {
         Parts {
@@ -83,6 +88,7 @@ impl Board for SimBoard {
             indicators: self.leds,
             stop_button: self.stop_button,
             watchdog: self.watchdog,
+            laser_controls: self.laser_controls,
         }
     }
 }
@@ -206,6 +212,10 @@ impl Spawn<SimBoard> for SimSpawner {
 
     fn watchdog(&mut self, task: WatchdogTask<SimWatchdog>) {
         self.firmware("watchdog", task.run());
+    }
+
+    fn laser_controls(&mut self, task: LaserControlsTask<SimLaserControls>) {
+        self.firmware("laser controls", task.run());
     }
 }
 

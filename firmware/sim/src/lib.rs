@@ -4,6 +4,7 @@
 
 pub mod board;
 pub mod clock;
+pub mod controls;
 pub mod dac;
 pub mod drawing;
 pub mod executor;

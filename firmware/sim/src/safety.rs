@@ -21,6 +21,10 @@
 //!   the host sent gets exactly one `ok` / `error: …`, after its data
 //!   lines, in the order the lines were sent; bracketed notices are not
 //!   replies but must be whole lines.
+//! * **(e) the laser controls** ([`ViolationKind::LitWithoutControls`],
+//!   on a board with them): no laser lit while the interlock is open or
+//!   the key off, without the emission indicator on for the emission
+//!   delay, or without a reset since the last opening (`controls.rs`).
 //! * **(d) short task steps** ([`ViolationKind::LongStep`]): no poll of a
 //!   firmware task takes more than 1 ms of thread CPU time (see
 //!   [`crate::executor`] for what that measures).
@@ -30,6 +34,7 @@
 //! the executor's step accounting. The galvo laser is read in one place,
 //! [`galvo_stretches`]: the **effective** laser state of each sample.
 
+mod controls;
 mod dark;
 mod moving;
 mod replies;
@@ -38,6 +43,7 @@ mod timeline;
 
 use std::fmt;
 
+use crate::controls::ControlsRecord;
 use crate::dac::DacRecording;
 use crate::executor::{LONG_STEP_NS, TaskSteps};
 use crate::physics::PhysicalGalvo;
@@ -45,6 +51,7 @@ use crate::recorder::{EventRecord, ServoSample};
 use crate::usb_host::Transcript;
 use crate::world::SimReport;
 
+use controls::laser_controls_obeyed;
 use dark::dark_after_stops;
 use moving::{galvo_jumps_dark, gimbal_dwell_mode, gimbal_travel_dark};
 use replies::one_reply_per_line;
@@ -84,6 +91,9 @@ pub enum ViolationKind {
     Replies,
     /// (d) A firmware task step longer than 1 ms of CPU time.
     LongStep,
+    /// (e) A laser lit while the interlock was open or the key off, before
+    /// the emission indicator's delay, or without a reset since.
+    LitWithoutControls,
 }
 
 impl ViolationKind {
@@ -96,6 +106,7 @@ impl ViolationKind {
             ViolationKind::LitWithoutArrival => "lit-without-arrival",
             ViolationKind::Replies => "replies",
             ViolationKind::LongStep => "long-step",
+            ViolationKind::LitWithoutControls => "lit-without-controls",
         }
     }
 }
@@ -205,6 +216,9 @@ pub struct SafetyInputs<'a> {
     pub galvo_physics: PhysicalGalvo,
     /// Simulated time at the end of the run, µs.
     pub end_us: u64,
+    /// The laser controls' inputs and indicator (`None`: the board has
+    /// none).
+    pub controls: Option<&'a ControlsRecord>,
 }
 
 impl<'a> SafetyInputs<'a> {
@@ -220,6 +234,7 @@ impl<'a> SafetyInputs<'a> {
             task_steps: &report.task_steps,
             galvo_physics: PhysicalGalvo::default(),
             end_us: report.end_time_us,
+            controls: report.laser_controls.as_ref(),
         }
     }
 }
@@ -263,6 +278,10 @@ pub fn check_inputs(inputs: &SafetyInputs<'_>) -> Vec<Violation> {
         one_reply_per_line(inputs.transcript),
     );
     add(ViolationKind::LongStep, short_steps(inputs.task_steps));
+    add(
+        ViolationKind::LitWithoutControls,
+        laser_controls_obeyed(inputs, &timeline),
+    );
     all
 }
 
