@@ -58,7 +58,8 @@ impl<C: LaserControls> LaserControlsTask<C> {
     }
 
     /// Puts `view` into effect: the gate first (dark at once), then the
-    /// indicator, the published state and a notice for each change.
+    /// indicator, the published state and a notice for each change; a
+    /// latch after arming also stops the run (a stop request).
     fn apply(&mut self, logic: &ControlsLogic, view: ControlsView, shown: Option<ControlsView>) {
         let permitted = logic.emission_permitted();
         if permitted != self.gate.is_permitted() {
@@ -79,6 +80,12 @@ impl<C: LaserControls> LaserControlsTask<C> {
             ControlsState::Armed => "laser enabled",
         };
         log::info!("laser controls: {}", text);
+        let was_arming = shown.is_some_and(|s| !matches!(s.state, ControlsState::Latched(_)));
+        if was_arming && matches!(view.state, ControlsState::Latched(_)) {
+            // The run that may have been lit stops (as the stop button):
+            // the gate is dark already, its drawing is cut short.
+            self.command.stop_request.signal(());
+        }
         if shown.is_some() {
             let _ = self
                 .command

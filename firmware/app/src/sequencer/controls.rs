@@ -4,7 +4,7 @@
 //! and forbid the master gate directly (`crate::laser_controls`).
 
 use super::machine::{Action, ActionSink, Core};
-use crate::laser_controls::{ControlsState, ControlsView};
+use crate::laser_controls::{ControlsState, ControlsView, LatchCause};
 
 /// The reply to `arm` on a board without the controls.
 const NO_CONTROLS: &str = "this board has no laser controls (no interlock, key or indicator)";
@@ -50,6 +50,16 @@ impl Core {
                 state
             ),
         );
+    }
+
+    /// Who asked for a stop request: the stop button, or the laser
+    /// controls when they latched emission off.
+    pub(super) fn stop_request_cause(&self) -> &'static str {
+        match self.controls.map(|view| view.state) {
+            Some(ControlsState::Latched(LatchCause::InterlockOpened)) => "interlock opened",
+            Some(ControlsState::Latched(LatchCause::KeyOff)) => "key switch off",
+            _ => "stop button",
+        }
     }
 
     /// grbl's `Door:n` for `?` while the controls keep the laser off.

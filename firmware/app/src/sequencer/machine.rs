@@ -142,7 +142,7 @@ impl Core {
         }
         match event {
             Event::Command { command, readings } => self.command(command, &readings, out),
-            Event::StopRequest => self.stop("stop button", out),
+            Event::StopRequest => self.stop(self.stop_request_cause(), out),
             Event::Servo(outcome) => self.servo_outcome(outcome, out),
             Event::Galvo(event) => self.galvo_event(event, out),
             Event::Stepper(event) => self.stepper_event(event, out),
