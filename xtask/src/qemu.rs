@@ -301,6 +301,13 @@ pub fn run(args: QemuArgs) -> Result<ExitCode> {
     if args.galvo_dac {
         features.push("galvo-dac");
     }
+    if steps
+        .iter()
+        .any(|s| matches!(s, BoardStep::Script(step) if step.uses_laser_controls()))
+    {
+        // `@interlock` / `@key`: a board with the laser controls.
+        features.push("laser-controls");
+    }
     if args.defmt_log {
         features.push("defmt-log");
     }
