@@ -2,10 +2,10 @@
 //! implements one of `laser-app`'s board traits
 //! ([`laser_app::app::Board`] and friends) over the HAL.
 
+use embassy_futures::select::select;
 use embassy_stm32::Peri;
 use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::gpio::OutputType;
-use embassy_futures::select::select;
 use embassy_stm32::gpio::{Input, Level, Output};
 use embassy_stm32::mode::Async;
 use embassy_stm32::pac;

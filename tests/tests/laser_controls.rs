@@ -58,27 +58,40 @@ fn status_line(report: &SimReport, n: usize) -> String {
 
 #[test]
 fn power_up_is_not_armed_and_nothing_lights_until_arm() {
-    let report = run("@interlock closed\ntarget galvo\npattern tuning 0 0 8 once\n\
-         wait 1500\nstatus\n");
+    let report = run(
+        "@interlock closed\ntarget galvo\npattern tuning 0 0 8 once\n\
+         wait 1500\nstatus\n",
+    );
     assert!(lit(&report).is_empty(), "lit before arm");
     assert_eq!(
         status_line(&report, 0),
         "laser controls: interlock closed, key on, not armed since power-up"
     );
     let record = report.laser_controls.as_ref().unwrap();
-    assert_eq!(record.indicator, [(0, false)], "the indicator never came on");
+    assert_eq!(
+        record.indicator,
+        [(0, false)],
+        "the indicator never came on"
+    );
 }
 
 #[test]
 fn arm_lights_the_indicator_first_and_the_laser_only_after_the_delay() {
-    let report = run("target galvo\n@key on\nwait 50\narm\npattern tuning 0 0 8\nwait 5000\nstop\n");
+    let report =
+        run("target galvo\n@key on\nwait 50\narm\npattern tuning 0 0 8\nwait 5000\nstop\n");
     let armed = sent_at(&report, "arm", 0);
     let record = report.laser_controls.as_ref().unwrap();
     let (on_at, _) = *record.indicator.iter().find(|(_, on)| *on).expect("on");
-    assert!(on_at >= armed && on_at - armed < 10_000, "{on_at} vs {armed}");
+    assert!(
+        on_at >= armed && on_at - armed < 10_000,
+        "{on_at} vs {armed}"
+    );
     let lit = lit(&report);
     let first = lit.first().expect("lit after the delay").start_ns / 1000;
-    assert!(first >= on_at + DELAY_US, "lit at {first} µs, indicator {on_at}");
+    assert!(
+        first >= on_at + DELAY_US,
+        "lit at {first} µs, indicator {on_at}"
+    );
     // The pattern started before the delay ended and lights within a few
     // ms of its end (the loop keeps drawing, dark, until then).
     assert!(first < on_at + DELAY_US + 50_000, "lit at {first} µs");
@@ -86,9 +99,11 @@ fn arm_lights_the_indicator_first_and_the_laser_only_after_the_delay() {
 
 #[test]
 fn an_interlock_opened_mid_pattern_darkens_within_1_ms_and_latches_until_reset() {
-    let report = run("target galvo\n@interlock closed\nwait 50\narm\nwait 3100\npattern tuning 0 0 8\n\
+    let report = run(
+        "target galvo\n@interlock closed\nwait 50\narm\nwait 3100\npattern tuning 0 0 8\n\
          wait 500\n@interlock open\nwait 300\n@interlock closed\nwait 500\nstatus\n\
-         pattern tuning 0 0 8\nwait 1000\nstop\narm\npattern tuning 0 0 8\nwait 4000\nstop\n");
+         pattern tuning 0 0 8\nwait 1000\nstop\narm\npattern tuning 0 0 8\nwait 4000\nstop\n",
+    );
     let record = report.laser_controls.as_ref().unwrap();
     let opened = record
         .interlock_closed
@@ -122,7 +137,10 @@ fn an_interlock_opened_mid_pattern_darkens_within_1_ms_and_latches_until_reset()
         .map(|s| s.start_ns / 1000)
         .find(|t| *t > opened)
         .expect("lit again after the reset");
-    assert!(first_after >= rearmed + DELAY_US, "{first_after} vs {rearmed}");
+    assert!(
+        first_after >= rearmed + DELAY_US,
+        "{first_after} vs {rearmed}"
+    );
     assert!(
         report
             .transcript
@@ -136,8 +154,10 @@ fn an_interlock_opened_mid_pattern_darkens_within_1_ms_and_latches_until_reset()
 
 #[test]
 fn arm_is_refused_while_the_interlock_is_open_or_the_key_off() {
-    let report = run("@interlock open\narm\n@interlock closed\n@key off\nwait 100\narm\n\
-         @key on\nwait 100\narm\n");
+    let report = run(
+        "@interlock open\narm\n@interlock closed\n@key off\nwait 100\narm\n\
+         @key on\nwait 100\narm\n",
+    );
     let replies: Vec<&str> = report
         .transcript
         .lines
@@ -158,8 +178,10 @@ fn arm_is_refused_while_the_interlock_is_open_or_the_key_off() {
 #[test]
 fn the_key_switch_latches_like_the_interlock_on_the_gimbal() {
     // Gimbal goto: lit while holding (laser auto).
-    let report = run("@key on\nwait 50\narm\nwait 3100\ngoto 0 0\nwait 1000\n@key off\nwait 200\n\
-         @key on\nwait 200\n@realtime ?\nstatus\n");
+    let report = run(
+        "@key on\nwait 50\narm\nwait 3100\ngoto 0 0\nwait 1000\n@key off\nwait 200\n\
+         @key on\nwait 200\n@realtime ?\nstatus\n",
+    );
     let record = report.laser_controls.as_ref().unwrap();
     let off = record.key_on.iter().find(|(_, on)| !on).unwrap().0;
     let gimbal = &report.recording.laser_events;

@@ -16,8 +16,8 @@ use laser_sim::servo_port::BusFaults;
 use laser_sim::world::{SimOptions, run};
 
 use crate::qemu::{
-    BoardStep,
-    BoardEvent, BoardRun, Drive, MachineOptions, parse_board_script, run_board, split_at_resets,
+    BoardEvent, BoardRun, BoardStep, Drive, MachineOptions, parse_board_script, run_board,
+    split_at_resets,
 };
 use crate::toolchain::workspace_root;
 

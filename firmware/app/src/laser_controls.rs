@@ -170,7 +170,9 @@ mod tests {
             ControlsState::Arming,
             ControlsState::Armed,
         ] {
-            for (interlock_closed, key_on) in [(false, false), (true, false), (false, true), (true, true)] {
+            for (interlock_closed, key_on) in
+                [(false, false), (true, false), (false, true), (true, true)]
+            {
                 let view = ControlsView {
                     inputs: ControlInputs {
                         interlock_closed,

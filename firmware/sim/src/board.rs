@@ -19,8 +19,8 @@ use std::rc::Rc;
 
 use embassy_executor::Spawner;
 use laser_app::app::{
-    Board, Console, ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, Parts,
-    SequencerTask, ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
+    Board, Console, ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, Parts, SequencerTask,
+    ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::stepper::{StepPulseTask, StepperTask};

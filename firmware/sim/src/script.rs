@@ -180,7 +180,8 @@ mod tests {
 
     #[test]
     fn laser_control_steps_parse_and_bad_levels_are_refused() {
-        let steps = parse_script("@interlock open\n@interlock closed\n@key off\n@key on\n").unwrap();
+        let steps =
+            parse_script("@interlock open\n@interlock closed\n@key off\n@key on\n").unwrap();
         assert_eq!(
             steps,
             vec![

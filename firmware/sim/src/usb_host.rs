@@ -17,8 +17,8 @@ use embassy_sync::pipe::Pipe;
 use embassy_sync::signal::Signal;
 use embassy_time::Timer;
 
-use crate::executor::{self, TaskKind};
 use crate::controls::ControlWiring;
+use crate::executor::{self, TaskKind};
 use crate::panel::ButtonContacts;
 use crate::script::Step;
 

@@ -33,10 +33,10 @@ impl<C: LaserControls> LaserControlsTask<C> {
         loop {
             let now_us = Instant::now().as_micros();
             logic.sample(now_us, self.controls.read());
-            if let Some(delay_ms) = arm_request.take() {
-                if let Err(refused) = logic.arm(now_us, u64::from(delay_ms) * 1000) {
-                    log::warning!("laser controls: arm refused ({})", refused.describe());
-                }
+            if let Some(delay_ms) = arm_request.take()
+                && let Err(refused) = logic.arm(now_us, u64::from(delay_ms) * 1000)
+            {
+                log::warning!("laser controls: arm refused ({})", refused.describe());
             }
             let view = ControlsView::of(&logic);
             self.apply(&logic, view, shown);

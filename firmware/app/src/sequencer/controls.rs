@@ -45,7 +45,11 @@ impl Core {
             out,
             format_args!(
                 "laser controls: interlock {}, key {}, {}",
-                if view.inputs.interlock_closed { "closed" } else { "open" },
+                if view.inputs.interlock_closed {
+                    "closed"
+                } else {
+                    "open"
+                },
                 if view.inputs.key_on { "on" } else { "off" },
                 state
             ),

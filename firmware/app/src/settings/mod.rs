@@ -15,8 +15,8 @@
 //! where it is kept (two flash sectors, power-fail safe). Errors are
 //! [`SettingsError`]s; the command line prints them as they are.
 
-mod error;
 mod controls;
+mod error;
 mod gcode;
 mod geometry;
 mod legacy;

@@ -39,7 +39,11 @@ fn lit_after_the_delay_with_everything_closed_holds() {
 fn lit_before_the_delay_or_without_the_indicator_is_a_violation() {
     let early = check(&armed_at_1s(), &[(3 * S, true), (5 * S, false)]);
     assert_eq!(early.len(), 1, "{early:?}");
-    assert!(early[0].detail.contains("after the emission indicator came on"));
+    assert!(
+        early[0]
+            .detail
+            .contains("after the emission indicator came on")
+    );
     let dark_indicator = check(&armed_at_1s(), &[(S / 2, true), (S, false)]);
     assert!(dark_indicator[0].detail.contains("indicator off"));
 }
@@ -47,7 +51,9 @@ fn lit_before_the_delay_or_without_the_indicator_is_a_violation() {
 #[test]
 fn lit_after_an_opening_without_a_reset_is_a_violation_within_1_ms_is_not() {
     let mut record = armed_at_1s();
-    record.interlock_closed.extend([(6 * S, false), (7 * S, true)]);
+    record
+        .interlock_closed
+        .extend([(6 * S, false), (7 * S, true)]);
     // The firmware darkened at once: fine.
     assert!(check(&record, &[(4 * S, true), (6 * S + 500, false)]).is_empty());
     // Still lit 2 ms after the opening.
