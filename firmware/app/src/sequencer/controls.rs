@@ -71,3 +71,6 @@ impl Core {
         self.controls.and_then(|view| view.door_substate())
     }
 }
+
+#[cfg(test)]
+mod tests;
