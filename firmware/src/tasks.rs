@@ -114,7 +114,8 @@ async fn watchdog(task: WatchdogTask<IndependentDog>) -> ! {
     task.run().await
 }
 
-/// Laser controls PD1–PD3: interlock, key switch, emission indicator.
+/// Laser controls PD1–PD3: interlock, key switch, emission indicator (on
+/// the galvo executor).
 #[embassy_executor::task]
 async fn laser_controls(task: LaserControlsTask<LaserControlPins>) -> ! {
     task.run().await
@@ -169,6 +170,9 @@ impl Spawn<Stm32Board> for TaskSpawner {
     }
 
     fn laser_controls(&mut self, task: LaserControlsTask<LaserControlPins>) {
-        self.thread.spawn(defmt::unwrap!(laser_controls(task)));
+        // On the galvo executor (interrupt priority): an opening
+        // interlock darkens the laser without waiting for a thread-mode
+        // task's step to end.
+        self.galvo.spawn(defmt::unwrap!(laser_controls(task)));
     }
 }
