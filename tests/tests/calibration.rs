@@ -5,24 +5,26 @@
 //! the same pattern then lands much closer to the grid points.
 
 use kinematics_core::{MeasuredPoint, fit};
-use laser_sim::physics::PhysicalGimbal;
+use laser_sim::bench::BenchBuild;
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with};
 
-fn imperfect_build() -> PhysicalGimbal {
-    let mut physical = PhysicalGimbal::default();
-    physical.gimbal.geometry.frame.pose.roll_deg = 1.0;
-    physical.gimbal.geometry.yaw.zero_deg = 0.8;
-    physical
+/// The build error of the README's calibration figures, as
+/// `cargo xtask sim --board-roll-deg 1 --yaw-zero-deg 0.8` sets it.
+fn imperfect_build() -> BenchBuild {
+    BenchBuild {
+        board_roll_deg: 1.0,
+        yaw_zero_deg: 0.8,
+        ..BenchBuild::default()
+    }
 }
 
 fn run_grid(setup: &str) -> SimReport {
     let report = run_with(
         &format!("{setup}set dwell_ms 50\npattern grid-full serpentine once\n"),
-        SimOptions {
-            physical: imperfect_build(),
-            ..SimOptions::default()
-        },
+        imperfect_build()
+            .apply(SimOptions::default())
+            .expect("a valid build error"),
     );
     assert_safe_allowing(&report, UNTIL_STEP_FIXES);
     assert!(report.succeeded(false), "{:?}", report.transcript);

@@ -7,7 +7,7 @@ use laser_sim::stepper::{StepEdge, StepPin};
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::gcode_job::{Piece, fit};
 use system_tests::gcode_toolpath::{gimbal_spot_mm, lit_mm};
-use system_tests::{gimbal_dark_after, run_with, terminal_lines};
+use system_tests::{gimbal_dark_after, run_with, sent_at, terminal_lines};
 
 /// Runs `script` on `target stepper` with default options.
 fn run(script: &str) -> SimReport {
@@ -319,8 +319,8 @@ fn dollar_h_on_the_stepper_answers_when_homing_has_ended() {
             .spot
             .iter()
             .filter(|s| s.laser)
-            .all(|s| s.t_us > ok_at),
-        "lit only in the G1s"
+            .all(|s| s.t_us >= ok_at),
+        "lit only in the G1s (from the first one's start on: the line starts where homing left the spot)"
     );
 }
 
@@ -560,4 +560,97 @@ fn status_reads_home_while_dollar_h_homes_the_stepper() {
         after.last().is_some_and(|l| l.starts_with("<Idle|")),
         "{after:?}"
     );
+}
+
+#[test]
+fn a_resume_while_a_hold_still_brakes_goes_on_once_at_rest_and_the_job_finishes() {
+    // Issue 25 defect 3: `~` 5 ms after `!` left the job stuck in `Run`.
+    let report =
+        run("G0 X70 Y40\n@realtime !\nwait 5\n@realtime ~\nwait 3000\n?\nG0 X0 Y0\nwait 2000\n?\n");
+    let reports = statuses(&report);
+    let [first, last] = reports[..] else {
+        panic!("two status reports: {reports:?}");
+    };
+    assert!(first.starts_with("<Idle|"), "{first}");
+    assert!(dist(mpos(first), [70.0, 40.0]) < 0.01, "{first}");
+    assert!(last.starts_with("<Idle|"), "{last}");
+    assert!(dist(mpos(last), [0.0, 0.0]) < 0.01, "{last}");
+    // The spot went there and came back.
+    let reached = gimbal_spot_mm(&report)
+        .iter()
+        .any(|s| dist(s.1, [70.0, 40.0]) < 1.0);
+    assert!(reached, "the spot never reached (70, 40)");
+    assert!(dist(spot_mm_at(&report, report.end_time_us), [0.0, 0.0]) < 0.5);
+}
+
+#[test]
+fn the_first_g1_after_power_up_a_reset_or_target_stepper_is_lit_at_its_feed() {
+    // Issue 25 defect 4: it ran dark at rapid speed (20 mm in ~130 ms).
+    let cases = [
+        ("power-up", "", [0.0, 20.0]),
+        (
+            "soft reset",
+            "G0 X-10\nwait 1000\n@realtime 0x18\nwait 100\n$X\n",
+            [-10.0, 10.0],
+        ),
+        (
+            "target stepper",
+            "G0 X-10\nwait 1000\ntarget stepper\nwait 100\n",
+            [-10.0, 10.0],
+        ),
+    ];
+    for (case, before, [x0, x1]) in cases {
+        let report = run(&format!("{before}M3 S1000\nG1 X{x1} F600\nwait 3000\n"));
+        let from_us = sent_at(&report, &format!("G1 X{x1} F600"));
+        let lit: Vec<(u64, [f64; 2])> = gimbal_spot_mm(&report)
+            .into_iter()
+            .filter(|s| s.2 && s.0 > from_us)
+            .map(|s| (s.0, s.1))
+            .collect();
+        assert!(lit.len() > 10, "{case}: lit {} samples", lit.len());
+        let lit_s = (lit[lit.len() - 1].0 - lit[0].0) as f64 / 1e6;
+        // 20 mm at 10 mm/s: 2 s (the ramps add a little).
+        assert!((1.9..2.2).contains(&lit_s), "{case}: lit for {lit_s} s");
+        for (t, p) in &lit {
+            // On the programmed line (a step's rounding off it).
+            let on = p[1].abs() < 0.6 && p[0] > x0 - 0.6 && p[0] < x1 + 0.6;
+            assert!(on, "{case}: lit at {p:?} at {t} µs, off the line");
+        }
+        let end = spot_mm_at(&report, report.end_time_us);
+        assert!(dist(end, [x1, 0.0]) < 0.6, "{case}: ended at {end:?}");
+    }
+}
+
+#[test]
+fn a_line_typed_ahead_of_target_stepper_runs_to_its_end() {
+    // The stop of `target stepper` came to rest after the line's move
+    // was sent; its report used to drop the move (stuck in `Run`).
+    let report = run(
+        "G0 X10\nwait 1000\n@type-ahead target stepper\n@type-ahead G1 X20 F600\nwait 3000\n?\n",
+    );
+    let status = statuses(&report).pop().expect("a status report");
+    assert!(status.starts_with("<Idle|"), "{status}");
+    assert!(dist(mpos(status), [20.0, 0.0]) < 0.01, "{status}");
+}
+
+#[test]
+fn a_line_from_axes_beyond_their_soft_limits_is_refused_with_alarm_2_dark() {
+    // Pan at 13.5°, then its limit set to 10°: no board line
+    // starts there; the job ends in a soft-limit alarm, nothing lit moves.
+    let report =
+        run("G0 X-60\nwait 1000\nset stepper.pan.max_deg 10\nM3 S1000\nG1 X0 F600\nwait 2000\n?\n");
+    let lines = terminal_lines(&report);
+    assert!(
+        lines.contains(&"[MSG:stepper: move refused: Unreachable]") && lines.contains(&"ALARM:2"),
+        "{lines:?}"
+    );
+    let status = statuses(&report).pop().expect("a status report");
+    assert!(status.starts_with("<Alarm|"), "{status}");
+    let g1_us = sent_at(&report, "G1 X0 F600");
+    let moved_lit = gimbal_spot_mm(&report)
+        .iter()
+        .filter(|s| s.2 && s.0 >= g1_us)
+        .any(|s| dist(s.1, [-60.0, 0.0]) > 0.5);
+    assert!(!moved_lit, "lit off the start");
+    assert!(dist(spot_mm_at(&report, report.end_time_us), [-60.0, 0.0]) < 0.5);
 }

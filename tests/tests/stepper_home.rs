@@ -78,8 +78,50 @@ fn homing_reports_a_switch_that_never_closes_within_the_travel() {
         &report,
         "error: home failed: pan switch not found within the travel; not homed",
     );
-    let counted = report.stepper.axes[0].counted_steps() as f64 * DEG_PER_STEP;
-    assert!((counted - 124.0).abs() < 0.1, "seeked {counted}°");
+    let farthest = pan_extreme_steps(&report) as f64 * DEG_PER_STEP;
+    assert!((farthest - 124.0).abs() < 0.1, "seeked {farthest}°");
+    // Then back to where the seek began: the position stays known.
+    assert_eq!(report.stepper.axes[0].counted_steps(), 0);
+}
+
+/// The pan step position farthest from power-up during the run, steps
+/// (from the STEP and DIR edges; DIR high is negative).
+fn pan_extreme_steps(report: &SimReport) -> i64 {
+    let (mut at, mut negative, mut farthest) = (0_i64, false, 0_i64);
+    for e in report.stepper.edges.iter().filter(|e| e.axis == 0) {
+        match e.pin {
+            StepPin::Dir => negative = e.high,
+            StepPin::Step if e.high => {
+                at += if negative { -1 } else { 1 };
+                if at.abs() > farthest.abs() {
+                    farthest = at;
+                }
+            }
+            _ => {}
+        }
+    }
+    farthest
+}
+
+#[test]
+fn failed_homing_repeated_leaves_the_axis_where_it_was_and_status_says_homing() {
+    // Issue 25 defect 6: each failed `$H` wound pan another 124° while
+    // `?` said MPos:0,0; `status` said idle while it sought.
+    let script = "set stepper.pan.home_dir 1\nset stepper.pan.home_deg 30\ntarget stepper\n\
+                  home\nwait 500\nstatus\nwait 20000\n$H\n$H\n$H\n?\n$X\nG0 X0 Y0\nwait 2000\n?\n";
+    let report = run_pan(script, 0.0, 170.0);
+    line(&report, "state: homing");
+    let lines = terminal_lines(&report);
+    let alarms = lines.iter().filter(|l| **l == "ALARM:9").count();
+    assert_eq!(alarms, 3, "{lines:?}");
+    assert_eq!(report.stepper.axes[0].counted_steps(), 0);
+    let statuses: Vec<&str> = lines.into_iter().filter(|l| l.starts_with('<')).collect();
+    for status in &statuses {
+        assert!(status.contains("|MPos:0.000,0.000,"), "{status}");
+    }
+    assert!(statuses.last().is_some_and(|s| s.starts_with("<Idle|")));
+    let spot = report.recording.spot.last().expect("spot samples");
+    assert!(spot.x_cm.hypot(spot.y_cm) < 0.05, "spot at {spot:?}");
 }
 
 #[test]

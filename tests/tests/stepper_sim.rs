@@ -3,8 +3,8 @@
 //! simulated STEP/DIR drivers and motors, the spot from the counted steps
 //! through the exact FK.
 
-use kinematics_core::stepper::StepperAxis;
 use laser_app::stepper::{LINE_TOLERANCE_MM, StepperConfig};
+use laser_sim::bench::BenchBuild;
 use laser_sim::stepper::{MotorLimits, StepPin, StepperGeometry};
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::{gimbal_dark_after, run_with, sent_at, spec_patterns};
@@ -163,24 +163,12 @@ const FINE_MICROSTEPS: u32 = 256;
 /// rate and acceleration scaled to the finer microsteps: the same motor).
 #[test]
 fn lines_circles_and_rects_within_a_tenth_of_a_millimetre_at_256_microsteps() {
-    let scale = f64::from(FINE_MICROSTEPS) / 32.0;
-    let motor = MotorLimits::default();
-    let axis = StepperAxis {
-        deg_per_step: 1.8 / f64::from(FINE_MICROSTEPS),
-        ..StepperAxis::default()
-    };
-    let options = SimOptions {
-        stepper_geometry: StepperGeometry {
-            axes: [axis; 2],
-            ..StepperGeometry::default()
-        },
-        stepper_motor: MotorLimits {
-            microsteps: FINE_MICROSTEPS,
-            max_rate_steps_per_s: motor.max_rate_steps_per_s * scale,
-            max_accel_steps_per_s2: motor.max_accel_steps_per_s2 * scale,
-        },
-        ..SimOptions::default()
-    };
+    let options = BenchBuild {
+        stepper_microsteps: FINE_MICROSTEPS,
+        ..BenchBuild::default()
+    }
+    .apply(SimOptions::default())
+    .expect("a driver setting");
     let setup = format!("set stepper.microsteps {FINE_MICROSTEPS}\n");
     for worst in figure_deviations_mm(&setup, &options) {
         assert!(worst <= 0.1, "{worst}");

@@ -3,12 +3,16 @@
 
 mod bench_m4;
 mod calib;
+mod doctor;
 mod fuzz;
+mod hil;
 mod json_out;
 mod kin;
+mod path_remap;
 mod plan;
 mod qemu;
 mod scenario;
+mod serial;
 mod sim;
 mod size_gcode;
 mod size_stack;
@@ -31,12 +35,19 @@ enum Command {
     Test,
     /// Build the release firmware for thumbv7em-none-eabihf.
     Build,
+    /// Check this machine for the first hour with a board: toolchain,
+    /// flip-link, probe-rs, udev rules, probes, the board's console (and
+    /// with --port, that the firmware answers and matches this checkout).
+    Doctor(doctor::DoctorArgs),
     /// The hot paths on the Cortex-M4F ISA (QEMU mps2-an386, -icount): instruction counts, µs, budgets.
     BenchM4,
     /// Build the release firmware and flash it with `probe-rs run` (streams defmt logs).
     Flash,
     /// Print the release firmware's size (text/data/bss) against the budget.
     Size,
+    /// The hardware acceptance run: the shared scenarios against a board
+    /// over its serial console, a pass/fail table and a JSON report.
+    Hil(hil::HilArgs),
     /// Run the firmware tasks on the host against simulated servos (virtual time).
     Sim(sim::SimArgs),
     /// Run the firmware on QEMU's mps2-an386 (Cortex-M4F) against the simulator's servos.
@@ -59,13 +70,21 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if builds_for_the_target(&cli.command)
+        && let Err(err) = path_remap::apply()
+    {
+        eprintln!("xtask: error: {err:#}");
+        return ExitCode::FAILURE;
+    }
     let result = match cli.command {
         Command::Test => toolchain::test().map(|()| ExitCode::SUCCESS),
         Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
+        Command::Doctor(args) => doctor::run(args),
         Command::BenchM4 => bench_m4::bench_m4().map(|_table| ExitCode::SUCCESS),
         Command::Flash => toolchain::flash().map(|()| ExitCode::SUCCESS),
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => sim::run_sim(args),
+        Command::Hil(args) => hil::run(args),
         Command::Qemu(args) => qemu::run(args),
         Command::Kin(args) => kin::run(args),
         Command::Calib(args) => calib::run(args),
@@ -95,4 +114,18 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Commands that build for the firmware target (their panic paths are
+/// remapped so the image size does not depend on the machine).
+fn builds_for_the_target(command: &Command) -> bool {
+    matches!(
+        command,
+        Command::Test
+            | Command::Build
+            | Command::BenchM4
+            | Command::Flash
+            | Command::Size
+            | Command::Qemu(_)
+    )
 }

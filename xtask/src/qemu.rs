@@ -29,10 +29,10 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use laser_sim::recorder::{Recording, SpotSample};
 
-pub use board_log::{BoardEvent, BoardLog};
+pub use board_log::{BoardEvent, BoardLog, LogLine, parse_line};
 pub use defmt_log::check_channel as check_defmt_channel;
 pub use machine::{Machine, MachineOptions};
-pub use pty::check_console as check_pty_console;
+pub use pty::{check_console as check_pty_console, with_board_on_pty};
 pub use script::{BoardStep, parse_board_script, split_at_resets};
 use script::{run_steps, wait_until_idle};
 pub use terminal::Terminal;

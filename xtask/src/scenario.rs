@@ -259,6 +259,19 @@ pub fn run_on_qemu() -> Result<()> {
         failures.push(format!("--pty console: {e:#}"));
     }
     let started = std::time::Instant::now();
+    let verdict = crate::hil::check_on_qemu(&plain);
+    match &verdict {
+        Ok(rows) => print!(
+            "cargo xtask hil on the QEMU board's PTY: ok\n{}",
+            crate::hil::table(rows)
+        ),
+        Err(_) => println!("cargo xtask hil on the QEMU board's PTY: FAILED"),
+    }
+    println!("  ({:.1} s)", started.elapsed().as_secs_f64());
+    if let Err(e) = verdict {
+        failures.push(format!("hil on QEMU: {e:#}"));
+    }
+    let started = std::time::Instant::now();
     let verdict = crate::qemu::build_image_with(&["defmt-log"], true)
         .and_then(|elf| crate::qemu::check_defmt_channel(&elf));
     println!(

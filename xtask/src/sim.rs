@@ -1,11 +1,15 @@
 //! `cargo xtask sim`: run the firmware's tasks on the host against simulated
 //! servos, in virtual time, and draw where the laser went.
 
+mod bench_args;
+#[cfg(test)]
+mod doc_commands;
+
 use std::io::Read as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result, anyhow, bail};
 use laser_sim::executor::RunEnd;
 use laser_sim::script::{DEMO_SCRIPT, parse_script};
 use laser_sim::servo_port::{BusFaults, SilentWindow};
@@ -37,6 +41,10 @@ pub struct SimArgs {
     /// Write every stepper STEP/DIR edge as CSV `t_ns,axis,pin,level`.
     #[arg(long)]
     steps: Option<PathBuf>,
+    /// Write every dwell as a measurement for `cargo xtask calib fit`
+    /// (CSV `x,y,dx,dy`, mm: commanded point, spot minus commanded).
+    #[arg(long)]
+    dwells: Option<PathBuf>,
     /// Galvo loop compute time per DAC sample, ns (models a slower CPU:
     /// above the 10 µs sample period the loop underruns).
     #[arg(long, default_value_t = 0)]
@@ -85,6 +93,9 @@ pub struct SimArgs {
     /// Log level of the firmware logs on stderr (error, warn, info, debug, trace, off).
     #[arg(long, default_value = "info")]
     log: String,
+    /// How the simulated bench is built and set.
+    #[command(flatten)]
+    bench: bench_args::BenchArgs,
 }
 
 /// Parses the `--fault` specs.
@@ -186,16 +197,20 @@ fn script_text(args: &SimArgs) -> Result<(String, bool)> {
     Ok((script_text, demo))
 }
 
-/// Runs `cargo xtask sim`.
-pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
-    let level: log::LevelFilter = args.log.parse().map_err(|_| {
-        anyhow::anyhow!(
-            "bad --log level {:?} (off, error, warn, info, debug, trace)",
-            args.log
-        )
-    })?;
-    laser_sim::logger::init(level);
-    let (script_text, demo) = script_text(&args)?;
+/// A run as the options describe it, ready to go.
+struct Prepared {
+    options: SimOptions,
+    /// Where the drawing goes (the demo draws `sim.svg`).
+    svg: Option<PathBuf>,
+    until_idle: bool,
+    bench: laser_sim::bench::BenchBuild,
+    /// The script's lines, for the microstep hint.
+    typed: Vec<String>,
+}
+
+/// Reads the script and turns the options into the simulator's.
+fn prepare(args: &SimArgs) -> Result<Prepared> {
+    let (script_text, demo) = script_text(args)?;
     let script = parse_script(&script_text)?;
     let (faults, slow_factor) = parse_faults(&args.faults)?;
     let svg = args
@@ -224,26 +239,56 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
             stop,
         }
     });
-    let report = run(SimOptions {
-        script,
-        pty,
-        realtime: args.realtime || args.interactive || args.pty.is_some(),
-        interactive: args.interactive,
+    let bench = args.bench.build();
+    let options = bench
+        .apply(SimOptions {
+            script,
+            pty,
+            realtime: args.realtime || args.interactive || args.pty.is_some(),
+            interactive: args.interactive,
+            until_idle,
+            faults,
+            slow_factor,
+            max_time_ms: (max_time_s * 1000.0) as u64,
+            echo: true,
+            galvo_cost_ns_per_sample: args.galvo_cost_ns,
+            laser_controls: args.laser_controls,
+            ..SimOptions::default()
+        })
+        .map_err(|e| anyhow!("bench options: {e}"))?;
+    Ok(Prepared {
+        options,
+        svg,
         until_idle,
-        faults,
-        slow_factor,
-        max_time_ms: (max_time_s * 1000.0) as u64,
-        echo: true,
-        galvo_cost_ns_per_sample: args.galvo_cost_ns,
-        laser_controls: args.laser_controls,
-        ..SimOptions::default()
-    });
-    write_outputs(&args, svg.as_deref(), &report)?;
+        bench,
+        typed: script_text.lines().map(str::to_owned).collect(),
+    })
+}
+
+/// Runs `cargo xtask sim`.
+pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
+    let level: log::LevelFilter = args.log.parse().map_err(|_| {
+        anyhow::anyhow!(
+            "bad --log level {:?} (off, error, warn, info, debug, trace)",
+            args.log
+        )
+    })?;
+    laser_sim::logger::init(level);
+    let prepared = prepare(&args)?;
+    let report = run(prepared.options);
+    write_outputs(&args, prepared.svg.as_deref(), &report)?;
     print_summary(&report);
+    if !report.stepper.edges.is_empty()
+        && let Some(hint) = prepared
+            .bench
+            .microstep_hint(laser_sim::bench::microsteps_set_by(&prepared.typed))
+    {
+        eprintln!("xtask sim: hint: {hint}");
+    }
     let unsafe_run = args.check_safety && !safety_holds(&report);
     Ok(exit_code(
         &report,
-        until_idle,
+        prepared.until_idle,
         args.allow_errors,
         unsafe_run,
     ))
@@ -273,6 +318,10 @@ fn write_outputs(args: &SimArgs, svg: Option<&Path>, report: &SimReport) -> Resu
         std::fs::write(path, report.stepper.edges_csv())
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
+    if let Some(path) = &args.dwells {
+        std::fs::write(path, report.recording.dwells_csv())
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
     Ok(())
 }
 
@@ -288,6 +337,9 @@ fn print_summary(report: &SimReport) {
         report.galvo_underruns,
         report.transcript.error_replies
     );
+    if let Some(worst) = report.recording.worst_dwell_error_mm() {
+        eprintln!("xtask sim: worst dwell error (spot vs commanded point): {worst:.2} mm");
+    }
     if !report.stepper.edges.is_empty() {
         eprint!("xtask sim: {}", report.stepper.report());
     }

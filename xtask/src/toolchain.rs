@@ -11,7 +11,7 @@ pub const TARGET: &str = "thumbv7em-none-eabihf";
 /// probe-rs chip name of the STM32F4DISCOVERY's MCU.
 pub const CHIP: &str = "STM32F407VGTx";
 /// Release-image budget for flash (text + data), bytes (SPEC §2: sectors
-/// 0–6).
+/// 0–6; the saved settings use sectors 10–11).
 pub const FLASH_BUDGET_BYTES: u64 = 384 * 1024;
 /// Release-image budget for static RAM (data + bss), bytes (SPEC §2).
 pub const RAM_BUDGET_BYTES: u64 = 96 * 1024;

@@ -9,6 +9,7 @@
 //! without ever waiting for the host (the console's writer sends them).
 
 use core::fmt;
+use core::sync::atomic::{AtomicBool, Ordering};
 
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
@@ -45,6 +46,7 @@ pub static HELP_LINES: &[&str] = &[
     "save                         store parameters in flash",
     "status                       state, target, faults",
     "version                      firmware version",
+    "trace on|off                 laser and run events as notices",
     "help                         this list",
 ];
 
@@ -83,6 +85,10 @@ pub enum Command {
     },
     /// Laser mode.
     Laser(LaserMode),
+    /// Report every laser change and laser-deciding sequencer event as a
+    /// `[trace …]` notice (on) or not (off): what `cargo xtask hil` checks
+    /// on a real board.
+    Trace(bool),
     /// Kinematic model.
     Model(AimModel),
     /// Set a parameter.
@@ -154,6 +160,7 @@ impl Command {
             Command::Goto(_) => "goto",
             Command::Grid { .. } => "grid",
             Command::Laser(_) => "laser",
+            Command::Trace(_) => "trace",
             Command::Model(_) => "model",
             Command::Set { .. } => "set",
             Command::Get(_) => "get",
@@ -199,6 +206,7 @@ impl fmt::Debug for Command {
             Command::Set { param, value } => write!(f, "set {} {}", param.name, Shortest(*value)),
             Command::Get(param) => write!(f, "get {}", param.name),
             Command::Grbl(line) => f.write_str(line.as_str()),
+            Command::Trace(on) => f.write_str(if *on { "trace on" } else { "trace off" }),
             other => f.write_str(other.name()),
         }
     }
@@ -228,6 +236,7 @@ impl PartialEq for Command {
             }
             (Command::Get(a), Command::Get(b)) => a.name == b.name,
             (Command::Grbl(a), Command::Grbl(b)) => a == b,
+            (Command::Trace(a), Command::Trace(b)) => a == b,
             (a, b) => core::mem::discriminant(a) == core::mem::discriminant(b),
         }
     }
@@ -259,6 +268,9 @@ pub struct CommandLink {
     /// while a line waits for room in the motion queue. When full (a host
     /// flooding `?`), further ones are dropped.
     pub realtime: Channel<CriticalSectionRawMutex, RealtimeRequest, REALTIME_QUEUE_DEPTH>,
+    /// `trace on`: laser changes and laser-deciding events are reported as
+    /// notices (`app::trace`).
+    trace: AtomicBool,
 }
 
 /// A realtime command as the console took it out of the byte stream.
@@ -283,7 +295,18 @@ impl CommandLink {
             outbound: Outbound::new(),
             stop_request: Signal::new(),
             realtime: Channel::new(),
+            trace: AtomicBool::new(false),
         }
+    }
+
+    /// Whether `trace on` is in force.
+    pub fn tracing(&self) -> bool {
+        self.trace.load(Ordering::Relaxed)
+    }
+
+    /// Turns the event trace on or off (`trace on|off`).
+    pub fn set_tracing(&self, on: bool) {
+        self.trace.store(on, Ordering::Relaxed);
     }
 
     /// Queues an unsolicited notice line, printed in brackets. Never

@@ -20,6 +20,8 @@ pub enum Activity {
     Goto,
     /// Running (or holding) queued G-code motion.
     Gcode,
+    /// The stepper homes (`home`, `$H`); laser off.
+    Homing,
 }
 
 /// Where the current point is in its cycle.

@@ -1,6 +1,6 @@
 //! Number formatting for replies without `core`'s float formatting, whose
-//! Grisu/Dragon code and tables cost ~12 KB of the firmware's 128 KiB
-//! flash budget. The bottom layer of the application: everything that
+//! Grisu/Dragon code and tables cost ~12 KB of the firmware's flash (budget
+//! 384 KiB, SPEC §2). The bottom layer of the application: everything that
 //! prints numbers (settings, commands, sequencer, command line) uses it,
 //! and it uses nothing of the application.
 //!

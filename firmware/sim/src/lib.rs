@@ -2,6 +2,7 @@
 //! bodies (from `laser-app`) on embassy's executor in virtual time, against
 //! simulated FashionStar servos and galvos, and records where the laser went.
 
+pub mod bench;
 pub mod board;
 pub mod clock;
 pub mod controls;

@@ -178,6 +178,33 @@ impl Recording {
         out
     }
 
+    /// Every dwell as a measurement for `cargo xtask calib fit`: CSV
+    /// `x,y,dx,dy`, mm — the commanded board point and where the spot
+    /// really was minus it (what a user measures with a ruler).
+    pub fn dwells_csv(&self) -> String {
+        let mut out = String::from("x,y,dx,dy\n");
+        for d in &self.dwells {
+            let _ = writeln!(
+                out,
+                "{:.4},{:.4},{:.4},{:.4}",
+                d.target_cm.0 * 10.0,
+                d.target_cm.1 * 10.0,
+                (d.spot_cm.0 - d.target_cm.0) * 10.0,
+                (d.spot_cm.1 - d.target_cm.1) * 10.0
+            );
+        }
+        out
+    }
+
+    /// The largest distance between a dwell's commanded point and the
+    /// spot, mm (`None` without dwells).
+    pub fn worst_dwell_error_mm(&self) -> Option<f64> {
+        self.dwells
+            .iter()
+            .map(|d| (d.spot_cm.0 - d.target_cm.0).hypot(d.spot_cm.1 - d.target_cm.1) * 10.0)
+            .reduce(f64::max)
+    }
+
     /// Gimbal laser power at time `t_us`, ‰ (0 before the first change).
     pub fn power_at(&self, t_us: u64) -> u16 {
         self.laser_power

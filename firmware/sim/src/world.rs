@@ -81,7 +81,7 @@ fn is_idle(status: &StatusBoard) -> bool {
     match s.activity {
         Activity::Idle => true,
         Activity::Goto => s.phase == Some(Phase::Holding),
-        Activity::Pattern(_) | Activity::Gcode => false,
+        Activity::Pattern(_) | Activity::Gcode | Activity::Homing => false,
     }
 }
 

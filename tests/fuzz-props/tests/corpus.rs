@@ -100,6 +100,7 @@ fn console_corpus_holds_and_covers_every_command() {
         "model",
         "set",
         "get",
+        "trace",
     ];
     for name in every {
         assert!(commands.contains(name), "no corpus input parses `{name}`");

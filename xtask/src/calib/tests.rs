@@ -284,3 +284,23 @@ fn coefficients_outside_the_firmware_range_are_refused() {
     let e = firmware_commands(&report, Path::new("m.csv")).unwrap_err();
     assert!(e.starts_with("err.dx.c0 = "), "{e}");
 }
+
+#[test]
+fn the_readme_example_measurements_fit() {
+    let out = tmp("readme-model.txt");
+    let args = FitArgs {
+        input: Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/examples/measured-grid.csv"),
+        output: Some(out.clone()),
+    };
+    let json: serde_json::Value = serde_json::from_str(&fit_command(&args).unwrap()).unwrap();
+    let written = std::fs::read_to_string(&out).unwrap();
+    std::fs::remove_file(&out).ok();
+    assert_eq!(json["dx"]["n"].as_u64(), Some(121));
+    assert_eq!(
+        written
+            .lines()
+            .filter(|l| l.starts_with("set err."))
+            .count(),
+        12
+    );
+}

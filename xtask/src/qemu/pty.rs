@@ -24,7 +24,7 @@ use laser_sim::pty::{Pty, PtyBridge};
 
 use super::machine::{Machine, MachineOptions};
 use super::terminal::SharedTerminal;
-use super::{Drive, run_board};
+use super::{BoardRun, Drive, run_board};
 
 /// Opens the PTY (making `link` a symlink to it) and starts its bridge.
 pub fn open(link: Option<&Path>) -> Result<(Pty, PtyBridge)> {
@@ -115,11 +115,14 @@ fn connect(path: &Path) -> Result<(File, Receiver<Vec<u8>>)> {
     Ok((port, rx))
 }
 
-/// The `--pty` console checked end to end on the board from `elf`: a host
-/// program opens the PTY, types `version` and the G-code `$I`, and reads
-/// both replies from the emulated board.
-pub fn check_console(elf: &Path) -> Result<()> {
-    const LIMIT: Duration = Duration::from_secs(30);
+/// Runs the board from `elf` with its console on a fresh PTY, calls
+/// `talk` with the PTY's device path while it runs, then stops the board:
+/// `talk`'s result and the board's run.
+pub fn with_board_on_pty<T>(
+    elf: &Path,
+    limit: Duration,
+    talk: impl FnOnce(&Path) -> T,
+) -> Result<(T, BoardRun)> {
     let (pty, bridge) = open(None)?;
     let path = pty.path.clone();
     let stop = Arc::new(AtomicBool::new(false));
@@ -132,9 +135,23 @@ pub fn check_console(elf: &Path) -> Result<()> {
         stop: stop.clone(),
     };
     let elf = elf.to_owned();
-    let board = std::thread::spawn(move || run_board(&elf, &options, drive, false, LIMIT, false));
-    let talk = || -> Result<String> {
-        let (mut port, chunks) = connect(&path)?;
+    let board = std::thread::spawn(move || run_board(&elf, &options, drive, false, limit, false));
+    let talked = talk(&path);
+    stop.store(true, Ordering::Relaxed);
+    let run = board
+        .join()
+        .map_err(|_| anyhow::anyhow!("the board thread panicked"))??;
+    drop(pty);
+    Ok((talked, run))
+}
+
+/// The `--pty` console checked end to end on the board from `elf`: a host
+/// program opens the PTY, types `version` and the G-code `$I`, and reads
+/// both replies from the emulated board.
+pub fn check_console(elf: &Path) -> Result<()> {
+    const LIMIT: Duration = Duration::from_secs(30);
+    let talk = |path: &Path| -> Result<String> {
+        let (mut port, chunks) = connect(path)?;
         let deadline = Instant::now() + LIMIT;
         let mut text = String::new();
         port.write_all(b"version\r\n")?;
@@ -144,12 +161,7 @@ pub fn check_console(elf: &Path) -> Result<()> {
         read_until_ok(&chunks, &mut text, from, deadline)?;
         Ok(text)
     };
-    let talked = talk();
-    stop.store(true, Ordering::Relaxed);
-    let run = board
-        .join()
-        .map_err(|_| anyhow::anyhow!("the board thread panicked"))??;
-    drop(pty);
+    let (talked, run) = with_board_on_pty(elf, LIMIT, talk)?;
     let text = talked?;
     if !text.contains("[VER:") {
         bail!("`$I` on the PTY got no [VER:…] line: {text:?}");

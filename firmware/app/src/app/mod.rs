@@ -17,6 +17,7 @@
 mod board;
 mod controls;
 mod tasks;
+pub mod trace;
 
 pub use self::board::{
     Board, Console, Indicators, LaserControls, Leds, NoGalvoDac, NoLaserControls, NoStepper, Parts,

@@ -89,7 +89,15 @@ impl<L: LaserSwitch, S: SettingsStore> SequencerTask<L, S> {
             controls,
         };
         let mut sequencer = Sequencer::new(
-            command, servo, actuators, status, self.laser, gate, self.store,
+            command,
+            servo,
+            actuators,
+            status,
+            super::trace::TracedLaser::new(self.laser, command, || {
+                embassy_time::Instant::now().as_micros()
+            }),
+            gate,
+            self.store,
         )
         .await;
         sequencer.run().await

@@ -56,6 +56,12 @@ fn parse_command(name: &str, args: &mut Args<'_>) -> Result<Command, CommandErro
         keyword(args, "status", &[("status", Command::GalvoStatus)])?
     } else if is("save") {
         Command::Save
+    } else if is("trace") {
+        keyword(
+            args,
+            "on|off",
+            &[("on", Command::Trace(true)), ("off", Command::Trace(false))],
+        )?
     } else if is("goto") {
         Command::Goto(point(args, "x_cm", "y_cm")?)
     } else if is("grid") {

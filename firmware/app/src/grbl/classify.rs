@@ -52,7 +52,7 @@ mod tests {
     /// Every command word of the product (cli/parse.rs).
     const PRODUCT_WORDS: &[&str] = &[
         "help", "version", "status", "stop", "params", "target", "planner", "galvo", "save",
-        "pattern", "goto", "grid", "laser", "model", "set", "get", "home",
+        "pattern", "goto", "grid", "laser", "model", "set", "get", "home", "trace",
     ];
 
     #[test]
@@ -100,8 +100,8 @@ mod tests {
 
     #[test]
     fn readme_command_table_words_are_all_known() {
-        // First word of every row of the README's command table.
-        let readme = include_str!("../../../../README.md");
+        // First word of every row of the command reference's table.
+        let readme = include_str!("../../../../docs/console.md");
         let table: Vec<&str> = readme
             .lines()
             .skip_while(|l| !l.starts_with("| command |"))
@@ -109,7 +109,7 @@ mod tests {
             .take_while(|l| l.starts_with("| `"))
             .filter_map(|l| l.trim_start_matches("| `").split([' ', '`', '\\']).next())
             .collect();
-        assert!(table.len() >= 10, "README table not found: {table:?}");
+        assert!(table.len() >= 10, "command table not found: {table:?}");
         for word in table {
             assert!(
                 PRODUCT_WORDS.contains(&word),

@@ -19,7 +19,7 @@
 //! LTO, one codegen unit: +20 962 B over the same binary folding the
 //! line's bytes (text +8 892 B, rodata +12 072 B), of which 14 954 B are
 //! `core`'s f32 parsing (`dec2flt`, its 10.4 KB power-of-five table) that
-//! this firmware does not link otherwise — 8 % of the 256 KiB budget for
+//! this firmware does not link otherwise — 8 % of the then 256 KiB budget for
 //! the lexical layer alone, before grbl's semantics.
 //! Flash cost of this module (parser, jog, `$` commands, every report and
 //! the settings table) measured in a thumbv7em `opt-level = "z"` LTO build:

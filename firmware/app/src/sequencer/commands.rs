@@ -49,6 +49,8 @@ impl Core {
                 self.ok(out);
             }
             Command::Arm => self.arm(out),
+            // The shell switched the trace as the command arrived.
+            Command::Trace(_) => self.ok(out),
             Command::Home => match self.start_homing(out) {
                 Ok(()) => self.ok(out),
                 Err(reason) => self.error(out, reason),

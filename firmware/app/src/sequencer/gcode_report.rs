@@ -55,7 +55,7 @@ impl Core {
         let motion = &g.motion;
         let state = match (g.mode, motion.hold) {
             // A `$H` waiting for the stepper's homing (grbl's `Home`).
-            _ if g.homing => MachineState::Home,
+            _ if g.homing || self.stepper_homing => MachineState::Home,
             (GrblMode::Alarm, _) => MachineState::Alarm,
             (GrblMode::Check, _) => MachineState::Check,
             (_, Hold::Held) => MachineState::Hold {

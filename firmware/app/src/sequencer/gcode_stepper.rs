@@ -35,6 +35,8 @@ pub(super) struct StepperJob {
     waiting: bool,
     /// A hold came to rest: `~` asks the stepper to go on with its moves.
     held: bool,
+    /// A hold was asked and the stepper has not reported rest yet.
+    braking: bool,
     /// The feed override the stepper task has, % (`None`: not sent since
     /// the last stop).
     feed_percent: Option<u8>,
@@ -93,8 +95,7 @@ impl Core {
             // where the hold stopped.
             job.inflight = current.stepper_seq;
             out.act(Action::Stepper(StepperRequest::Resume));
-            let motion = &mut self.gcode.motion;
-            motion.gimbal_lit = lit && motion.arrived;
+            self.gcode.motion.gimbal_lit = lit;
             return;
         }
         let Some((point, shape)) = stepper_move(&current.block) else {
@@ -110,7 +111,9 @@ impl Core {
         }
         motion.stepper.lit = lit;
         motion.stepper.laser = laser;
-        motion.gimbal_lit = lit && motion.arrived;
+        // Unlike a servo's, the stepper's position is known from the
+        // start (its counted steps): the first move is cut from there.
+        motion.gimbal_lit = lit;
     }
 
     /// The programmed spot speed of a feed move, mm/s (`None`: G0, at
@@ -200,12 +203,29 @@ impl Core {
                 }
                 true
             }
+            StepperEvent::Refused { seq, why } if motion.stepper.inflight == Some(seq) => {
+                // The checks before it passed, the stepper refused it
+                // (its axes beyond their soft limits): as on the galvo.
+                self.notify(out, format_args!("MSG:stepper: move refused: {why:?}"));
+                self.grbl_alarm(Alarm::SoftLimit, out);
+                true
+            }
             StepperEvent::Stopped { steps } => {
+                let braked = core::mem::take(&mut motion.stepper.braking);
+                if !braked && !motion.is_idle() {
+                    // The rest of a stop from before the job (`target
+                    // stepper` typed ahead of it): its moves run on.
+                    return false;
+                }
                 self.gcode_stepper_at(steps);
                 let motion = &mut self.gcode.motion;
-                if motion.hold == Hold::Stopping {
-                    motion.hold = Hold::Held;
-                    motion.stepper.held = true;
+                motion.stepper.held |= braked;
+                match motion.hold {
+                    Hold::Stopping if braked => motion.hold = Hold::Held,
+                    // `~` came while it braked: it goes on now it is at
+                    // rest (grbl resumes a hold once it is complete).
+                    Hold::None if braked => self.gcode_stepper_send(out),
+                    _ => {}
                 }
                 self.grbl_sync_position();
                 false
@@ -232,26 +252,25 @@ impl Core {
         }
     }
 
-    /// The end of homing: when a `$H` waits, its reply — `ok` (unlocked,
-    /// MPos where homing left the spot, at `steps`) or, as grbl, `ALARM:N`
-    /// (locked) and then `ok`; parameters that allow no homing: `error:5`.
+    /// The end of homing (`failed`: why it failed), the axes at rest at
+    /// `steps`: MPos where homing left the spot (a failed seek moved the
+    /// axes too); when a `$H` waits, its reply — `ok` (unlocked) or, as
+    /// grbl, `ALARM:N` (locked) and then `ok`; parameters that allow no
+    /// homing: `error:5`.
     #[inline(never)]
     pub(super) fn gcode_homing_done(
         &mut self,
-        homed: Result<[i32; 2], HomingFailure>,
+        steps: [i32; 2],
+        failed: Option<HomingFailure>,
         out: &mut dyn ActionSink,
     ) {
+        if self.gcode.motion.is_idle() {
+            self.gcode_stepper_at(steps);
+            self.grbl_sync_position();
+        }
         if !core::mem::take(&mut self.gcode.homing) {
             return;
         }
-        let failed = match homed {
-            Ok(steps) => {
-                self.gcode_stepper_at(steps);
-                self.grbl_sync_position();
-                None
-            }
-            Err(why) => Some(why),
-        };
         let alarm = match failed {
             None => {
                 self.gcode.mode = GrblMode::Normal;
@@ -288,6 +307,7 @@ impl Core {
         }
         motion.gimbal_lit = false;
         motion.hold = Hold::Stopping;
+        motion.stepper.braking = true;
         out.act(Action::Stepper(StepperRequest::Hold));
         true
     }
@@ -317,3 +337,6 @@ impl StepperJob {
         *self = Self::default();
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -97,6 +97,8 @@ pub struct Core {
     pub(super) inputs: Inputs,
     /// The grbl session: G-code parser, motion queue, grbl settings.
     pub(super) gcode: super::gcode::Gcode,
+    /// The stepper task homes (`home` or `$H` sent, its end not reported).
+    pub(super) stepper_homing: bool,
     /// The laser controls' state (`None`: the board has none).
     pub(super) controls: Option<crate::laser_controls::ControlsView>,
 }
@@ -128,6 +130,7 @@ impl Core {
                 stepper_attached: false,
             },
             gcode: super::gcode::Gcode::new(),
+            stepper_homing: false,
             controls: None,
         }
     }
@@ -181,6 +184,7 @@ impl Core {
         Snapshot {
             activity: match run {
                 None if !self.gcode.motion.is_idle() => Activity::Gcode,
+                None if self.stepper_homing => Activity::Homing,
                 None => Activity::Idle,
                 Some(r) => match r.kind.pattern() {
                     Some(p) => Activity::Pattern(p),

@@ -36,7 +36,7 @@ use embassy_time::{Duration, Instant, Timer};
 pub use self::galvo::config_from;
 pub use self::laser::{LaserEvent, LaserPower, LaserSwitch, laser_wanted};
 pub use self::machine::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
-use crate::command::CommandLink;
+use crate::command::{Command, CommandLink};
 use crate::galvo::{GalvoLink, GalvoRequest};
 use crate::laser_controls::ControlsLink;
 use crate::laser_gate::LaserGate;
@@ -237,6 +237,9 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
         match event {
             Either4::First(Either::First(command)) => {
                 log::debug!("command: {:?}", command);
+                if let Command::Trace(on) = command {
+                    io.link.set_tracing(on);
+                }
                 Event::Command {
                     command,
                     readings: io.readings(),

@@ -65,6 +65,7 @@ impl Core {
             Activity::Idle => self.data(out, format_args!("state: idle")),
             Activity::Goto => self.data(out, format_args!("state: goto")),
             Activity::Gcode => self.data(out, format_args!("state: G-code")),
+            Activity::Homing => self.data(out, format_args!("state: homing")),
             Activity::Pattern(p) => self.data(
                 out,
                 format_args!(

@@ -166,6 +166,9 @@ impl Core {
 
     /// The stepper task's report.
     pub(super) fn stepper_event(&mut self, event: StepperEvent, out: &mut dyn ActionSink) {
+        if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
+            self.stepper_homing = false;
+        }
         if self.gcode_stepper_event(&event, out) {
             return;
         }
@@ -215,9 +218,9 @@ impl Core {
                         Fixed::<3>(j.pitch_deg)
                     ),
                 );
-                self.gcode_homing_done(Ok(steps), out);
+                self.gcode_homing_done(steps, None, out);
             }
-            StepperEvent::HomingFailed(why) => {
+            StepperEvent::HomingFailed { why, steps } => {
                 let text = match why {
                     HomingFailure::NoSwitches => "no homing switches configured",
                     HomingFailure::NotFound(0) => "pan switch not found within the travel",
@@ -227,7 +230,7 @@ impl Core {
                     HomingFailure::BadConfig => "parameters refused for the homing moves",
                 };
                 self.notify(out, format_args!("error: home failed: {text}; not homed"));
-                self.gcode_homing_done(Err(why), out);
+                self.gcode_homing_done(steps, Some(why), out);
             }
         }
     }
@@ -250,6 +253,7 @@ impl Core {
         }
         self.stop("home", out);
         out.act(Action::Stepper(StepperRequest::Home));
+        self.stepper_homing = true;
         Ok(())
     }
 

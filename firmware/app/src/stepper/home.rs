@@ -3,9 +3,10 @@
 //! it closes (at most the soft-limit span plus two pull-offs), back off
 //! the pull-off distance, approach again at the latch speed until it
 //! closes, take that step as the switch's joint angle (the zero), pull
-//! off. The step timer halts the steps before the first step event that
-//! finds the switch closed, so the latch point is the first microstep
-//! inside the switch.
+//! off (a switch not found: the axis goes back to where its seek
+//! began, so the position stays known). The step timer halts the steps
+//! before the first step event that finds the switch closed, so the
+//! latch point is the first microstep inside the switch.
 
 use embassy_futures::select::{Either3, select, select3};
 use embassy_time::Timer;
@@ -39,8 +40,12 @@ impl Running {
         let _ = link.take_halt();
         self.stopping = false;
         self.deferred = None;
-        self.motion.rest_at(link.position_steps());
-        let result = self.home_axes(&config, link).await;
+        let start = link.position_steps();
+        self.motion.rest_at(start);
+        let mut result = self.home_axes(&config, link).await;
+        if let Err(HomingFailure::NotFound(axis)) = result {
+            result = self.back_to(link, usize::from(axis), start, &config).await;
+        }
         link.set_limit_mode(LimitMode::Guard);
         self.motion.rest_at(link.position_steps());
         result.map(|()| link.position_steps())
@@ -92,6 +97,26 @@ impl Running {
             log::info!("stepper: axis {} homed", axis);
         }
         Ok(())
+    }
+
+    /// Axis `axis`'s switch was not found: back to its steps at the
+    /// start of the cycle (`start`; its seek began there: an axis before
+    /// it moves only itself) at the seek speed, so the axes end where the
+    /// cycle found them (a failed `$H` repeated does not wind the axis
+    /// round). Returns the failure to report.
+    async fn back_to(
+        &mut self,
+        link: &StepperLink,
+        axis: usize,
+        start: [i32; 2],
+        config: &StepperConfig,
+    ) -> Result<(), HomingFailure> {
+        let back = start[axis & 1].wrapping_sub(link.position_steps()[axis & 1]);
+        if back != 0 {
+            let speed = config.homing.seek_deg_s;
+            self.jog(link, axis, back, speed, LimitMode::Ignore).await?;
+        }
+        Err(HomingFailure::NotFound(axis as u8))
     }
 
     /// Moves axis `axis` by `steps` at `speed_deg_s` with the limit check

@@ -35,7 +35,8 @@ pub struct StepperMotion {
     prep: SegmentPrep,
     /// Step position where the queued moves end, `[pan, tilt]`.
     planned: [i32; 2],
-    /// Board point of the last target (`None` after a stop).
+    /// Board point of the last target (`None` after a stop: then the
+    /// board point of `planned`).
     last_point: Option<BoardPoint>,
     line: Option<PieceCut>,
     /// The move in flight, reported when its last step has run.
@@ -169,17 +170,21 @@ impl StepperMotion {
         }
         let end = self.steps_at(point)?;
         self.apply_junction();
-        let queued = match self
+        // After power-up, a stop or a halt the line starts where the
+        // counted steps are.
+        let from = self
             .last_point
-            .and_then(|from| Curve::of(from, point, shape))
-        {
+            .or_else(|| self.board_point_of(self.planned));
+        let queued = match from.and_then(|from| Curve::of(from, point, shape)) {
             Some(curve) => Queued::Cut(PieceCut {
                 curve,
                 feed_mm_s,
                 pieces: self.pieces_for(curve)?,
                 next: 1,
             }),
-            None => Queued::Travel(end),
+            None if shape == MoveShape::Travel => Queued::Travel(end),
+            // Axes off the board (no board point): no line from there.
+            None => return Err(StepperRefusal::Unreachable),
         };
         self.last_point = Some(point);
         if self.line.is_some() {
@@ -214,6 +219,16 @@ impl StepperMotion {
     fn steps_at(&self, point: BoardPoint) -> Result<[i32; 2], StepperRefusal> {
         let j = self.joints_at(point)?;
         self.config.steps_of(j)
+    }
+
+    /// The board point the axes aim at from step position `steps`
+    /// (`None`: off the board, or beyond the soft limits — e.g. wound by
+    /// a failed homing seek — where a line cut from it would first turn
+    /// the axes back through the limits).
+    pub(super) fn board_point_of(&self, steps: [i32; 2]) -> Option<BoardPoint> {
+        let j = self.config.joints_of(steps)?;
+        self.config.steps_of(j).ok()?;
+        self.config.gimbal.fk(j).ok()
     }
 
     fn joints_at(&self, point: BoardPoint) -> Result<JointAngles, StepperRefusal> {

@@ -229,7 +229,10 @@ impl Running {
             StepperRequest::Home => {
                 let event = match self.home(link).await {
                     Ok(steps) => StepperEvent::Homed { steps },
-                    Err(why) => StepperEvent::HomingFailed(why),
+                    Err(why) => StepperEvent::HomingFailed {
+                        why,
+                        steps: link.position_steps(),
+                    },
                 };
                 link.events.send(event).await;
             }

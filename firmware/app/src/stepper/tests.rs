@@ -243,3 +243,72 @@ fn board_circle_stays_on_the_circle() {
     let start = config.steps_of(config.gimbal.ik(top).unwrap()).unwrap();
     assert_eq!(*positions.last().unwrap(), start);
 }
+
+/// Steps `motion` until everything planned has stepped; returns the
+/// position after every step event and the time it took, s.
+fn drain_timed(motion: &mut StepperMotion, link: &StepperLink) -> (Vec<[i32; 2]>, f64) {
+    let (mut positions, mut ticks) = (Vec::new(), 0_u64);
+    loop {
+        while !link.with_queue(|q| q.is_full()) {
+            let Some(seg) = motion.next_segment() else {
+                break;
+            };
+            link.with_queue(|q| q.push(seg)).unwrap();
+        }
+        let Some(tick) = link.step_tick() else {
+            if motion.is_planned_out() {
+                return (positions, ticks as f64 / f64::from(STEP_TIMER_HZ));
+            }
+            continue;
+        };
+        ticks += u64::from(tick.period_ticks);
+        positions.push(link.position_steps());
+    }
+}
+
+#[test]
+fn the_first_line_after_power_up_or_a_rest_is_cut_at_its_feed_from_the_counted_steps() {
+    let config = StepperConfig::default();
+    let at_steps = |p: BoardPoint| config.steps_of(config.gimbal.ik(p).unwrap()).unwrap();
+    // Power-up (step 0), and a rest after a halt somewhere else.
+    for rest in [None, Some(BoardPoint::new(-3.0, 2.0))] {
+        let link = link();
+        let mut motion = StepperMotion::new(config).unwrap();
+        let start = rest.map_or([0, 0], at_steps);
+        if rest.is_some() {
+            // The steps halted there (the step timer counted them).
+            link.set_position(0, start[0]);
+            link.set_position(1, start[1]);
+            motion.rest_at(start);
+        }
+        let from = config.gimbal.fk(config.joints_of(start).unwrap()).unwrap();
+        let to = BoardPoint::new(from.x_cm + 2.0, from.y_cm);
+        // 20 mm at 10 mm/s (G1 X20 F600): 2 s plus the ramps.
+        motion.move_to(1, to, MoveShape::Line, Some(10.0)).unwrap();
+        let (positions, seconds) = drain_timed(&mut motion, link);
+        assert!(
+            (2.0..2.2).contains(&seconds),
+            "{rest:?}: 20 mm in {seconds} s"
+        );
+        for steps in &positions {
+            let spot = config.gimbal.fk(config.joints_of(*steps).unwrap()).unwrap();
+            let off_mm = 10.0 * (spot.y_cm - from.y_cm).abs();
+            let bound = LINE_TOLERANCE_MM + one_step_mm(&config, spot);
+            assert!(off_mm <= bound, "{rest:?}: {off_mm} mm off the line");
+        }
+    }
+}
+
+#[test]
+fn no_line_is_cut_from_axes_wound_beyond_the_soft_limits() {
+    let mut motion = StepperMotion::new(StepperConfig::default()).unwrap();
+    // A failed homing seek left pan at 372° (6 613 steps).
+    motion.rest_at([6613, 0]);
+    let to = BoardPoint::new(1.0, 0.0);
+    assert_eq!(
+        motion.move_to(1, to, MoveShape::Line, Some(10.0)),
+        Err(StepperRefusal::Unreachable)
+    );
+    // Travel back is allowed.
+    assert_eq!(motion.move_to(2, to, MoveShape::Travel, None), Ok(true));
+}

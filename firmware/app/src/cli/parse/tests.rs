@@ -203,6 +203,7 @@ fn every_help_line_names_a_command_that_parses_with_its_example() {
         "save",
         "status",
         "version",
+        "trace on",
         "help",
     ];
     assert_eq!(examples.len(), HELP_LINES.len());

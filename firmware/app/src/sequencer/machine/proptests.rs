@@ -380,7 +380,10 @@ impl Harness {
                 match kind {
                     1..=3 => StepperEvent::LimitHit { axes: kind, steps },
                     4 => StepperEvent::Homed { steps },
-                    _ => StepperEvent::HomingFailed(crate::stepper::HomingFailure::Interrupted),
+                    _ => StepperEvent::HomingFailed {
+                        why: crate::stepper::HomingFailure::Interrupted,
+                        steps,
+                    },
                 }
             }
             _ => unreachable!("not a stepper step: {step:?}"),
@@ -558,7 +561,8 @@ impl Harness {
     /// The invariants on the outputs and the status view.
     fn check_outputs(&self) -> Result<(), std::string::String> {
         let view = self.core.status();
-        let idle = view.activity == Activity::Idle;
+        // Homing has no point either (and is dark).
+        let idle = matches!(view.activity, Activity::Idle | Activity::Homing);
         if idle != view.phase.is_none() || idle != view.point_index.is_none() {
             return Err("status view contradicts itself".into());
         }

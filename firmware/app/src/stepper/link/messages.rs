@@ -141,8 +141,14 @@ pub enum StepperEvent {
         /// Position, microsteps.
         steps: [i32; 2],
     },
-    /// `Home` failed (the position is not homed).
-    HomingFailed(HomingFailure),
+    /// `Home` failed (the position is not homed; the axes are at rest at
+    /// `steps` of the zero they had, counted through the homing moves).
+    HomingFailed {
+        /// Why.
+        why: HomingFailure,
+        /// Position, microsteps.
+        steps: [i32; 2],
+    },
 }
 
 /// Why homing failed.

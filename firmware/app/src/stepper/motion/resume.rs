@@ -94,9 +94,7 @@ impl StepperMotion {
     /// board point; nothing queued).
     pub fn resume(&mut self, steps: [i32; 2]) -> Result<(), StepperRefusal> {
         let at = self
-            .config
-            .joints_of(steps)
-            .and_then(|j| self.config.gimbal.fk(j).ok())
+            .board_point_of(steps)
             .ok_or(StepperRefusal::Unreachable)?;
         let h = &mut self.history;
         let mut from = h.start.unwrap_or(at);
