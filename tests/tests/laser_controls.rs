@@ -2,7 +2,7 @@
 //! `docs/laser-safety.md`) in the simulator: the remote interlock and key
 //! switch (`@interlock`, `@key` script steps), the emission indicator and
 //! `arm`, on the galvo (whose lit DAC samples are recorded one by one)
-//! and the gimbal, all under the safety checker (rule (e) included).
+//! and the gimbal, all under the safety checker (rule (g) included).
 
 use laser_sim::safety::{GalvoStretch, ViolationKind, check, galvo_stretches};
 use laser_sim::world::{SimOptions, SimReport};
@@ -205,7 +205,7 @@ fn the_key_switch_latches_like_the_interlock_on_the_gimbal() {
 #[test]
 fn the_checker_flags_a_laser_lit_without_the_controls() {
     // The same lit run, checked against controls that were never armed:
-    // rule (e) must see it.
+    // rule (g) must see it.
     let mut report = run_with(
         "target galvo\nwait 50\narm\nwait 3100\npattern tuning 0 0 8\nwait 500\nstop\n",
         SimOptions {

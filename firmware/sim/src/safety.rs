@@ -21,7 +21,10 @@
 //!   the host sent gets exactly one `ok` / `error: …`, after its data
 //!   lines, in the order the lines were sent; bracketed notices are not
 //!   replies but must be whole lines.
-//! * **(e) the laser controls** ([`ViolationKind::LitWithoutControls`],
+//! * **(e) on the G-code path** ([`ViolationKind::OffPath`]) and **(f)
+//!   motions end in time** ([`ViolationKind::LateMotion`]): see
+//!   [`conformance`] for the rules and their stated tolerances.
+//! * **(g) the laser controls** ([`ViolationKind::LitWithoutControls`],
 //!   on a board with them): no laser lit while the interlock is open or
 //!   the key off, without the emission indicator on for the emission
 //!   delay, or without a reset since the last opening (`controls.rs`).
@@ -34,8 +37,11 @@
 //! the executor's step accounting. The galvo laser is read in one place,
 //! [`galvo_stretches`]: the **effective** laser state of each sample.
 
+mod conformance;
 mod controls;
 mod dark;
+mod gcode_model;
+mod gcode_piece;
 mod moving;
 mod replies;
 mod steps;
@@ -47,15 +53,18 @@ use crate::controls::ControlsRecord;
 use crate::dac::DacRecording;
 use crate::executor::{LONG_STEP_NS, TaskSteps};
 use crate::physics::PhysicalGalvo;
-use crate::recorder::{EventRecord, ServoSample};
+use crate::recorder::{EventRecord, ServoSample, SpotSample};
 use crate::usb_host::Transcript;
 use crate::world::SimReport;
 
+use conformance::gcode_conformance;
+pub use conformance::{DURATION_SLACK_S, RAPID_MIN_MM_S};
 use controls::laser_controls_obeyed;
 use dark::dark_after_stops;
 use moving::{galvo_jumps_dark, gimbal_dwell_mode, gimbal_travel_dark};
 use replies::one_reply_per_line;
 use steps::short_steps;
+pub use steps::{NOISE_RUNS, steady_steps};
 use timeline::SettingsTimeline;
 
 /// Time after a stop (fault, button, underrun, …) within which every
@@ -91,7 +100,11 @@ pub enum ViolationKind {
     Replies,
     /// (d) A firmware task step longer than 1 ms of CPU time.
     LongStep,
-    /// (e) A laser lit while the interlock was open or the key off, before
+    /// (e) A lit G-code sample off the commanded path.
+    OffPath,
+    /// (f) A G-code motion not ended within its bound.
+    LateMotion,
+    /// (g) A laser lit while the interlock was open or the key off, before
     /// the emission indicator's delay, or without a reset since.
     LitWithoutControls,
 }
@@ -106,6 +119,8 @@ impl ViolationKind {
             ViolationKind::LitWithoutArrival => "lit-without-arrival",
             ViolationKind::Replies => "replies",
             ViolationKind::LongStep => "long-step",
+            ViolationKind::OffPath => "off-path",
+            ViolationKind::LateMotion => "late-motion",
             ViolationKind::LitWithoutControls => "lit-without-controls",
         }
     }
@@ -208,6 +223,8 @@ pub struct SafetyInputs<'a> {
     pub events: &'a [EventRecord],
     /// Servo angles and targets.
     pub servos: &'a [ServoSample],
+    /// The gimbal's or stepper's spot on the board.
+    pub spot: &'a [SpotSample],
     /// The terminal transcript.
     pub transcript: &'a Transcript,
     /// Step accounting of every task.
@@ -230,6 +247,7 @@ impl<'a> SafetyInputs<'a> {
             underruns_ns: &report.dac.underrun_detected_ns,
             events: &report.recording.events,
             servos: &report.recording.servos,
+            spot: &report.recording.spot,
             transcript: &report.transcript,
             task_steps: &report.task_steps,
             galvo_physics: PhysicalGalvo::default(),
@@ -278,6 +296,9 @@ pub fn check_inputs(inputs: &SafetyInputs<'_>) -> Vec<Violation> {
         one_reply_per_line(inputs.transcript),
     );
     add(ViolationKind::LongStep, short_steps(inputs.task_steps));
+    let (off_path, late) = gcode_conformance(inputs);
+    add(ViolationKind::OffPath, off_path);
+    add(ViolationKind::LateMotion, late);
     add(
         ViolationKind::LitWithoutControls,
         laser_controls_obeyed(inputs, &timeline),

@@ -6,9 +6,11 @@
 //! `@type-ahead <line>` types a line without waiting for its reply,
 //! `@realtime <byte>` sends one of grbl's realtime bytes (`?`, `!`, `~`
 //! or hex: `0x18`, `0x9b`, …; no line, no reply awaited), `@button`
-//! presses the board's stop button, and `@interlock open|closed` and
-//! `@key off|on` set the laser controls' inputs (a script that uses them
-//! runs on a board with the laser controls fitted).
+//! presses the board's stop button, `@close` / `@open` close the
+//! console port (unplug: what was not read yet is lost) and open it
+//! again (a new session), and `@interlock open|closed` and `@key off|on`
+//! set the laser controls' inputs (a script that uses them runs on a
+//! board with the laser controls fitted).
 
 use anyhow::{Context, Result, bail};
 
@@ -29,6 +31,11 @@ pub enum Step {
     StopButton,
     /// Send one grbl realtime byte (no line end, no reply awaited).
     Realtime(u8),
+    /// The host closes the port (DTR drops): replies not read yet are
+    /// lost, as are lines still awaiting them.
+    ClosePort,
+    /// The host opens the port again (a new session).
+    OpenPort,
     /// Close (`true`) or open the laser controls' remote interlock.
     Interlock(bool),
     /// Turn the laser controls' key switch on (`true`) or off.
@@ -118,6 +125,8 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
                 steps.push(Step::SendAhead(typed.to_owned()));
             }
             Some("@button") if line == "@button" => steps.push(Step::StopButton),
+            Some("@close") if line == "@close" => steps.push(Step::ClosePort),
+            Some("@open") if line == "@open" => steps.push(Step::OpenPort),
             Some("@realtime") => steps.push(Step::Realtime(realtime_byte(words.next(), number)?)),
             Some(d @ "@interlock") => steps.push(Step::Interlock(control_level(
                 d,
@@ -134,8 +143,8 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
             Some(directive) if directive.starts_with('@') => {
                 bail!(
                     "script line {number}: unknown directive {directive:?} \
-                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, \
-                     @interlock open|closed, @key off|on)"
+                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, @close, \
+                     @open, @interlock open|closed, @key off|on)"
                 );
             }
             _ => steps.push(Step::Send(line.to_owned())),

@@ -17,11 +17,10 @@
 mod board;
 mod controls;
 mod tasks;
-pub mod trace;
 
 pub use self::board::{
-    Board, Console, Indicators, LaserControls, Leds, NoGalvoDac, NoLaserControls, NoStepper, Parts,
-    StopButton, Watchdog,
+    Board, Console, HostPresence, Indicators, LaserControls, Leds, NoGalvoDac, NoHangUp,
+    NoLaserControls, NoStepper, Parts, StopButton, Watchdog,
 };
 pub use self::controls::{CONTROLS_POLL, LaserControlsTask};
 pub use self::tasks::{

@@ -1,4 +1,4 @@
-//! (e) The laser controls (on a board with them): no lit sample, gimbal
+//! (g) The laser controls (on a board with them): no lit sample, gimbal
 //! or galvo,
 //!
 //! * while the remote interlock reads open or the key switch off (from
