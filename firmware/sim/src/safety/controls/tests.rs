@@ -25,6 +25,7 @@ fn check(record: &ControlsRecord, gimbal_laser: &[(u64, bool)]) -> Vec<Violation
         task_steps: &[],
         galvo_physics: PhysicalGalvo::default(),
         end_us: 20 * S,
+        spot: &[],
         controls: Some(record),
     };
     laser_controls_obeyed(&inputs, &SettingsTimeline::from_transcript(&transcript))
