@@ -11,6 +11,7 @@
 //! | laser enable / power | PB0 (active high): TIM3_CH3 PWM (AF2, 1 kHz) for a power level, GPIO when dark or full (`laser_pwm`); galvo laser stream DMA2 stream 1 ch 7 (TIM8_UP) |
 //! | LEDs                | PD12 green heartbeat, PD13 orange laser, PD14 red fault, PD15 blue USB |
 //! | user button         | PA0 (stop + laser off) |
+//! | laser controls      | PD1 remote interlock, PD2 key switch (pull-up inputs, EXTI1/EXTI2; closed to GND = closed / on), PD3 emission indicator (active high) — `docs/laser-safety.md` |
 //! | stepper pan STEP / DIR  | PE9 TIM1_CH1 (AF1, one-pulse: the pulse timed by TIM1) / PE10 GPIO (the step events on an interrupt executor, `tasks.rs`) |
 //! | stepper tilt STEP / DIR | PE11 TIM1_CH2 (AF1, one-pulse) / PE12 GPIO |
 //! | stepper ENABLE (both)   | PE13 (polarity a parameter; released = the idle level) |
@@ -45,7 +46,8 @@ use static_cell::StaticCell;
 use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac, darken_laser_stream};
 use crate::laser_pwm::{LaserPin, laser_dark};
 use crate::parts::{
-    IndependentDog, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UsbDtr, UserButton,
+    IndependentDog, LaserControlPins, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UsbDtr,
+    UserButton,
 };
 use crate::settings_flash::{FlashSettings, settings_store};
 
@@ -54,6 +56,8 @@ bind_interrupts!(struct Irqs {
     USART2 => usart::BufferedInterruptHandler<peripherals::USART2>;
     DMA1_STREAM5 => HalfInterrupt;
     EXTI0 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI0>;
+    EXTI1 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI1>;
+    EXTI2 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI2>;
     FLASH => flash::InterruptHandler;
 });
 
@@ -141,6 +145,8 @@ pub struct Stm32Board {
     /// Stepper pan/tilt driver inputs (PE9–PE13, STEP from TIM1), limit
     /// switches (PE7, PE8).
     pub stepper: TimerStepper,
+    /// Remote interlock (PD1), key switch (PD2), emission indicator (PD3).
+    pub laser_controls: LaserControlPins,
 }
 
 impl Board for Stm32Board {
@@ -154,6 +160,7 @@ impl Board for Stm32Board {
     type Indicators = StatusLeds;
     type StopButton = UserButton;
     type Watchdog = IndependentDog;
+    type LaserControls = LaserControlPins;
 
     fn into_parts(self) -> Parts<Self> {
         Parts {
@@ -167,6 +174,7 @@ impl Board for Stm32Board {
             indicators: self.leds,
             stop_button: self.button,
             watchdog: self.watchdog,
+            laser_controls: Some(self.laser_controls),
         }
     }
 }
@@ -241,6 +249,11 @@ pub fn init(spawner: Spawner) -> Stm32Board {
             Output::new(p.PE13, Level::High, Speed::Low),
             [Input::new(p.PE7, Pull::Up), Input::new(p.PE8, Pull::Up)],
         ),
+        laser_controls: LaserControlPins {
+            interlock: ExtiInput::new(p.PD1, p.EXTI1, Pull::Up, Irqs),
+            key: ExtiInput::new(p.PD2, p.EXTI2, Pull::Up, Irqs),
+            indicator: Output::new(p.PD3, Level::Low, Speed::Low),
+        },
     }
 }
 

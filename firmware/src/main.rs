@@ -38,6 +38,9 @@ static GALVO_LINK: GalvoLink = GalvoLink::new();
 static STATUS: StatusBoard = StatusBoard::new();
 /// Sequencer ↔ stepper task ↔ step timer.
 static STEPPER_LINK: laser_app::stepper::StepperLink = laser_app::stepper::StepperLink::new();
+/// Laser-controls task ↔ sequencer.
+static CONTROLS_LINK: laser_app::laser_controls::ControlsLink =
+    laser_app::laser_controls::ControlsLink::new();
 /// Runs the galvo loop in the UART4 interrupt (UART4 itself is unused).
 static GALVO_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 
@@ -57,6 +60,7 @@ async fn main(spawner: Spawner) {
         status: &STATUS,
         gate: &board::LASER_GATE,
         stepper: &STEPPER_LINK,
+        controls: &CONTROLS_LINK,
     };
     interrupt::UART4.set_priority(board::GALVO_PRIORITY);
     let galvo = GALVO_EXECUTOR.start(interrupt::UART4);

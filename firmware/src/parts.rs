@@ -7,7 +7,7 @@ use embassy_futures::select::{Either, select};
 use embassy_stm32::Peri;
 use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::gpio::OutputType;
-use embassy_stm32::gpio::{Input, Output};
+use embassy_stm32::gpio::{Input, Level, Output};
 use embassy_stm32::mode::Async;
 use embassy_stm32::pac;
 use embassy_stm32::pac::timer::regs::CcmrOutputGp16;
@@ -21,8 +21,10 @@ use embassy_time::{Duration, Instant, Timer};
 use embassy_usb::class::cdc_acm::{BufferedReceiver, ControlChanged, Sender};
 use embedded_io_async::Read;
 use laser_app::app::{
-    Console, HostPresence, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog,
+    Console, HostPresence, Indicators, LaserControls, Leds, StopButton, WATCHDOG_TIMEOUT_US,
+    Watchdog,
 };
+use laser_app::laser_controls::ControlInputs;
 use laser_app::stepper::{
     CCMR1_IDLE, DriverSignals, OnePulseTiming, StepPace, StepperConfig, StepperDrive,
 };
@@ -129,6 +131,40 @@ impl StopButton for UserButton {
         Timer::at(self.armed_from).await;
         self.input.wait_for_rising_edge().await;
         self.armed_from = Instant::now() + DEBOUNCE;
+    }
+}
+
+/// The laser controls (`docs/laser-safety.md`): remote interlock PD1 and
+/// key switch PD2, pull-up inputs each closed to GND by its loop (low =
+/// closed / on: a cut wire or nothing attached reads open / off), the
+/// emission indicator PD3 (active high, LED and/or buzzer driver).
+pub struct LaserControlPins {
+    /// PD1 with its EXTI line: the remote interlock loop.
+    pub interlock: ExtiInput<'static, Async>,
+    /// PD2 with its EXTI line: the key switch.
+    pub key: ExtiInput<'static, Async>,
+    /// PD3: the emission indicator.
+    pub indicator: Output<'static>,
+}
+
+impl LaserControls for LaserControlPins {
+    fn read(&mut self) -> ControlInputs {
+        ControlInputs {
+            interlock_closed: self.interlock.is_low(),
+            key_on: self.key.is_low(),
+        }
+    }
+
+    async fn changed(&mut self) {
+        select(
+            self.interlock.wait_for_any_edge(),
+            self.key.wait_for_any_edge(),
+        )
+        .await;
+    }
+
+    fn set_indicator(&mut self, on: bool) {
+        self.indicator.set_level(Level::from(on));
     }
 }
 

@@ -13,8 +13,8 @@ use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::usart::{BufferedUartRx, BufferedUartTx};
 use embassy_usb::UsbDevice;
 use laser_app::app::{
-    ConsoleTask, GalvoTask, IndicatorTask, SequencerTask, ServoBusTask, Spawn, StopButtonTask,
-    WatchdogTask,
+    ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, SequencerTask, ServoBusTask, Spawn,
+    StopButtonTask, WatchdogTask,
 };
 use laser_app::galvo::GalvoMemory;
 
@@ -23,7 +23,9 @@ use static_cell::StaticCell;
 use crate::board::Stm32Board;
 use crate::galvo_dac::{self, Stm32GalvoDac};
 use crate::laser_pwm::LaserPin;
-use crate::parts::{IndependentDog, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton};
+use crate::parts::{
+    IndependentDog, LaserControlPins, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton,
+};
 use crate::settings_flash::FlashSettings;
 use laser_app::stepper::{StepPulseTask, StepperTask};
 
@@ -112,6 +114,13 @@ async fn watchdog(task: WatchdogTask<IndependentDog>) -> ! {
     task.run().await
 }
 
+/// Laser controls PD1–PD3: interlock, key switch, emission indicator (on
+/// the galvo executor).
+#[embassy_executor::task]
+async fn laser_controls(task: LaserControlsTask<LaserControlPins>) -> ! {
+    task.run().await
+}
+
 /// Spawns the task bodies on the embassy executors (each task's pool holds
 /// one: the wiring spawns each once).
 pub struct TaskSpawner {
@@ -158,5 +167,12 @@ impl Spawn<Stm32Board> for TaskSpawner {
 
     fn watchdog(&mut self, task: WatchdogTask<IndependentDog>) {
         self.thread.spawn(defmt::unwrap!(watchdog(task)));
+    }
+
+    fn laser_controls(&mut self, task: LaserControlsTask<LaserControlPins>) {
+        // On the galvo executor (interrupt priority): an opening
+        // interlock darkens the laser without waiting for a thread-mode
+        // task's step to end.
+        self.galvo.spawn(defmt::unwrap!(laser_controls(task)));
     }
 }

@@ -97,6 +97,9 @@ pub fn run_all(port: &Path, reset: Reset<'_>) -> Result<Vec<Row>> {
                     Err(e) => Verdict::Fail(format!("{e:#}")),
                 },
                 Ok(run::Ran::NoGalvo) => Verdict::Skipped("this board has no galvo output".into()),
+                Ok(run::Ran::SwitchesInputs) => Verdict::Skipped(
+                    "the interlock and key cannot be switched over the console".into(),
+                ),
                 Err(e) => Verdict::Fail(format!("{e:#}")),
             },
         };

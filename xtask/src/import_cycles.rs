@@ -297,6 +297,7 @@ mod tests {
         &["domain"],
         &["settings"],
         &["status", "laser_gate"],
+        &["laser_controls"],
         &["grbl"],
         &["command", "outbound"],
         &["servo", "galvo", "stepper"],

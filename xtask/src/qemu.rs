@@ -112,7 +112,8 @@ pub fn build_image() -> Result<PathBuf> {
 }
 
 /// Builds the board's release image with `features` (after
-/// `--no-default-features` when `no_default`); its path.
+/// `--no-default-features` when `no_default`); its path (a copy named
+/// after the features).
 pub fn build_image_with(features: &[&str], no_default: bool) -> Result<PathBuf> {
     crate::bench_m4::qemu::ensure_qemu()?;
     ensure_flip_link()?;
@@ -125,7 +126,19 @@ pub fn build_image_with(features: &[&str], no_default: bool) -> Result<PathBuf> 
         args.extend(["--features", joined.as_str()]);
     }
     crate::bench_m4::cargo_in(MANIFEST, &args)?;
-    Ok(target_dir().join(TARGET).join("release").join("qemu-m4"))
+    let built = target_dir().join(TARGET).join("release").join("qemu-m4");
+    // Cargo writes every feature set to the same file: keep a copy per
+    // set, so images built one after the other (`--scenarios`) stay apart.
+    let mut name = String::from("qemu-m4-");
+    name.push_str(if no_default { "no-default" } else { "default" });
+    for feature in features {
+        name.push('-');
+        name.push_str(feature);
+    }
+    let copy = built.with_file_name(name);
+    std::fs::copy(&built, &copy)
+        .with_context(|| format!("cannot copy {} to {}", built.display(), copy.display()))?;
+    Ok(copy)
 }
 
 /// The script text: the file, stdin (`-` or piped), or nothing when
@@ -300,6 +313,13 @@ pub fn run(args: QemuArgs) -> Result<ExitCode> {
     let mut features = Vec::new();
     if args.galvo_dac {
         features.push("galvo-dac");
+    }
+    if steps
+        .iter()
+        .any(|s| matches!(s, BoardStep::Script(step) if step.uses_laser_controls()))
+    {
+        // `@interlock` / `@key`: a board with the laser controls.
+        features.push("laser-controls");
     }
     if args.defmt_log {
         features.push("defmt-log");

@@ -16,7 +16,8 @@ use laser_sim::servo_port::BusFaults;
 use laser_sim::world::{SimOptions, run};
 
 use crate::qemu::{
-    BoardEvent, BoardRun, Drive, MachineOptions, parse_board_script, run_board, split_at_resets,
+    BoardEvent, BoardRun, BoardStep, Drive, MachineOptions, parse_board_script, run_board,
+    split_at_resets,
 };
 use crate::toolchain::workspace_root;
 
@@ -38,6 +39,9 @@ pub struct Scenario {
     pub faults: Vec<String>,
     /// `#! galvo-dac`: the board has a galvo DAC stream.
     pub galvo_dac: bool,
+    /// The script sets the laser controls (`@interlock`, `@key`): the
+    /// board has them.
+    pub laser_controls: bool,
 }
 
 impl Scenario {
@@ -51,6 +55,9 @@ impl Scenario {
             .map(|s| s.trim().to_owned())
             .collect();
         let galvo_dac = script.lines().any(|l| l.trim() == "#! galvo-dac");
+        let laser_controls = parse_board_script(&script)?
+            .iter()
+            .any(|s| matches!(s, BoardStep::Script(step) if step.uses_laser_controls()));
         let name = path
             .file_stem()
             .and_then(|s| s.to_str())
@@ -61,6 +68,7 @@ impl Scenario {
             script,
             faults,
             galvo_dac,
+            laser_controls,
         })
     }
 
@@ -213,10 +221,16 @@ pub fn run_on_qemu() -> Result<()> {
     } else {
         None
     };
+    let controls = if scenarios.iter().any(|s| s.laser_controls) {
+        Some(crate::qemu::build_image_with(&["laser-controls"], false)?)
+    } else {
+        None
+    };
     let mut failures = Vec::new();
     for scenario in scenarios {
-        let elf = match &galvo {
-            Some(image) if scenario.galvo_dac => image,
+        let elf = match (&galvo, &controls) {
+            (Some(image), _) if scenario.galvo_dac => image,
+            (_, Some(image)) if scenario.laser_controls => image,
             _ => &plain,
         };
         if let Err(e) = on_simulator(&scenario).and_then(|o| check(&scenario.name, &o)) {

@@ -49,6 +49,12 @@ pub struct SimArgs {
     /// above the 10 µs sample period the loop underruns).
     #[arg(long, default_value_t = 0)]
     galvo_cost_ns: u64,
+    /// Fit the laser controls (remote interlock, key switch, emission
+    /// indicator; bench wiring: closed and on): no laser lights before
+    /// `arm` (`docs/laser-safety.md`). A script with `@interlock` or `@key`
+    /// steps fits them anyway.
+    #[arg(long)]
+    laser_controls: bool,
     /// Inject a fault: `servo-silent:<id>@<t_ms>[-<end_ms>]`, `servo-corrupt:<probability>`
     /// (per response byte), `servo-forge:<probability>` (per angle response: a wrong angle
     /// with a valid checksum), `servo-slow:<factor>` (repeatable).
@@ -246,6 +252,7 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
             max_time_ms: (max_time_s * 1000.0) as u64,
             echo: true,
             galvo_cost_ns_per_sample: args.galvo_cost_ns,
+            laser_controls: args.laser_controls,
             ..SimOptions::default()
         })
         .map_err(|e| anyhow!("bench options: {e}"))?;

@@ -34,6 +34,7 @@ pub static HELP_LINES: &[&str] = &[
     "pattern rect <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
     "pattern tuning [<cx_cm> <cy_cm> <size_cm>] [once]   (galvo)",
     "stop                         stop the pattern, laser off",
+    "arm                          laser controls: reset, laser after the delay",
     "home                         home the stepper on its switches",
     "goto <x_cm> <y_cm>           aim at a board point",
     "grid <xi> <yi>               aim at a grid point",
@@ -73,6 +74,10 @@ pub enum Command {
     },
     /// Stop whatever runs; laser off.
     Stop,
+    /// The laser controls' manual reset: with the interlock closed and the
+    /// key on, the emission indicator comes on and the laser may emit
+    /// after `laser.emission_delay_s`.
+    Arm,
     /// Aim at a board point and hold it.
     Goto(PointCm),
     /// Aim at a grid point and hold it.
@@ -155,6 +160,7 @@ impl Command {
             Command::Status => "status",
             Command::Pattern { .. } => "pattern",
             Command::Stop => "stop",
+            Command::Arm => "arm",
             Command::Goto(_) => "goto",
             Command::Grid { .. } => "grid",
             Command::Laser(_) => "laser",

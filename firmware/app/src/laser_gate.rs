@@ -22,10 +22,15 @@
 //!   started: it opens only if nobody closed the gate since, so a stale
 //!   opener (a run already stopped) cannot relight it.
 //!
+//! * [`LaserGate::forbid`] (the laser controls: interlock open, key off,
+//!   not armed) closes the gate and refuses every [`LaserGate::open`]
+//!   until [`LaserGate::permit`]: the controls' AND on every laser output.
+//!   A gate starts permitted (a board without the controls).
+//!
 //! Use one `static` gate shared by the sequencer (gimbal laser pin), the
 //! galvo loop (sample stream) and the board (the pin itself).
 
-use core::sync::atomic::{AtomicU32, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 /// The gate's state: whether it is open and its generation (the number of
 /// closes since boot, wrapping).
@@ -64,6 +69,8 @@ pub struct LaserGate {
     /// [`GateState`] packed: generation << 1 | open. Generations count
     /// modulo 2³¹.
     state: AtomicU32,
+    /// The laser controls permit emission (see [`LaserGate::forbid`]).
+    permitted: AtomicBool,
     /// Called with the new state after every change (a close always is
     /// one): on the target it clears the laser pin when the gate closes,
     /// in the simulator it records the change with its time.
@@ -84,6 +91,7 @@ impl LaserGate {
     pub const fn with_hook(on_change: fn(GateState)) -> Self {
         Self {
             state: AtomicU32::new(0),
+            permitted: AtomicBool::new(true),
             on_change,
         }
     }
@@ -149,10 +157,35 @@ impl LaserGate {
         }
     }
 
+    /// Closes the gate for good (a new generation, as [`Self::close`])
+    /// and refuses every [`Self::open`] until [`Self::permit`]: the laser
+    /// controls latched emission off. Returns the new generation.
+    pub fn forbid(&self) -> u32 {
+        // First the flag, then the close: an opener that saw the flag
+        // still set opens under the old generation, which the close ends.
+        self.permitted.store(false, Ordering::SeqCst);
+        self.close()
+    }
+
+    /// Lets runs open the gate again (the laser controls are armed). Opens
+    /// nothing by itself: runs stopped by [`Self::forbid`] stay dark.
+    pub fn permit(&self) {
+        self.permitted.store(true, Ordering::SeqCst);
+    }
+
+    /// Whether the laser controls permit emission.
+    pub fn is_permitted(&self) -> bool {
+        self.permitted.load(Ordering::SeqCst)
+    }
+
     /// Opens the gate for a run that started under `generation`; refused
-    /// (`false`, gate unchanged) when it was closed since. `true` when
-    /// the gate is open for `generation` afterwards.
+    /// (`false`, gate unchanged) when it was closed since or the laser
+    /// controls forbid emission. `true` when the gate is open for
+    /// `generation` afterwards.
     pub fn open(&self, generation: u32) -> bool {
+        if !self.is_permitted() {
+            return false;
+        }
         let closed = GateState {
             generation,
             open: false,
@@ -252,6 +285,22 @@ mod tests {
         let g2 = gate.close();
         assert!(!gate.open(g));
         assert!(gate.open(g2));
+    }
+
+    #[test]
+    fn a_forbidden_gate_refuses_every_open_until_permitted() {
+        let gate = LaserGate::new();
+        assert!(gate.is_permitted(), "a board without controls");
+        let g = gate.close();
+        assert!(gate.open(g));
+        let g2 = gate.forbid();
+        assert_ne!(g, g2, "forbidding ends the run's generation");
+        assert!(!gate.is_open() && !gate.passes(true, g));
+        assert!(!gate.open(g2), "not even the current generation opens");
+        assert!(!gate.open(g));
+        gate.permit();
+        assert!(!gate.open(g), "the run that was lit stays dark");
+        assert!(gate.open(g2), "a new run lights");
     }
 
     #[test]

@@ -26,6 +26,7 @@ pub mod command;
 pub mod domain;
 pub mod galvo;
 pub mod grbl;
+pub mod laser_controls;
 pub mod laser_gate;
 mod log;
 pub mod outbound;

@@ -10,6 +10,7 @@
 //! | embassy-time          | APB timers 0/1 0x4000_0000/0x4000_1000 (IRQ 8/9) |
 //! | watchdog              | CMSDK watchdog 0x4000_8000 (NMI, then reset) |
 //! | laser pin, LEDs       | reported on the log channel                  |
+//! | laser controls (feature `laser-controls`) | interlock/key bytes on UART2's input, indicator reported on the log channel |
 //! | settings              | top 64 KiB of RAM (survives a board reset)   |
 //!
 //! QEMU connects each UART to a chardev (`cargo xtask qemu`: Unix sockets
@@ -47,6 +48,10 @@ impl Board for QemuBoard {
     type StopButton = UartButton;
     type Watchdog = CmsdkWatchdog;
     type Stepper = laser_app::app::NoStepper;
+    #[cfg(not(feature = "laser-controls"))]
+    type LaserControls = laser_app::app::NoLaserControls;
+    #[cfg(feature = "laser-controls")]
+    type LaserControls = crate::controls::ChannelLaserControls;
 
     fn into_parts(self) -> Parts<Self> {
         Parts {
@@ -63,6 +68,10 @@ impl Board for QemuBoard {
             stop_button: self.button,
             watchdog: CmsdkWatchdog,
             stepper: None,
+            #[cfg(not(feature = "laser-controls"))]
+            laser_controls: None,
+            #[cfg(feature = "laser-controls")]
+            laser_controls: Some(crate::controls::ChannelLaserControls { shown: None }),
         }
     }
 }

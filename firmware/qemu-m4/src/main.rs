@@ -6,6 +6,8 @@
 #![no_main]
 
 mod board;
+#[cfg(feature = "laser-controls")]
+mod controls;
 #[cfg(feature = "defmt-log")]
 mod defmt_channel;
 mod executor;
@@ -37,6 +39,10 @@ static GALVO_LINK: GalvoLink = GalvoLink::new();
 /// Sequencer ↔ stepper channels (no stepper task serves them on this board:
 /// `target stepper` is refused).
 static STEPPER_LINK: laser_app::stepper::StepperLink = laser_app::stepper::StepperLink::new();
+/// Laser-controls task ↔ sequencer (nothing behind it without the
+/// `laser-controls` feature).
+static CONTROLS_LINK: laser_app::laser_controls::ControlsLink =
+    laser_app::laser_controls::ControlsLink::new();
 /// Shared state for LEDs and the watchdog.
 static STATUS: StatusBoard = StatusBoard::new();
 
@@ -64,6 +70,7 @@ fn main() -> ! {
         stepper: &STEPPER_LINK,
         status: &STATUS,
         gate: &parts::LASER_GATE,
+        controls: &CONTROLS_LINK,
     };
     executor::run(|spawner| wire(board, links, &mut tasks::TaskSpawner(spawner)))
 }

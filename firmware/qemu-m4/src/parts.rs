@@ -128,7 +128,8 @@ pub const STATS_BYTE: u8 = b'S';
 
 /// The stop button: [`BUTTON_BYTE`] arriving on UART2 (the host's
 /// `@button`). [`STATS_BYTE`] there asks for the board's measurements
-/// (`crate::stats`); other bytes are ignored.
+/// (`crate::stats`); with the laser controls, their bytes set the
+/// interlock and key (`crate::controls`); other bytes are ignored.
 pub struct UartButton {
     /// UART2, receive side.
     pub rx: Uart,
@@ -142,6 +143,11 @@ impl StopButton for UartButton {
                 match byte[0] {
                     BUTTON_BYTE => return,
                     STATS_BYTE => crate::stats::report(),
+                    #[cfg(feature = "laser-controls")]
+                    other => {
+                        crate::controls::note_control_byte(other);
+                    }
+                    #[cfg(not(feature = "laser-controls"))]
                     _ => {}
                 }
             }

@@ -7,8 +7,8 @@ use embassy_executor::Spawner;
 #[cfg(not(feature = "galvo-dac"))]
 use laser_app::app::NoGalvoDac;
 use laser_app::app::{
-    ConsoleTask, GalvoTask, IndicatorTask, NoStepper, SequencerTask, ServoBusTask, Spawn,
-    StopButtonTask, WatchdogTask,
+    ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, NoStepper, SequencerTask,
+    ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::stepper::{StepPulseTask, StepperTask};
 
@@ -24,6 +24,12 @@ async fn console(task: ConsoleTask<UartConsole>) -> ! {
 
 #[embassy_executor::task]
 async fn servo_bus(task: ServoBusTask<Uart, Uart>) -> ! {
+    task.run().await
+}
+
+#[cfg(feature = "laser-controls")]
+#[embassy_executor::task]
+async fn laser_controls(task: LaserControlsTask<crate::controls::ChannelLaserControls>) -> ! {
     task.run().await
 }
 
@@ -119,6 +125,19 @@ impl Spawn<QemuBoard> for TaskSpawner {
 
     fn stop_button(&mut self, task: StopButtonTask<UartButton>) {
         spawned("stop button", stop_button(task), &self.0);
+    }
+
+    #[cfg(not(feature = "laser-controls"))]
+    fn laser_controls(&mut self, task: LaserControlsTask<laser_app::app::NoLaserControls>) {
+        task.unreachable()
+    }
+
+    #[cfg(feature = "laser-controls")]
+    fn laser_controls(
+        &mut self,
+        task: LaserControlsTask<crate::controls::ChannelLaserControls>,
+    ) {
+        spawned("laser controls", laser_controls(task), &self.0);
     }
 
     fn watchdog(&mut self, task: WatchdogTask<CmsdkWatchdog>) {

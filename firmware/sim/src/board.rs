@@ -12,6 +12,7 @@
 //! | galvo DAC     | the simulated double-buffered DAC ([`SimDac`]), or none |
 //! | stepper STEP/DIR/ENABLE | the driver models ([`SimStepperDrive`]), or none |
 //! | LEDs, button, watchdog | recorded models ([`crate::panel`])       |
+//! | interlock, key, emission indicator | script-set inputs, recorded indicator ([`crate::controls`]), or none |
 
 use std::cell::Cell;
 use std::convert::Infallible;
@@ -19,12 +20,13 @@ use std::rc::Rc;
 
 use embassy_executor::Spawner;
 use laser_app::app::{
-    Board, Console, ConsoleTask, GalvoTask, HostPresence, IndicatorTask, Parts, SequencerTask,
-    ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
+    Board, Console, ConsoleTask, GalvoTask, HostPresence, IndicatorTask, LaserControlsTask, Parts,
+    SequencerTask, ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::stepper::{StepPulseTask, StepperTask};
 
+use crate::controls::SimLaserControls;
 use crate::dac::SimDac;
 use crate::executor::{TaskKind, spawn_task};
 use crate::panel::{SimLeds, SimStopButton, SimWatchdog};
@@ -54,6 +56,8 @@ pub struct SimBoard {
     pub stop_button: SimStopButton,
     /// The watchdog.
     pub watchdog: SimWatchdog,
+    /// The laser controls, if the board has them.
+    pub laser_controls: Option<SimLaserControls>,
 }
 
 impl Board for SimBoard {
@@ -67,6 +71,7 @@ impl Board for SimBoard {
     type Indicators = SimLeds;
     type StopButton = SimStopButton;
     type Watchdog = SimWatchdog;
+    type LaserControls = SimLaserControls;
 
     fn into_parts(self) -> Parts<Self> {
         Parts {
@@ -84,6 +89,7 @@ impl Board for SimBoard {
             indicators: self.leds,
             stop_button: self.stop_button,
             watchdog: self.watchdog,
+            laser_controls: self.laser_controls,
         }
     }
 }
@@ -232,6 +238,10 @@ impl Spawn<SimBoard> for SimSpawner {
 
     fn watchdog(&mut self, task: WatchdogTask<SimWatchdog>) {
         self.firmware("watchdog", task.run());
+    }
+
+    fn laser_controls(&mut self, task: LaserControlsTask<SimLaserControls>) {
+        self.firmware("laser controls", task.run());
     }
 }
 

@@ -5,6 +5,7 @@
 pub mod bench;
 pub mod board;
 pub mod clock;
+pub mod controls;
 pub mod dac;
 pub mod drawing;
 pub mod executor;

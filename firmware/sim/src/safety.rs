@@ -24,6 +24,10 @@
 //! * **(e) on the G-code path** ([`ViolationKind::OffPath`]) and **(f)
 //!   motions end in time** ([`ViolationKind::LateMotion`]): see
 //!   [`conformance`] for the rules and their stated tolerances.
+//! * **(g) the laser controls** ([`ViolationKind::LitWithoutControls`],
+//!   on a board with them): no laser lit while the interlock is open or
+//!   the key off, without the emission indicator on for the emission
+//!   delay, or without a reset since the last opening (`controls.rs`).
 //! * **(d) short task steps** ([`ViolationKind::LongStep`]): no poll of a
 //!   firmware task takes more than 1 ms of thread CPU time (see
 //!   [`crate::executor`] for what that measures).
@@ -34,6 +38,7 @@
 //! [`galvo_stretches`]: the **effective** laser state of each sample.
 
 mod conformance;
+mod controls;
 mod dark;
 mod gcode_model;
 mod gcode_piece;
@@ -44,6 +49,7 @@ mod timeline;
 
 use std::fmt;
 
+use crate::controls::ControlsRecord;
 use crate::dac::DacRecording;
 use crate::executor::{LONG_STEP_NS, TaskSteps};
 use crate::physics::PhysicalGalvo;
@@ -53,6 +59,7 @@ use crate::world::SimReport;
 
 use conformance::gcode_conformance;
 pub use conformance::{DURATION_SLACK_S, RAPID_MIN_MM_S};
+use controls::laser_controls_obeyed;
 use dark::dark_after_stops;
 use moving::{galvo_jumps_dark, gimbal_dwell_mode, gimbal_travel_dark};
 use replies::one_reply_per_line;
@@ -97,6 +104,9 @@ pub enum ViolationKind {
     OffPath,
     /// (f) A G-code motion not ended within its bound.
     LateMotion,
+    /// (g) A laser lit while the interlock was open or the key off, before
+    /// the emission indicator's delay, or without a reset since.
+    LitWithoutControls,
 }
 
 impl ViolationKind {
@@ -111,6 +121,7 @@ impl ViolationKind {
             ViolationKind::LongStep => "long-step",
             ViolationKind::OffPath => "off-path",
             ViolationKind::LateMotion => "late-motion",
+            ViolationKind::LitWithoutControls => "lit-without-controls",
         }
     }
 }
@@ -222,6 +233,9 @@ pub struct SafetyInputs<'a> {
     pub galvo_physics: PhysicalGalvo,
     /// Simulated time at the end of the run, µs.
     pub end_us: u64,
+    /// The laser controls' inputs and indicator (`None`: the board has
+    /// none).
+    pub controls: Option<&'a ControlsRecord>,
 }
 
 impl<'a> SafetyInputs<'a> {
@@ -238,6 +252,7 @@ impl<'a> SafetyInputs<'a> {
             task_steps: &report.task_steps,
             galvo_physics: PhysicalGalvo::default(),
             end_us: report.end_time_us,
+            controls: report.laser_controls.as_ref(),
         }
     }
 }
@@ -284,6 +299,10 @@ pub fn check_inputs(inputs: &SafetyInputs<'_>) -> Vec<Violation> {
     let (off_path, late) = gcode_conformance(inputs);
     add(ViolationKind::OffPath, off_path);
     add(ViolationKind::LateMotion, late);
+    add(
+        ViolationKind::LitWithoutControls,
+        laser_controls_obeyed(inputs, &timeline),
+    );
     all
 }
 

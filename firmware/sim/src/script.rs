@@ -6,9 +6,11 @@
 //! `@type-ahead <line>` types a line without waiting for its reply,
 //! `@realtime <byte>` sends one of grbl's realtime bytes (`?`, `!`, `~`
 //! or hex: `0x18`, `0x9b`, …; no line, no reply awaited), `@button`
-//! presses the board's stop button, and `@close` / `@open` close the
+//! presses the board's stop button, `@close` / `@open` close the
 //! console port (unplug: what was not read yet is lost) and open it
-//! again (a new session).
+//! again (a new session), and `@interlock open|closed` and `@key off|on`
+//! set the laser controls' inputs (a script that uses them runs on a
+//! board with the laser controls fitted).
 
 use anyhow::{Context, Result, bail};
 
@@ -34,6 +36,31 @@ pub enum Step {
     ClosePort,
     /// The host opens the port again (a new session).
     OpenPort,
+    /// Close (`true`) or open the laser controls' remote interlock.
+    Interlock(bool),
+    /// Turn the laser controls' key switch on (`true`) or off.
+    Key(bool),
+}
+
+impl Step {
+    /// Whether the step needs the board's laser controls.
+    pub fn uses_laser_controls(&self) -> bool {
+        matches!(self, Step::Interlock(_) | Step::Key(_))
+    }
+}
+
+/// The level of `@interlock open|closed` / `@key off|on`.
+fn control_level(
+    directive: &str,
+    word: Option<&str>,
+    [off, on]: [&str; 2],
+    number: usize,
+) -> Result<bool> {
+    match word {
+        Some(w) if w == on => Ok(true),
+        Some(w) if w == off => Ok(false),
+        _ => bail!("script line {number}: `{directive}` needs {off} or {on}"),
+    }
 }
 
 /// The byte of `@realtime <byte>`: one of grbl's realtime commands, as
@@ -101,10 +128,23 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
             Some("@close") if line == "@close" => steps.push(Step::ClosePort),
             Some("@open") if line == "@open" => steps.push(Step::OpenPort),
             Some("@realtime") => steps.push(Step::Realtime(realtime_byte(words.next(), number)?)),
+            Some(d @ "@interlock") => steps.push(Step::Interlock(control_level(
+                d,
+                words.next(),
+                ["open", "closed"],
+                number,
+            )?)),
+            Some(d @ "@key") => steps.push(Step::Key(control_level(
+                d,
+                words.next(),
+                ["off", "on"],
+                number,
+            )?)),
             Some(directive) if directive.starts_with('@') => {
                 bail!(
                     "script line {number}: unknown directive {directive:?} \
-                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, @close, @open)"
+                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, @close, \
+                     @open, @interlock open|closed, @key off|on)"
                 );
             }
             _ => steps.push(Step::Send(line.to_owned())),
@@ -145,6 +185,24 @@ mod tests {
         assert!(parse_script("@realtime 0x41").is_err(), "A is not realtime");
         assert!(parse_script("@realtime").is_err());
         assert!(parse_script("@realtime 0xZZ").is_err());
+    }
+
+    #[test]
+    fn laser_control_steps_parse_and_bad_levels_are_refused() {
+        let steps =
+            parse_script("@interlock open\n@interlock closed\n@key off\n@key on\n").unwrap();
+        assert_eq!(
+            steps,
+            vec![
+                Step::Interlock(false),
+                Step::Interlock(true),
+                Step::Key(false),
+                Step::Key(true)
+            ]
+        );
+        assert!(steps.iter().all(Step::uses_laser_controls));
+        assert!(parse_script("@interlock on").is_err());
+        assert!(parse_script("@key").is_err());
     }
 
     #[test]

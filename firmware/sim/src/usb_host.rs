@@ -17,6 +17,7 @@ use embassy_sync::pipe::Pipe;
 use embassy_sync::signal::Signal;
 use embassy_time::Timer;
 
+use crate::controls::ControlWiring;
 use crate::executor::{self, TaskKind};
 use crate::panel::ButtonContacts;
 use crate::script::Step;
@@ -206,10 +207,25 @@ impl UsbHost {
     }
 }
 
-/// Runs one script step; `@button` presses `button` (the interactive
-/// terminal has no button).
-async fn run_step(host: &UsbHost, step: Step, button: Option<&ButtonContacts>) {
+/// Runs one script step; `@button` presses `button`, `@interlock` and
+/// `@key` set `controls` (the interactive terminal has neither).
+async fn run_step(
+    host: &UsbHost,
+    step: Step,
+    button: Option<&ButtonContacts>,
+    controls: Option<&ControlWiring>,
+) {
     match step {
+        Step::Interlock(closed) => {
+            if let Some(controls) = controls {
+                controls.set_interlock(closed);
+            }
+        }
+        Step::Key(on) => {
+            if let Some(controls) = controls {
+                controls.set_key(on);
+            }
+        }
         Step::StopButton => {
             if let Some(button) = button {
                 button.press();
@@ -233,9 +249,14 @@ async fn run_step(host: &UsbHost, step: Step, button: Option<&ButtonContacts>) {
 
 /// Types the script: each command line, then waits for its closing reply;
 /// `@button` steps press the board's stop `button`.
-pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, button: Rc<ButtonContacts>) {
+pub async fn script_task(
+    steps: Vec<Step>,
+    host: Rc<UsbHost>,
+    button: Rc<ButtonContacts>,
+    controls: Option<Rc<ControlWiring>>,
+) {
     for step in steps {
-        run_step(&host, step, Some(&button)).await;
+        run_step(&host, step, Some(&button), controls.as_deref()).await;
     }
     host.replies_read().await;
     host.transcript.borrow_mut().script_done = true;
@@ -249,7 +270,7 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
         match lines.try_recv() {
             Ok(line) => {
                 for step in crate::script::parse_script(&line).unwrap_or_default() {
-                    run_step(&host, step, None).await;
+                    run_step(&host, step, None, None).await;
                 }
             }
             Err(std::sync::mpsc::TryRecvError::Empty) => Timer::after_millis(20).await,
@@ -267,6 +288,7 @@ pub fn host_tasks(
     script: Vec<Step>,
     host: Rc<UsbHost>,
     button: Rc<ButtonContacts>,
+    controls: Option<Rc<ControlWiring>>,
 ) -> impl FnOnce(&Spawner) + 'static {
     move |spawner| {
         if interactive {
@@ -289,7 +311,7 @@ pub fn host_tasks(
                 spawner,
                 "host (script)",
                 TaskKind::Simulator,
-                script_task(script, host.clone(), button),
+                script_task(script, host.clone(), button, controls),
             );
         }
         executor::spawn_task(
@@ -411,7 +433,7 @@ mod tests {
             10_000_000,
             move |spawner| {
                 let button = Rc::new(ButtonContacts::default());
-                executor::spawn(&spawner, script_task(steps, h1, button));
+                executor::spawn(&spawner, script_task(steps, h1, button, None));
                 executor::spawn(&spawner, terminal_task(h2));
                 executor::spawn(&spawner, echo_ok_device(h3));
             },

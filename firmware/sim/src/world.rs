@@ -14,6 +14,7 @@ use embassy_executor::Spawner;
 use laser_app::app::{Links, wire};
 use laser_app::command::CommandLink;
 use laser_app::galvo::{GalvoConfig, GalvoLink};
+use laser_app::laser_controls::ControlsLink;
 use laser_app::sequencer::SettingsStore;
 use laser_app::servo::task::ServoLink;
 use laser_app::settings::store::FlashSettingsStore;
@@ -22,6 +23,7 @@ use laser_app::stepper::StepperLink;
 use sequential_storage::map::MapConfig;
 
 use crate::board::{SimBoard, SimSpawner};
+use crate::controls::{ControlWiring, SimLaserControls};
 use crate::dac::{DacRecording, SimDac};
 use crate::executor::{self, RunEnd, TaskKind};
 use crate::flash::{FlashTiming, SimFlash};
@@ -92,6 +94,8 @@ struct World {
     dac: Rc<RefCell<DacRecording>>,
     panel: SharedPanel,
     button: Rc<ButtonContacts>,
+    /// The laser controls' wiring, on a board with them.
+    controls: Option<Rc<ControlWiring>>,
     flash: SettingsFlash,
     bus: Rc<RefCell<SimServoBus>>,
     port: Rc<SimServoPort>,
@@ -112,7 +116,10 @@ impl World {
             status: Box::leak(Box::new(StatusBoard::new())),
             gate: recorded_gate(&dac),
             stepper: Box::leak(Box::new(StepperLink::new())),
+            controls: Box::leak(Box::new(ControlsLink::new())),
         };
+        let fitted =
+            options.laser_controls || options.script.iter().any(|s| s.uses_laser_controls());
         let recording = Rc::new(RefCell::new(Recording::default()));
         let gimbal = options.physical;
         let bus = Rc::new(RefCell::new(SimServoBus::new(
@@ -139,6 +146,7 @@ impl World {
             dac,
             panel: SharedPanel::default(),
             button: Rc::new(ButtonContacts::default()),
+            controls: fitted.then(|| Rc::new(ControlWiring::bench())),
             flash: boot_settings_flash(options),
             bus,
             port,
@@ -181,6 +189,7 @@ impl World {
                 panel: self.panel.clone(),
             },
             watchdog: SimWatchdog(self.panel.clone()),
+            laser_controls: self.controls.clone().map(SimLaserControls),
             stepper: options.stepper.then(|| {
                 SimStepperDrive::new(
                     self.stepper.clone(),
@@ -202,6 +211,7 @@ impl World {
                 options.script.clone(),
                 self.host.clone(),
                 self.button.clone(),
+                self.controls.clone(),
             )),
         };
         let mut sim_spawner = SimSpawner::new(spawner, host_tasks);
@@ -240,6 +250,7 @@ impl World {
             task_steps: executor::task_steps(),
             panel: self.panel_at_end(end_time_us),
             stepper: self.stepper_at_end(end_time_us),
+            laser_controls: self.controls.as_ref().map(|c| c.record()),
         }
     }
 

@@ -24,6 +24,8 @@ pub enum Ran {
     Outcome(Outcome),
     /// It needs a galvo and the board has none.
     NoGalvo,
+    /// It switches the laser controls' inputs, which the console cannot.
+    SwitchesInputs,
 }
 
 /// The console with what the board said so far.
@@ -192,6 +194,10 @@ pub fn run_scenario(
     }
     session.harness("target gimbal")?;
     session.harness("model exact")?;
+    if scenario.laser_controls {
+        return Ok(Ran::SwitchesInputs);
+    }
+    arm(&mut session)?;
     let before = params(&mut session)?;
     session.trace_on()?;
     let steps = parse_board_script(&scenario.script)?;
@@ -219,6 +225,9 @@ pub fn run_scenario(
             BoardStep::Script(Step::Realtime(byte)) => session.console.send_bytes(&[byte])?,
             BoardStep::Script(Step::StopButton) => {
                 bail!("the stop button cannot be pressed over the console")
+            }
+            BoardStep::Script(Step::Interlock(_) | Step::Key(_)) => {
+                bail!("the interlock and key cannot be switched over the console")
             }
             BoardStep::Script(Step::ClosePort | Step::OpenPort) => {
                 bail!("@close/@open: the harness keeps its port open")
@@ -251,4 +260,27 @@ pub fn run_scenario(
         session.harness("save")?;
     }
     Ok(Ran::Outcome(session.outcome))
+}
+
+/// Arms the laser controls (a board with them starts not armed) and waits
+/// out the emission indicator's delay; a board without them is fine.
+fn arm(session: &mut Session<'_>) -> Result<()> {
+    let (data, _) = session.harness("get laser.emission_delay_s")?;
+    let delay_s = data
+        .iter()
+        .find_map(|l| l.strip_prefix("laser.emission_delay_s = "))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|value| value.parse::<f64>().ok())
+        .filter(|s| s.is_finite() && *s >= 0.0)
+        .unwrap_or(60.0);
+    let (_, closer) = session.harness("arm")?;
+    if closer == "ok" {
+        session.pump(Duration::from_secs_f64(delay_s + 0.2), |_| false)?;
+    } else if !closer.contains("no laser controls") {
+        bail!(
+            "`arm` refused ({closer}): close the interlock and key inputs \
+             (PD1 and PD2 to GND, docs/laser-safety.md)"
+        );
+    }
+    Ok(())
 }

@@ -27,6 +27,10 @@ const BOOT_TIMEOUT: Duration = Duration::from_secs(20);
 /// The byte that presses the board's stop button (`firmware/qemu-m4`'s
 /// `BUTTON_BYTE`), sent on the log channel's input.
 const BUTTON_BYTE: u8 = b'B';
+/// The bytes that open / close the board's remote interlock and turn its
+/// key switch off / on (`firmware/qemu-m4`'s `controls.rs`).
+const INTERLOCK_BYTES: [u8; 2] = [b'I', b'i'];
+const KEY_BYTES: [u8; 2] = [b'K', b'k'];
 /// The byte that asks the board for its `@stats` report.
 const STATS_BYTE: u8 = b'S';
 /// Seed of the fault injection's random numbers (as the simulator's).
@@ -285,6 +289,21 @@ impl Machine {
     pub fn press_button(&mut self) -> Result<()> {
         self.log_input
             .write_all(&[BUTTON_BYTE])
+            .context("writing to the log channel socket")
+    }
+
+    /// Opens (`false`) or closes the board's remote interlock (an image
+    /// built with the `laser-controls` feature).
+    pub fn set_interlock(&mut self, closed: bool) -> Result<()> {
+        self.log_input
+            .write_all(&[INTERLOCK_BYTES[usize::from(closed)]])
+            .context("writing to the log channel socket")
+    }
+
+    /// Turns the board's key switch off (`false`) or on.
+    pub fn set_key(&mut self, on: bool) -> Result<()> {
+        self.log_input
+            .write_all(&[KEY_BYTES[usize::from(on)]])
             .context("writing to the log channel socket")
     }
 

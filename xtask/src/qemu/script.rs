@@ -77,6 +77,8 @@ pub fn run_step(machine: &mut Machine, step: &BoardStep, deadline: Instant) -> R
         }
         BoardStep::Script(Step::StopButton) => machine.press_button()?,
         BoardStep::Script(Step::Realtime(byte)) => machine.send_realtime(*byte)?,
+        BoardStep::Script(Step::Interlock(closed)) => machine.set_interlock(*closed)?,
+        BoardStep::Script(Step::Key(on)) => machine.set_key(*on)?,
         BoardStep::Script(Step::ClosePort | Step::OpenPort) => {
             anyhow::bail!("@close/@open: the QEMU board's console is a UART (no port to close)")
         }

@@ -20,6 +20,7 @@ pub fn check(name: &str, outcome: &Outcome) -> Result<()> {
         "garbage_flood" => garbage_flood,
         "save_reset" => save_reset,
         "galvo_tuning" => galvo_tuning,
+        "interlock" => interlock,
         other => bail!("no assertions for scenario {other:?}"),
     };
     ensure!(outcome.script_done, "{board}: the script did not finish");
@@ -239,5 +240,33 @@ fn galvo_tuning(o: &Outcome) -> Result<()> {
         .find(|l| l.starts_with("underruns:"))
         .ok_or_else(|| anyhow::anyhow!("galvo status without an underrun count"))?;
     ensure!(underruns.starts_with("underruns: 0,"), "{underruns}");
+    Ok(())
+}
+
+/// Nothing lit before `arm`; one lit goto after it; the interlock opening
+/// stops it dark within 1 ms; closed again the controls stay latched and
+/// the next goto stays dark.
+fn interlock(o: &Outcome) -> Result<()> {
+    let has = |line: &str| o.transcript.iter().any(|l| l == line);
+    ensure!(
+        has("laser controls: interlock closed, key on, not armed since power-up"),
+        "power-up not reported as not armed"
+    );
+    ensure!(
+        has("laser controls: interlock closed, key on, latched: the interlock opened"),
+        "the opening not latched"
+    );
+    let Some(opened_at) = stopped_because(o, "interlock") else {
+        bail!("no stop for the interlock: {:?}", o.events);
+    };
+    let edges = lit_edges(o);
+    ensure!(
+        edges.len() == 1 && edges[0] < opened_at,
+        "lit at {edges:?} µs (one lit goto before the opening at {opened_at} µs)"
+    );
+    ensure!(
+        !lit_at(o, opened_at + DARK_WITHIN_US),
+        "lit 1 ms after the interlock stop at {opened_at} µs"
+    );
     Ok(())
 }

@@ -9,6 +9,7 @@
 use embedded_io_async::{Read, Write};
 
 use crate::galvo::{DacSample, DacStream, Half, Underrun};
+use crate::laser_controls::ControlInputs;
 use crate::sequencer::{LaserSwitch, SettingsStore};
 use crate::stepper::{DriverSignals, StepperDrive};
 
@@ -80,6 +81,43 @@ pub trait StopButton {
     /// Waits for the next press. A board with a bouncing switch debounces
     /// here (presses during the bounce are not presses).
     async fn pressed(&mut self);
+}
+
+/// The laser controls of a Class 3B/4 product (`docs/laser-safety.md`):
+/// the remote interlock and key switch inputs and the emission indicator
+/// output. The laser-controls task debounces the inputs.
+#[allow(async_fn_in_trait)]
+pub trait LaserControls {
+    /// The raw input levels now. Wiring faults must read as open / off
+    /// (the target's inputs are pulled up and closed to ground).
+    fn read(&mut self) -> ControlInputs;
+    /// Waits until an input may have changed (an edge on either; early
+    /// returns are harmless). The task also polls every
+    /// [`CONTROLS_POLL`](super::CONTROLS_POLL).
+    async fn changed(&mut self);
+    /// Switches the emission indicator (LED and/or buzzer).
+    fn set_indicator(&mut self, on: bool);
+}
+
+/// The laser controls of a board that has none (the simulator unless
+/// asked for them): no value of this type exists, so
+/// [`Parts::laser_controls`] is `None`, no controls task runs and the
+/// master gate stays permitted.
+#[derive(Debug)]
+pub enum NoLaserControls {}
+
+impl LaserControls for NoLaserControls {
+    fn read(&mut self) -> ControlInputs {
+        match *self {}
+    }
+
+    async fn changed(&mut self) {
+        match *self {}
+    }
+
+    fn set_indicator(&mut self, _on: bool) {
+        match *self {}
+    }
 }
 
 /// A watchdog that resets the MCU when it is not fed within
@@ -183,6 +221,9 @@ pub trait Board {
     type StopButton: StopButton;
     /// The watchdog.
     type Watchdog: Watchdog;
+    /// The interlock, key switch and emission indicator
+    /// ([`NoLaserControls`] on a board without them).
+    type LaserControls: LaserControls;
 
     /// Hands the parts over to the application.
     fn into_parts(self) -> Parts<Self>
@@ -213,4 +254,7 @@ pub struct Parts<B: Board + ?Sized> {
     pub stop_button: B::StopButton,
     /// The watchdog (not started yet).
     pub watchdog: B::Watchdog,
+    /// The laser controls (indicator off), when the board has them: then
+    /// no laser emits until they are armed.
+    pub laser_controls: Option<B::LaserControls>,
 }

@@ -15,12 +15,14 @@
 //! See `ARCHITECTURE.md` for what a board provides and how to add one.
 
 mod board;
+mod controls;
 mod tasks;
 
 pub use self::board::{
-    Board, Console, HostPresence, Indicators, Leds, NoGalvoDac, NoHangUp, NoStepper, Parts,
-    StopButton, Watchdog,
+    Board, Console, HostPresence, Indicators, LaserControls, Leds, NoGalvoDac, NoHangUp,
+    NoLaserControls, NoStepper, Parts, StopButton, Watchdog,
 };
+pub use self::controls::{CONTROLS_POLL, LaserControlsTask};
 pub use self::tasks::{
     ConsoleTask, GalvoTask, HEARTBEAT_TICKS, INDICATOR_PERIOD, IndicatorTask, SequencerTask,
     ServoBusTask, StopButtonTask, WATCHDOG_CHECK_PERIOD, WATCHDOG_TIMEOUT_US, WatchdogTask,
@@ -29,6 +31,7 @@ pub use self::tasks::{
 
 use crate::command::CommandLink;
 use crate::galvo::GalvoLink;
+use crate::laser_controls::ControlsLink;
 use crate::laser_gate::LaserGate;
 use crate::servo::task::ServoLink;
 use crate::status::StatusBoard;
@@ -54,6 +57,9 @@ pub struct Links {
     /// Sequencer ↔ stepper task ↔ step timer (no task serves it on a
     /// board without stepper outputs).
     pub stepper: &'static StepperLink,
+    /// Laser-controls task ↔ sequencer (nothing publishes on it on a
+    /// board without the controls).
+    pub controls: &'static ControlsLink,
 }
 
 /// Runs task bodies as tasks. Embassy tasks cannot be generic, so a board
@@ -82,15 +88,23 @@ pub trait Spawn<B: Board> {
     fn stop_button(&mut self, task: StopButtonTask<B::StopButton>);
     /// The watchdog.
     fn watchdog(&mut self, task: WatchdogTask<B::Watchdog>);
+    /// The laser controls (only called when the board has them; a board
+    /// with [`NoLaserControls`] answers [`LaserControlsTask::unreachable`]).
+    fn laser_controls(&mut self, task: LaserControlsTask<B::LaserControls>);
 }
 
 /// Builds the whole task set from `board` and `links` and spawns it
 /// through `spawner`, in dataflow order: console, servo bus, sequencer,
 /// galvo loop (when the board has a DAC), step timer and stepper task
-/// (when it has stepper outputs), then the LEDs, the stop button and the
-/// watchdog.
+/// (when it has stepper outputs), then the LEDs, the stop button, the
+/// watchdog and the laser controls (when it has them: the gate is
+/// forbidden before anything is spawned).
 pub fn wire<B: Board>(board: B, links: Links, spawner: &mut impl Spawn<B>) {
     let parts = board.into_parts();
+    if parts.laser_controls.is_some() {
+        // Power-up: no emission until armed, from before any task runs.
+        links.gate.forbid();
+    }
     spawner.console(ConsoleTask {
         port: parts.console,
         link: links.command,
@@ -136,6 +150,14 @@ pub fn wire<B: Board>(board: B, links: Links, spawner: &mut impl Spawn<B>) {
         status: links.status,
         servo: links.servo,
     });
+    if let Some(controls) = parts.laser_controls {
+        spawner.laser_controls(LaserControlsTask {
+            controls,
+            link: links.controls,
+            gate: links.gate,
+            command: links.command,
+        });
+    }
 }
 
 #[cfg(test)]

@@ -89,8 +89,13 @@ impl<L: LaserSwitch, S: SettingsStore> SequencerTask<L, S> {
             status,
             gate,
             stepper,
+            controls,
         } = self.links;
-        let actuators = ActuatorLinks { galvo, stepper };
+        let actuators = ActuatorLinks {
+            galvo,
+            stepper,
+            controls,
+        };
         let mut sequencer = Sequencer::new(
             command, servo, actuators, status, self.laser, gate, self.store,
         )

@@ -91,13 +91,21 @@ impl StopButton for Part {
     async fn pressed(&mut self) {}
 }
 
+impl LaserControls for Part {
+    fn read(&mut self) -> crate::laser_controls::ControlInputs {
+        crate::laser_controls::ControlInputs::default()
+    }
+    async fn changed(&mut self) {}
+    fn set_indicator(&mut self, _on: bool) {}
+}
+
 impl Watchdog for Part {
     fn start(&mut self) {}
     fn feed(&mut self) {}
 }
 
 /// A board whose parts all carry its number; with or without a galvo DAC
-/// (and stepper outputs, which come with it here).
+/// (and stepper outputs and laser controls, which come with it here).
 struct TestBoard {
     id: u8,
     has_dac: bool,
@@ -114,6 +122,7 @@ impl Board for TestBoard {
     type Indicators = Part;
     type StopButton = Part;
     type Watchdog = Part;
+    type LaserControls = Part;
 
     fn into_parts(self) -> Parts<Self> {
         let part = Part(self.id);
@@ -132,6 +141,7 @@ impl Board for TestBoard {
             indicators: part,
             stop_button: part,
             watchdog: part,
+            laser_controls: self.has_dac.then_some(part),
         }
     }
 }
@@ -171,6 +181,9 @@ impl Spawn<TestBoard> for Spawned {
     fn watchdog(&mut self, task: WatchdogTask<Part>) {
         self.0.push(("watchdog", task.dog));
     }
+    fn laser_controls(&mut self, task: LaserControlsTask<Part>) {
+        self.0.push(("laser controls", task.controls));
+    }
 }
 
 static COMMAND: CommandLink = CommandLink::new();
@@ -179,6 +192,7 @@ static GALVO: GalvoLink = GalvoLink::new();
 static STATUS: StatusBoard = StatusBoard::new();
 static GATE: LaserGate = LaserGate::new();
 static STEPPER: crate::stepper::StepperLink = crate::stepper::StepperLink::new();
+static CONTROLS: crate::laser_controls::ControlsLink = crate::laser_controls::ControlsLink::new();
 
 fn links() -> Links {
     Links {
@@ -188,6 +202,7 @@ fn links() -> Links {
         status: &STATUS,
         gate: &GATE,
         stepper: &STEPPER,
+        controls: &CONTROLS,
     }
 }
 
@@ -215,7 +230,12 @@ fn every_task_gets_its_part_once_in_dataflow_order() {
             ("indicators", p),
             ("stop button", p),
             ("watchdog", p),
+            ("laser controls", p),
         ]
+    );
+    assert!(
+        !GATE.is_permitted(),
+        "a board with laser controls starts with the gate forbidden"
     );
 }
 

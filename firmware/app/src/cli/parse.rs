@@ -46,6 +46,8 @@ fn parse_command(name: &str, args: &mut Args<'_>) -> Result<Command, CommandErro
         Command::Status
     } else if is("stop") {
         Command::Stop
+    } else if is("arm") {
+        Command::Arm
     } else if is("home") {
         Command::Home
     } else if is("params") {

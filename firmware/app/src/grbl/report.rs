@@ -59,6 +59,10 @@ pub enum MachineState {
     Home,
     /// `$SLP`.
     Sleep,
+    /// grbl's safety door, here the laser controls keeping the laser off:
+    /// `Door:1` interlock open or key off, `Door:0` closed and waiting for
+    /// the reset (`arm`), `Door:3` the emission indicator's delay runs.
+    Door(u8),
 }
 
 /// Override values, % (grbl's `Ov:feed,rapid,spindle`).
@@ -124,6 +128,7 @@ fn write_state(w: &mut impl Write, state: MachineState) -> fmt::Result {
         MachineState::Check => "Check",
         MachineState::Home => "Home",
         MachineState::Sleep => "Sleep",
+        MachineState::Door(substate) => return write!(w, "Door:{substate}"),
     })
 }
 

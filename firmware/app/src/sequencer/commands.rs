@@ -38,6 +38,7 @@ impl Core {
                 self.stop("stop command", out);
                 self.ok(out);
             }
+            Command::Arm => self.arm(out),
             // The shell switched the trace as the command arrived.
             Command::Trace(_) => self.ok(out),
             Command::Home => match self.start_homing(out) {

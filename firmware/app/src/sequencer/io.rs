@@ -115,6 +115,12 @@ pub enum Action {
     /// Shut the master gate: dark at once, same generation (the run may
     /// light again).
     ShutGate,
+    /// Arm the laser controls (their manual reset) with this emission
+    /// indicator delay, ms.
+    ArmLaser {
+        /// The indicator's lead before emission becomes possible, ms.
+        delay_ms: u32,
+    },
     /// Switch the gimbal laser; on only through the master gate (when it
     /// refuses, the shell answers [`Event::GateLost`]).
     GimbalLaser(bool),

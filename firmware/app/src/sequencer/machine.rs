@@ -103,6 +103,8 @@ pub struct Core {
     pub(super) jobs: crate::sequencer::drivers::DriverJobs,
     /// The stepper task homes (`home` or `$H` sent, its end not reported).
     pub(super) stepper_homing: bool,
+    /// The laser controls' state (`None`: the board has none).
+    pub(super) controls: Option<crate::laser_controls::ControlsView>,
 }
 
 impl Core {
@@ -134,6 +136,7 @@ impl Core {
             gcode: crate::sequencer::gcode::Gcode::new(),
             jobs: crate::sequencer::drivers::DriverJobs::new(),
             stepper_homing: false,
+            controls: None,
         }
     }
 
@@ -147,7 +150,7 @@ impl Core {
         }
         match event {
             Event::Command { command, readings } => self.command(command, &readings, out),
-            Event::StopRequest => self.stop("stop button", out),
+            Event::StopRequest => self.stop(self.stop_request_cause(), out),
             Event::Servo(outcome) => self.servo_outcome(outcome, out),
             Event::Galvo(event) => self.galvo_event(event, out),
             Event::Stepper(event) => self.stepper_event(event, out),

@@ -12,6 +12,7 @@
 //! view on the [`StatusBoard`].
 
 mod commands;
+mod controls;
 mod drivers;
 mod faults;
 mod gcode;
@@ -30,6 +31,7 @@ pub use self::laser::{LaserEvent, LaserPower, LaserSwitch, laser_wanted};
 pub use self::machine::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::{Command, CommandLink};
 use crate::galvo::{GalvoLink, GalvoRequest};
+use crate::laser_controls::ControlsLink;
 use crate::laser_gate::LaserGate;
 use crate::log;
 use crate::outbound::LineKind;
@@ -73,6 +75,9 @@ pub struct ActuatorLinks<'a> {
     pub galvo: &'a GalvoLink,
     /// The stepper task's (served only on a board with stepper outputs).
     pub stepper: &'a StepperLink,
+    /// The laser controls task's (served only on a board with the
+    /// controls).
+    pub controls: &'a ControlsLink,
 }
 
 /// What the core's actions act on.
@@ -85,6 +90,8 @@ struct Io<'a, L: LaserSwitch, S: SettingsStore> {
     /// The stepper link (whether a stepper task serves it is its
     /// [`StepperLink::is_attached`]).
     stepper: &'a StepperLink,
+    /// The laser controls' link (`arm` requests, their state).
+    controls: &'a ControlsLink,
     status: &'a StatusBoard,
     laser: L,
     /// The master laser gate: closed at once by every stop, opened only
@@ -139,6 +146,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             servo,
             galvo: actuators.galvo,
             stepper: actuators.stepper,
+            controls: actuators.controls,
             status,
             laser,
             gate,
@@ -262,6 +270,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             };
             self.core
                 .note_stepper_speed(self.io.stepper.speed_permille());
+            self.core.note_laser_controls(self.io.controls.view());
             self.core.on(inputs, event, &mut self.io);
             let follow_up = core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing);
             if follow_up != FollowUp::Nothing {
@@ -379,6 +388,7 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
             Action::ShutGate => {
                 self.gate.shut();
             }
+            Action::ArmLaser { delay_ms } => self.controls.arm.signal(delay_ms),
             Action::GimbalLaser(on) => self.set_laser(on),
             Action::GimbalPower(power) => self.set_power(power),
             Action::Note(event) => {

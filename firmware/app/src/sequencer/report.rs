@@ -153,6 +153,7 @@ impl Core {
                 self.settings.laser_mode.name()
             ),
         );
+        self.status_controls_line(out);
         match s.faulty_servo {
             Some(id) => {
                 let id = u32::from(id);

@@ -15,6 +15,7 @@
 //! where it is kept (two flash sectors, power-fail safe). Errors are
 //! [`SettingsError`]s; the command line prints them as they are.
 
+mod controls;
 mod error;
 mod gcode;
 mod geometry;
@@ -228,6 +229,9 @@ pub struct Settings {
     pub gcode_junction_mm: f64,
     /// The PELCO port.
     pub pelco: PelcoSettings,
+    /// The laser controls' emission indicator lead: on this long after
+    /// `arm` before the laser may emit, s.
+    pub emission_delay_s: f64,
 }
 
 impl Default for Settings {
@@ -263,6 +267,7 @@ impl Default for Settings {
             stepper: StepperSettings::default(),
             gcode_junction_mm: 0.01,
             pelco: PelcoSettings::default(),
+            emission_delay_s: controls::DEFAULT_EMISSION_DELAY_S,
         }
     }
 }

@@ -26,6 +26,7 @@ fn inputs<'a>(
         task_steps: &[],
         galvo_physics: PhysicalGalvo::default(),
         end_us: 1_000_000,
+        controls: None,
     }
 }
 

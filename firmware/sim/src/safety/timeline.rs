@@ -84,4 +84,14 @@ impl SettingsTimeline {
         }
         mode == LaserMode::Dwell
     }
+
+    /// Smallest emission indicator delay in force at any time up to
+    /// `t_us`, s.
+    pub(super) fn min_emission_delay_s(&self, t_us: u64) -> f64 {
+        self.changes
+            .iter()
+            .take_while(|(sent, _, _)| *sent <= t_us)
+            .map(|(_, _, s)| s.emission_delay_s)
+            .fold(Settings::default().emission_delay_s, f64::min)
+    }
 }

@@ -1,6 +1,7 @@
 //! What a simulation is asked to do ([`SimOptions`]) and what it
 //! produced ([`SimReport`]).
 
+use crate::controls::ControlsRecord;
 use crate::dac::DacRecording;
 use crate::executor::{self, RunEnd};
 use crate::flash::{FlashStats, PowerCut};
@@ -68,6 +69,10 @@ pub struct SimOptions {
     /// Limit switches on the stepper axes `[pan, tilt]` (none: inputs
     /// read open).
     pub stepper_switches: [Option<LimitSwitch>; 2],
+    /// The board has the laser controls (interlock, key switch, emission
+    /// indicator; bench wiring: closed and on). Also fitted when the
+    /// script has `@interlock` or `@key` steps.
+    pub laser_controls: bool,
     /// Serve the console on a pseudo-terminal instead of the script
     /// (real time; the run ends when its stop flag is set).
     #[cfg(unix)]
@@ -98,6 +103,7 @@ impl Default for SimOptions {
             stepper_motor: MotorLimits::default(),
             stepper_geometry: StepperGeometry::default(),
             stepper_switches: [None; 2],
+            laser_controls: false,
             #[cfg(unix)]
             pty: None,
         }
@@ -134,6 +140,8 @@ pub struct SimReport {
     pub panel: PanelRecord,
     /// The stepper drivers: counted steps, pulse timing, stalls, edges.
     pub stepper: PanTiltDrivers,
+    /// What the laser controls did, on a board with them.
+    pub laser_controls: Option<ControlsRecord>,
 }
 
 impl SimReport {

@@ -188,6 +188,7 @@ fn every_help_line_names_a_command_that_parses_with_its_example() {
         "pattern rect 0 0 1 1 once",
         "pattern tuning once",
         "stop",
+        "arm",
         "home",
         "goto 1 1",
         "grid 1 1",

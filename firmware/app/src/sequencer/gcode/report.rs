@@ -70,6 +70,10 @@ impl Core {
                 decelerating: false,
             },
             (_, Hold::Stopping) => MachineState::Hold { decelerating: true },
+            // The laser controls keep the laser off (grbl's safety door).
+            _ if self.door_substate().is_some() => {
+                MachineState::Door(self.door_substate().unwrap_or(0))
+            }
             _ if motion.jogging() => MachineState::Jog,
             _ if motion.is_idle() => MachineState::Idle,
             _ => MachineState::Run,

@@ -502,6 +502,7 @@ impl Harness {
             }
             Action::Stepper(_) => self.step_owed = None,
             Action::ConfigureGalvo(_)
+            | Action::ArmLaser { .. }
             | Action::ConfigureStepper(_)
             | Action::AllowGalvoLaser(_)
             | Action::GimbalPower(_)

@@ -11,7 +11,7 @@ use crate::settings::*;
 
 /// Every parameter's id as it was given (ids never change): a parameter
 /// whose id is not this one, or a new parameter not listed here, fails.
-const STABLE_IDS: [(u16, &str); 82] = [
+const STABLE_IDS: [(u16, &str); 83] = [
     (10, "oq_cm"),
     (11, "ol_cm"),
     (20, "grid.pitch_cm"),
@@ -94,11 +94,13 @@ const STABLE_IDS: [(u16, &str); 82] = [
     (200, "pelco.address"),
     (201, "pelco.baud"),
     (202, "pelco.timeout_s"),
+    (210, "laser.emission_delay_s"),
 ];
 
 /// Parameters added after the version-2 records (the stepper's, `$11`
-/// and the PELCO port's): such records leave them at their defaults.
-const STEPPER_PARAMS: usize = 28;
+/// the PELCO port's and the emission delay): such records leave them
+/// at their defaults.
+const STEPPER_PARAMS: usize = 29;
 
 /// A version-2 record written by the firmware before ids (galvo build: 54
 /// values) with the values of [`fixture_settings`].
@@ -267,10 +269,10 @@ fn the_record_is_magic_version_count_id_value_entries_and_crc() {
     assert_eq!(values_in(&s.to_record()), values);
     assert!(MAX_RECORD_LEN >= RECORD_LEN && MAX_RECORD_LEN >= V2_GALVO.len());
     if has_galvo() {
-        // 17 runs of 82 values, 1 padding byte: ≈ 180 saves fill a
-        // 128 KiB sector (tests/tests/settings_sim.rs; the decision is in
+        // 18 runs of 83 values, 2 padding bytes: ≈ 178 saves fill a 128 KiB
+        // sector (tests/tests/settings_sim.rs; the decision is in
         // settings/stepper.rs).
-        assert_eq!(RECORD_LEN, 8 + 17 * 3 + 82 * 8 + 1 + 4);
+        assert_eq!(RECORD_LEN, 8 + 18 * 3 + 83 * 8 + 2 + 4);
     }
 }
 

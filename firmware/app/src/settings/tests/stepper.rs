@@ -134,11 +134,12 @@ fn a_record_saved_before_the_stepper_parameters_loads_them_at_their_defaults() {
     assert_eq!(loaded.layout, RecordLayout::IdKeyed);
     assert_eq!(
         (loaded.unknown, loaded.defaulted),
-        // The stepper's, `$11` and the PELCO port's.
-        (0, STEPPER_PARAMS.len() + 1 + 3)
+        // The stepper's, `$11`, the PELCO port's and the emission delay.
+        (0, STEPPER_PARAMS.len() + 1 + 3 + 1)
     );
     assert_eq!(loaded.settings.stepper, StepperSettings::default());
-    // The one after them, `$11`, at its default too.
+    // The ones after them, `$11` and the emission delay, at their
+    // defaults too.
     assert_eq!(loaded.settings.gcode_junction_mm, 0.01);
     // Its other values are those it was written with.
     assert_eq!(loaded.settings.dwell_ms, 250.0);
