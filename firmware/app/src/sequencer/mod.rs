@@ -27,6 +27,7 @@ mod laser;
 mod machine;
 mod report;
 mod run;
+mod servo_setup;
 mod stepper;
 
 use embassy_futures::select::{Either, Either4, select, select4};
