@@ -5,8 +5,11 @@
 //! long (the script goes on, so lines can be typed during the stall),
 //! `@type-ahead <line>` types a line without waiting for its reply,
 //! `@realtime <byte>` sends one of grbl's realtime bytes (`?`, `!`, `~`
-//! or hex: `0x18`, `0x9b`, …; no line, no reply awaited) and `@button`
-//! presses the board's stop button.
+//! or hex: `0x18`, `0x9b`, …; no line, no reply awaited), `@button`
+//! presses the board's stop button, and `@unplug-servo <slot>` /
+//! `@plug-servo <slot>` unplug and plug back the cable of a servo on the
+//! bus (slots count from 1 in the order the bus was built: yaw, pitch,
+//! then any more; a servo unplugged hears and answers nothing).
 
 use anyhow::{Context, Result, bail};
 
@@ -27,6 +30,14 @@ pub enum Step {
     StopButton,
     /// Send one grbl realtime byte (no line end, no reply awaited).
     Realtime(u8),
+    /// Unplug (or plug back) the cable of the servo in `slot` (0-based;
+    /// the script counts from 1).
+    ServoCable {
+        /// Slot on the bus, from 0.
+        slot: usize,
+        /// Plugged in after the step.
+        plugged: bool,
+    },
 }
 
 /// The byte of `@realtime <byte>`: one of grbl's realtime commands, as
@@ -92,10 +103,24 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
             }
             Some("@button") if line == "@button" => steps.push(Step::StopButton),
             Some("@realtime") => steps.push(Step::Realtime(realtime_byte(words.next(), number)?)),
+            Some(word @ ("@unplug-servo" | "@plug-servo")) => {
+                let slot = ms_argument(word, words, number)
+                    .ok()
+                    .and_then(|n| usize::try_from(n).ok())
+                    .filter(|&n| n >= 1)
+                    .with_context(|| {
+                        format!("script line {number}: `{word} <slot>` takes a slot from 1")
+                    })?;
+                steps.push(Step::ServoCable {
+                    slot: slot - 1,
+                    plugged: word == "@plug-servo",
+                });
+            }
             Some(directive) if directive.starts_with('@') => {
                 bail!(
                     "script line {number}: unknown directive {directive:?} \
-                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button)"
+                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, \
+                     @unplug-servo <slot>, @plug-servo <slot>)"
                 );
             }
             _ => steps.push(Step::Send(line.to_owned())),
@@ -178,6 +203,30 @@ mod tests {
             "@type-ahead",
             "@stall 5",
         ] {
+            let err = parse_script(&format!("stop\n{bad}\n"))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("line 2"), "{bad}: {err}");
+        }
+    }
+
+    #[test]
+    fn servo_cable_steps_count_slots_from_one() {
+        let steps = parse_script("@unplug-servo 1\n@plug-servo 2\n").unwrap();
+        assert_eq!(
+            steps,
+            vec![
+                Step::ServoCable {
+                    slot: 0,
+                    plugged: false
+                },
+                Step::ServoCable {
+                    slot: 1,
+                    plugged: true
+                }
+            ]
+        );
+        for bad in ["@unplug-servo", "@unplug-servo 0", "@plug-servo x", "@plug-servo 1 2"] {
             let err = parse_script(&format!("stop\n{bad}\n"))
                 .unwrap_err()
                 .to_string();

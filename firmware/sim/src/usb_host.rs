@@ -141,14 +141,35 @@ impl UsbHost {
     }
 }
 
-/// Runs one script step; `@button` presses `button` (the interactive
-/// terminal has no button).
-async fn run_step(host: &UsbHost, step: Step, button: Option<&ButtonContacts>) {
+/// What the script's `@` steps reach on the bench: the board's stop
+/// button and the servo bus's cables.
+#[derive(Clone)]
+pub struct Hands {
+    /// The board's stop button (`@button`).
+    pub button: Rc<ButtonContacts>,
+    /// The servo bus (`@unplug-servo`, `@plug-servo`).
+    pub bus: Rc<RefCell<crate::servo_model::SimServoBus>>,
+}
+
+/// Runs one script step; `@` steps act through `hands` (the interactive
+/// terminal has none).
+async fn run_step(host: &UsbHost, step: Step, hands: Option<&Hands>) {
     match step {
         Step::StopButton => {
-            if let Some(button) = button {
-                button.press();
+            if let Some(hands) = hands {
+                hands.button.press();
             }
+        }
+        Step::ServoCable { slot, plugged } => {
+            let done = hands.is_some_and(|h| h.bus.borrow_mut().set_plugged(slot, plugged));
+            let what = if plugged { "plugged" } else { "unplugged" };
+            // A log line, not the transcript: that holds the console's
+            // lines only.
+            log::info!(
+                "bench: servo in slot {} {}",
+                slot + 1,
+                if done { what } else { "not there" }
+            );
         }
         Step::WaitMs(ms) => Timer::after_millis(ms).await,
         Step::Send(line) => {
@@ -165,10 +186,10 @@ async fn run_step(host: &UsbHost, step: Step, button: Option<&ButtonContacts>) {
 }
 
 /// Types the script: each command line, then waits for its closing reply;
-/// `@button` steps press the board's stop `button`.
-pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, button: Rc<ButtonContacts>) {
+/// `@` steps act through `hands`.
+pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, hands: Hands) {
     for step in steps {
-        run_step(&host, step, Some(&button)).await;
+        run_step(&host, step, Some(&hands)).await;
     }
     host.replies_read().await;
     host.transcript.borrow_mut().script_done = true;
@@ -194,12 +215,12 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
 
 /// Starts the simulated host: the script (or the interactive terminal)
 /// typing (from stdin when `interactive`), and the terminal reading;
-/// `@button` presses `button`.
+/// `@` steps act through `hands`.
 pub fn host_tasks(
     interactive: bool,
     script: Vec<Step>,
     host: Rc<UsbHost>,
-    button: Rc<ButtonContacts>,
+    hands: Hands,
 ) -> impl FnOnce(&Spawner) + 'static {
     move |spawner| {
         if interactive {
@@ -222,7 +243,7 @@ pub fn host_tasks(
                 spawner,
                 "host (script)",
                 TaskKind::Simulator,
-                script_task(script, host.clone(), button),
+                script_task(script, host.clone(), hands),
             );
         }
         executor::spawn_task(
@@ -335,8 +356,11 @@ mod tests {
             false,
             10_000_000,
             move |spawner| {
-                let button = Rc::new(ButtonContacts::default());
-                executor::spawn(&spawner, script_task(steps, h1, button));
+                let hands = Hands {
+                    button: Rc::new(ButtonContacts::default()),
+                    bus: Rc::default(),
+                };
+                executor::spawn(&spawner, script_task(steps, h1, hands));
                 executor::spawn(&spawner, terminal_task(h2));
                 executor::spawn(&spawner, echo_ok_device(h3));
             },

@@ -220,6 +220,9 @@ pub fn run_scenario(
             BoardStep::Script(Step::StopButton) => {
                 bail!("the stop button cannot be pressed over the console")
             }
+            BoardStep::Script(Step::ServoCable { .. }) => {
+                bail!("a servo cannot be unplugged over the console")
+            }
             BoardStep::Reset => {
                 session.pump(REPLY_LIMIT, |s| s.owed == 0)?;
                 let Some(reset) = reset else {

@@ -77,6 +77,15 @@ pub fn run_step(machine: &mut Machine, step: &BoardStep, deadline: Instant) -> R
         }
         BoardStep::Script(Step::StopButton) => machine.press_button()?,
         BoardStep::Script(Step::Realtime(byte)) => machine.send_realtime(*byte)?,
+        BoardStep::Script(Step::ServoCable { slot, plugged }) => {
+            let mut side = machine
+                .servos
+                .lock()
+                .map_err(|_| anyhow::anyhow!("the servo bus thread panicked"))?;
+            if !side.bus.set_plugged(*slot, *plugged) {
+                anyhow::bail!("the servo bus has no slot {}", slot + 1);
+            }
+        }
     }
     Ok(true)
 }
