@@ -286,4 +286,6 @@ impl SimServo {
 }
 
 #[cfg(test)]
+mod setup_tests;
+#[cfg(test)]
 mod tests;
