@@ -104,13 +104,11 @@ fn response() -> impl Strategy<Value = Response> {
                 data: heapless::Vec::from_slice(&data).unwrap(),
             })
         ),
-        any::<(u8, u8, u8)>().prop_map(|(id, address, result)| Response::WriteData(
-            WriteResult {
-                id,
-                address,
-                result
-            }
-        )),
+        any::<(u8, u8, u8)>().prop_map(|(id, address, result)| Response::WriteData(WriteResult {
+            id,
+            address,
+            result
+        })),
     ]
 }
 

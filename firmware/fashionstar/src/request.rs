@@ -26,8 +26,8 @@ use heapless::Vec;
 use crate::entry::{Entry, read_sync, write_sync};
 use crate::wire::{PayloadWriter, Reader};
 use crate::{
-    DecodeError, MAX_PAYLOAD_LEN, MAX_READ_DATA_LEN, Message, REQUEST_HEADER, SetAngle, SetAngleByInterval,
-    SetAngleByVelocity, SyncEntries, code,
+    DecodeError, MAX_PAYLOAD_LEN, MAX_READ_DATA_LEN, Message, REQUEST_HEADER, SetAngle,
+    SetAngleByInterval, SetAngleByVelocity, SyncEntries, code,
 };
 
 /// A request frame (controller → servo).

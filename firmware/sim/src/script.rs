@@ -226,7 +226,12 @@ mod tests {
                 }
             ]
         );
-        for bad in ["@unplug-servo", "@unplug-servo 0", "@plug-servo x", "@plug-servo 1 2"] {
+        for bad in [
+            "@unplug-servo",
+            "@unplug-servo 0",
+            "@plug-servo x",
+            "@plug-servo 1 2",
+        ] {
             let err = parse_script(&format!("stop\n{bad}\n"))
                 .unwrap_err()
                 .to_string();

@@ -137,7 +137,10 @@ impl Core {
     /// its axis's zero_deg (in the settings, range-checked).
     fn set_zero(&mut self, id: u8, tenths: i16, out: &mut dyn ActionSink) {
         let Some(param) = self.zero_param(id) else {
-            return self.error(out, format_args!("servo {id} is neither yaw.id nor pitch.id"));
+            return self.error(
+                out,
+                format_args!("servo {id} is neither yaw.id nor pitch.id"),
+            );
         };
         let deg = f64::from(tenths) / 10.0;
         if let Err(e) = self.settings.set(param, deg) {

@@ -37,7 +37,10 @@ fn write_data_to_address_34_re_ids_the_servo_answering_under_its_old_id() {
         }))]
     );
     assert_eq!(bus.servo_in_slot(0).map(SimServo::id), Some(7));
-    assert!(bus.receive(2 * MS, &frame(&Request::Ping { id: 0 })).is_empty());
+    assert!(
+        bus.receive(2 * MS, &frame(&Request::Ping { id: 0 }))
+            .is_empty()
+    );
     assert_eq!(
         decode_all(&bus.receive(3 * MS, &frame(&Request::Ping { id: 7 }))),
         [Ok(Response::Ping { id: 7 })]
@@ -105,7 +108,10 @@ type Cable = Option<(usize, bool)>;
 /// Runs the firmware's servo task on `bus` and has it do each job in turn
 /// (after its cable step), in one run of virtual time; returns what each
 /// reported and when it ended, µs.
-fn run_jobs(bus: &Rc<RefCell<SimServoBus>>, jobs: &[(Cable, BusJob)]) -> Vec<(Vec<BusReport>, u64)> {
+fn run_jobs(
+    bus: &Rc<RefCell<SimServoBus>>,
+    jobs: &[(Cable, BusJob)],
+) -> Vec<(Vec<BusReport>, u64)> {
     let port = Rc::new(SimServoPort::new(
         bus.clone(),
         Rc::new(RefCell::new(Recording::default())),
@@ -179,7 +185,10 @@ fn a_scan_finds_every_servo_with_its_monitor_data_in_under_3_s() {
     let BusReport::Servo(r) = reports[0] else {
         panic!("{reports:?}")
     };
-    assert_eq!((r.voltage_mv, r.temperature_raw), (SUPPLY_MV, TEMPERATURE_RAW));
+    assert_eq!(
+        (r.voltage_mv, r.temperature_raw),
+        (SUPPLY_MV, TEMPERATURE_RAW)
+    );
     assert_eq!(
         reports.last(),
         Some(&BusReport::Done(BusEnd::Scanned {
