@@ -21,7 +21,8 @@ pub struct SimArgs {
     /// Script of command lines (`wait <ms>` pauses; `#` comments;
     /// `@stall-read <ms>` stops the host reading replies for a while,
     /// `@type-ahead <line>` types without waiting for the reply, `@button`
-    /// presses the stop button); `-`
+    /// presses the stop button, `@unplug-servo <slot>` / `@plug-servo
+    /// <slot>` unplug and plug back a servo's cable); `-`
     /// reads it from stdin. Without it, piped stdin is the script, and a
     /// terminal or empty stdin runs the demo (writing sim.svg).
     #[arg(long)]
@@ -54,6 +55,12 @@ pub struct SimArgs {
     /// with a valid checksum), `servo-slow:<factor>` (repeatable).
     #[arg(long = "fault")]
     faults: Vec<String>,
+    /// The ids the simulated servos on the bus have at power-up, in slot
+    /// order (yaw, pitch, any more), e.g. `0,0` for two servos as they
+    /// ship (default: the gimbal's ids, 0 and 1). `@unplug-servo <slot>` /
+    /// `@plug-servo <slot>` in the script unplug and plug back a cable.
+    #[arg(long, value_name = "ID,ID,…", value_delimiter = ',')]
+    servo_ids: Vec<u8>,
     /// Run until the script has ended and the sequencer is idle; exit 1 if
     /// any command got `error:` (unless --allow-errors).
     #[arg(long)]
@@ -246,6 +253,7 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
             max_time_ms: (max_time_s * 1000.0) as u64,
             echo: true,
             galvo_cost_ns_per_sample: args.galvo_cost_ns,
+            servo_ids: (!args.servo_ids.is_empty()).then(|| args.servo_ids.clone()),
             ..SimOptions::default()
         })
         .map_err(|e| anyhow!("bench options: {e}"))?;
