@@ -52,7 +52,7 @@ fn lines(actions: &[Action]) -> Vec<std::string::String> {
     actions
         .iter()
         .filter_map(|a| match a {
-            Action::Line(Line::Data(t)) => Some(std::format!("{}", t.as_str())),
+            Action::Line(Line::Data(t)) => Some(std::string::ToString::to_string(t.as_str())),
             Action::Line(Line::Ok) => Some("ok".into()),
             Action::Line(Line::Error(t)) => Some(std::format!("error: {}", t.as_str())),
             _ => None,
