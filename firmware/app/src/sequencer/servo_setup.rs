@@ -16,6 +16,9 @@ const BUSY: &str = "stop the running pattern, goto or G-code before servo set-up
 
 impl Core {
     /// Starts a `servo …` command (its reply closes when the job ends).
+    /// Not inlined, nor is the report handler: their reply lines stay out
+    /// of the sequencer task's frame.
+    #[inline(never)]
     pub(super) fn servo_setup(&mut self, setup: ServoSetup, out: &mut dyn ActionSink) {
         if self.run.is_some() || !self.gcode.motion.is_idle() || self.stepper_homing {
             return self.error(out, BUSY);
@@ -70,6 +73,7 @@ impl Core {
 
     /// A line or the end of set-up job `seq` (ignored unless it is the
     /// one pending).
+    #[inline(never)]
     pub(super) fn servo_bus_report(
         &mut self,
         seq: u32,
