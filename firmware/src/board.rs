@@ -25,6 +25,7 @@
 //! handlers), the galvo executor at [`GALVO_PRIORITY`] below them and above
 //! thread mode (USB, sequencer, servo bus).
 
+use core::sync::atomic::AtomicBool;
 use embassy_executor::Spawner;
 use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::flash::{self, Flash};
@@ -43,7 +44,9 @@ use static_cell::StaticCell;
 
 use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac, darken_laser_stream};
 use crate::laser_pwm::{LaserPin, laser_dark};
-use crate::parts::{IndependentDog, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton};
+use crate::parts::{
+    IndependentDog, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UsbDtr, UserButton,
+};
 use crate::settings_flash::{FlashSettings, settings_store};
 
 bind_interrupts!(struct Irqs {
@@ -265,6 +268,7 @@ fn usb_console(
     static CONTROL_BUF: StaticCell<[u8; 64]> = StaticCell::new();
     static CDC_STATE: StaticCell<State> = StaticCell::new();
     static USB_RX_BUFFER: StaticCell<[u8; USB_PACKET_BYTES as usize]> = StaticCell::new();
+    static USB_DTR: StaticCell<UsbDtr> = StaticCell::new();
     let mut builder = embassy_usb::Builder::new(
         driver,
         device_config,
@@ -275,9 +279,13 @@ fn usb_console(
     );
     let class = CdcAcmClass::new(&mut builder, CDC_STATE.init(State::new()), USB_PACKET_BYTES);
     let device = builder.build();
-    let (tx, rx) = class.split();
+    let (tx, rx, control) = class.split_with_control();
     let rx = rx.into_buffered(USB_RX_BUFFER.init([0; USB_PACKET_BYTES as usize]));
-    (device, UsbConsole { tx, rx })
+    let dtr = USB_DTR.init(UsbDtr {
+        control,
+        seen: AtomicBool::new(false),
+    });
+    (device, UsbConsole { tx, rx, dtr })
 }
 
 /// Servo bus: USART2 (PA2 TX, PA3 RX), interrupt-driven both ways (its

@@ -2,6 +2,8 @@
 //! implements one of `laser-app`'s board traits
 //! ([`laser_app::app::Board`] and friends) over the HAL.
 
+use core::sync::atomic::{AtomicBool, Ordering};
+use embassy_futures::select::{Either, select};
 use embassy_stm32::Peri;
 use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::gpio::OutputType;
@@ -16,8 +18,11 @@ use embassy_stm32::timer::{Ch1, Ch2};
 use embassy_stm32::usb::Driver;
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_time::{Duration, Instant, Timer};
-use embassy_usb::class::cdc_acm::{BufferedReceiver, Sender};
-use laser_app::app::{Console, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog};
+use embassy_usb::class::cdc_acm::{BufferedReceiver, ControlChanged, Sender};
+use embedded_io_async::Read;
+use laser_app::app::{
+    Console, HostPresence, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog,
+};
 use laser_app::stepper::{
     CCMR1_IDLE, DriverSignals, OnePulseTiming, StepPace, StepperConfig, StepperDrive,
 };
@@ -31,15 +36,62 @@ pub struct UsbConsole {
     pub tx: Sender<'static, UsbDriver>,
     /// CDC-ACM receive half (buffered).
     pub rx: BufferedReceiver<'static, UsbDriver>,
+    /// The host's DTR (raised when a program opens the port).
+    pub dtr: &'static UsbDtr,
 }
 
 impl Console for UsbConsole {
     type Rx = BufferedReceiver<'static, UsbDriver>;
     type Tx = Sender<'static, UsbDriver>;
+    type Presence = &'static UsbDtr;
 
+    /// Once the host dropped DTR (closed the port), what it had sent and
+    /// the device not yet read is of that session: dropped until DTR rises
+    /// again. A host that never raises DTR is served as it talks.
     async fn connected(&mut self) -> (&mut Self::Rx, &mut Self::Tx) {
-        self.rx.wait_connection().await;
+        let mut stale = [0u8; 64];
+        loop {
+            self.rx.wait_connection().await;
+            if self.dtr.control.dtr() {
+                self.dtr.seen.store(true, Ordering::Relaxed);
+                break;
+            }
+            if !self.dtr.seen.load(Ordering::Relaxed) {
+                break;
+            }
+            let changed = self.dtr.control.control_changed();
+            if let Either::Second(Err(_)) = select(changed, self.rx.read(&mut stale)).await {
+                // Unplugged: the next host may not use DTR.
+                self.dtr.seen.store(false, Ordering::Relaxed);
+            }
+        }
         (&mut self.rx, &mut self.tx)
+    }
+
+    fn presence(&self) -> &'static UsbDtr {
+        self.dtr
+    }
+}
+
+/// The CDC-ACM control lines: the host's DTR tells it has the port open.
+pub struct UsbDtr {
+    /// DTR/RTS changes (one waiter: the console task).
+    pub control: ControlChanged<'static>,
+    /// The host raised DTR since it was plugged in: it uses DTR, so DTR
+    /// dropping is its hang-up.
+    pub seen: AtomicBool,
+}
+
+impl HostPresence for &'static UsbDtr {
+    async fn hung_up(&mut self) {
+        loop {
+            if self.control.dtr() {
+                self.seen.store(true, Ordering::Relaxed);
+            } else if self.seen.load(Ordering::Relaxed) {
+                return;
+            }
+            self.control.control_changed().await;
+        }
     }
 }
 

@@ -7,6 +7,7 @@ pub mod gcode_toolpath;
 mod random;
 pub mod spec_patterns;
 
+pub use laser_sim::safety::{NOISE_RUNS, steady_steps};
 pub use random::{XorShift, random_meaningful_commands};
 
 use laser_sim::safety::{Violation, ViolationKind, check, report_text};
@@ -131,28 +132,6 @@ pub fn assert_safe_allowing(report: &SimReport, open: &[ViolationKind]) {
 /// `safety_checker.rs` (path checks) and `redteam_galvo.rs` (jump planning
 /// at every sample period).
 pub const UNTIL_STEP_FIXES: &[ViolationKind] = &[ViolationKind::LongStep];
-
-/// Runs of a simulation [`least_noisy`] makes at most.
-pub const NOISE_RUNS: usize = 3;
-
-/// Host CPU-time figures (task steps, longest polls) carry host noise:
-/// page faults, other tests' threads. The simulation itself is
-/// deterministic, so work that really takes too long shows in every run.
-/// Runs `run` up to [`NOISE_RUNS`] times, stopping at the first result
-/// whose `excess` is zero, and returns the one with the least excess.
-pub fn least_noisy<T>(mut run: impl FnMut() -> T, excess: impl Fn(&T) -> u128) -> T {
-    let mut best = run();
-    for _ in 1..NOISE_RUNS {
-        if excess(&best) == 0 {
-            break;
-        }
-        let again = run();
-        if excess(&again) < excess(&best) {
-            best = again;
-        }
-    }
-    best
-}
 
 /// Every line of the terminal transcript (`> command` for what was sent).
 pub fn terminal_lines(report: &SimReport) -> Vec<&str> {

@@ -254,3 +254,32 @@ fn a_host_that_reads_gets_every_line_even_when_it_types_ahead() {
     assert_eq!(audit.data_lines, audit.data_lines_expected);
     assert!(audit.data_lines > 100);
 }
+
+#[test]
+fn a_host_that_reads_with_short_pauses_gets_every_typed_ahead_line_run() {
+    // Issue 25, defect 7: a host that reads (here with a 150 ms pause,
+    // shorter than `usb::HOST_STALL`) typing ahead more than the reply
+    // queue holds had most lines refused as "not reading". Its input must
+    // wait instead (back-pressure), and every line run.
+    for (line, data) in [("version", "laser-pointer"), ("$G", "[GC:")] {
+        let mut script = String::from("@stall-read 150\n");
+        for _ in 0..600 {
+            script += &format!("@type-ahead {line}\n");
+        }
+        script += "wait 2000\n";
+        let report = run_with(&script, SimOptions::default());
+        assert!(report.transcript.script_done);
+        let lines = &report.transcript.lines;
+        let refused = lines.iter().filter(|(_, l)| l.contains("not run")).count();
+        let closers = lines.iter().filter(|(_, l)| l == "ok").count();
+        let answers = lines.iter().filter(|(_, l)| l.starts_with(data)).count();
+        assert_eq!(refused, 0, "{line}: lines refused to a host that reads");
+        assert_eq!((closers, answers), (600, 600), "{line}");
+        let dropped = report
+            .transcript
+            .notices
+            .iter()
+            .filter(|(_, n)| n.contains("dropped"));
+        assert_eq!(dropped.count(), 0, "{line}: replies dropped");
+    }
+}

@@ -20,15 +20,11 @@
 //! Real time and network (the first install): not in `cargo xtask test`;
 //! `cargo xtask senders` runs them (`--ignored`).
 
+use laser_sim::on_pty::SimOnPty;
+use laser_sim::world::{SimOptions, SimReport};
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
-
-use laser_sim::pty::PtyOptions;
-use laser_sim::world::{SimOptions, SimReport, run};
 use system_tests::gcode_job::{Job, SpotMm, fit, rapids_dark};
 use system_tests::gcode_toolpath::{galvo_spot_mm, gimbal_spot_mm, lit_mm};
 
@@ -164,24 +160,15 @@ fn stream(sender: &Sender, prepare: &[&str], job: &Path, extra: &[&str]) -> (Sim
         sender.script
     ));
     std::fs::create_dir_all(&work).unwrap();
-    let link = work.join("pty");
-    let stop = Arc::new(AtomicBool::new(false));
-    let options = SimOptions {
-        pty: Some(PtyOptions {
-            link: Some(link.clone()),
-            stop: stop.clone(),
-        }),
-        realtime: true,
-        max_time_ms: 400_000,
-        ..SimOptions::default()
-    };
-    let _ = std::fs::remove_file(&link);
-    let sim = std::thread::spawn(move || run(options));
-    let started = Instant::now();
-    while !link.exists() {
-        assert!(started.elapsed() < Duration::from_secs(20), "no PTY");
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    let sim = SimOnPty::start(
+        work.join("pty"),
+        SimOptions {
+            max_time_ms: 400_000,
+            ..SimOptions::default()
+        },
+    )
+    .expect("the simulator starts");
+    let link = sim.link.clone();
     for line in prepare {
         type_command(&link, line);
     }
@@ -194,8 +181,7 @@ fn stream(sender: &Sender, prepare: &[&str], job: &Path, extra: &[&str]) -> (Sim
         .current_dir(&work)
         .output()
         .expect("the sender runs");
-    stop.store(true, Ordering::Relaxed);
-    let report = sim.join().expect("the simulator ends");
+    let report = sim.finish();
     let stdout = String::from_utf8_lossy(&output.stdout);
     let label = sender.label;
     assert!(

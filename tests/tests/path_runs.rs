@@ -21,16 +21,12 @@ const LONGEST_POLL_US: u128 = 5_000;
 /// simulated time.
 const REPLY_WITHIN_US: u64 = 5_000;
 
-/// Runs `script`; the report and the longest executor poll (host CPU),
-/// the least noisy of up to three runs (see `least_noisy`).
+/// Runs `script`; the report and its longest firmware step (host CPU),
+/// counting only long steps that recur in every run (see `steady_steps`).
 fn run_timed(script: &str, options: SimOptions) -> (SimReport, std::time::Duration) {
-    system_tests::least_noisy(
-        || {
-            let report = run_with(script, options.clone());
-            (report, laser_sim::executor::longest_poll())
-        },
-        |(_, longest)| longest.as_micros().saturating_sub(LONGEST_POLL_US - 1),
-    )
+    let report = system_tests::steady_steps(|| run_with(script, options.clone()));
+    let longest = laser_sim::executor::longest_firmware_step(&report.task_steps);
+    (report, longest)
 }
 
 #[test]

@@ -4,16 +4,17 @@
 use laser_sim::world::SimOptions;
 use system_tests::{lit_sample_times_ns, run_with, run_with_galvo_cost};
 
-/// Longest executor poll (host CPU) of a run with two 160 mm galvo jumps at
-/// sample period `ts_us` with `planner`, µs.
+/// Longest firmware task step (host CPU) of a run with two 160 mm galvo
+/// jumps at sample period `ts_us` with `planner`, counting only long steps
+/// that recur in every run (see `steady_steps`), µs.
 fn longest_poll_of_jumps(ts_us: u32, planner: &str) -> u128 {
     let script = format!(
         "target galvo\nplanner {planner}\nset galvo.ts_us {ts_us}\nwait 50\n\
          goto 8 5\nwait 100\ngoto -8 -5\nwait 100\nstop\n"
     );
-    let report = run_with(&script, SimOptions::default());
+    let report = system_tests::steady_steps(|| run_with(&script, SimOptions::default()));
     assert!(report.succeeded(false), "{:?}", report.transcript);
-    laser_sim::executor::longest_poll().as_micros()
+    laser_sim::executor::longest_firmware_step(&report.task_steps).as_micros()
 }
 
 #[test]
@@ -21,20 +22,18 @@ fn a_galvo_jump_is_planned_without_holding_the_executor_at_any_sample_period() {
     // SPEC §9: no task step holds the executor for more than 1 ms (on the
     // target; the host is 30–60× faster at f64). At the default 10 µs
     // the jump plans in ~70 µs; at 53 µs the same jumps took 2.6 ms in one
-    // poll. Best of three runs per period (host timing noise).
+    // poll. Long steps count only when they recur in every run (host
+    // load inflates a poll now and then, never the same one each time).
     let mut worst = (0, 0);
     for ts_us in [10, 23, 35, 53, 71, 86, 116] {
-        let best = (0..3)
-            .map(|_| longest_poll_of_jumps(ts_us, "optimal"))
-            .min()
-            .unwrap_or(0);
-        eprintln!("ts {ts_us} µs: longest poll {best} µs");
-        if best > worst.1 {
-            worst = (ts_us, best);
+        let longest = longest_poll_of_jumps(ts_us, "optimal");
+        eprintln!("ts {ts_us} µs: longest poll {longest} µs");
+        if longest > worst.1 {
+            worst = (ts_us, longest);
         }
     }
     assert!(
-        worst.1 < 1_000,
+        worst.1 <= 1_000,
         "at galvo.ts_us {} one executor poll took {} µs of host CPU",
         worst.0,
         worst.1
@@ -144,4 +143,37 @@ fn an_idle_galvo_loop_never_underruns_after_a_job_however_slow() {
             notices.len()
         );
     }
+}
+
+#[test]
+fn an_underrun_is_told_with_the_stop_it_makes_never_after_it() {
+    // Issue 25, defect 9: at 15 µs of compute per sample the pattern
+    // underran and stopped (told), then the parked loop underran again
+    // and a second notice said "stopped" of a pattern stopped before.
+    let report = run_with_galvo_cost(
+        "target galvo\npattern tuning\nwait 500\nstop\nwait 500\npattern tuning\nwait 500\n",
+        15_000,
+    );
+    assert!(
+        report.galvo_underruns >= 3,
+        "the loop underran while parked too: {}",
+        report.galvo_underruns
+    );
+    let told: Vec<u64> = report
+        .transcript
+        .notices
+        .iter()
+        .filter(|(_, n)| n.contains("galvo underrun"))
+        .map(|(t, _)| *t)
+        .collect();
+    let second_start = report
+        .transcript
+        .lines
+        .iter()
+        .filter(|(_, l)| l == "> pattern tuning")
+        .nth(1)
+        .map(|(t, _)| *t)
+        .expect("the pattern was started twice");
+    assert_eq!(told.len(), 2, "one notice per pattern stopped: {told:?}");
+    assert!(told[0] < 500_000 && told[1] >= second_start, "{told:?}");
 }

@@ -11,8 +11,8 @@ use laser_sim::safety::{check, report_text};
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, SimReport};
 use system_tests::{
-    NOISE_RUNS, UNTIL_STEP_FIXES, XorShift, assert_safe_allowing, least_noisy,
-    random_meaningful_commands, run_with,
+    NOISE_RUNS, UNTIL_STEP_FIXES, XorShift, assert_safe_allowing, random_meaningful_commands,
+    run_with, steady_steps,
 };
 
 /// Random sessions per campaign.
@@ -172,8 +172,8 @@ fn random_sessions_with_faults_and_stalls_are_safe() {
 #[test]
 fn random_sessions_have_short_task_steps() {
     for seed in 0..SESSIONS {
-        // A long step must recur in every run (see `least_noisy`).
-        let violations = least_noisy(|| check(&run_session(seed)), |v| v.len() as u128);
+        // A long step must recur in every run (see `steady_steps`).
+        let violations = check(&steady_steps(|| run_session(seed)));
         assert!(
             violations.is_empty(),
             "session {seed}, in each of {NOISE_RUNS} runs:\n{}",

@@ -11,6 +11,11 @@
 //! microseconds are estimated at [`CLOCK_MHZ`](report::CLOCK_MHZ) with [`CPI`](report::CPI) cycles per
 //! instruction. Not modelled: flash wait states (the ART accelerator hides
 //! most), the VDIV/VSQRT latency (14 cycles each), bus contention with DMA.
+//!
+//! Besides chosen inputs, seeded random sweeps (`sweep.*` rows: 3 000
+//! two-axis jumps, 200 strokes with close corners, in the same QEMU run,
+//! one timer window per input) report their dearest input, and the
+//! budgets apply to it (see `docs/bench-m4-sweeps.md`).
 
 mod budgets;
 pub(crate) mod qemu;

@@ -276,7 +276,23 @@ pub fn run_sim(args: SimArgs) -> Result<ExitCode> {
     })?;
     laser_sim::logger::init(level);
     let prepared = prepare(&args)?;
-    let report = run(prepared.options);
+    // A scripted run is deterministic in virtual time: with
+    // `--check-safety` a long task step must recur in every run, so host
+    // load alone cannot fail it (re-run at most twice, only when a step
+    // was long). A real-time or terminal session runs once.
+    let report = if args.check_safety && !prepared.options.realtime {
+        let mut runs = 0;
+        laser_sim::safety::steady_steps(|| {
+            runs += 1;
+            // The transcript is echoed once.
+            run(SimOptions {
+                echo: runs == 1,
+                ..prepared.options.clone()
+            })
+        })
+    } else {
+        run(prepared.options.clone())
+    };
     write_outputs(&args, prepared.svg.as_deref(), &report)?;
     print_summary(&report);
     if !report.stepper.edges.is_empty()

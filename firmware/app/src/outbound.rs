@@ -29,6 +29,10 @@ use heapless::Deque;
 
 use crate::text::{REPLY_LINE_LEN, ReplyText, reply_text};
 
+mod dropped;
+pub use dropped::Dropped;
+use dropped::dropped_notice;
+
 /// Size of the outbound queue, bytes (lines are stored with a 2-byte
 /// header). Holds the longest reply (`params`, about 5.5 KiB stored) with
 /// room to spare, so a host that reads gets every line.
@@ -49,6 +53,11 @@ pub const NOTICE_LIMIT: usize = OUTBOUND_BYTES - CLOSER_ROOM;
 /// Data lines may fill the queue up to this many bytes (the rest is kept
 /// for four notices and the closer).
 pub const DATA_LIMIT: usize = NOTICE_LIMIT - 4 * (LINE_ENTRY_MAX + MARKER_ENTRY);
+
+/// Room a line's reply is given before the line is taken while the host
+/// reads, bytes (grbl's longest, `$$`, stores about 700; the product's
+/// long replies wait for the queue to drain instead).
+pub const REPLY_ROOM: usize = 1024;
 
 /// What a queued line is; decides how it is printed and its priority.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -107,57 +116,6 @@ impl LineKind {
 /// Entry code of a drop marker.
 const MARKER_CODE: u8 = 0xff;
 
-/// Lines dropped because the queue was full.
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Dropped {
-    /// Data lines of replies.
-    pub data_lines: u32,
-    /// Notices (faults, recoveries).
-    pub notices: u32,
-}
-
-impl Dropped {
-    /// Whether nothing was dropped.
-    pub fn is_empty(&self) -> bool {
-        self.data_lines == 0 && self.notices == 0
-    }
-
-    fn count(&mut self, kind: LineKind) {
-        match kind {
-            LineKind::Data => self.data_lines = self.data_lines.saturating_add(1),
-            LineKind::Notice => self.notices = self.notices.saturating_add(1),
-            // Closers always have room (see the module doc); should one
-            // ever be refused it is counted with the data lines.
-            LineKind::Ok | LineKind::Error | LineKind::GrblError => {
-                self.data_lines = self.data_lines.saturating_add(1)
-            }
-        }
-    }
-}
-
-/// The notice reporting dropped lines (`info:` for reply lines only,
-/// `error:` when notices, which may report faults, were lost too).
-impl fmt::Display for Dropped {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let plural = |n: u32| if n == 1 { "" } else { "s" };
-        let (lines, notices) = (self.data_lines, self.notices);
-        if notices == 0 {
-            write!(f, "info: {lines} reply line{}", plural(lines))?;
-        } else {
-            write!(f, "error: {notices} notice{}", plural(notices))?;
-            if lines > 0 {
-                write!(f, " and {lines} reply line{}", plural(lines))?;
-            }
-        }
-        f.write_str(" dropped while the host was not reading")?;
-        if notices > 0 {
-            f.write_str("; `status` shows faults")?;
-        }
-        Ok(())
-    }
-}
-
 /// One line taken from the queue for writing.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct OutLine {
@@ -175,6 +133,11 @@ struct Queue {
     dropped: Dropped,
     /// A command was dispatched and has not been closed yet.
     awaiting_close: bool,
+    /// The command in flight belongs to a host session that ended: its
+    /// data lines and closer are discarded when they come.
+    orphaned: bool,
+    /// Lines taken by the writer (wrapping): the host reads while it grows.
+    taken: u32,
 }
 
 impl Queue {
@@ -186,6 +149,8 @@ impl Queue {
                 notices: 0,
             },
             awaiting_close: false,
+            orphaned: false,
+            taken: 0,
         }
     }
 
@@ -199,6 +164,11 @@ impl Queue {
     /// Queues `text` as a `kind` line, after a drop marker if lines were
     /// dropped before it; counts it as dropped when its share is full.
     fn push(&mut self, kind: LineKind, text: &str) -> bool {
+        if self.orphaned && kind != LineKind::Notice {
+            // Nobody asked for it any more; not a drop to report.
+            self.orphaned = !kind.is_closer();
+            return true;
+        }
         // At most REPLY_LINE_LEN bytes, cut on a character boundary.
         let mut end = text.len().min(REPLY_LINE_LEN);
         while !text.is_char_boundary(end) {
@@ -235,9 +205,52 @@ impl Queue {
         out
     }
 
+    /// A new host session: drops every queued entry but notices (no
+    /// command owns them), keeps the count of notices dropped, orphans the
+    /// command in flight; returns whether there was one.
+    fn new_session(&mut self) -> bool {
+        let mut notices_dropped = self.dropped.notices;
+        let mut left = self.bytes.len();
+        while left >= HEADER {
+            let [code, len] = self.pop_bytes::<2>();
+            left = left.saturating_sub(HEADER + usize::from(len));
+            let keep = code == LineKind::Notice.code();
+            if code == MARKER_CODE {
+                let _lines = self.pop_bytes::<4>();
+                let notices = u32::from_le_bytes(self.pop_bytes::<4>());
+                notices_dropped = notices_dropped.saturating_add(notices);
+                continue;
+            }
+            if keep {
+                self.push_bytes(&[code, len]);
+            }
+            for _ in 0..len {
+                let byte = self.bytes.pop_front().unwrap_or(b'?');
+                if keep {
+                    // Room: the entry's bytes were just taken out.
+                    let _ = self.bytes.push_back(byte);
+                }
+            }
+        }
+        self.dropped = Dropped {
+            data_lines: 0,
+            notices: notices_dropped,
+        };
+        self.orphaned = self.awaiting_close;
+        self.awaiting_close
+    }
+
     /// Takes the oldest entry: a line, or a drop marker turned into its
     /// notice. With an empty queue, reports drops not yet reported.
     fn pop(&mut self) -> Option<OutLine> {
+        let line = self.pop_entry();
+        if line.is_some() {
+            self.taken = self.taken.wrapping_add(1);
+        }
+        line
+    }
+
+    fn pop_entry(&mut self) -> Option<OutLine> {
         let Some([code, len]) = (self.bytes.len() >= HEADER).then(|| self.pop_bytes::<2>()) else {
             if self.dropped.is_empty() {
                 return None;
@@ -264,13 +277,6 @@ impl Queue {
             kind: LineKind::from_code(code).unwrap_or(LineKind::Data),
             text,
         })
-    }
-}
-
-fn dropped_notice(dropped: Dropped) -> OutLine {
-    OutLine {
-        kind: LineKind::Notice,
-        text: reply_text(format_args!("{dropped}")),
     }
 }
 
@@ -353,9 +359,33 @@ impl Outbound {
         self.queued_bytes() <= OUTBOUND_BYTES - CLOSER_ROOM
     }
 
+    /// Whether the reply of a line (up to [`REPLY_ROOM`] bytes of data
+    /// lines and its closer) fits: the console waits for it while the host
+    /// reads before it takes the next line.
+    pub fn has_reply_room(&self) -> bool {
+        self.queued_bytes() + REPLY_ROOM <= DATA_LIMIT
+    }
+
     /// Lines dropped and not yet reported.
     pub fn unreported_drops(&self) -> Dropped {
         self.with(|q| q.dropped)
+    }
+
+    /// Lines the writer has taken so far (wrapping): while it does not
+    /// change the host reads nothing.
+    pub fn lines_taken(&self) -> u32 {
+        self.with(|q| q.taken)
+    }
+
+    /// Starts a new host session (a host connected): the replies still
+    /// queued for the last one are discarded (notices are kept: faults
+    /// belong to no session), and a command still in flight answers no
+    /// one: its data lines and closer are discarded when they come.
+    /// Returns whether a command was in flight (the console stops it).
+    pub fn new_session(&self) -> bool {
+        let in_flight = self.with(Queue::new_session);
+        self.freed.signal(());
+        in_flight
     }
 
     /// Marks a command as dispatched: its closer is awaited.

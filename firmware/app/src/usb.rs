@@ -21,7 +21,7 @@
 //! when its closer has room (so the host's input waits instead).
 
 use embassy_futures::select::{Either, select};
-use embassy_time::{Duration, with_timeout};
+use embassy_time::{Duration, Instant, Timer, with_timeout};
 use embedded_io_async::{Read, Write};
 
 use heapless::Deque;
@@ -37,14 +37,19 @@ use crate::log;
 use crate::outbound::{LineKind as OutKind, OutLine, Outbound};
 use crate::text::REPLY_LINE_LEN;
 
-/// Before a command whose reply has data lines, the console waits this long
-/// at most for earlier output to reach the host, so a host that reads
-/// (even slowly) gets every line; after it the host counts as not reading
-/// and the command runs anyway (lines that do not fit are dropped and
-/// counted). Commands without data lines (`stop`, `goto`, …) never wait,
-/// and once the host counts as not reading no command waits again until
-/// the queue has drained: the wait is paid once per stall, so lines typed
-/// behind many data commands (a `stop`) are not held back by each.
+mod flow;
+use flow::{HostReading, OwedClosers};
+
+/// A host that reads nothing for this long counts as not reading (until it
+/// reads a line again). Before a command whose reply has data lines, the
+/// console waits this long at most for earlier output to reach the host,
+/// so a host that reads (even slowly) gets every line; and a line that
+/// finds no room for its closer waits for room (its host's input waits:
+/// back-pressure) as long as the host reads a line within this time.
+/// Once the host counts as not reading, data commands run at once (lines
+/// that do not fit are dropped and counted) and lines without room for a
+/// closer are refused: the wait is paid once per stall, so lines typed
+/// behind many commands (a `stop`) are not held back by each.
 pub const HOST_STALL: Duration = Duration::from_millis(250);
 
 /// Longest line on the wire without its line end: `error: ` + text, bytes.
@@ -62,15 +67,22 @@ pub enum ConsoleEnd {
     WriteFailed,
 }
 
-/// Serves the command line until the input ends or reading or writing
-/// fails. Each complete line gets exactly one closing reply (`ok` or
-/// `error: …`), possibly preceded by data lines. Lines still queued when it
-/// ends are written by the next call (after a USB reconnect).
+/// Serves the command line to one host session until the input ends or
+/// reading or writing fails. Each complete line gets exactly one closing
+/// reply (`ok` or `error: …`), possibly preceded by data lines. A session
+/// starts afresh: replies still queued for an earlier one are dropped
+/// (notices kept), and a command of an earlier one still running is
+/// stopped (as `stop` does) and its reply dropped, so a host that opens
+/// the port again is answered at once whatever the last one left.
 pub async fn run_console<R: Read, W: Write>(
     rx: &mut R,
     tx: &mut W,
     link: &CommandLink,
 ) -> ConsoleEnd {
+    if link.outbound.new_session() {
+        log::warning!("usb: the last session's command still runs: stopped");
+        link.stop_request.signal(());
+    }
     match select(read_lines(rx, link), write_lines(tx, &link.outbound)).await {
         Either::First(end) | Either::Second(end) => end,
     }
@@ -79,13 +91,11 @@ pub async fn run_console<R: Read, W: Write>(
 /// Reads lines and dispatches them, one command in flight at a time.
 async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
     let out = &link.outbound;
-    // A command sent before a reconnect is answered first.
+    // The last session's command (stopped) is closed first.
     out.wait_until(|o| !o.awaiting_close()).await;
     let mut assembler = LineAssembler::new();
     let mut input = RxBuffer::new();
-    // The host let a `HOST_STALL` pass without reading, and the queue has
-    // not drained since.
-    let mut host_not_reading = false;
+    let mut reading = HostReading::default();
     let mut owed = OwedClosers::default();
     loop {
         let Some(byte) = input.bytes.pop_front() else {
@@ -114,6 +124,23 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
             continue;
         };
         owed.pay(link);
+        if owed.is_empty() && !out.has_reply_room() && !reading.not_reading(out) {
+            // A host that reads gets room soon: wait for it.
+            match wait_for_reply_room(rx, &mut input, link).await {
+                Ok(Room::Free) => {}
+                Ok(Room::Stalled) => {
+                    log::warning!("usb: host is not reading; lines are refused");
+                    reading.stalled(out);
+                }
+                Ok(Room::AfterReset) => {
+                    // The line was typed before the soft reset: flushed,
+                    // as grbl flushes its buffer.
+                    assembler = LineAssembler::new();
+                    continue;
+                }
+                Err(end) => return end,
+            }
+        }
         if !owed.is_empty() || !out.has_closer_room() {
             // The host types ahead but reads nothing, and its replies
             // fill the queue: this line cannot be answered in order
@@ -147,7 +174,7 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
             }
             Err(e) => link.error(e),
             Ok(line) if classify(line.as_str()) == LineKind::Product => {
-                dispatch(line.as_str(), link, &mut host_not_reading).await;
+                dispatch(line.as_str(), link, &mut reading).await;
             }
             Ok(line) => match dispatch_grbl(line.as_str(), rx, &mut input, link).await {
                 Ok(Filled::Bytes) => {}
@@ -279,60 +306,51 @@ async fn dispatch_grbl<R: Read>(
     }
 }
 
-/// Closers owed to lines that arrived while the outbound queue had no room
-/// for their replies (a host typing ahead but not reading), in order, as
-/// runs: `ok` for a `stop` (carried out at once), `error:` for any other
-/// line (not run).
-#[derive(Default)]
-struct OwedClosers {
-    /// `(ok, count)` runs, oldest first.
-    runs: heapless::Deque<(bool, u32), 8>,
+/// What [`wait_for_reply_room`] saw.
+enum Room {
+    /// A reply fits.
+    Free,
+    /// The host read nothing for [`HOST_STALL`].
+    Stalled,
+    /// A soft reset came (a reply fits).
+    AfterReset,
 }
 
-/// Reply of a line that was not run because its reply could not be queued.
-const NOT_RUN: &str =
-    "not run: the host was not reading replies (output queue full); send it again";
-
-impl OwedClosers {
-    fn is_empty(&self) -> bool {
-        self.runs.is_empty()
-    }
-
-    /// Owes one closer (`ok` when `ok`); `false` when there is no room
-    /// left to remember it (nothing recorded).
-    fn owe(&mut self, ok: bool) -> bool {
-        if let Some((last_ok, count)) = self.runs.back_mut()
-            && *last_ok == ok
-        {
-            *count = count.saturating_add(1);
-            return true;
+/// Waits until a reply fits in the outbound queue while the host reads
+/// (a line taken within each [`HOST_STALL`]), reading on meanwhile:
+/// realtime bytes act at once, line bytes wait in the RX buffer and,
+/// once it is full, in the host (back-pressure).
+async fn wait_for_reply_room<R: Read>(
+    rx: &mut R,
+    input: &mut RxBuffer,
+    link: &CommandLink,
+) -> Result<Room, ConsoleEnd> {
+    let out = &link.outbound;
+    let mut reset = false;
+    let mut taken = out.lines_taken();
+    let mut deadline = Instant::now() + HOST_STALL;
+    loop {
+        if out.has_reply_room() {
+            return Ok(if reset { Room::AfterReset } else { Room::Free });
         }
-        self.runs.push_back((ok, 1)).is_ok()
-    }
-
-    /// Queues as many owed closers, oldest first, as the outbound queue has
-    /// room for.
-    fn pay(&mut self, link: &CommandLink) {
-        while link.outbound.has_closer_room() {
-            let Some((ok, count)) = self.runs.front_mut() else {
-                return;
-            };
-            if *ok {
-                link.ok();
-            } else {
-                link.error(NOT_RUN);
-            }
-            *count -= 1;
-            if *count == 0 {
-                self.runs.pop_front();
-            }
+        if out.lines_taken() != taken {
+            taken = out.lines_taken();
+            deadline = Instant::now() + HOST_STALL;
+        }
+        let progress = out.wait_until(|o| o.has_reply_room() || o.lines_taken() != taken);
+        let waited = select(select(progress, Timer::at(deadline)), input.fill(rx, link));
+        match waited.await {
+            Either::First(Either::First(())) | Either::Second(Ok(Filled::Bytes)) => {}
+            Either::First(Either::Second(())) => return Ok(Room::Stalled),
+            Either::Second(Ok(Filled::SoftReset)) => reset = true,
+            Either::Second(Err(end)) => return Err(end),
         }
     }
 }
 
 /// Parses one line and runs it; returns once its reply is closed (queued,
-/// not necessarily written). `host_not_reading`: see [`HOST_STALL`].
-async fn dispatch(line: &str, link: &CommandLink, host_not_reading: &mut bool) {
+/// not necessarily written). `reading`: see [`HOST_STALL`].
+async fn dispatch(line: &str, link: &CommandLink, reading: &mut HostReading) {
     let out = &link.outbound;
     let command = match parse_line(line) {
         Ok(Some(command)) => command,
@@ -342,14 +360,11 @@ async fn dispatch(line: &str, link: &CommandLink, host_not_reading: &mut bool) {
             return link.error(e);
         }
     };
-    if out.queued_bytes() == 0 {
-        *host_not_reading = false;
-    }
-    if command.replies_with_data() && out.queued_bytes() > 0 && !*host_not_reading {
+    if command.replies_with_data() && out.queued_bytes() > 0 && !reading.not_reading(out) {
         let drained = with_timeout(HOST_STALL, out.wait_until(|o| o.queued_bytes() == 0)).await;
         if drained.is_err() {
             log::warning!("usb: host is not reading; replies may be dropped");
-            *host_not_reading = true;
+            reading.stalled(out);
         }
     }
     // No await between marking and sending: a console cancelled by a

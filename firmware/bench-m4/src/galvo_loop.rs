@@ -33,18 +33,62 @@ impl DacStream for M4Dac {
 }
 
 /// The loop as the firmware builds it.
-fn m4_loop(config: GalvoConfig) -> Result<GalvoLoop, GalvoError> {
+pub fn m4_loop(config: GalvoConfig) -> Result<GalvoLoop, GalvoError> {
     GalvoLoop::for_dac::<M4Dac>(config)
 }
 
 /// Runs the loop until it is idle (not measured).
-fn settle(galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
+pub fn settle(galvo: &mut GalvoLoop, half: &mut [DacSample; HALF]) {
     for _ in 0..10_000 {
         if galvo.phase() == ScanPhase::Idle && galvo.queued_points() == 0 {
             return;
         }
         galvo.fill(half, |_| {});
     }
+}
+
+/// What one job cost, half by half (timer ticks; see [`measure_job`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct JobCost {
+    /// The dearest refill that started and ended in the steady phase.
+    pub steady: Option<u32>,
+    /// The dearest refill of the job.
+    pub refill: u32,
+    /// The dearest prep call that prepared a step: (ticks, steps).
+    pub prep: Option<(u32, u32)>,
+    /// A refill waited for a step the prep stage had not prepared.
+    pub waited: bool,
+}
+
+/// Runs the job queued in `galvo` to its end as `GalvoLoop::run` runs it
+/// (the prep stage between halves, then the refill) and measures every
+/// half: see [`JobCost`]; `steady` is the phase whose halves count as
+/// steady.
+pub fn measure_job(
+    galvo: &mut GalvoLoop,
+    half: &mut [DacSample; HALF],
+    steady: ScanPhase,
+) -> JobCost {
+    let mut cost = JobCost::default();
+    let unprepared = galvo.unprepared_samples();
+    for _ in 0..20_000usize {
+        let before = galvo.phase();
+        if before == ScanPhase::Idle && galvo.queued_points() == 0 {
+            break;
+        }
+        let mut steps = 0;
+        let ticks = window(|| steps = galvo.prep());
+        if steps > 0 && cost.prep.is_none_or(|(t, n)| ticks / steps as u32 > t / n) {
+            cost.prep = Some((ticks, steps as u32));
+        }
+        let ticks = window(|| galvo.refill(half, |_| {}));
+        cost.refill = cost.refill.max(ticks);
+        if before == steady && galvo.phase() == steady {
+            cost.steady = Some(cost.steady.map_or(ticks, |t| t.max(ticks)));
+        }
+    }
+    cost.waited = galvo.unprepared_samples() != unprepared;
+    cost
 }
 
 /// Measures every half of a job as `GalvoLoop::run` runs it: the prep
@@ -59,40 +103,22 @@ fn job_halves(
     half: &mut [DacSample; HALF],
     steady: ScanPhase,
 ) {
-    let (mut steady_max, mut refill_max, mut steady_seen) = (0u32, 0u32, false);
-    let mut prep_max: Option<(u32, u32)> = None;
-    let unprepared = galvo.unprepared_samples();
-    for _ in 0..20_000usize {
-        let before = galvo.phase();
-        if before == ScanPhase::Idle && galvo.queued_points() == 0 {
-            break;
-        }
-        let mut steps = 0;
-        let ticks = window(|| steps = galvo.prep());
-        if steps > 0 && prep_max.is_none_or(|(t, n)| ticks / steps as u32 > t / n) {
-            prep_max = Some((ticks, steps as u32));
-        }
-        let ticks = window(|| galvo.refill(half, |_| {}));
-        refill_max = refill_max.max(ticks);
-        if before == steady && galvo.phase() == steady {
-            steady_max = steady_max.max(ticks);
-            steady_seen = true;
-        }
-    }
+    let cost = measure_job(galvo, half, steady);
     let mut name: Name = Name::new();
-    if galvo.unprepared_samples() != unprepared {
+    if cost.waited {
         return b.fail(id, "the refill waited for an unprepared step");
     }
-    if steady_seen {
-        name.set(id, ".steady");
-        b.report(name.as_str(), steady_max, HALF as u32);
-    } else {
-        b.fail(id, "no steady half");
+    match cost.steady {
+        Some(ticks) => {
+            name.set(id, ".steady");
+            b.report(name.as_str(), ticks, HALF as u32);
+        }
+        None => b.fail(id, "no steady half"),
     }
     name.set(id, ".refill");
-    b.report(name.as_str(), refill_max, 1);
+    b.report(name.as_str(), cost.refill, 1);
     name.set(id, ".prep");
-    match prep_max {
+    match cost.prep {
         Some((ticks, steps)) => b.report(name.as_str(), ticks, steps),
         None => b.fail(id, "nothing prepared"),
     }

@@ -33,6 +33,8 @@ mod path;
 mod planning;
 mod semihosting;
 mod stepper;
+mod sweep;
+mod sweep_strokes;
 mod timer;
 
 use harness::{Bench, calibration_loop, window};
@@ -65,6 +67,8 @@ fn main() -> ! {
     galvo_loop::loop_halves(&mut b);
     planning::planning(&mut b);
     stepper::stepper(&mut b);
+    sweep::jump_sweep(&mut b);
+    sweep_strokes::stroke_sweep(&mut b);
 
     let _ = writeln!(b.out, "done {}", b.failures);
     b.out.flush();

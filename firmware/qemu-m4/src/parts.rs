@@ -6,7 +6,9 @@
 use core::sync::atomic::{AtomicU16, Ordering};
 
 use embedded_io_async::Read;
-use laser_app::app::{Console, Indicators, Leds, StopButton, WATCHDOG_TIMEOUT_US, Watchdog};
+use laser_app::app::{
+    Console, Indicators, Leds, NoHangUp, StopButton, WATCHDOG_TIMEOUT_US, Watchdog,
+};
 use laser_app::laser_gate::{GateState, LaserGate};
 use laser_app::sequencer::{LaserEvent, LaserPower, LaserSwitch};
 
@@ -85,9 +87,15 @@ pub struct UartConsole {
 impl Console for UartConsole {
     type Rx = Uart;
     type Tx = Uart;
+    type Presence = NoHangUp;
 
     async fn connected(&mut self) -> (&mut Uart, &mut Uart) {
         (&mut self.rx, &mut self.tx)
+    }
+
+    /// A UART without modem lines cannot tell.
+    fn presence(&self) -> NoHangUp {
+        NoHangUp
     }
 }
 

@@ -13,13 +13,14 @@
 //! | stepper STEP/DIR/ENABLE | the driver models ([`SimStepperDrive`]), or none |
 //! | LEDs, button, watchdog | recorded models ([`crate::panel`])       |
 
+use std::cell::Cell;
 use std::convert::Infallible;
 use std::rc::Rc;
 
 use embassy_executor::Spawner;
 use laser_app::app::{
-    Board, Console, ConsoleTask, GalvoTask, IndicatorTask, Parts, SequencerTask, ServoBusTask,
-    Spawn, StopButtonTask, WatchdogTask,
+    Board, Console, ConsoleTask, GalvoTask, HostPresence, IndicatorTask, Parts, SequencerTask,
+    ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::stepper::{StepPulseTask, StepperTask};
@@ -72,7 +73,7 @@ impl Board for SimBoard {
             console: SimConsole {
                 rx: HostRx(self.host.clone()),
                 tx: HostTx(self.host),
-                connections: 0,
+                connection: Rc::default(),
             },
             servo_rx: PortHandle(self.servo_port.clone()),
             servo_tx: PortHandle(self.servo_port),
@@ -87,25 +88,50 @@ impl Board for SimBoard {
     }
 }
 
-/// The console port: the simulated terminal connects once, at boot, and
-/// stays connected.
+/// The console port: the simulated terminal is connected at boot; a
+/// script's `@close` / `@open` (or a PTY host closing and opening the
+/// port) end its connection and begin the next.
 pub struct SimConsole {
     rx: HostRx,
     tx: HostTx,
-    connections: u32,
+    /// The connection last returned (`None`: none yet).
+    connection: Rc<Cell<Option<u32>>>,
 }
 
 impl Console for SimConsole {
     type Rx = HostRx;
     type Tx = HostTx;
+    type Presence = SimPresence;
 
     async fn connected(&mut self) -> (&mut HostRx, &mut HostTx) {
-        if self.connections > 0 {
-            // The terminal never reconnects.
-            core::future::pending::<()>().await;
+        let host = &self.rx.0;
+        if let Some(last) = self.connection.get() {
+            host.port_closed(last).await;
         }
-        self.connections += 1;
+        self.connection.set(Some(host.port_opened().await));
         (&mut self.rx, &mut self.tx)
+    }
+
+    fn presence(&self) -> SimPresence {
+        SimPresence {
+            host: self.rx.0.clone(),
+            connection: self.connection.clone(),
+        }
+    }
+}
+
+/// The simulated host's presence: it hangs up when its port closes.
+pub struct SimPresence {
+    host: Rc<UsbHost>,
+    /// The connection the console serves.
+    connection: Rc<Cell<Option<u32>>>,
+}
+
+impl HostPresence for SimPresence {
+    async fn hung_up(&mut self) {
+        if let Some(connection) = self.connection.get() {
+            self.host.port_closed(connection).await;
+        }
     }
 }
 

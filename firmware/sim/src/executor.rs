@@ -182,6 +182,77 @@ pub fn longest_poll() -> std::time::Duration {
     std::time::Duration::from_nanos(ns)
 }
 
+/// The longest firmware task step of `steps` (a run's accounting), in
+/// thread CPU time.
+pub fn longest_firmware_step(steps: &[TaskSteps]) -> std::time::Duration {
+    let ns = steps
+        .iter()
+        .filter(|t| t.kind == TaskKind::Firmware)
+        .map(|t| t.max_cpu_ns)
+        .max()
+        .unwrap_or(0);
+    std::time::Duration::from_nanos(ns)
+}
+
+/// The step accounting of several runs of the same simulation with the
+/// host's noise taken out: only the long steps that recur in **every**
+/// run. A simulation is deterministic in virtual time, so a step is the
+/// same work in every run and is identified by its task (spawn order) and
+/// simulated instant; its cost is the least CPU time any run measured.
+/// Host load (other processes, a sibling hyper-thread, the hypervisor)
+/// inflates a poll's CPU time now and then, never the same poll in every
+/// run; work that really takes too long shows in each. A poll that was
+/// short in one run counts as short: its longest, `max_cpu_ns`, is then
+/// the least of the runs' longest, capped at [`LONG_STEP_NS`].
+///
+/// `runs` must be runs of one simulation (same tasks in the same order);
+/// the counts of polls come from the first.
+pub fn recurring_steps(runs: &[Vec<TaskSteps>]) -> Vec<TaskSteps> {
+    let Some((first, others)) = runs.split_first() else {
+        return Vec::new();
+    };
+    first
+        .iter()
+        .enumerate()
+        .map(|(i, task)| {
+            let same: Vec<&TaskSteps> = others
+                .iter()
+                .filter_map(|run| run.get(i))
+                .filter(|t| t.name == task.name)
+                .collect();
+            let long_steps: Vec<(u64, u64)> = task
+                .long_steps
+                .iter()
+                .filter_map(|&(t_us, cpu_ns)| {
+                    same.iter()
+                        .try_fold(cpu_ns, |least, other| {
+                            let again = other.long_steps.iter().find(|s| s.0 == t_us)?;
+                            Some(least.min(again.1))
+                        })
+                        .map(|least| (t_us, least))
+                })
+                .collect();
+            let recurring_max = long_steps.iter().max_by_key(|s| s.1).copied();
+            let least_max = same
+                .iter()
+                .map(|t| t.max_cpu_ns)
+                .fold(task.max_cpu_ns, u64::min)
+                .min(LONG_STEP_NS);
+            let (max_cpu_ns, max_at_us) = match recurring_max {
+                Some((t_us, cpu_ns)) => (cpu_ns, t_us),
+                None => (least_max, task.max_at_us),
+            };
+            TaskSteps {
+                long_step_count: long_steps.len() as u64,
+                long_steps,
+                max_cpu_ns,
+                max_at_us,
+                ..task.clone()
+            }
+        })
+        .collect()
+}
+
 /// CPU time this thread has used, ns.
 #[cfg(unix)]
 fn thread_cpu_ns() -> u64 {

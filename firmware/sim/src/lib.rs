@@ -11,6 +11,8 @@ pub mod executor;
 pub mod flash;
 pub mod laser;
 pub mod logger;
+#[cfg(unix)]
+pub mod on_pty;
 pub mod panel;
 pub mod physics;
 #[cfg(unix)]

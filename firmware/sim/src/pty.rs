@@ -9,8 +9,11 @@
 //! kernel's PTY buffer fills, so the sender's writes block), and the
 //! device's output goes out through a bounded channel to a writer thread
 //! that blocks when the host does not read (the device's writes then wait,
-//! as on USB). The simulator keeps the slave side open itself, so a host
-//! may close and reopen the port.
+//! as on USB). With [`PtyBridge::start`] the simulator keeps the slave
+//! side open itself, so a host may close and reopen the port unnoticed;
+//! the simulator's console uses [`PtyBridge::start_with_hangups`]
+//! instead, which tells when the host closes and opens the port, so the
+//! console starts a new session for each host (as USB's DTR does).
 
 use std::fs::{File, OpenOptions};
 use std::io::{Read, Write};
@@ -24,10 +27,11 @@ use std::sync::mpsc::{Receiver, SyncSender, TryRecvError, TrySendError, sync_cha
 
 use anyhow::{Context, Result, bail};
 use embassy_executor::Spawner;
-use embassy_futures::select::{Either, select};
 use embassy_time::Timer;
 
 use crate::usb_host::UsbHost;
+
+mod hangup;
 
 /// Where the console appears and what ends the run.
 #[derive(Debug, Clone)]
@@ -43,8 +47,9 @@ pub struct PtyOptions {
 /// slave's device path the host opens.
 pub struct Pty {
     master: File,
-    /// Kept open so the master never sees a hang-up between host sessions.
-    _slave: File,
+    /// Kept open so the master never sees a hang-up between host sessions
+    /// (released by [`PtyBridge::start_with_hangups`]).
+    _slave: Option<File>,
     /// The device path (`/dev/pts/N`).
     pub path: PathBuf,
 }
@@ -87,7 +92,7 @@ pub fn open() -> Result<Pty> {
         }
         Ok(Pty {
             master,
-            _slave: slave,
+            _slave: Some(slave),
             path,
         })
     }
@@ -154,52 +159,76 @@ const POLL_US: u64 = 500;
 
 /// The simulator's side of the bridge: host bytes to the console's input
 /// pipe, the console's output to the host (recorded in the transcript as
-/// lines, like the scripted terminal's). Marks the script done once
-/// `stop` is set.
+/// lines, like the scripted terminal's), both at once (the host's input
+/// waits while the console's input pipe is full, never its output).
+/// A bridge started with hangups closes and opens the simulated port as
+/// the host does. Marks the script done once `stop` is set.
 pub async fn pty_task(host: Rc<UsbHost>, pty: Pty, bridge: PtyBridge, stop: Arc<AtomicBool>) {
     let _open = pty;
-    let mut outgoing: Option<Vec<u8>> = None;
+    let PtyBridge { from_host, to_host } = bridge;
+    embassy_futures::join::join(
+        host_to_device(&host, &from_host, &to_host, &stop),
+        device_to_host(&host, &to_host),
+    )
+    .await;
+}
+
+/// Host → device (waits while the console's input pipe is full); markers
+/// of a bridge with hangups close and open the port.
+async fn host_to_device(
+    host: &UsbHost,
+    from_host: &Receiver<Vec<u8>>,
+    to_host: &SyncSender<Vec<u8>>,
+    stop: &AtomicBool,
+) {
     let mut typed = (Vec::new(), false);
-    let mut received = Vec::new();
-    let mut chunk = [0u8; 128];
     loop {
         if stop.load(Ordering::Relaxed) {
             host.transcript.borrow_mut().script_done = true;
         }
-        // Host → device (waits while the console's input pipe is full).
-        match bridge.from_host.try_recv() {
-            Ok(bytes) => {
+        match from_host.try_recv() {
+            Ok(bytes) if bytes.is_empty() && host.port_is_open() => {
+                host.close_port();
+                typed = (Vec::new(), false);
+                hangup::acknowledge_close(to_host);
+            }
+            Ok(bytes) if bytes.is_empty() => host.open_port(),
+            Ok(bytes) if host.port_is_open() => {
                 host.record_typed(&mut typed, &bytes);
                 host.to_device.write_all(&bytes).await;
+            }
+            Ok(_) => {}
+            Err(TryRecvError::Empty | TryRecvError::Disconnected) => {
+                Timer::after_micros(POLL_US).await;
+            }
+        }
+    }
+}
+
+/// Device → host, one chunk in hand at a time (dropped when the port
+/// closes meanwhile).
+async fn device_to_host(host: &UsbHost, to_host: &SyncSender<Vec<u8>>) {
+    let mut outgoing: Option<(u32, Vec<u8>)> = None;
+    let mut received = Vec::new();
+    let mut chunk = [0u8; 128];
+    loop {
+        if let Some((connection, bytes)) = outgoing.take() {
+            if !host.port_is_open() || host.connection() != connection {
                 continue;
             }
-            Err(TryRecvError::Empty | TryRecvError::Disconnected) => {}
-        }
-        // Device → host, one chunk in hand at a time.
-        if let Some(bytes) = outgoing.take() {
-            match bridge.to_host.try_send(bytes) {
-                Ok(()) => {}
-                Err(TrySendError::Full(bytes)) => outgoing = Some(bytes),
-                Err(TrySendError::Disconnected(_)) => {}
+            match to_host.try_send(bytes) {
+                Ok(()) | Err(TrySendError::Disconnected(_)) => {}
+                Err(TrySendError::Full(bytes)) => {
+                    outgoing = Some((connection, bytes));
+                    Timer::after_micros(POLL_US).await;
+                }
             }
-        }
-        if outgoing.is_some() {
-            Timer::after_micros(POLL_US).await;
             continue;
         }
-        match select(
-            host.from_device.read(&mut chunk),
-            Timer::after_micros(POLL_US),
-        )
-        .await
-        {
-            Either::First(n) => {
-                let bytes = chunk.get(..n).unwrap_or(&[]).to_vec();
-                host.record_received(&mut received, &bytes);
-                outgoing = Some(bytes);
-            }
-            Either::Second(()) => {}
-        }
+        let n = host.from_device.read(&mut chunk).await;
+        let bytes = chunk.get(..n).unwrap_or(&[]).to_vec();
+        host.record_received(&mut received, &bytes);
+        outgoing = Some((host.connection(), bytes));
     }
 }
 
@@ -211,7 +240,8 @@ pub fn host_start(host: Rc<UsbHost>, options: PtyOptions) -> impl FnOnce(&Spawne
         if let Some(link) = &options.link {
             link_to(link, &pty.path)?;
         }
-        let bridge = PtyBridge::start(&pty)?;
+        let mut pty = pty;
+        let bridge = PtyBridge::start_with_hangups(&mut pty)?;
         Ok((pty, bridge))
     });
     move |spawner| match opened {

@@ -21,6 +21,9 @@
 //!   the host sent gets exactly one `ok` / `error: …`, after its data
 //!   lines, in the order the lines were sent; bracketed notices are not
 //!   replies but must be whole lines.
+//! * **(e) on the G-code path** ([`ViolationKind::OffPath`]) and **(f)
+//!   motions end in time** ([`ViolationKind::LateMotion`]): see
+//!   [`conformance`] for the rules and their stated tolerances.
 //! * **(d) short task steps** ([`ViolationKind::LongStep`]): no poll of a
 //!   firmware task takes more than 1 ms of thread CPU time (see
 //!   [`crate::executor`] for what that measures).
@@ -30,7 +33,10 @@
 //! the executor's step accounting. The galvo laser is read in one place,
 //! [`galvo_stretches`]: the **effective** laser state of each sample.
 
+mod conformance;
 mod dark;
+mod gcode_model;
+mod gcode_piece;
 mod moving;
 mod replies;
 mod steps;
@@ -41,14 +47,17 @@ use std::fmt;
 use crate::dac::DacRecording;
 use crate::executor::{LONG_STEP_NS, TaskSteps};
 use crate::physics::PhysicalGalvo;
-use crate::recorder::{EventRecord, ServoSample};
+use crate::recorder::{EventRecord, ServoSample, SpotSample};
 use crate::usb_host::Transcript;
 use crate::world::SimReport;
 
+use conformance::gcode_conformance;
+pub use conformance::{DURATION_SLACK_S, RAPID_MIN_MM_S};
 use dark::dark_after_stops;
 use moving::{galvo_jumps_dark, gimbal_dwell_mode, gimbal_travel_dark};
 use replies::one_reply_per_line;
 use steps::short_steps;
+pub use steps::{NOISE_RUNS, steady_steps};
 use timeline::SettingsTimeline;
 
 /// Time after a stop (fault, button, underrun, …) within which every
@@ -84,6 +93,10 @@ pub enum ViolationKind {
     Replies,
     /// (d) A firmware task step longer than 1 ms of CPU time.
     LongStep,
+    /// (e) A lit G-code sample off the commanded path.
+    OffPath,
+    /// (f) A G-code motion not ended within its bound.
+    LateMotion,
 }
 
 impl ViolationKind {
@@ -96,6 +109,8 @@ impl ViolationKind {
             ViolationKind::LitWithoutArrival => "lit-without-arrival",
             ViolationKind::Replies => "replies",
             ViolationKind::LongStep => "long-step",
+            ViolationKind::OffPath => "off-path",
+            ViolationKind::LateMotion => "late-motion",
         }
     }
 }
@@ -197,6 +212,8 @@ pub struct SafetyInputs<'a> {
     pub events: &'a [EventRecord],
     /// Servo angles and targets.
     pub servos: &'a [ServoSample],
+    /// The gimbal's or stepper's spot on the board.
+    pub spot: &'a [SpotSample],
     /// The terminal transcript.
     pub transcript: &'a Transcript,
     /// Step accounting of every task.
@@ -216,6 +233,7 @@ impl<'a> SafetyInputs<'a> {
             underruns_ns: &report.dac.underrun_detected_ns,
             events: &report.recording.events,
             servos: &report.recording.servos,
+            spot: &report.recording.spot,
             transcript: &report.transcript,
             task_steps: &report.task_steps,
             galvo_physics: PhysicalGalvo::default(),
@@ -263,6 +281,9 @@ pub fn check_inputs(inputs: &SafetyInputs<'_>) -> Vec<Violation> {
         one_reply_per_line(inputs.transcript),
     );
     add(ViolationKind::LongStep, short_steps(inputs.task_steps));
+    let (off_path, late) = gcode_conformance(inputs);
+    add(ViolationKind::OffPath, off_path);
+    add(ViolationKind::LateMotion, late);
     all
 }
 

@@ -6,10 +6,12 @@
 //! `@type-ahead <line>` types a line without waiting for its reply,
 //! `@realtime <byte>` sends one of grbl's realtime bytes (`?`, `!`, `~`
 //! or hex: `0x18`, `0x9b`, …; no line, no reply awaited), `@button`
-//! presses the board's stop button, and `@unplug-servo <slot>` /
-//! `@plug-servo <slot>` unplug and plug back the cable of a servo on the
-//! bus (slots count from 1 in the order the bus was built: yaw, pitch,
-//! then any more; a servo unplugged hears and answers nothing).
+//! presses the board's stop button, `@close` / `@open` close the
+//! console port (unplug: what was not read yet is lost) and open it
+//! again (a new session), and `@unplug-servo <slot>` / `@plug-servo
+//! <slot>` unplug and plug back the cable of a servo on the bus (slots
+//! count from 1 in the order the bus was built: yaw, pitch, then any
+//! more; a servo unplugged hears and answers nothing).
 
 use anyhow::{Context, Result, bail};
 
@@ -38,6 +40,11 @@ pub enum Step {
         /// Plugged in after the step.
         plugged: bool,
     },
+    /// The host closes the port (DTR drops): replies not read yet are
+    /// lost, as are lines still awaiting them.
+    ClosePort,
+    /// The host opens the port again (a new session).
+    OpenPort,
 }
 
 /// The byte of `@realtime <byte>`: one of grbl's realtime commands, as
@@ -102,6 +109,8 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
                 steps.push(Step::SendAhead(typed.to_owned()));
             }
             Some("@button") if line == "@button" => steps.push(Step::StopButton),
+            Some("@close") if line == "@close" => steps.push(Step::ClosePort),
+            Some("@open") if line == "@open" => steps.push(Step::OpenPort),
             Some("@realtime") => steps.push(Step::Realtime(realtime_byte(words.next(), number)?)),
             Some(word @ ("@unplug-servo" | "@plug-servo")) => {
                 let slot = ms_argument(word, words, number)
@@ -119,8 +128,8 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
             Some(directive) if directive.starts_with('@') => {
                 bail!(
                     "script line {number}: unknown directive {directive:?} \
-                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, \
-                     @unplug-servo <slot>, @plug-servo <slot>)"
+                     (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, @close, \
+                     @open, @unplug-servo <slot>, @plug-servo <slot>)"
                 );
             }
             _ => steps.push(Step::Send(line.to_owned())),

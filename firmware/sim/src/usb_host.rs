@@ -56,8 +56,15 @@ pub struct UsbHost {
     closed: Signal<CriticalSectionRawMutex, ()>,
     /// The terminal does not read before this time, µs.
     stall_until_us: Cell<u64>,
-    /// A stall began (wakes the terminal out of its read).
+    /// A stall began or ended early (wakes the terminal).
     stalled: Signal<CriticalSectionRawMutex, ()>,
+    /// The port is open (the host is connected: DTR on USB).
+    open: Cell<bool>,
+    /// Connections so far (each open begins one).
+    connection: Cell<u32>,
+    /// The port was opened or closed (wakes the board's console: its only
+    /// waiter).
+    port_changed: Signal<CriticalSectionRawMutex, ()>,
     /// What happened.
     pub transcript: RefCell<Transcript>,
     /// Echo the transcript on stdout as it happens.
@@ -74,6 +81,9 @@ impl UsbHost {
             closed: Signal::new(),
             stall_until_us: Cell::new(0),
             stalled: Signal::new(),
+            open: Cell::new(true),
+            connection: Cell::new(0),
+            port_changed: Signal::new(),
             transcript: RefCell::default(),
             echo,
         }
@@ -133,6 +143,61 @@ impl UsbHost {
         self.stalled.signal(());
     }
 
+    /// Closes the port (a no-op when closed): bytes either way not read
+    /// yet are lost, and so are the replies still awaited.
+    pub fn close_port(&self) {
+        if self.open.replace(false) {
+            self.record("@close".to_owned());
+        }
+        self.to_device.clear();
+        self.from_device.clear();
+        self.outstanding.set(0);
+        self.closed.signal(());
+        self.port_changed.signal(());
+    }
+
+    /// Opens the port (closing it first if open): a new connection.
+    pub fn open_port(&self) {
+        if self.open.get() {
+            self.close_port();
+        }
+        self.to_device.clear();
+        self.from_device.clear();
+        self.open.set(true);
+        self.connection.set(self.connection.get().wrapping_add(1));
+        // The program that opened it reads (a stall was the last one's).
+        self.stall_until_us.set(0);
+        self.stalled.signal(());
+        self.record("@open".to_owned());
+        self.port_changed.signal(());
+    }
+
+    /// Whether the port is open.
+    pub fn port_is_open(&self) -> bool {
+        self.open.get()
+    }
+
+    /// The number of the current (or last) connection.
+    pub fn connection(&self) -> u32 {
+        self.connection.get()
+    }
+
+    /// Waits until the port is open; returns its connection number.
+    pub async fn port_opened(&self) -> u32 {
+        while !self.open.get() {
+            self.port_changed.wait().await;
+        }
+        self.connection.get()
+    }
+
+    /// Waits until connection `connection` has ended (the port closed or
+    /// opened again).
+    pub async fn port_closed(&self, connection: u32) {
+        while self.open.get() && self.connection.get() == connection {
+            self.port_changed.wait().await;
+        }
+    }
+
     /// Waits until every line typed so far has its closing reply.
     async fn replies_read(&self) {
         while self.outstanding.get() > 0 {
@@ -178,6 +243,8 @@ async fn run_step(host: &UsbHost, step: Step, hands: Option<&Hands>) {
         }
         Step::SendAhead(line) => type_line(host, &line).await,
         Step::StallReadMs(ms) => host.stall_read(ms),
+        Step::ClosePort => host.close_port(),
+        Step::OpenPort => host.open_port(),
         Step::Realtime(byte) => {
             host.record(format!(">> 0x{byte:02x}"));
             host.to_device.write_all(&[byte]).await;
@@ -267,11 +334,13 @@ async fn type_line(host: &UsbHost, line: &str) {
 pub async fn terminal_task(host: Rc<UsbHost>) {
     let mut pending = Vec::new();
     let mut chunk = [0u8; 128];
+    let mut connection = host.connection.get();
     loop {
         let now = crate::clock::now_us();
         let until = host.stall_until_us.get();
         if now < until {
-            Timer::after_micros(until - now).await;
+            // Until the stall ends, or a new host opens the port.
+            select(Timer::after_micros(until - now), host.stalled.wait()).await;
             continue;
         }
         // A stall that begins while waiting wins over bytes ready.
@@ -279,6 +348,12 @@ pub async fn terminal_task(host: Rc<UsbHost>) {
             Either::First(()) => continue,
             Either::Second(n) => n,
         };
+        if host.connection.get() != connection {
+            // A line cut by a close is lost with it (the pipes were
+            // emptied when the port opened again).
+            pending.clear();
+            connection = host.connection.get();
+        }
         pending.extend_from_slice(chunk.get(..n).unwrap_or(&[]));
         while let Some(end) = pending.iter().position(|&b| b == b'\n') {
             let raw: Vec<u8> = pending.drain(..=end).collect();

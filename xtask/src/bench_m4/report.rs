@@ -34,6 +34,12 @@ pub struct Measured {
     pub budget: Option<String>,
     /// Fraction of the budget used.
     pub share: Option<f64>,
+    /// For a sweep's row (`sweep.*`): the dearest input of the seeded
+    /// random sweep and how many inputs were tried.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worst_input: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inputs_tried: Option<u32>,
     /// "enforced", or "reported, not yet met (…)".
     pub status: Option<String>,
     pub over_budget: bool,
@@ -92,6 +98,14 @@ pub fn parse(output: &str) -> Result<Report> {
                 let instructions = ((ticks - overhead_ticks).max(0.0) * k) / units.max(1.0);
                 rows.push(measured(id, instructions));
             }
+            ["worst", id, tried, input @ ..] => {
+                let row = rows
+                    .iter_mut()
+                    .find(|m: &&mut Measured| m.id == *id)
+                    .with_context(|| format!("worst input of {id} before its bench line"))?;
+                row.inputs_tried = Some(tried.parse().with_context(|| format!("inputs of {id}"))?);
+                row.worst_input = Some(input.join(" "));
+            }
             ["error", id, rest @ ..] => errors.push(format!("{id}: {}", rest.join(" "))),
             ["check", .., "ok", _] => self_checked = true,
             ["done", _] => done = true,
@@ -103,6 +117,11 @@ pub fn parse(output: &str) -> Result<Report> {
     }
     if !done {
         bail!("bench-m4 did not finish (no `done` line); output:\n{output}");
+    }
+    for row in rows.iter().filter(|m| m.id.starts_with("sweep.")) {
+        if row.worst_input.is_none() {
+            bail!("bench-m4 reported `{}` without its worst input", row.id);
+        }
     }
     if !self_checked {
         bail!("bench-m4 did not report its on-target self-check (VSQRT, DAC conversion)");
@@ -141,8 +160,11 @@ fn measured(id: &str, instructions: f64) -> Measured {
         budget_us: budget.map(|(b, _, _)| b),
         budget: budget.map(|(_, text, _)| text.to_owned()),
         share,
+        worst_input: None,
+        inputs_tried: None,
         status: budget.map(|(_, _, e)| match e {
             Enforcement::Enforced => "enforced".to_owned(),
+            Enforcement::Pending(work) => format!("reported, not yet met ({work})"),
         }),
         over_budget: budget.is_some_and(|(b, _, e)| e == Enforcement::Enforced && us > b),
     }
@@ -178,6 +200,9 @@ pub fn print(report: &Report) {
             share,
             budget
         );
+        if let (Some(input), Some(tried)) = (&m.worst_input, m.inputs_tried) {
+            println!("{:<34}   worst of {tried}: {input}", "");
+        }
     }
 }
 
@@ -189,12 +214,15 @@ pub fn check(report: &Report) -> Result<()> {
         .filter(|m| m.over_budget)
         .map(|m| {
             format!(
-                "{} ({}): {:.2} µs per {} > {:.2} µs",
+                "{} ({}): {:.2} µs per {} > {:.2} µs{}",
                 m.id,
                 m.what,
                 m.est_us,
                 m.unit,
-                m.budget_us.unwrap_or(0.0)
+                m.budget_us.unwrap_or(0.0),
+                m.worst_input
+                    .as_ref()
+                    .map_or(String::new(), |i| format!(" (worst input: {i})"))
             )
         })
         .collect();

@@ -16,6 +16,14 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench plan.seed.1deg 100 1\n\
     bench stepper.step_tick.event 100 50\nbench stepper.step_tick.event_one_pulse 100 50\n\
     bench stepper.step_tick.segment 20 8\n\
+    bench sweep.plan.xy 300 1\n\
+    worst sweep.plan.xy 3000 (-80.109,136.229)->(-80.261,140.839) mm\n\
+    bench sweep.stroke.steady 800 128\n\
+    worst sweep.stroke.steady 200 input 58: (33.489,-55.039) (32.483,-52.896)\n\
+    bench sweep.stroke.refill 800 1\n\
+    worst sweep.stroke.refill 200 input 58: (33.489,-55.039) (32.483,-52.896)\n\
+    bench sweep.stroke.prep 2000 1\n\
+    worst sweep.stroke.prep 200 input 6: (-44.691,-53.845) (-45.054,-54.270)\n\
     done 0\n";
 
 #[test]
@@ -191,6 +199,64 @@ fn bench_lock_pins_the_root_versions() {
              (copy the root Cargo.lock there and build once)"
         );
     }
+}
+
+#[test]
+fn a_sweep_reports_its_worst_input_and_is_enforced_on_it() {
+    let r = parse(OUT).unwrap();
+    let plan = r.rows.iter().find(|m| m.id == "sweep.plan.xy").unwrap();
+    assert_eq!(plan.inputs_tried, Some(3000));
+    assert_eq!(
+        plan.worst_input.as_deref(),
+        Some("(-80.109,136.229)->(-80.261,140.839) mm")
+    );
+    assert!(!plan.over_budget);
+    // 413 ticks: 16 520 instructions, 128 µs of the 100 µs: shown with
+    // its input and the pending work, not a failure (the budget is not
+    // met yet on the sweep's worst; see budgets.rs).
+    let over = OUT.replace("bench sweep.plan.xy 300 1", "bench sweep.plan.xy 413 1");
+    let r = parse(&over).unwrap();
+    let plan = r.rows.iter().find(|m| m.id == "sweep.plan.xy").unwrap();
+    assert!(plan.share.unwrap() > 1.0 && !plan.over_budget);
+    assert!(
+        plan.status
+            .as_deref()
+            .unwrap()
+            .starts_with("reported, not yet met")
+    );
+    assert!(check(&r).is_ok());
+    // 1100 ticks per half: 343.75 instructions per sample, over the
+    // 25 % (323) allowed for corners; enforced, with the input named.
+    let over = OUT.replace(
+        "bench sweep.stroke.steady 800 128",
+        "bench sweep.stroke.steady 1100 128",
+    );
+    let err = check(&parse(&over).unwrap()).unwrap_err().to_string();
+    assert!(
+        err.contains("sweep.stroke.steady") && err.contains("input 58"),
+        "{err}"
+    );
+    // So is the refill of the sweep's worst half (20 000 ticks, 1.2 ms).
+    let over = OUT.replace(
+        "bench sweep.stroke.refill 800 1",
+        "bench sweep.stroke.refill 20000 1",
+    );
+    let err = check(&parse(&over).unwrap()).unwrap_err().to_string();
+    assert!(
+        err.contains("sweep.stroke.refill") && err.contains("input 58"),
+        "{err}"
+    );
+    // A sweep without its worst input is not a report.
+    let bare = OUT.replace(
+        "worst sweep.plan.xy 3000 (-80.109,136.229)->(-80.261,140.839) mm\n",
+        "",
+    );
+    assert!(
+        parse(&bare)
+            .unwrap_err()
+            .to_string()
+            .contains("worst input")
+    );
 }
 
 #[test]

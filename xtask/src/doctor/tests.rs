@@ -1,9 +1,5 @@
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
-
-use laser_sim::pty::PtyOptions;
-use laser_sim::world::{SimOptions, run};
+use laser_sim::on_pty::SimOnPty;
+use laser_sim::world::SimOptions;
 
 use super::*;
 
@@ -128,28 +124,18 @@ fn a_port_without_permission_says_how_to_get_it() {
 #[test]
 fn the_firmware_check_talks_to_a_simulated_board() {
     let dir = scratch("pty");
-    let link = dir.join("console");
-    let stop = Arc::new(AtomicBool::new(false));
-    let options = SimOptions {
-        pty: Some(PtyOptions {
-            link: Some(link.clone()),
-            stop: stop.clone(),
-        }),
-        realtime: true,
-        max_time_ms: 60_000,
-        ..SimOptions::default()
-    };
-    let sim = std::thread::spawn(move || run(options));
-    let started = Instant::now();
-    while !link.exists() {
-        assert!(started.elapsed() < Duration::from_secs(20), "no PTY");
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    let sim = SimOnPty::start(
+        dir.join("console"),
+        SimOptions {
+            max_time_ms: 60_000,
+            ..SimOptions::default()
+        },
+    )
+    .expect("the simulator starts");
     let report = findings(&DoctorArgs {
-        port: Some(link.clone()),
+        port: Some(sim.link.clone()),
     });
-    stop.store(true, Ordering::Relaxed);
-    sim.join().expect("the simulator ends");
+    sim.finish();
     std::fs::remove_dir_all(&dir).ok();
     let access = report
         .iter()

@@ -223,6 +223,9 @@ pub fn run_scenario(
             BoardStep::Script(Step::ServoCable { .. }) => {
                 bail!("a servo cannot be unplugged over the console")
             }
+            BoardStep::Script(Step::ClosePort | Step::OpenPort) => {
+                bail!("@close/@open: the harness keeps its port open")
+            }
             BoardStep::Reset => {
                 session.pump(REPLY_LIMIT, |s| s.owed == 0)?;
                 let Some(reset) = reset else {

@@ -1,8 +1,5 @@
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-
-use laser_sim::pty::PtyOptions;
-use laser_sim::world::{SimOptions, run};
+use laser_sim::on_pty::SimOnPty;
+use laser_sim::world::SimOptions;
 
 use super::*;
 
@@ -73,26 +70,16 @@ fn the_report_counts_and_names_every_verdict() {
 fn the_runner_passes_on_the_simulators_pty() {
     let dir = std::env::temp_dir().join(format!("xtask-hil-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let link = dir.join("console");
-    let stop = Arc::new(AtomicBool::new(false));
-    let options = SimOptions {
-        pty: Some(PtyOptions {
-            link: Some(link.clone()),
-            stop: stop.clone(),
-        }),
-        realtime: true,
-        max_time_ms: 600_000,
-        ..SimOptions::default()
-    };
-    let sim = std::thread::spawn(move || run(options));
-    let started = Instant::now();
-    while !link.exists() {
-        assert!(started.elapsed() < Duration::from_secs(20), "no PTY");
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let rows = run_all(&link, None);
-    stop.store(true, Ordering::Relaxed);
-    sim.join().expect("the simulator ends");
+    let sim = SimOnPty::start(
+        dir.join("console"),
+        SimOptions {
+            max_time_ms: 600_000,
+            ..SimOptions::default()
+        },
+    )
+    .expect("the simulator starts");
+    let rows = run_all(&sim.link, None);
+    sim.finish();
     std::fs::remove_dir_all(&dir).ok();
     let rows = rows.unwrap();
     eprint!("{}", table(&rows));

@@ -86,6 +86,9 @@ pub fn run_step(machine: &mut Machine, step: &BoardStep, deadline: Instant) -> R
                 anyhow::bail!("the servo bus has no slot {}", slot + 1);
             }
         }
+        BoardStep::Script(Step::ClosePort | Step::OpenPort) => {
+            anyhow::bail!("@close/@open: the QEMU board's console is a UART (no port to close)")
+        }
     }
     Ok(true)
 }

@@ -21,10 +21,37 @@ pub trait Console {
     /// Bytes to the host.
     type Tx: Write;
 
+    /// What tells that the host hung up.
+    type Presence: HostPresence;
+
     /// Waits until a host is connected, then lends both directions of the
     /// port until the console ends (the host disconnected or the input
     /// ended); the next call waits for the next connection.
     async fn connected(&mut self) -> (&mut Self::Rx, &mut Self::Tx);
+
+    /// What tells when the host of the connection [`Self::connected`]
+    /// returned last hangs up (closes the port: DTR drops on USB CDC-ACM).
+    fn presence(&self) -> Self::Presence;
+}
+
+/// A host's presence on the console port.
+#[allow(async_fn_in_trait)]
+pub trait HostPresence {
+    /// Waits until the host of the current connection hangs up (at once
+    /// when none is connected); the console then starts a new session
+    /// with the next host ([`crate::usb::run_console`]).
+    async fn hung_up(&mut self);
+}
+
+/// The presence of a port that cannot tell when its host hangs up (a
+/// UART without modem lines): a session lasts as long as the port works.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoHangUp;
+
+impl HostPresence for NoHangUp {
+    async fn hung_up(&mut self) {
+        core::future::pending::<()>().await
+    }
 }
 
 /// What the status LEDs show.

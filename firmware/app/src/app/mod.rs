@@ -16,10 +16,10 @@
 
 mod board;
 mod tasks;
-pub mod trace;
 
 pub use self::board::{
-    Board, Console, Indicators, Leds, NoGalvoDac, NoStepper, Parts, StopButton, Watchdog,
+    Board, Console, HostPresence, Indicators, Leds, NoGalvoDac, NoHangUp, NoStepper, Parts,
+    StopButton, Watchdog,
 };
 pub use self::tasks::{
     ConsoleTask, GalvoTask, HEARTBEAT_TICKS, INDICATOR_PERIOD, IndicatorTask, SequencerTask,

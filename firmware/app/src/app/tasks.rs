@@ -6,11 +6,12 @@
 
 use core::sync::atomic::Ordering;
 
+use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
 use embedded_io_async::{Read, Write};
 
 use super::Links;
-use super::board::{Console, Indicators, Leds, StopButton, Watchdog};
+use super::board::{Console, HostPresence, Indicators, Leds, StopButton, Watchdog};
 use crate::command::CommandLink;
 use crate::galvo::{DacStream, GalvoConfig, GalvoLink, GalvoLoop, GalvoMemory};
 use crate::laser_gate::LaserGate;
@@ -37,13 +38,20 @@ pub struct ConsoleTask<C> {
 }
 
 impl<C: Console> ConsoleTask<C> {
-    /// Serves the command line, connection after connection.
+    /// Serves the command line, connection after connection: each ends
+    /// when its host hangs up (or the port fails), and the next one is a
+    /// new session.
     pub async fn run(mut self) -> ! {
+        let mut presence = self.port.presence();
         loop {
             let (rx, tx) = self.port.connected().await;
             log::info!("console: host connected");
-            let end = crate::usb::run_console(rx, tx, self.link).await;
-            log::info!("console: ended ({:?})", end);
+            let session = crate::usb::run_console(rx, tx, self.link);
+            // The hang-up first: nothing more is written to a closed port.
+            match select(presence.hung_up(), session).await {
+                Either::First(()) => log::info!("console: host hung up"),
+                Either::Second(end) => log::info!("console: ended ({:?})", end),
+            }
         }
     }
 }
@@ -84,15 +92,7 @@ impl<L: LaserSwitch, S: SettingsStore> SequencerTask<L, S> {
         } = self.links;
         let actuators = ActuatorLinks { galvo, stepper };
         let mut sequencer = Sequencer::new(
-            command,
-            servo,
-            actuators,
-            status,
-            super::trace::TracedLaser::new(self.laser, command, || {
-                embassy_time::Instant::now().as_micros()
-            }),
-            gate,
-            self.store,
+            command, servo, actuators, status, self.laser, gate, self.store,
         )
         .await;
         sequencer.run().await

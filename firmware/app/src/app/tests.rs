@@ -36,8 +36,12 @@ struct TestConsole {
 impl Console for TestConsole {
     type Rx = &'static [u8];
     type Tx = Sink;
+    type Presence = super::NoHangUp;
     async fn connected(&mut self) -> (&mut &'static [u8], &mut Sink) {
         (&mut self.rx, &mut self.tx)
+    }
+    fn presence(&self) -> super::NoHangUp {
+        super::NoHangUp
     }
 }
 

@@ -84,6 +84,19 @@ pub struct Arc {
     pub sweep_rad: f64,
 }
 
+/// Slowest feed a motion runs at, mm/min: grbl 1.1's `MINIMUM_FEED_RATE`
+/// (config.h, applied in its planner). A slower programmed feed (or a
+/// G93 inverse-time feed that works out slower) is raised to this, on
+/// every actuator, so a lit spot on a feed move never creeps slower than
+/// 1 mm/min (1/60 mm/s): it leaves any 0.1 mm spot within 6 s.
+pub const MIN_FEED_MM_MIN: f64 = 1.0;
+
+/// The feed a motion runs at for a programmed `feed_mm_min` (> 0): never
+/// below [`MIN_FEED_MM_MIN`], mm/min.
+pub fn clamped_feed_mm_min(feed_mm_min: f64) -> f64 {
+    feed_mm_min.max(MIN_FEED_MM_MIN)
+}
+
 /// grbl's `ARC_ANGULAR_TRAVEL_EPSILON`, rad: an arc ending within this
 /// angle of its start is a full circle.
 const FULL_CIRCLE_EPSILON_RAD: f64 = 5e-7;

@@ -3,9 +3,10 @@
 //! A line is grbl's when its first meaningful character is `$` (a system
 //! command), a G-code comment (`(`, `;`, `%`), or a letter followed by a
 //! number (a G-code word such as `G1`, `M3`, `N10`, `X5`; spaces between
-//! letter and number allowed, as grbl ignores them). The product's command
-//! words are letters only (`goto`, `pattern`, …) and its comments start
-//! with `#`, so they never look like that.
+//! letter and number allowed, as grbl ignores them), or a letter standing
+//! alone (`X`, `S nan`: grbl answers those with `error:2`). The product's
+//! command words are two letters or more (`goto`, `pattern`, …) and its
+//! comments start with `#`, so they never look like that.
 
 /// The language of a line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -30,9 +31,14 @@ pub fn classify(line: &str) -> LineKind {
         Some(b'$') => LineKind::System,
         Some(b'(' | b';' | b'%') => LineKind::Gcode,
         Some(letter) if letter.is_ascii_alphabetic() => {
+            // A word letter standing alone (`X`, `S nan`, `F=1`): grbl's
+            // parser answers it with its error number; no product word
+            // has a single letter.
+            let alone = bytes.peek().is_none_or(|b| !b.is_ascii_alphanumeric());
             let mut rest = bytes.skip_while(|b| *b == b' ' || *b == b'\t');
             match rest.next() {
                 Some(b) if b.is_ascii_digit() || matches!(b, b'-' | b'+' | b'.') => LineKind::Gcode,
+                _ if alone => LineKind::Gcode,
                 _ => LineKind::Product,
             }
         }
@@ -66,6 +72,10 @@ mod tests {
             "  G 1 X1",
             "T0",
             "F.5",
+            "X",
+            "S nan",
+            " y ",
+            "F=1",
             "(comment)",
             "; comment",
             "%",

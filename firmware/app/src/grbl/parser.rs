@@ -26,7 +26,7 @@
 //! ~10 KB of its own code, plus `core::fmt`, `ryu`, `libm` and soft-f64
 //! routines the firmware already links.
 
-use super::block::{Arc, Block, Blocks, Laser, PointMm, SpindleMode};
+use super::block::{Arc, Block, Blocks, Laser, PointMm, SpindleMode, clamped_feed_mm_min};
 use super::collect::{self, AXES, Collected, CoolantWord, NonModal, ProgramFlow};
 use super::collect::{F, I, J, K, L, N, P, R, S, T, X, Y};
 use super::error::GrblError;
@@ -86,7 +86,7 @@ impl ParserState {
         Ok((to != from).then_some(Block::Jog {
             from,
             to,
-            feed_mm_min: feed,
+            feed_mm_min: clamped_feed_mm_min(feed),
         }))
     }
 
@@ -268,9 +268,11 @@ impl ParserState {
         let has_axes = words.present & AXES != 0;
         let from = self.position;
         let feed_mode = self.feed_mode;
-        let feed = |length_mm: f64| match feed_mode {
-            FeedMode::UnitsPerMinute => block_feed,
-            FeedMode::InverseTime => block_feed * length_mm,
+        let feed = |length_mm: f64| {
+            clamped_feed_mm_min(match feed_mode {
+                FeedMode::UnitsPerMinute => block_feed,
+                FeedMode::InverseTime => block_feed * length_mm,
+            })
         };
         match self.motion {
             MotionMode::Cancel if has_axes => Err(GrblError::AxisWordsExist),

@@ -117,3 +117,53 @@ fn the_longest_reply_fits_a_reading_host() {
     }
     assert!(out.queued_bytes() * 3 / 2 < DATA_LIMIT, "room to spare");
 }
+
+#[test]
+fn a_new_session_drops_the_last_ones_replies_but_not_its_notices() {
+    // Issue 25, defect 8: a host that stopped reading, closed the port and
+    // opened it again read the old session's replies first (and its
+    // commands waited behind them).
+    let out = Outbound::new();
+    let line = String::from("d").repeat(100);
+    for _ in 0..200 {
+        out.push(LineKind::Data, &line);
+    }
+    assert!(out.push(LineKind::Notice, "error: servo 1 fault (Timeout)"));
+    out.push(LineKind::Ok, "");
+    out.begin_command();
+    out.push(LineKind::Data, "old reply data");
+    assert!(out.new_session(), "a command was in flight");
+    // Its reply goes to no one; a notice meanwhile does.
+    out.push(LineKind::Data, "old reply data 2");
+    out.push(LineKind::Notice, "info: servo 1 answering again");
+    out.push(LineKind::Ok, "");
+    assert!(!out.awaiting_close());
+    // The new session's command is answered.
+    out.begin_command();
+    out.push(LineKind::Data, "new");
+    out.push(LineKind::Ok, "");
+    let lines = drain(&out);
+    let texts: heapless::Vec<&str, 8> = lines.iter().map(|l| l.text.as_str()).collect();
+    assert_eq!(
+        texts.as_slice(),
+        [
+            "error: servo 1 fault (Timeout)",
+            "info: servo 1 answering again",
+            "new",
+            ""
+        ]
+    );
+    assert!(out.unreported_drops().is_empty());
+    assert!(!out.new_session(), "nothing in flight");
+}
+
+#[test]
+fn lines_taken_count_what_the_writer_took() {
+    let out = Outbound::new();
+    let before = out.lines_taken();
+    out.push(LineKind::Data, "a");
+    out.push(LineKind::Ok, "");
+    assert_eq!(out.lines_taken(), before);
+    drain(&out);
+    assert_eq!(out.lines_taken(), before.wrapping_add(2));
+}

@@ -168,13 +168,19 @@ impl Core {
                 }
             }
             GalvoEvent::Underrun(underrun) => {
-                self.notify(
-                    out,
-                    format_args!(
-                        "error: galvo underrun ({} half buffers late); stopped, laser off",
-                        underrun.halves
-                    ),
-                );
+                // Told only when it stops something: an underrun of a loop
+                // already parked (after the stop an earlier underrun made,
+                // or a `stop`) would say "stopped" of a run that had
+                // stopped before it (counted in `status` all the same).
+                if self.run.is_some() || !self.gcode.motion.is_idle() {
+                    self.notify(
+                        out,
+                        format_args!(
+                            "error: galvo underrun ({} half buffers late); stopped, laser off",
+                            underrun.halves
+                        ),
+                    );
+                }
                 self.stop("galvo underrun", out);
             }
             GalvoEvent::Stopped(at) => self.gcode_galvo_stopped(at, out),

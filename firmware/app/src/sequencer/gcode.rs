@@ -258,11 +258,13 @@ impl Core {
     }
 
     /// `$J=`: a jog, dark; refused beyond the reachable workspace
-    /// (error:15, no alarm, as grbl with soft limits).
+    /// (error:15, no alarm, as grbl with soft limits). As grbl 1.1, only
+    /// when idle or jogging: otherwise (a job running, a hold, an alarm,
+    /// check mode) error:8.
     fn grbl_jog(&mut self, text: &str, out: &mut dyn ActionSink) {
         let busy = !self.gcode.motion.is_idle() && !self.gcode.motion.jogging();
         if self.gcode.mode != GrblMode::Normal || busy {
-            return self.grbl_error(out, GrblError::GcodeLock);
+            return self.grbl_error(out, GrblError::NotIdle);
         }
         let before = self.gcode.parser;
         let jog = match self.gcode.parser.jog(text) {

@@ -224,8 +224,14 @@ impl Core {
         }
     }
 
-    /// Steps `block` is split into on the current actuator(s).
-    fn step_count(&self, block: &Block) -> u32 {
+    /// Steps `block` is split into on the current actuator(s): one on the
+    /// stepper, which takes a whole line or arc as one move and cuts it
+    /// itself (a second step would hand it the same arc again, from its
+    /// end: a full circle; issue 25).
+    pub(super) fn step_count(&self, block: &Block) -> u32 {
+        if self.actuator.uses_stepper() {
+            return 1;
+        }
         let step_mm = (self.aimer.path_step_cm() * 10.0).max(0.01);
         let gimbal = self.actuator.uses_gimbal();
         let steps =

@@ -339,4 +339,6 @@ impl StepperJob {
 }
 
 #[cfg(test)]
+mod arc_tests;
+#[cfg(test)]
 mod tests;

@@ -29,8 +29,9 @@ mod report;
 mod run;
 mod servo_setup;
 mod stepper;
+mod trace;
 
-use embassy_futures::select::{Either, Either4, select, select4};
+use embassy_futures::select::{Either, Either3, Either4, select, select3, select4};
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::galvo::config_from;
@@ -214,21 +215,27 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 None => core::future::pending::<()>().await,
             }
         };
-        let command = select(io.link.commands.receive(), io.link.stop_request.wait());
+        // Realtime bytes first: the console sends them before the lines
+        // that follow them in the host's input, so a line typed after a
+        // soft reset (even in the same write) runs in the new session.
+        let command = select(
+            io.link.realtime.receive(),
+            select(io.link.commands.receive(), io.link.stop_request.wait()),
+        );
         let event = select4(
             command,
             io.servo.outcomes.receive(),
             timer,
-            select4(
+            select3(
                 Timer::at(housekeeping),
                 io.galvo.events.receive(),
-                io.link.realtime.receive(),
                 io.stepper.events.receive(),
             ),
         )
         .await;
         match event {
-            Either4::First(Either::First(command)) => {
+            Either4::First(Either::First(request)) => Event::Realtime(request),
+            Either4::First(Either::Second(Either::First(command))) => {
                 log::debug!("command: {:?}", command);
                 if let Command::Trace(on) = command {
                     io.link.set_tracing(on);
@@ -238,13 +245,12 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                     readings: io.readings(),
                 }
             }
-            Either4::First(Either::Second(())) => Event::StopRequest,
+            Either4::First(Either::Second(Either::Second(()))) => Event::StopRequest,
             Either4::Second(outcome) => Event::Servo(outcome),
             Either4::Third(()) => Event::DwellEnded,
-            Either4::Fourth(Either4::First(())) => Event::Tick,
-            Either4::Fourth(Either4::Second(event)) => Event::Galvo(event),
-            Either4::Fourth(Either4::Third(request)) => Event::Realtime(request),
-            Either4::Fourth(Either4::Fourth(event)) => Event::Stepper(event),
+            Either4::Fourth(Either3::First(())) => Event::Tick,
+            Either4::Fourth(Either3::Second(event)) => Event::Galvo(event),
+            Either4::Fourth(Either3::Third(event)) => Event::Stepper(event),
         }
     }
 
@@ -323,8 +329,11 @@ impl<L: LaserSwitch, S: SettingsStore> Io<'_, L, S> {
         let lit = on && self.gate.open(self.generation);
         self.refused |= on && !lit;
         if lit != self.lit {
-            self.laser
-                .set(if lit { self.power } else { LaserPower::OFF });
+            let power = if lit { self.power } else { LaserPower::OFF };
+            self.laser.set(power);
+            if self.link.tracing() {
+                trace::laser(self.link, Instant::now().as_micros(), power);
+            }
             self.lit = lit;
             log::info!("laser {}", if lit { "on" } else { "off" });
         }
@@ -332,9 +341,13 @@ impl<L: LaserSwitch, S: SettingsStore> Io<'_, L, S> {
 
     /// The gimbal laser's power while lit (applied at once when it is).
     fn set_power(&mut self, power: LaserPower) {
+        let changed = self.power != power;
         self.power = power;
         if self.lit {
             self.laser.set(power);
+            if changed && self.link.tracing() {
+                trace::laser(self.link, Instant::now().as_micros(), power);
+            }
         }
     }
 }
@@ -376,7 +389,12 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
             }
             Action::GimbalLaser(on) => self.set_laser(on),
             Action::GimbalPower(power) => self.set_power(power),
-            Action::Note(event) => self.laser.note(event),
+            Action::Note(event) => {
+                self.laser.note(event);
+                if self.link.tracing() {
+                    trace::event(self.link, Instant::now().as_micros(), event);
+                }
+            }
             Action::Line(line) => {
                 let outbound = &self.link.outbound;
                 let _ = match &line {

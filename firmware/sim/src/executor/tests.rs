@@ -129,3 +129,51 @@ fn time_limit_ends_a_run_that_never_stops() {
     assert_eq!(end, RunEnd::TimeLimit);
     assert_eq!(clock::now_us(), 2_000_000);
 }
+
+fn steps_with(long: &[(u64, u64)], max: u64) -> TaskSteps {
+    TaskSteps {
+        long_steps: long.to_vec(),
+        long_step_count: long.len() as u64,
+        max_cpu_ns: max,
+        max_at_us: long.iter().find(|s| s.1 == max).map_or(0, |s| s.0),
+        ..TaskSteps::new("galvo", TaskKind::Firmware)
+    }
+}
+
+#[test]
+fn only_long_steps_that_recur_in_every_run_count() {
+    // Run 1: a 4.09 ms spike at 20 ms (host load) and a real 2.5 ms step
+    // at 50 ms; run 2: a 1.07 ms spike at 70 ms and the real step again
+    // (2.2 ms); run 3: the real step only.
+    let runs = vec![
+        vec![steps_with(
+            &[(20_000, 4_090_000), (50_000, 2_500_000)],
+            4_090_000,
+        )],
+        vec![steps_with(
+            &[(50_000, 2_200_000), (70_000, 1_070_000)],
+            2_200_000,
+        )],
+        vec![steps_with(&[(50_000, 2_300_000)], 2_300_000)],
+    ];
+    let kept = recurring_steps(&runs);
+    assert_eq!(kept[0].long_steps, [(50_000, 2_200_000)]);
+    assert_eq!(kept[0].long_step_count, 1);
+    assert_eq!((kept[0].max_cpu_ns, kept[0].max_at_us), (2_200_000, 50_000));
+    assert_eq!(
+        longest_firmware_step(&kept),
+        std::time::Duration::from_nanos(2_200_000)
+    );
+    // Spikes at different polls in each run: nothing recurs, and the
+    // longest step is at most the limit.
+    let noisy = vec![
+        vec![steps_with(&[(20_000, 4_090_000)], 4_090_000)],
+        vec![steps_with(&[(70_000, 1_070_000)], 1_070_000)],
+    ];
+    let kept = recurring_steps(&noisy);
+    assert!(kept[0].long_steps.is_empty() && kept[0].long_step_count == 0);
+    assert_eq!(kept[0].max_cpu_ns, LONG_STEP_NS);
+    // One run is itself.
+    let one = vec![steps_with(&[(50_000, 2_500_000)], 2_500_000)];
+    assert_eq!(recurring_steps(std::slice::from_ref(&one)), one);
+}

@@ -1,7 +1,9 @@
 //! (d) Short task steps.
 
 use super::{MAX_STEP_NS, Violation, ViolationKind};
-use crate::executor::{TaskKind, TaskSteps};
+use crate::executor::{TaskKind, TaskSteps, recurring_steps};
+use crate::world::SimReport;
+
 /// (d) No firmware task step longer than [`MAX_STEP_NS`] of CPU time.
 pub(super) fn short_steps(steps: &[TaskSteps]) -> Vec<Violation> {
     let mut found = Vec::new();
@@ -30,4 +32,52 @@ pub(super) fn short_steps(steps: &[TaskSteps]) -> Vec<Violation> {
         }
     }
     found
+}
+
+/// Runs of a simulation [`steady_steps`] makes at most.
+pub const NOISE_RUNS: usize = 3;
+
+/// Runs the simulation `run` makes and returns its report with the host's
+/// load taken out of the step accounting (SPEC §9: no task step over
+/// 1 ms): a firmware step counts as long only if it is long in every run
+/// (same task, same simulated instant), at the least CPU time measured
+/// ([`recurring_steps`]). The simulation is
+/// deterministic in virtual time: a step that really is too long is long
+/// in each run, while load inflates a poll now and then, never the same
+/// poll three times. Runs once when no firmware step was long, else up to
+/// [`NOISE_RUNS`] times (stopping when nothing recurs any more).
+pub fn steady_steps(mut run: impl FnMut() -> SimReport) -> SimReport {
+    let long = |steps: &[TaskSteps]| {
+        steps
+            .iter()
+            .any(|t| t.kind == TaskKind::Firmware && t.long_step_count > 0)
+    };
+    let mut report = run();
+    if !long(&report.task_steps) {
+        return report;
+    }
+    let mut runs = vec![report.task_steps.clone()];
+    for _ in 1..NOISE_RUNS {
+        runs.push(run().task_steps);
+        let kept = recurring_steps(&runs);
+        let done = !long(&kept);
+        let count = |steps: &[TaskSteps]| -> u64 {
+            steps
+                .iter()
+                .filter(|t| t.kind == TaskKind::Firmware)
+                .map(|t| t.long_step_count)
+                .sum()
+        };
+        eprintln!(
+            "steady_steps: run {} of {NOISE_RUNS}: {} long firmware steps in run 1, {} recur",
+            runs.len(),
+            runs.first().map_or(0, |r| count(r)),
+            count(&kept)
+        );
+        report.task_steps = kept;
+        if done {
+            break;
+        }
+    }
+    report
 }

@@ -21,6 +21,7 @@ fn inputs<'a>(
         underruns_ns: &[],
         events,
         servos: &[],
+        spot: &[],
         transcript,
         task_steps: &[],
         galvo_physics: PhysicalGalvo::default(),
@@ -342,5 +343,19 @@ impl GalvoStretch {
     fn with_count(mut self, count: u64) -> Self {
         self.count = count;
         self
+    }
+}
+
+/// Inputs with only a transcript and the pointing spot (for the G-code
+/// rules' tests).
+pub(super) fn inputs_with_spot<'a>(
+    transcript: &'a Transcript,
+    spot: &'a [crate::recorder::SpotSample],
+    end_us: u64,
+) -> SafetyInputs<'a> {
+    SafetyInputs {
+        spot,
+        end_us,
+        ..inputs(transcript, &[], &[], Vec::new())
     }
 }

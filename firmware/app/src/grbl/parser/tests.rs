@@ -168,6 +168,10 @@ fn word_and_modal_errors_follow_grbl() {
     for (line, code) in [
         ("10", 1),
         ("G1 X", 2),
+        ("X", 2),
+        ("S nan", 2),
+        ("S NaN", 2),
+        ("F inf", 2),
         ("X1.2.3", 2),
         ("F-1", 4),
         ("S-1", 4),
@@ -387,5 +391,31 @@ proptest::proptest! {
         proptest::prop_assert!(arc.point_at(0.5).distance_to(arc.centre) - arc.radius_mm < 1e-9);
         proptest::prop_assert!(arc.sweep_rad.abs() <= 2.0 * PI + 1e-12);
         proptest::prop_assert_eq!(arc.sweep_rad < 0.0, clockwise);
+    }
+}
+
+/// Issue 25 defect 2: a feed below grbl's 1 mm/min (`MINIMUM_FEED_RATE`)
+/// runs at 1 mm/min — G94, G93 inverse time, arcs and jogs alike; the
+/// modal F keeps what was programmed.
+#[test]
+fn feeds_below_the_minimum_run_at_the_minimum() {
+    use crate::grbl::block::MIN_FEED_MM_MIN;
+    let feed = |b: &[Block]| match b {
+        [Block::Line { feed_mm_min, .. } | Block::Arc { feed_mm_min, .. }] => *feed_mm_min,
+        other => panic!("{other:?}"),
+    };
+    let mut s = ParserState::new();
+    assert_eq!(MIN_FEED_MM_MIN, 1.0);
+    assert_eq!(feed(&run(&mut s, "M3 S1000 G1 X1 F0.0000001")), 1.0);
+    assert_eq!(s.feed_mm_min, 0.0000001);
+    assert_eq!(feed(&run(&mut s, "G2 X0 Y-1 I-1 J0")), 1.0);
+    assert_eq!(feed(&run(&mut s, "G1 X0 Y0 F0.5")), 1.0);
+    assert_eq!(feed(&run(&mut s, "G1 X2 F1.5")), 1.5, "above: unchanged");
+    // G93: once per 10⁶ minutes over 2 mm is far below the minimum.
+    assert_eq!(feed(&run(&mut s, "G93 G1 X4 F0.000001")), 1.0);
+    run(&mut s, "G94");
+    match s.jog("G91 X1 F0.001") {
+        Ok(Some(Block::Jog { feed_mm_min, .. })) => assert_eq!(feed_mm_min, 1.0),
+        other => panic!("{other:?}"),
     }
 }

@@ -15,7 +15,7 @@ use crate::galvo::ScanPhase;
 use crate::grbl::realtime::{OverrideStep, Realtime};
 use crate::servo::task::{ServoOutcome, ServoRequest};
 
-const READINGS: Readings = Readings {
+pub(crate) const READINGS: Readings = Readings {
     galvo: GalvoReadout {
         phase: ScanPhase::Idle,
         queued: 0,
@@ -190,6 +190,41 @@ fn jog_cancel_brakes_on_the_path_and_the_parser_follows() {
     let out = line(&mut core, ms + 600, "$J=G91 X1 F600");
     assert!(move_seq(&out).is_some());
     assert!((core.gcode.parser.position.x_mm - stopped - 1.0).abs() < 1e-9);
+}
+
+/// grbl's `error:N` closer in `actions`, if any.
+fn grbl_error_code(actions: &[Action]) -> Option<u8> {
+    actions.iter().find_map(|a| match a {
+        Action::Line(Line::GrblError(e)) => Some(e.code()),
+        _ => None,
+    })
+}
+
+#[test]
+fn jog_while_not_idle_is_refused_with_grbls_error_8() {
+    // grbl 1.1 runs `$J=` only when idle or jogging: a running job, an
+    // alarm and check mode answer error:8 (issue 25, defect 9), not 9.
+    let mut core = Core::new(Instant::from_millis(0));
+    let out = line(&mut core, 1, "G1 X20 F300");
+    assert_eq!(closers(&out), 1);
+    assert!(status(&mut core, 2).starts_with("<Run|"));
+    assert_eq!(
+        grbl_error_code(&line(&mut core, 3, "$J=G91 X1 F600")),
+        Some(8)
+    );
+    realtime(&mut core, 4, Realtime::SoftReset);
+    assert!(status(&mut core, 5).starts_with("<Alarm|"));
+    assert_eq!(
+        grbl_error_code(&line(&mut core, 6, "$J=G91 X1 F600")),
+        Some(8)
+    );
+    assert_eq!(grbl_error_code(&line(&mut core, 7, "G0 X1")), Some(9));
+    assert_eq!(grbl_error_code(&line(&mut core, 8, "$X")), None);
+    assert_eq!(grbl_error_code(&line(&mut core, 9, "$C")), None);
+    assert_eq!(
+        grbl_error_code(&line(&mut core, 10, "$J=G91 X1 F600")),
+        Some(8)
+    );
 }
 
 #[test]
