@@ -4,10 +4,8 @@
 //! works. `servo zero` makes the servo's angle the axis's zero, which
 //! `goto` then aims with.
 
-use fashionstar::{Request, RequestDecoder};
-use laser_sim::recorder::Direction;
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::run_with;
+use system_tests::{commanded_at, run_with};
 
 /// The console lines (commands as `> …`, replies, notices) as text.
 fn transcript(report: &SimReport) -> Vec<String> {
@@ -41,29 +39,6 @@ fn reply_of(lines: &[String], command: &str, nth: usize) -> Vec<String> {
         }
     }
     reply
-}
-
-/// The last set-angle target each servo id was sent before `t_us`, 0.1°.
-fn last_targets(report: &SimReport) -> Vec<(u8, i16)> {
-    let mut decoder = RequestDecoder::new();
-    let mut targets: Vec<(u8, i16)> = Vec::new();
-    for f in report
-        .recording
-        .frames
-        .iter()
-        .filter(|f| f.direction == Direction::Tx)
-    {
-        for &b in &f.bytes {
-            if let Some(Ok(Request::SyncSetAngle(entries))) = decoder.feed(b) {
-                for e in entries {
-                    targets.retain(|(id, _)| *id != e.id);
-                    targets.push((e.id, e.angle_tenths_deg));
-                }
-            }
-        }
-    }
-    targets.sort();
-    targets
 }
 
 const DUPLICATE_IDS_SCRIPT: &str = "\
@@ -171,7 +146,7 @@ fn servo_zero_sets_the_axis_zero_that_goto_aims_with() {
         .unwrap_or_else(|| panic!("{zero:?}"));
     assert!(deg.abs() > 1.0, "goto 6 0 turned the yaw servo: {deg}");
     // `goto 0 0` is joint zero: the yaw servo is sent to the new zero.
-    let yaw_target = last_targets(&report)
+    let yaw_target = commanded_at(&report, u64::MAX)
         .into_iter()
         .find(|(id, _)| *id == 0)
         .map(|(_, t)| t);
