@@ -41,8 +41,9 @@ fn the_store_reads_the_record_the_earlier_firmware_saved() {
     assert_eq!(record, V2_RECORD);
     let loaded = Settings::load_record(&record).expect("it loads");
     assert_eq!(loaded.layout, RecordLayout::Positional);
-    // The stepper's 24 parameters and `$11` came later: at their defaults.
-    assert_eq!((loaded.unknown, loaded.defaulted), (0, 25));
+    // The stepper's 24 parameters, `$11` and the PELCO port's 3 came
+    // later: at their defaults.
+    assert_eq!((loaded.unknown, loaded.defaulted), (0, 28));
 }
 
 #[test]

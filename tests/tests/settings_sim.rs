@@ -148,8 +148,9 @@ fn a_save_on_the_target_geometry_programs_a_few_hundred_words_and_rarely_erases(
     );
     // A save without an erase is a couple of milliseconds of programming.
     assert!(busiest_append_us < 3_000, "{busiest_append_us} µs");
-    // A sector takes hundreds of records before an erase is due: ≈ 190
-    // of 684 bytes (was 263 of 488 before the stepper parameters; the
-    // decision is in laser-app's settings/stepper.rs).
-    assert!(saves_before_erase > 180, "{saves_before_erase}");
+    // A sector takes hundreds of records before an erase is due: 179 of
+    // 720 bytes (≈ 190 of 692 before the PELCO port's 3 parameters, 263
+    // of 488 before the stepper's; the decision is in laser-app's
+    // settings/stepper.rs and settings/pelco.rs).
+    assert!(saves_before_erase > 170, "{saves_before_erase}");
 }

@@ -40,6 +40,12 @@ pub struct CalibArgs {
 enum CalibCommand {
     /// Fit the error model to measured points; prints JSON.
     Fit(FitArgs),
+    /// Write the printable camera target (SVG, print at 100 %).
+    Target(camera::TargetArgs),
+    /// Measure the spot in camera frames and fit the error model.
+    Camera(camera::CameraArgs),
+    /// Render the simulator's grid run as virtual-camera frames.
+    Frames(frames::FramesArgs),
 }
 
 #[derive(clap::Args, Debug)]
@@ -81,8 +87,12 @@ struct FitOut {
 
 /// Runs `calib …`.
 pub fn run(args: CalibArgs) -> anyhow::Result<ExitCode> {
-    let CalibCommand::Fit(a) = args.command;
-    Ok(emit(fit_command(&a)))
+    Ok(emit(match args.command {
+        CalibCommand::Fit(a) => fit_command(&a),
+        CalibCommand::Target(a) => camera::target_command(&a),
+        CalibCommand::Camera(a) => camera::camera_command(&a),
+        CalibCommand::Frames(a) => frames::frames_command(&a),
+    }))
 }
 
 fn fit_command(a: &FitArgs) -> Result<String, String> {
@@ -134,7 +144,7 @@ fn comment_line(text: &str) -> String {
 }
 
 /// The model as firmware command lines (see the module docs).
-fn firmware_commands(report: &FitReport, source: &Path) -> Result<String, String> {
+pub(crate) fn firmware_commands(report: &FitReport, source: &Path) -> Result<String, String> {
     let mut out = String::new();
     let comments = [
         "Error model for the laser pointing controller (SPEC 5), written by".to_owned(),
@@ -175,6 +185,9 @@ fn axis_summary(axis: &str, f: &AxisFit) -> String {
         f.sse, f.r2
     )
 }
+
+pub(crate) mod camera;
+mod frames;
 
 #[cfg(test)]
 mod tests;

@@ -6,6 +6,8 @@ mod calib;
 mod doctor;
 mod fuzz;
 mod hil;
+#[cfg(test)]
+mod import_cycles;
 mod json_out;
 mod kin;
 mod path_remap;

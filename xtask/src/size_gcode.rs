@@ -1,6 +1,8 @@
 //! The G-code path's share of the firmware image, for `cargo xtask size`:
 //! the symbols of the grbl protocol layer (`laser_app::grbl`) and of the
-//! sequencer's G-code session and motion queue (`sequencer::gcode*`), read
+//! sequencer's G-code session (`sequencer::gcode`) and the drivers' G-code
+//! stages (the gimbal's stream, the galvo's strokes, the stepper's
+//! hand-over: [`GCODE_SYMBOLS`]), read
 //! with `llvm-nm`. Code the optimiser inlined into other functions (the
 //! console and sequencer tasks) is not attributed, so the flash figure is
 //! a lower bound; the RAM figure is the state the G-code path adds.
@@ -11,7 +13,15 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 
 /// Symbol name parts that belong to the G-code path.
-const GCODE_SYMBOLS: [&str; 2] = ["laser_app::grbl::", "laser_app::sequencer::gcode"];
+const GCODE_SYMBOLS: [&str; 7] = [
+    "laser_app::grbl::",
+    "laser_app::sequencer::gcode",
+    "laser_app::sequencer::drivers::gimbal::",
+    "laser_app::sequencer::drivers::galvo::gcode",
+    "laser_app::sequencer::drivers::galvo::ahead",
+    "laser_app::sequencer::drivers::galvo::hold",
+    "laser_app::sequencer::drivers::stepper::gcode",
+];
 
 /// Flash bytes (code and read-only data) and symbol count of the G-code
 /// path in `nm` (output of `llvm-nm --print-size --demangle`).
@@ -51,7 +61,7 @@ pub fn report(elf: &Path, llvm_size: &Path) -> Result<()> {
     let (bytes, symbols) = flash_of(&String::from_utf8_lossy(&out.stdout));
     let ram = laser_app::sequencer::GCODE_RAM_BYTES;
     println!(
-        "  G-code path: flash >= {bytes} B in {symbols} functions/tables (grbl layer, sequencer::gcode*; inlined code not counted), RAM {ram} B (session, 16-block queue, realtime queue, RX buffer)"
+        "  G-code path: flash >= {bytes} B in {symbols} functions/tables (grbl layer, sequencer::gcode, the drivers' G-code stages; inlined code not counted), RAM {ram} B (session, 16-block queue, realtime queue, RX buffer)"
     );
     Ok(())
 }
@@ -63,11 +73,13 @@ mod tests {
     #[test]
     fn only_gcode_symbols_in_flash_are_counted() {
         let nm = "08000100 00000040 T laser_app::grbl::parser::<impl laser_app::grbl::state::ParserState>::execute\n\
-                  08000200 00000010 t laser_app::sequencer::gcode_motion::point_at\n\
+                  08000200 00000010 t laser_app::sequencer::gcode::queue::point_at\n\
+                  08000210 00000008 t laser_app::sequencer::drivers::galvo::hold::<impl laser_app::sequencer::machine::Core>::gcode_galvo_hold\n\
+                  08000218 00000004 t laser_app::sequencer::drivers::galvo::points::<impl laser_app::sequencer::machine::Core>::stop_galvo\n\
                   08000300 00000020 R laser_app::grbl::settings_map::SETTINGS\n\
                   20000000 00000100 B laser_app::grbl::something_in_ram\n\
                   08000400 00000080 T laser_app::usb::run_console\n\
                   08000500 T no_size_symbol\n";
-        assert_eq!(flash_of(nm), (0x40 + 0x10 + 0x20, 3));
+        assert_eq!(flash_of(nm), (0x40 + 0x10 + 0x8 + 0x20, 4));
     }
 }

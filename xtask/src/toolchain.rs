@@ -18,22 +18,25 @@ pub const RAM_BUDGET_BYTES: u64 = 96 * 1024;
 /// rustup components the project uses (llvm-tools provides `llvm-size`).
 const COMPONENTS: [&str; 3] = ["rustfmt", "clippy", "llvm-tools"];
 /// Crates that build for the host (everything but the firmware binary).
-const HOST_PACKAGES: [&str; 9] = [
+const HOST_PACKAGES: [&str; 10] = [
     "kinematics-core",
     "galvo-planner",
     "fashionstar",
+    "pelco",
     "laser-app",
     "galvo-dma",
     "laser-sim",
     "xtask",
+    "camera-calib",
     "system-tests",
     "fuzz-props",
 ];
 /// `no_std` crates that must also build for the target.
-const TARGET_LIBRARIES: [&str; 5] = [
+const TARGET_LIBRARIES: [&str; 6] = [
     "kinematics-core",
     "galvo-planner",
     "fashionstar",
+    "pelco",
     "laser-app",
     "galvo-dma",
 ];

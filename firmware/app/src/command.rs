@@ -18,6 +18,7 @@ use embassy_sync::signal::Signal;
 use crate::domain::{Actuator, AimModel, Pattern, PointCm};
 use crate::grbl::realtime::Realtime;
 use crate::outbound::{LineKind, Outbound};
+use crate::pelco::PelcoStatus;
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
 use crate::text::{ReplyText, Shortest};
 
@@ -39,6 +40,7 @@ pub static HELP_LINES: &[&str] = &[
     "target gimbal|galvo|both     which actuator draws",
     "planner optimal|seed         galvo jump planner",
     "galvo status                 galvo loop state, underruns",
+    "pelco status                 PELCO port: frames, errors, last command",
     "set <param> <value>          change a parameter",
     "get <param>                  read a parameter",
     "params                       list parameters",
@@ -314,6 +316,9 @@ pub struct CommandLink {
     /// while a line waits for room in the motion queue. When full (a host
     /// flooding `?`), further ones are dropped.
     pub realtime: Channel<CriticalSectionRawMutex, RealtimeRequest, REALTIME_QUEUE_DEPTH>,
+    /// What the PELCO port has seen (`pelco status`, answered by the
+    /// console itself).
+    pub pelco: PelcoStatus,
     /// `trace on`: laser changes and laser-deciding events are reported as
     /// notices (`app::trace`).
     trace: AtomicBool,
@@ -341,6 +346,7 @@ impl CommandLink {
             outbound: Outbound::new(),
             stop_request: Signal::new(),
             realtime: Channel::new(),
+            pelco: PelcoStatus::new(),
             trace: AtomicBool::new(false),
         }
     }

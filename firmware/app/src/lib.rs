@@ -29,6 +29,7 @@ pub mod grbl;
 pub mod laser_gate;
 mod log;
 pub mod outbound;
+pub mod pelco;
 pub mod sequencer;
 pub mod servo;
 pub mod settings;

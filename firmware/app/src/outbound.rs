@@ -27,6 +27,7 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 use heapless::Deque;
 
+pub use self::quiet::QuietReply;
 use crate::text::{REPLY_LINE_LEN, ReplyText, reply_text};
 
 mod dropped;
@@ -138,6 +139,10 @@ struct Queue {
     orphaned: bool,
     /// Lines taken by the writer (wrapping): the host reads while it grows.
     taken: u32,
+    /// The command in flight is quiet (see [`Outbound::begin_quiet_command`]).
+    quiet: bool,
+    /// The reply of the last quiet command, kept from the host.
+    quiet_reply: QuietReply,
 }
 
 impl Queue {
@@ -151,6 +156,11 @@ impl Queue {
             awaiting_close: false,
             orphaned: false,
             taken: 0,
+            quiet: false,
+            quiet_reply: QuietReply {
+                data: ReplyText::new(),
+                closed: None,
+            },
         }
     }
 
@@ -307,12 +317,20 @@ impl Outbound {
     /// counted) because its share of the queue is full. A closer also ends
     /// the command in flight.
     pub fn push(&self, kind: LineKind, text: &str) -> bool {
+        let mut quiet = false;
         let queued = self.with(|q| {
             if kind.is_closer() {
                 q.awaiting_close = false;
             }
-            q.push(kind, text)
+            quiet = q.keep_quiet(kind, text);
+            quiet || q.push(kind, text)
         });
+        if quiet {
+            if kind.is_closer() {
+                self.freed.signal(());
+            }
+            return true;
+        }
         if queued {
             self.queued.signal(());
         } else {
@@ -413,5 +431,6 @@ impl Default for Outbound {
     }
 }
 
+mod quiet;
 #[cfg(test)]
 mod tests;

@@ -286,6 +286,8 @@ async fn dispatch_grbl<R: Read>(
         link.grbl_error(GrblError::LineOverflow);
         return Ok(Filled::Bytes);
     };
+    // A quiet command (the PELCO port's) may be in flight.
+    out.wait_until(|o| !o.awaiting_close()).await;
     out.begin_command();
     if link.commands.try_send(Command::Grbl(line)).is_err() {
         link.error("busy: the command queue is full");
@@ -352,6 +354,11 @@ async fn wait_for_reply_room<R: Read>(
 /// not necessarily written). `reading`: see [`HOST_STALL`].
 async fn dispatch(line: &str, link: &CommandLink, reading: &mut HostReading) {
     let out = &link.outbound;
+    if line.split_whitespace().eq(["pelco", "status"]) {
+        // Answered here: the port's counters are the console's to read.
+        link.pelco.report(|args| link.data(args));
+        return link.ok();
+    }
     let command = match parse_line(line) {
         Ok(Some(command)) => command,
         Ok(None) => return link.ok(),
@@ -367,6 +374,8 @@ async fn dispatch(line: &str, link: &CommandLink, reading: &mut HostReading) {
             reading.stalled(out);
         }
     }
+    // A quiet command (the PELCO port's) may be in flight.
+    out.wait_until(|o| !o.awaiting_close()).await;
     // No await between marking and sending: a console cancelled by a
     // disconnect cannot leave a command marked but unsent.
     out.begin_command();

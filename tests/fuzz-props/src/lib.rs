@@ -11,19 +11,22 @@
 pub mod calib;
 pub mod console;
 pub mod grbl;
+pub mod pelco;
 pub mod record;
 pub mod servo;
 
 /// Every fuzz target: the `[[bin]]` names in `tests/fuzz/Cargo.toml` and
 /// the folders of `tests/fuzz/corpus/`. `console` runs [`console::check`],
 /// `servo_protocol` [`servo::check`], `settings_record` [`record::check`],
-/// `calib_csv` [`calib::check`], `grbl` [`grbl::check`].
-pub const TARGETS: [&str; 5] = [
+/// `calib_csv` [`calib::check`], `grbl` [`grbl::check`], `pelco`
+/// [`pelco::check`].
+pub const TARGETS: [&str; 6] = [
     "console",
     "servo_protocol",
     "settings_record",
     "calib_csv",
     "grbl",
+    "pelco",
 ];
 
 /// Reads fields from fuzz input bytes: past the end every read is 0, so

@@ -9,7 +9,7 @@ use std::collections::BTreeSet;
 use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
 use std::path::{Path, PathBuf};
 
-use fuzz_props::{TARGETS, calib, console, grbl, record, servo};
+use fuzz_props::{TARGETS, calib, console, grbl, pelco, record, servo};
 
 fn fuzz_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../fuzz")
@@ -196,4 +196,54 @@ fn grbl_corpus_holds_and_covers_every_block_and_many_errors() {
     let errors: BTreeSet<u8> = all.iter().flat_map(|s| s.errors.iter().copied()).collect();
     assert!(errors.len() >= 20, "only errors {errors:?} in the corpus");
     assert!(all.iter().any(|s| s.realtime > 0), "no realtime byte");
+}
+
+#[test]
+fn pelco_corpus_holds_and_covers_every_command_in_both_dialects() {
+    let all = run_all("pelco", pelco::check);
+    let kinds: BTreeSet<String> = all
+        .iter()
+        .flat_map(|s| s.commands.iter().cloned())
+        .collect();
+    for kind in [
+        "stop",
+        "move",
+        "set-preset",
+        "clear-preset",
+        "goto-preset",
+        "set-aux",
+        "clear-aux",
+        "remote-reset",
+        "set-pan",
+        "set-tilt",
+        "query-pan",
+        "query-tilt",
+        "pan-position",
+        "tilt-position",
+        "other",
+    ] {
+        assert!(
+            kinds.contains(&format!("D:{kind}")),
+            "no corpus frame decodes as PELCO-D {kind}"
+        );
+    }
+    for kind in [
+        "stop",
+        "move",
+        "set-preset",
+        "goto-preset",
+        "set-pan",
+        "query-pan",
+    ] {
+        assert!(
+            kinds.contains(&format!("P:{kind}")),
+            "no corpus frame decodes as PELCO-P {kind}"
+        );
+    }
+    let bad: u32 = all.iter().map(|s| s.counters.bad_checksums).sum();
+    let foreign: u32 = all.iter().map(|s| s.counters.other_addresses).sum();
+    assert!(
+        bad > 0 && foreign > 0,
+        "the corpus has no bad or foreign frames"
+    );
 }

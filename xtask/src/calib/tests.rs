@@ -285,6 +285,72 @@ fn coefficients_outside_the_firmware_range_are_refused() {
     assert!(e.starts_with("err.dx.c0 = "), "{e}");
 }
 
+fn offline_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("camera/tests/data/offline")
+}
+
+fn camera_args(images: &Path, points: &Path, out: &str) -> camera::CameraArgs {
+    camera::CameraArgs::for_test(
+        images,
+        points,
+        &tmp(&format!("{out}-err.txt")),
+        &tmp(&format!("{out}-report.json")),
+        &tmp(&format!("{out}-errors.svg")),
+    )
+}
+
+/// The committed frames (`cargo xtask calib frames --every 11 --scale 0.5`:
+/// the simulator's build error seen by the virtual camera at 640 × 360).
+#[test]
+fn offline_camera_mode_fits_the_committed_frames() {
+    let dir = offline_dir();
+    let a = camera_args(&dir, &dir.join("points.csv"), "ok");
+    let json: serde_json::Value =
+        serde_json::from_str(&camera::camera_command(&a).unwrap()).unwrap();
+    assert_eq!(json["frames"], 11);
+    assert_eq!(json["markers"].as_array().unwrap().len(), 14);
+    assert!(json["reprojection_px"].as_f64().unwrap() < 0.3);
+    let before = json["before"]["worst_mm"].as_f64().unwrap();
+    let after = json["after_predicted"]["worst_mm"].as_f64().unwrap();
+    assert!(before > 3.0 && after < 0.5, "{before} -> {after}");
+    let lines = std::fs::read_to_string(tmp("ok-err.txt")).unwrap();
+    assert_eq!(
+        lines.lines().filter(|l| l.starts_with("set err.")).count(),
+        12
+    );
+    assert!(
+        std::fs::read_to_string(tmp("ok-errors.svg"))
+            .unwrap()
+            .contains("<line")
+    );
+    for f in ["ok-err.txt", "ok-report.json", "ok-errors.svg"] {
+        let _ = std::fs::remove_file(tmp(f));
+    }
+}
+
+#[test]
+fn offline_camera_mode_refuses_bad_input_and_writes_nothing() {
+    let dir = offline_dir();
+    let csv = tmp("bad-points.csv");
+    for (text, expect) in [
+        (
+            "image,x,y\nframe_000.png,-114.96,76.64\nmissing.png,0,0\n",
+            "line 3: image ",
+        ),
+        ("image,x,y\nbackground.png,0,0\n", "no laser spot found"),
+        ("image,x\n", "line 1: header must be exactly `image,x,y`"),
+    ] {
+        std::fs::write(&csv, text).unwrap();
+        let a = camera_args(&dir, &csv, "bad");
+        let err = camera::camera_command(&a).unwrap_err();
+        assert!(err.contains(expect), "{err}");
+        for f in ["bad-err.txt", "bad-report.json", "bad-errors.svg"] {
+            assert!(!tmp(f).exists(), "{f} written on refusal");
+        }
+    }
+    let _ = std::fs::remove_file(csv);
+}
+
 #[test]
 fn the_readme_example_measurements_fit() {
     let out = tmp("readme-model.txt");

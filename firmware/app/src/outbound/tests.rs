@@ -167,3 +167,29 @@ fn lines_taken_count_what_the_writer_took() {
     drain(&out);
     assert_eq!(out.lines_taken(), before.wrapping_add(2));
 }
+
+#[test]
+fn a_quiet_command_reply_is_kept_from_the_host_but_notices_are_not() {
+    let out = Outbound::new();
+    assert!(out.begin_quiet_command());
+    // One command at a time: neither a second quiet one nor the console's.
+    assert!(!out.begin_quiet_command());
+    assert!(out.awaiting_close());
+    assert!(out.push(LineKind::Data, "oq_cm = 100  # gimbal"));
+    assert!(out.push(LineKind::Notice, "servo 1 not answering"));
+    assert!(out.take_quiet_reply().is_none(), "not closed yet");
+    assert!(out.push(LineKind::Ok, ""));
+    assert!(!out.awaiting_close());
+    let reply = out.take_quiet_reply().expect("closed");
+    assert_eq!(reply.data.as_str(), "oq_cm = 100  # gimbal");
+    assert_eq!(reply.closed, Some(true));
+    assert!(out.take_quiet_reply().is_none(), "taken once");
+    let lines = drain(&out);
+    assert_eq!(lines.len(), 1);
+    assert_eq!(lines[0].kind, LineKind::Notice);
+    // The console's next command replies to the host as before.
+    out.begin_command();
+    assert!(out.push(LineKind::Error, "bad"));
+    assert_eq!(drain(&out).len(), 1);
+    assert!(out.take_quiet_reply().is_none());
+}

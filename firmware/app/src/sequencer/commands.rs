@@ -1,25 +1,15 @@
 //! Command handling: each command gets exactly one closing reply, and
 //! changes state only when it is accepted.
 
-use super::machine::{Action, ActionSink, AfterCheck, Core, Pending, Readings};
-use super::run::{RunKind, Start};
 use crate::command::Command;
-use crate::domain::{
-    Actuator, AimModel, Pattern, PatternCheck, PatternError, Target, check_target,
-};
+use crate::domain::{AimModel, Pattern, PatternCheck, PatternError, Target, check_target};
 use crate::galvo::GalvoError;
-use crate::settings::JumpPlanner;
-use crate::settings::{PARAMS, ParamLine, ParamSpec};
-
-/// Points a pattern check aims at per executor step. One gimbal IK point
-/// is ~170 µs of soft-float on the target; with the first point of the
-/// run aimed in the last step, a step aims at no more than four (~0.7 ms).
-pub(super) const CHECKS_PER_STEP: usize = 3;
-
-/// The reply to galvo commands when no galvo loop serves the link.
-const NO_GALVO: &str = "this build has no galvo output";
-/// The reply to `target stepper` when no stepper task serves the link.
-const NO_STEPPER: &str = "this build has no stepper output";
+use crate::sequencer::drivers::{Drivers, NO_GALVO};
+use crate::sequencer::machine::{
+    Action, ActionSink, AfterCheck, CHECKS_PER_STEP, Core, Pending, Readings,
+};
+use crate::sequencer::run::{RunKind, Start};
+use crate::settings::{JumpPlanner, PARAMS, ParamLine, ParamSpec};
 
 impl Core {
     /// Runs `command` (`readings`: what the shell read from the links).
@@ -93,13 +83,16 @@ impl Core {
     /// serves the link (except `target gimbal`, and `target stepper`,
     /// refused when no stepper task serves its link).
     fn galvo_command(&mut self, command: Command, readings: &Readings, out: &mut dyn ActionSink) {
-        let gimbal = command == Command::Target(Actuator::Gimbal);
-        if command == Command::Target(Actuator::Stepper) {
-            if !self.inputs.stepper_attached {
-                return self.error(out, NO_STEPPER);
+        let galvo_attached = self.inputs.galvo_room.is_some();
+        let served = match command {
+            Command::Target(actuator) => {
+                Drivers::check_attached(actuator, galvo_attached, self.inputs.stepper_attached)
             }
-        } else if !gimbal && self.inputs.galvo_room.is_none() {
-            return self.error(out, NO_GALVO);
+            _ if galvo_attached => Ok(()),
+            _ => Err(NO_GALVO),
+        };
+        if let Err(reason) = served {
+            return self.error(out, reason);
         }
         match command {
             Command::Target(actuator) => {
@@ -128,9 +121,7 @@ impl Core {
         self.model = model;
         self.geometry_changed();
         if self.run.is_some() {
-            if self.actuator.uses_galvo() {
-                self.stop_galvo(out);
-            }
+            self.drivers_supersede(out);
             self.begin_point(out);
         }
         self.ok(out);

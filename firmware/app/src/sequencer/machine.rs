@@ -5,7 +5,7 @@
 //! galvo queue arrive with each event ([`Inputs`]), what the shell reads
 //! from the links for a command with the command ([`Readings`]), and
 //! everything the core wants done leaves as an [`Action`] written, in
-//! order, into an [`ActionSink`]. The shell ([`super::Sequencer`]) applies
+//! order, into an [`ActionSink`]. The shell ([`crate::sequencer::Sequencer`]) applies
 //! them; the tests record them. What the status board shows is a view of
 //! this state ([`Core::status`]), and so is the dwell deadline
 //! ([`Core::dwell_deadline`]): neither can drift from it.
@@ -18,20 +18,22 @@
 //! in between; should something else arrive, a pending check is finished
 //! at once first, so every command still gets exactly one reply.
 
-use embassy_time::Instant;
-
-use super::faults::ServoFaults;
-use super::laser::laser_wanted;
-use super::run::Run;
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::log;
+use crate::sequencer::drivers::Driver;
+use crate::sequencer::faults::ServoFaults;
+pub use crate::sequencer::io::{Action, ActionSink, Event, GalvoReadout, Inputs, Line, Readings};
+use crate::sequencer::laser::laser_wanted;
+use crate::sequencer::run::Run;
 use crate::settings::{LoadedRecord, RecordError, Settings};
 use crate::status::{Activity, Snapshot};
 use crate::text::reply_text;
+use embassy_time::Instant;
 
-mod io;
-
-pub use io::{Action, ActionSink, Event, GalvoReadout, Inputs, Line, Readings};
+/// Points a pattern check aims at per executor step. One gimbal IK point
+/// is ~170 µs of soft-float on the target; with the first point of the
+/// run aimed in the last step, a step aims at no more than four (~0.7 ms).
+pub(super) const CHECKS_PER_STEP: usize = 3;
 
 /// A command waiting for a follow-up event before its reply.
 #[derive(Debug, Clone)]
@@ -59,7 +61,7 @@ pub(super) enum Pending {
 #[allow(clippy::large_enum_variant)] // No heap: held in the core's state.
 pub(super) enum AfterCheck {
     /// `pattern`: start it (or refuse it).
-    Start(super::run::Start),
+    Start(crate::sequencer::run::Start),
     /// `set` during a run: keep the new settings (or go back to `before`).
     KeepSettings {
         /// The settings before the `set`.
@@ -92,7 +94,7 @@ pub struct Core {
     /// Whether the gimbal laser is on.
     pub(super) laser_on: bool,
     /// The power the gimbal laser runs at while on.
-    pub(super) laser_power: super::LaserPower,
+    pub(super) laser_power: crate::sequencer::laser::LaserPower,
     /// The gate was closed by someone else since the core last closed it.
     pub(super) gate_lost: bool,
     /// Housekeeping ticks (liveness).
@@ -102,7 +104,9 @@ pub struct Core {
     /// jobs are sent).
     pub(super) inputs: Inputs,
     /// The grbl session: G-code parser, motion queue, grbl settings.
-    pub(super) gcode: super::gcode::Gcode,
+    pub(super) gcode: crate::sequencer::gcode::Gcode,
+    /// What each actuator driver keeps of the G-code job.
+    pub(super) jobs: crate::sequencer::drivers::DriverJobs,
     /// The stepper task homes (`home` or `$H` sent, its end not reported).
     pub(super) stepper_homing: bool,
 }
@@ -123,7 +127,7 @@ impl Core {
             last_aim: None,
             measured: None,
             laser_on: false,
-            laser_power: super::LaserPower::FULL,
+            laser_power: crate::sequencer::laser::LaserPower::FULL,
             gate_lost: false,
             heartbeat: 0,
             pending: None,
@@ -133,7 +137,8 @@ impl Core {
                 galvo_bisection: false,
                 stepper_attached: false,
             },
-            gcode: super::gcode::Gcode::new(),
+            gcode: crate::sequencer::gcode::Gcode::new(),
+            jobs: crate::sequencer::drivers::DriverJobs::new(),
             stepper_homing: false,
         }
     }
@@ -154,7 +159,7 @@ impl Core {
             Event::Stepper(event) => self.stepper_event(event, out),
             Event::DwellEnded => self.dwell_ended(out),
             Event::Tick => self.heartbeat = self.heartbeat.wrapping_add(1),
-            Event::CheckStep => self.check_step(super::commands::CHECKS_PER_STEP, out),
+            Event::CheckStep => self.check_step(CHECKS_PER_STEP, out),
             Event::Saved(result) => self.saved(result, out),
             Event::SettingsLoaded(loaded) => self.settings_loaded(loaded, out),
             Event::GateLost => self.gate_lost = true,
@@ -250,9 +255,10 @@ impl Core {
         // (a galvo underrun) until the run is stopped or restarted.
         // The stepper pan/tilt carries the gimbal's laser; no servo
         // blocks it.
-        let servo_blocked =
-            !self.actuator.uses_stepper() && self.faults.gimbal_laser_blocked(yaw, pitch, phase);
-        let wanted = (self.actuator.uses_gimbal() || self.actuator.uses_stepper())
+        let drivers = self.drivers();
+        let servo_blocked = drivers.any(Driver::needs_servos)
+            && self.faults.gimbal_laser_blocked(yaw, pitch, phase);
+        let wanted = drivers.any(Driver::carries_laser_pin)
             && (laser_wanted(self.settings.laser_mode, phase, servo_blocked)
                 || self.gcode_gimbal_lit())
             && !self.gate_lost;

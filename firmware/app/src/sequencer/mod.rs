@@ -12,29 +12,21 @@
 //! view on the [`StatusBoard`].
 
 mod commands;
+mod drivers;
 mod faults;
-mod galvo;
 mod gcode;
-mod gcode_galvo;
-mod gcode_motion;
-mod gcode_power;
-mod gcode_report;
-mod gcode_settings;
-mod gcode_step;
-mod gcode_stepper;
-mod gcode_stream;
+mod io;
 mod laser;
 mod machine;
 mod report;
 mod run;
 mod servo_setup;
-mod stepper;
 mod trace;
 
 use embassy_futures::select::{Either, Either3, Either4, select, select3, select4};
 use embassy_time::{Duration, Instant, Timer};
 
-pub use self::galvo::config_from;
+pub use self::drivers::galvo::config_from;
 pub use self::laser::{LaserEvent, LaserPower, LaserSwitch, laser_wanted};
 pub use self::machine::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::{Command, CommandLink};
@@ -52,9 +44,10 @@ use crate::stepper::{StepperLink, StepperRequest};
 pub use crate::settings::store::SettingsStore;
 
 /// RAM the G-code path adds, bytes (host layout): the sequencer's grbl
-/// session with its motion queue, the realtime command queue and the
-/// console's RX buffer.
+/// session with its motion queue, the drivers' G-code state, the
+/// realtime command queue and the console's RX buffer.
 pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::Gcode>()
+    + core::mem::size_of::<drivers::DriverJobs>()
     + core::mem::size_of::<
         embassy_sync::channel::Channel<
             embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex,

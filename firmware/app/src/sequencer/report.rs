@@ -1,11 +1,10 @@
 //! The data lines of `help`, `version`, `get` and `status`: text from the
 //! core's state (and, for `status`, what the shell read from the links).
 
-use super::machine::{ActionSink, Core, Readings};
 use crate::build_info;
-use crate::command::Command;
-use crate::command::HELP_LINES;
+use crate::command::{Command, HELP_LINES};
 use crate::domain::{AimModel, PointCm};
+use crate::sequencer::machine::{ActionSink, Core, Readings};
 use crate::status::{Activity, Phase, Snapshot};
 use crate::text::{Fixed, Int};
 

@@ -20,6 +20,7 @@ mod gcode;
 mod geometry;
 mod legacy;
 mod params;
+mod pelco;
 mod record;
 mod spec;
 mod stepper;
@@ -29,6 +30,7 @@ mod tests;
 
 pub use error::SettingsError;
 pub use params::{MAX_CODES_PER_RAD, MIN_CODES_PER_RAD, PARAMS, find_param};
+pub use pelco::{PELCO_BAUDS, PelcoSettings};
 pub use record::{
     LoadedRecord, MAX_RECORD_LEN, RECORD_LEN, RECORD_VERSION, RecordError, RecordLayout,
     claimed_record_len, crc32, intact_record_len,
@@ -224,6 +226,8 @@ pub struct Settings {
     pub stepper: StepperSettings,
     /// G-code's junction deviation (grbl's `$11`), mm.
     pub gcode_junction_mm: f64,
+    /// The PELCO port.
+    pub pelco: PelcoSettings,
 }
 
 impl Default for Settings {
@@ -258,6 +262,7 @@ impl Default for Settings {
             galvo: GalvoSettings::default(),
             stepper: StepperSettings::default(),
             gcode_junction_mm: 0.01,
+            pelco: PelcoSettings::default(),
         }
     }
 }
@@ -269,7 +274,7 @@ impl Settings {
     pub fn get(&self, param: &ParamSpec) -> f64 {
         let mut copy = *self;
         match param.slot {
-            Slot::Real(place) | Slot::Whole(place) => *place(&mut copy),
+            Slot::Real(place) | Slot::Whole(place) | Slot::Baud(place) => *place(&mut copy),
             Slot::Count(place) => f64::from(*place(&mut copy)),
             Slot::Sign(place) => f64::from(*place(&mut copy)),
             Slot::Laser => self.laser_mode.code(),
@@ -296,7 +301,7 @@ impl Settings {
     /// Stores an already checked value.
     fn apply(&mut self, param: &ParamSpec, value: f64) {
         match param.slot {
-            Slot::Real(place) | Slot::Whole(place) => *place(self) = value,
+            Slot::Real(place) | Slot::Whole(place) | Slot::Baud(place) => *place(self) = value,
             Slot::Count(place) => *place(self) = value as u8,
             Slot::Sign(place) => *place(self) = if value < 0.0 { -1 } else { 1 },
             Slot::Laser => {

@@ -28,9 +28,11 @@
 //! | 173–176 | stepper tilt: the same                        |
 //! | 177–183 | stepper homing: seek, latch, pull-off speeds/distance; pan home_dir, home_deg; tilt the same |
 //! | 190–199 | G-code: `$11` junction deviation 190 (`settings/gcode.rs`) |
+//! | 200–209 | PELCO port: address 200, baud 201, motion timeout 202 (`settings/pelco.rs`) |
 //! | 177–183 | stepper homing: seek, latch, pull-off; pan home_dir, home_deg; tilt the same |
 
 use super::gcode::GCODE_PARAMS;
+use super::pelco::PELCO_PARAMS;
 use super::spec::COEF_HELP;
 use super::spec::{ParamSpec, Precision, Slot, choice, count, err_coef, real};
 use super::stepper::STEPPER_PARAMS;
@@ -42,8 +44,10 @@ pub const MIN_CODES_PER_RAD: f64 = 1_000.0;
 pub const MAX_CODES_PER_RAD: f64 = 120_000.0;
 
 /// The parameter table (also the order of `params` and of the saved record).
-pub static PARAMS: &[ParamSpec] =
-    &joined::<78, 1, 79>(joined::<54, 24, 78>(BASE, STEPPER_PARAMS), GCODE_PARAMS);
+pub static PARAMS: &[ParamSpec] = &joined::<79, 3, 82>(
+    joined::<78, 1, 79>(joined::<54, 24, 78>(BASE, STEPPER_PARAMS), GCODE_PARAMS),
+    PELCO_PARAMS,
+);
 
 /// Every parameter of `a` then every one of `b` (the table is built from
 /// pieces kept next to what they describe).

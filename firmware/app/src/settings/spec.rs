@@ -15,6 +15,8 @@ pub(crate) enum Slot {
     /// A whole number stored as f64.
     Whole(fn(&mut Settings) -> &mut f64),
     Count(fn(&mut Settings) -> &mut u8),
+    /// A baud rate of the PELCO port (one of `PELCO_BAUDS`), stored as f64.
+    Baud(fn(&mut Settings) -> &mut f64),
     Sign(fn(&mut Settings) -> &mut i8),
     Laser,
     Planner,
@@ -154,6 +156,9 @@ pub(crate) fn check_value(param: &ParamSpec, value: f64) -> Result<(), SettingsE
     let whole = (value as i64) as f64 == value;
     match param.slot {
         Slot::Real(_) => Ok(()),
+        Slot::Baud(_) if !super::pelco::is_pelco_baud(value) => Err(SettingsError::Rejected(
+            "pelco.baud must be 2400, 4800, 9600 or 19200",
+        )),
         Slot::Count(_) | Slot::Whole(_) if !whole => {
             Err(SettingsError::Rejected("value must be a whole number"))
         }

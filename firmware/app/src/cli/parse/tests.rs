@@ -196,6 +196,7 @@ fn every_help_line_names_a_command_that_parses_with_its_example() {
         "target both",
         "planner seed",
         "galvo status",
+        "pelco status",
         "set dwell_ms 1",
         "get dwell_ms",
         "params",
@@ -213,6 +214,10 @@ fn every_help_line_names_a_command_that_parses_with_its_example() {
     for (line, example) in HELP_LINES.iter().zip(examples) {
         let name = line.split_ascii_whitespace().next().unwrap_or("");
         assert!(example.starts_with(name));
+        if example == "pelco status" {
+            // Answered by the console itself (crate::usb), never parsed.
+            continue;
+        }
         assert!(matches!(parse_line(example), Ok(Some(_))), "{example}");
     }
 }

@@ -3,17 +3,15 @@
 
 extern crate std;
 
-use std::string::String;
-use std::vec::Vec;
-
-use embassy_time::Instant;
-
-use super::super::gcode_motion::PLANNER_BLOCKS;
-use super::super::machine::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::{Command, GrblLine, RealtimeRequest};
 use crate::galvo::ScanPhase;
 use crate::grbl::realtime::{OverrideStep, Realtime};
+use crate::sequencer::gcode::queue::PLANNER_BLOCKS;
+use crate::sequencer::machine::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::servo::task::{ServoOutcome, ServoRequest};
+use embassy_time::Instant;
+use std::string::String;
+use std::vec::Vec;
 
 pub(crate) const READINGS: Readings = Readings {
     galvo: GalvoReadout {
@@ -353,7 +351,7 @@ fn follow(core: &mut Core, ms: u64) -> Vec<(f64, [f64; 2])> {
             break;
         }
         let p = core.gcode.motion.position;
-        trace.push((core.gcode.motion.stream.speed_mm_s(), [p.x_mm, p.y_mm]));
+        trace.push((core.jobs.gimbal.speed_mm_s(), [p.x_mm, p.y_mm]));
     }
     trace
 }

@@ -11,7 +11,7 @@ use crate::settings::*;
 
 /// Every parameter's id as it was given (ids never change): a parameter
 /// whose id is not this one, or a new parameter not listed here, fails.
-const STABLE_IDS: [(u16, &str); 79] = [
+const STABLE_IDS: [(u16, &str); 82] = [
     (10, "oq_cm"),
     (11, "ol_cm"),
     (20, "grid.pitch_cm"),
@@ -91,11 +91,14 @@ const STABLE_IDS: [(u16, &str); 79] = [
     (182, "stepper.tilt.home_dir"),
     (183, "stepper.tilt.home_deg"),
     (190, "gcode.junction_mm"),
+    (200, "pelco.address"),
+    (201, "pelco.baud"),
+    (202, "pelco.timeout_s"),
 ];
 
-/// Parameters added after the version-2 records (the stepper's and
-/// `$11`): such records leave them at their defaults.
-const STEPPER_PARAMS: usize = 25;
+/// Parameters added after the version-2 records (the stepper's, `$11`
+/// and the PELCO port's): such records leave them at their defaults.
+const STEPPER_PARAMS: usize = 28;
 
 /// A version-2 record written by the firmware before ids (galvo build: 54
 /// values) with the values of [`fixture_settings`].
@@ -264,10 +267,10 @@ fn the_record_is_magic_version_count_id_value_entries_and_crc() {
     assert_eq!(values_in(&s.to_record()), values);
     assert!(MAX_RECORD_LEN >= RECORD_LEN && MAX_RECORD_LEN >= V2_GALVO.len());
     if has_galvo() {
-        // 16 runs of 79 values, no padding: ≈ 190 saves fill a 128 KiB
-        // sector (tests/tests/settings_sim.rs; the decision is in
+        // 17 runs of 82 values, 1 padding byte: ≈ 180 saves fill a
+        // 128 KiB sector (tests/tests/settings_sim.rs; the decision is in
         // settings/stepper.rs).
-        assert_eq!(RECORD_LEN, 8 + 16 * 3 + 79 * 8 + 4);
+        assert_eq!(RECORD_LEN, 8 + 17 * 3 + 82 * 8 + 1 + 4);
     }
 }
 

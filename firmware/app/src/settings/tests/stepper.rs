@@ -134,7 +134,8 @@ fn a_record_saved_before_the_stepper_parameters_loads_them_at_their_defaults() {
     assert_eq!(loaded.layout, RecordLayout::IdKeyed);
     assert_eq!(
         (loaded.unknown, loaded.defaulted),
-        (0, STEPPER_PARAMS.len() + 1)
+        // The stepper's, `$11` and the PELCO port's.
+        (0, STEPPER_PARAMS.len() + 1 + 3)
     );
     assert_eq!(loaded.settings.stepper, StepperSettings::default());
     // The one after them, `$11`, at its default too.

@@ -1,0 +1,279 @@
+//! G-code and `$` lines and realtime commands of the session.
+
+use crate::command::RealtimeRequest;
+use crate::grbl::classify::{LineKind, classify};
+use crate::grbl::realtime::Realtime;
+use crate::grbl::report;
+use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
+use crate::grbl::{Alarm, Block, Blocks, GrblError};
+use crate::sequencer::drivers::Driver;
+use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
+use crate::sequencer::gcode::{GrblMode, GrblValues, NO_OVERRIDES};
+use crate::sequencer::machine::{Action, ActionSink, Core, Line};
+use crate::settings::Settings;
+use crate::text::{ReplyText, reply_text};
+
+impl Core {
+    /// A G-code or `$` line from the console: closed with `ok` (for a
+    /// motion, once it is queued) or `error:N`.
+    pub(in crate::sequencer) fn grbl_line(&mut self, line: &str, out: &mut dyn ActionSink) {
+        match classify(line) {
+            LineKind::System => self.grbl_system(line, out),
+            _ => self.grbl_gcode(line, out),
+        }
+    }
+
+    /// Closes the current reply with `error:N`.
+    pub(in crate::sequencer) fn grbl_error(&self, out: &mut dyn ActionSink, error: GrblError) {
+        out.act(Action::Line(Line::GrblError(error)));
+    }
+
+    /// A data line in grbl's form (no decoration).
+    pub(in crate::sequencer) fn grbl_data(&self, out: &mut dyn ActionSink, text: ReplyText) {
+        out.act(Action::Line(Line::Data(text)));
+    }
+
+    /// `ALARM:N`, the machine locked; motion stopped, laser dark.
+    pub(in crate::sequencer) fn grbl_alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
+        self.stop("grbl alarm", out);
+        self.gcode.mode = GrblMode::Alarm;
+        self.grbl_data(
+            out,
+            reply_text(format_args!("ALARM:{}", u32::from(alarm.code()))),
+        );
+    }
+
+    fn grbl_gcode(&mut self, line: &str, out: &mut dyn ActionSink) {
+        if self.gcode.mode == GrblMode::Alarm || self.gcode.motion.jogging() {
+            return self.grbl_error(out, GrblError::GcodeLock);
+        }
+        let before = self.gcode.parser;
+        let blocks = match self.gcode.parser.execute(line) {
+            Ok(blocks) => blocks,
+            Err(e) => return self.grbl_error(out, e),
+        };
+        if !blocks.iter().all(|b| self.block_reachable(b)) {
+            self.gcode.parser = before;
+            self.grbl_alarm(Alarm::SoftLimit, out);
+            self.ok(out);
+            return;
+        }
+        self.grbl_queue(blocks, out);
+    }
+
+    /// Queues `blocks` and answers `ok`, or keeps them until the queue has
+    /// room (the `ok` then waits: back-pressure to the sender).
+    fn grbl_queue(&mut self, blocks: Blocks, out: &mut dyn ActionSink) {
+        if self.gcode.mode == GrblMode::Check || blocks.is_empty() {
+            return self.ok(out);
+        }
+        self.gcode.motion.owed = Some(blocks);
+        self.grbl_take_owed(out);
+        self.grbl_advance(out);
+        self.gcode_galvo_send_ahead(out);
+    }
+
+    /// Moves the blocks of the line waiting for room into the queue when
+    /// they fit, and answers it.
+    pub(in crate::sequencer) fn grbl_take_owed(&mut self, out: &mut dyn ActionSink) {
+        let motion = &mut self.gcode.motion;
+        let Some(blocks) = motion.owed.as_ref() else {
+            return;
+        };
+        if PLANNER_BLOCKS - motion.queue.len() < blocks.len() {
+            return;
+        }
+        for block in motion.owed.take().into_iter().flatten() {
+            // Room was checked above.
+            let _ = self.gcode.motion.queue.push_back(block);
+        }
+        self.ok(out);
+    }
+
+    fn grbl_system(&mut self, line: &str, out: &mut dyn ActionSink) {
+        let command = match parse_system(line) {
+            Ok(command) => command,
+            Err(e) => return self.grbl_error(out, e),
+        };
+        let idle = self.gcode.motion.is_idle();
+        match command {
+            SystemCommand::Help
+            | SystemCommand::Settings
+            | SystemCommand::Parameters
+            | SystemCommand::ParserState
+            | SystemCommand::BuildInfo
+            | SystemCommand::StartupLines => self.grbl_info(command, out),
+            SystemCommand::CheckMode => return self.grbl_check_mode(idle, out),
+            SystemCommand::Unlock => {
+                if self.gcode.mode == GrblMode::Alarm {
+                    self.gcode.mode = GrblMode::Normal;
+                    self.notify(out, format_args!("MSG:Caution: Unlocked"));
+                }
+            }
+            SystemCommand::Home => return self.grbl_home(idle, out),
+            SystemCommand::Sleep => {
+                self.stop("grbl sleep", out);
+                self.grbl_sync_position();
+            }
+            SystemCommand::Jog(text) => return self.grbl_jog(text, out),
+            SystemCommand::Restore(scope) => {
+                if !idle {
+                    return self.grbl_error(out, GrblError::NotIdle);
+                }
+                if matches!(scope, RestoreScope::Settings | RestoreScope::All) {
+                    self.gcode.values = GrblValues::default();
+                    self.settings.gcode_junction_mm = Settings::default().gcode_junction_mm;
+                }
+                if matches!(scope, RestoreScope::Offsets | RestoreScope::All) {
+                    self.gcode.parser.g54 = crate::grbl::PointMm::ZERO;
+                    self.gcode.parser.g92 = crate::grbl::PointMm::ZERO;
+                }
+                self.notify(out, format_args!("MSG:Restoring defaults"));
+            }
+            SystemCommand::SetSetting { number, value } => {
+                if !idle {
+                    return self.grbl_error(out, GrblError::NotIdle);
+                }
+                if let Err(e) = self.grbl_set_setting(number, value, out) {
+                    return self.grbl_error(out, e);
+                }
+            }
+        }
+        self.ok(out);
+    }
+
+    /// `$C`: toggles check mode (only when idle; leaving it resets the
+    /// parser, as grbl does).
+    fn grbl_check_mode(&mut self, idle: bool, out: &mut dyn ActionSink) {
+        match self.gcode.mode {
+            GrblMode::Check => {
+                self.gcode.mode = GrblMode::Normal;
+                self.gcode.parser.soft_reset();
+                self.grbl_sync_position();
+                self.notify(out, format_args!("MSG:Disabled"));
+            }
+            GrblMode::Normal if idle => {
+                self.gcode.mode = GrblMode::Check;
+                self.notify(out, format_args!("MSG:Enabled"));
+            }
+            _ => return self.grbl_error(out, GrblError::NotIdle),
+        }
+        self.ok(out);
+    }
+
+    /// `$H`: no switches to home on; aims at the board origin (dark) and
+    /// unlocks an alarm.
+    fn grbl_home(&mut self, idle: bool, out: &mut dyn ActionSink) {
+        if !idle || self.gcode.mode == GrblMode::Check {
+            return self.grbl_error(out, GrblError::NotIdle);
+        }
+        if self.drivers().any(Driver::homes_with_switches) {
+            // The reply waits for the end of homing (grbl's `$H`): a
+            // sender's next lines wait with it.
+            return match self.start_homing(out) {
+                Ok(()) => self.gcode.homing = true,
+                Err(_) => self.grbl_error(out, GrblError::HomingDisabled),
+            };
+        }
+        self.gcode.mode = GrblMode::Normal;
+        let from = self.gcode.motion.position;
+        self.gcode.parser.position = crate::grbl::PointMm::ZERO;
+        let mut blocks = Blocks::new();
+        if from != crate::grbl::PointMm::ZERO {
+            let _ = blocks.push(Block::Rapid {
+                from,
+                to: crate::grbl::PointMm::ZERO,
+            });
+        }
+        self.grbl_queue(blocks, out);
+    }
+
+    /// `$J=`: a jog, dark; refused beyond the reachable workspace
+    /// (error:15, no alarm, as grbl with soft limits). As grbl 1.1, only
+    /// when idle or jogging: otherwise (a job running, a hold, an alarm,
+    /// check mode) error:8.
+    fn grbl_jog(&mut self, text: &str, out: &mut dyn ActionSink) {
+        let busy = !self.gcode.motion.is_idle() && !self.gcode.motion.jogging();
+        if self.gcode.mode != GrblMode::Normal || busy {
+            return self.grbl_error(out, GrblError::NotIdle);
+        }
+        let before = self.gcode.parser;
+        let jog = match self.gcode.parser.jog(text) {
+            Ok(jog) => jog,
+            Err(e) => return self.grbl_error(out, e),
+        };
+        let mut blocks = Blocks::new();
+        if let Some(block) = jog {
+            if !self.block_reachable(&block) {
+                self.gcode.parser = before;
+                return self.grbl_error(out, GrblError::TravelExceeded);
+            }
+            let _ = blocks.push(block);
+        }
+        self.grbl_queue(blocks, out);
+    }
+
+    /// The parser continues from where the spot is (after a stop, a
+    /// reset or a jog cancel).
+    pub(in crate::sequencer) fn grbl_sync_position(&mut self) {
+        if self.gcode.motion.is_idle() {
+            self.gcode.parser.position = self.gcode.motion.position;
+        }
+    }
+
+    /// A realtime command from the console.
+    pub(in crate::sequencer) fn grbl_realtime(
+        &mut self,
+        request: RealtimeRequest,
+        out: &mut dyn ActionSink,
+    ) {
+        let before = self.gcode.overrides;
+        let ov = &mut self.gcode.overrides;
+        match request.command {
+            Realtime::StatusReport => self.grbl_status(request.rx_free_bytes, out),
+            Realtime::FeedHold => self.grbl_hold(out),
+            Realtime::CycleStart => self.grbl_resume(out),
+            Realtime::SoftReset => self.grbl_reset(out),
+            Realtime::JogCancel => self.grbl_jog_cancel(out),
+            Realtime::FeedOverride(step) => {
+                ov.feed = step.apply(ov.feed, 10, 200);
+                self.gcode_stepper_override(out);
+            }
+            Realtime::RapidOverride(percent) => ov.rapid = percent,
+            Realtime::SpindleOverride(step) => ov.spindle = step.apply(ov.spindle, 10, 200),
+            Realtime::SpindleStop | Realtime::Ignored(_) => {}
+        }
+        self.grbl_report_changed_overrides(before);
+    }
+
+    /// 0x18: everything stops at once, laser dark; the parser's modes
+    /// reset (position, offsets and settings kept); ALARM:3 if it
+    /// interrupted motion.
+    fn grbl_reset(&mut self, out: &mut dyn ActionSink) {
+        let moving = self.gcode.motion.current.is_some() && self.gcode.motion.hold != Hold::Held;
+        // grbl's reset kills the motion at once where a driver can (the
+        // position is then uncertain: ALARM:3); `stop` would brake.
+        self.drivers_reset(out);
+        self.stop("grbl soft reset", out);
+        self.gcode.parser.soft_reset();
+        self.grbl_sync_position();
+        self.gcode.overrides = NO_OVERRIDES;
+        if self.gcode.mode == GrblMode::Check {
+            self.gcode.mode = GrblMode::Normal;
+        }
+        if moving {
+            self.gcode.mode = GrblMode::Alarm;
+            self.grbl_data(
+                out,
+                reply_text(format_args!(
+                    "ALARM:{}",
+                    u32::from(Alarm::ResetWhileMoving.code())
+                )),
+            );
+        }
+        self.grbl_data(out, reply_text(format_args!("{}", report::BANNER)));
+        if self.gcode.mode == GrblMode::Alarm {
+            self.notify(out, format_args!("MSG:'$H'|'$X' to unlock"));
+        }
+    }
+}

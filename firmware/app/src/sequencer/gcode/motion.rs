@@ -1,0 +1,210 @@
+//! Running the motion queue: blocks started, held, resumed, aborted.
+
+use crate::grbl::{Block, PointMm, SpindleMode};
+use crate::sequencer::drivers::Driver;
+use crate::sequencer::gcode::queue::{Current, Hold, MAX_STEPS, block_end, cm, point_at};
+use crate::sequencer::laser::LaserEvent;
+use crate::sequencer::machine::{Action, ActionSink, Core};
+use crate::settings::LaserMode;
+use embassy_time::Duration;
+
+impl Core {
+    /// Whether every point of `block` is within grbl's soft limits: on
+    /// the board (`$130` × `$131` about its centre) and within the reach
+    /// of the actuator(s) (end points, and arcs along their sweep).
+    pub(in crate::sequencer) fn block_reachable(&self, block: &Block) -> bool {
+        let Some(end) = block_end(block) else {
+            return true;
+        };
+        let s = &self.settings;
+        let half_width_mm = s.grid_pitch_cm * f64::from(s.grid_cols) * 5.0;
+        let half_height_mm = s.grid_pitch_cm * f64::from(s.grid_rows) * 5.0;
+        let reachable = |p: PointMm| {
+            let on_board = libm::fabs(p.x_mm) <= half_width_mm + 1e-9
+                && libm::fabs(p.y_mm) <= half_height_mm + 1e-9;
+            on_board && self.drivers_reach(cm(p))
+        };
+        match block {
+            Block::Arc { .. } => (0..=16).all(|k| reachable(point_at(block, k, 16))),
+            _ => reachable(end),
+        }
+    }
+
+    /// Steps `block` is split into on the current actuator(s).
+    fn step_count(&self, block: &Block) -> u32 {
+        // One arc sent as its chords would be drawn as that many whole
+        // arcs by a driver that takes arcs whole (each from its end: a
+        // full circle each).
+        if matches!(block, Block::Arc { .. }) && self.drivers().any(Driver::takes_arcs_whole) {
+            return 1;
+        }
+        let step_mm = (self.aimer.path_step_cm() * 10.0).max(0.01);
+        let gimbal = self.drivers().any(Driver::steps_lines);
+        let steps =
+            |length_mm: f64| libm::ceil(length_mm / step_mm).clamp(1.0, MAX_STEPS as f64) as u32;
+        match *block {
+            Block::Rapid { .. } => 1,
+            Block::Line { from, to, .. } | Block::Jog { from, to, .. } if gimbal => {
+                steps(from.distance_to(to))
+            }
+            Block::Arc { arc, .. } => {
+                let chords = arc.segment_count(self.gcode.values.arc_tolerance_mm, MAX_STEPS);
+                if gimbal {
+                    chords.max(steps(arc.length_mm()))
+                } else {
+                    chords
+                }
+            }
+            _ => 1,
+        }
+    }
+
+    /// Starts the next block when nothing runs (and no hold), skipping
+    /// blocks with nothing to move.
+    pub(in crate::sequencer) fn grbl_advance(&mut self, out: &mut dyn ActionSink) {
+        while self.gcode.motion.current.is_none() && self.gcode.motion.hold == Hold::None {
+            let Some(block) = self.gcode.motion.queue.pop_front() else {
+                return;
+            };
+            self.grbl_take_owed(out);
+            if !self.gcode.motion.started {
+                // A G-code job starts like a run: what ran stops, nothing
+                // of it may shine.
+                if let Some(run) = self.run.take() {
+                    crate::log::info!("stop {} (G-code started)", run.kind.name());
+                    out.act(Action::Note(LaserEvent::Stopped {
+                        why: "G-code started",
+                    }));
+                }
+                out.act(Action::Note(LaserEvent::RunStarted));
+                self.close_gate(out);
+                self.gcode.motion.started = true;
+            }
+            match block {
+                Block::Pause => self.gcode.motion.hold = Hold::Held,
+                Block::End => {}
+                Block::Dwell { seconds, laser } => {
+                    let until = self
+                        .inputs
+                        .now
+                        .saturating_add(Duration::from_micros((seconds.max(0.0) * 1e6) as u64));
+                    self.gcode.motion.gimbal_lit = self.gcode_lit(laser.mode, laser.power)
+                        && laser.mode == SpindleMode::Constant;
+                    self.gcode.motion.current = Some(self.new_current(block, 0));
+                    if let Some(c) = self.gcode.motion.current.as_mut() {
+                        c.until = Some(until);
+                    }
+                }
+                _ => {
+                    if self.drivers_take_block(&block, out) {
+                        continue;
+                    }
+                    let count = self.step_count(&block);
+                    self.gcode.motion.current = Some(self.new_current(block, count));
+                    self.gcode_send_step(out);
+                }
+            }
+        }
+    }
+
+    pub(in crate::sequencer) fn new_current(&self, block: Block, count: u32) -> Current {
+        Current {
+            block,
+            index: 1,
+            count,
+            from: self.gcode.motion.position,
+            servo_seq: None,
+            galvo_seq: None,
+            stepper_seq: None,
+            until: None,
+            cancelled: false,
+        }
+    }
+
+    /// Whether laser setting (`mode`, `power`) lights a feed move.
+    pub(in crate::sequencer) fn gcode_lit(&self, mode: SpindleMode, power: f64) -> bool {
+        let v = &self.gcode.values;
+        let fraction = crate::grbl::Laser { mode, power }.fraction(v.s_min, v.s_max);
+        fraction > 0.0 && self.settings.laser_mode == LaserMode::Auto
+    }
+
+    /// `!`: laser dark at once; the gimbal stops after the step in
+    /// flight, the galvo brakes along its stroke (held where it reports
+    /// marking stopped).
+    pub(in crate::sequencer) fn grbl_hold(&mut self, out: &mut dyn ActionSink) {
+        let motion = &self.gcode.motion;
+        if motion.hold != Hold::None || motion.is_idle() || self.gcode_stepper_hold(out) {
+            return;
+        }
+        let motion = &mut self.gcode.motion;
+        motion.gimbal_lit = false;
+        let galvo_in_flight = motion.current.is_some_and(|c| c.galvo_seq.is_some());
+        // A galvo stroke: held where the galvo reports it stopped marking.
+        let stroke = self.gcode_galvo_hold();
+        let motion = &mut self.gcode.motion;
+        if let Some(c) = motion.current.as_mut() {
+            // Its `done` no longer counts: a galvo step (not a stroke) is
+            // redone from its start on resume.
+            c.galvo_seq = None;
+        }
+        // A dwell runs to its end, dark; a servo move to its point.
+        let waiting = motion
+            .current
+            .is_some_and(|c| c.servo_seq.is_some() || c.until.is_some());
+        motion.hold = if waiting || stroke {
+            Hold::Stopping
+        } else {
+            Hold::Held
+        };
+        if galvo_in_flight {
+            // Closing the gate also darkens the samples the DAC holds.
+            self.close_gate(out);
+        }
+    }
+
+    /// `~`: resumes after a hold (or an M0 pause).
+    pub(in crate::sequencer) fn grbl_resume(&mut self, out: &mut dyn ActionSink) {
+        let motion = &mut self.gcode.motion;
+        match motion.hold {
+            Hold::None => {}
+            Hold::Stopping => motion.hold = Hold::None,
+            Hold::Held => {
+                motion.hold = Hold::None;
+                if motion.current.is_some() {
+                    self.gcode_send_step(out);
+                } else {
+                    self.grbl_advance(out);
+                }
+            }
+        }
+    }
+
+    /// 0x85: the jog stops after the step in flight; queued jogs dropped.
+    pub(in crate::sequencer) fn grbl_jog_cancel(&mut self, out: &mut dyn ActionSink) {
+        if !self.gcode.motion.jogging() {
+            return;
+        }
+        let motion = &mut self.gcode.motion;
+        motion.queue.clear();
+        let Some(c) = motion.current.as_mut() else {
+            return;
+        };
+        c.cancelled = true;
+        if c.galvo_seq.take().is_some() {
+            self.stop_galvo(out);
+            self.gcode_step_done(out);
+        }
+    }
+
+    /// A stop from anywhere (`stop`, the button, a fault, a reset, an
+    /// alarm): the queue is dropped; a line waiting for room is answered.
+    pub(in crate::sequencer) fn gcode_abort(&mut self, out: &mut dyn ActionSink) {
+        self.jobs.gimbal.clear();
+        self.jobs.stepper.clear();
+        if self.gcode.motion.clear() {
+            self.ok(out);
+        }
+        self.gcode_galvo_hold_dropped();
+        self.grbl_sync_position();
+    }
+}

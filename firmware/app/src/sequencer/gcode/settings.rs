@@ -1,0 +1,62 @@
+//! `$` settings of the G-code session.
+
+use crate::grbl::GrblError;
+use crate::grbl::settings_map::{self, Binding, GrblSetting};
+use crate::sequencer::gcode::product_param;
+use crate::sequencer::machine::{ActionSink, Core};
+use crate::settings::find_param;
+
+impl Core {
+    /// The value `$$` shows for `setting`.
+    pub(in crate::sequencer) fn grbl_setting_value(&self, setting: &GrblSetting) -> f64 {
+        let v = &self.gcode.values;
+        let s = &self.settings;
+        match setting.number {
+            10 => f64::from(v.report_mask),
+            12 => v.arc_tolerance_mm,
+            30 => v.s_max,
+            31 => v.s_min,
+            32 => f64::from(u8::from(v.laser_mode)),
+            130 => s.grid_pitch_cm * f64::from(s.grid_cols) * 10.0,
+            131 => s.grid_pitch_cm * f64::from(s.grid_rows) * 10.0,
+            n => match product_param(n).and_then(|(name, k)| Some((find_param(name)?, k))) {
+                Some((param, k)) => s.get(param) * k,
+                None => setting.default,
+            },
+        }
+    }
+
+    /// `$N=value`; on error nothing changed.
+    pub(in crate::sequencer) fn grbl_set_setting(
+        &mut self,
+        number: u16,
+        value: f64,
+        out: &mut dyn ActionSink,
+    ) -> Result<(), GrblError> {
+        let setting = settings_map::find(number).ok_or(GrblError::InvalidStatement)?;
+        let v = &mut self.gcode.values;
+        match number {
+            10 if value <= 3.0 => v.report_mask = value as u8,
+            12 if value > 0.0 => v.arc_tolerance_mm = value,
+            30 if value > v.s_min => v.s_max = value,
+            31 if value < v.s_max => v.s_min = value,
+            32 if value == 0.0 || value == 1.0 => v.laser_mode = value == 1.0,
+            n if product_param(n).is_some() => {
+                let (name, k) = product_param(n).ok_or(GrblError::InvalidStatement)?;
+                let param = find_param(name).ok_or(GrblError::InvalidStatement)?;
+                self.settings
+                    .set(param, value / k)
+                    .map_err(|_| GrblError::InvalidStatement)?;
+                self.configure_galvo(out);
+            }
+            // Fixed ones (and the board extent) take only their value.
+            _ if setting.binding == Binding::Fixed || matches!(number, 130 | 131) => {
+                if value != self.grbl_setting_value(setting) {
+                    return Err(GrblError::InvalidStatement);
+                }
+            }
+            _ => return Err(GrblError::InvalidStatement),
+        }
+        Ok(())
+    }
+}

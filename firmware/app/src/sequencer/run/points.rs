@@ -1,0 +1,342 @@
+//! Running a pattern or goto point by point on the drivers that draw.
+
+use crate::domain::{Aim, AimModel, PathCursor, Pattern, Target};
+use crate::log;
+use crate::sequencer::drivers::{Arrival, PathRun};
+use crate::sequencer::faults;
+use crate::sequencer::laser::LaserEvent;
+use crate::sequencer::machine::{Action, ActionSink, Core};
+use crate::sequencer::run::{Run, RunKind, Start};
+use crate::servo::task::{ServoOutcome, ServoRequest};
+use crate::status::Phase;
+use crate::text::{Fixed, reply_text};
+use embassy_time::Duration;
+
+impl Core {
+    /// Starts `start` at its first point.
+    pub(in crate::sequencer) fn start(&mut self, start: Start, out: &mut dyn ActionSink) {
+        let (name, once) = match start {
+            Start::Goto(_) => ("goto", true),
+            Start::Pattern { pattern, once } => (pattern.name(), once),
+        };
+        log::info!("start {} (once={})", name, once);
+        self.gcode_abort(out);
+        out.act(Action::Note(LaserEvent::RunStarted));
+        // Nothing of an earlier run may shine: a new gate generation, and
+        // the galvo drops its points and an underrun latch; the stepper
+        // comes to rest before the new run's first move.
+        self.close_gate(out);
+        self.stop_stepper(out);
+        self.run = None;
+        match self.run_kind(start) {
+            Some(kind) => {
+                self.run = Some(Run::new(kind));
+                self.begin_point(out);
+            }
+            None => {
+                log::info!("stop {} (pattern has no points)", name);
+                self.stop("pattern has no points", out);
+            }
+        }
+    }
+
+    /// How `start` runs on the current actuator; `None` when it has no
+    /// points (a path that cannot be interpolated, or one the gimbal
+    /// cannot draw).
+    fn run_kind(&self, start: Start) -> Option<RunKind> {
+        let (pattern, once) = match start {
+            Start::Goto(target) => return Some(RunKind::Goto(target)),
+            Start::Pattern { pattern, once } => (pattern, once),
+        };
+        if let Pattern::Grid(pattern) = pattern {
+            return Some(RunKind::Grid { pattern, once });
+        }
+        // The stepper traces paths exactly; with `model seed` it keeps the
+        // seed's point-by-point method (for comparison), as the gimbal.
+        match self.drivers().path_run(self.model == AimModel::Exact) {
+            PathRun::Traced => Self::traced(pattern, once),
+            PathRun::Marked => Some(RunKind::Marked { pattern, once }),
+            PathRun::Refused => None,
+            PathRun::Points => {
+                let cursor = self.path_cursor(&pattern)?;
+                Some(RunKind::Path {
+                    pattern,
+                    once,
+                    cursor,
+                })
+            }
+        }
+    }
+
+    /// The cursor at the first point of a pass of `pattern` (`None` when
+    /// it cannot be interpolated).
+    fn path_cursor(&self, pattern: &Pattern) -> Option<PathCursor> {
+        PathCursor::start(pattern, &self.aimer)?.ok()
+    }
+
+    /// Stops whatever runs — and, whatever the core thinks runs, the laser
+    /// and the galvo loop: the gate closes at once and the loop gets
+    /// `Stop`.
+    pub(in crate::sequencer) fn stop(&mut self, why: &'static str, out: &mut dyn ActionSink) {
+        out.act(Action::Note(LaserEvent::Stopped { why }));
+        self.close_gate(out);
+        self.stop_stepper(out);
+        if let Some(run) = self.run.take() {
+            log::info!("stop {} ({})", run.kind.name(), why);
+        }
+        self.gcode_abort(out);
+    }
+
+    /// The target of the current point of the run (`None`: past the last
+    /// point, or a path the galvo marks whole).
+    fn current_target(&self) -> Option<Target> {
+        let run = self.run?;
+        match run.kind {
+            RunKind::Goto(target) => Some(target),
+            RunKind::Grid { pattern, .. } => {
+                self.aimer.grid_target(&Pattern::Grid(pattern), run.index)
+            }
+            RunKind::Path { cursor, .. } => Some(cursor.target()),
+            RunKind::Traced { pattern, .. } => Self::traced_target(&pattern, run.index),
+            RunKind::Marked { .. } => None,
+        }
+    }
+
+    /// Sends the current point to the actuator(s).
+    pub(in crate::sequencer) fn begin_point(&mut self, out: &mut dyn ActionSink) {
+        let Some(run) = self.run else { return };
+        if let RunKind::Marked { pattern, .. } = run.kind {
+            self.begin_galvo_path(pattern, out);
+            return;
+        }
+        let Some(target) = self.current_target() else {
+            self.stop("pattern has no points", out);
+            return;
+        };
+        // Travel to the first point of a pass (or to a goto target) is off
+        // the figure: dark in every laser mode. A later pass of a closed
+        // figure starts where the last one ended (arrived there): no travel.
+        let holds = matches!(run.kind, RunKind::Goto(_));
+        let closed = run.pass > 0 && self.last_aim.is_some_and(|(t, _)| t.point == target.point);
+        let approach = holds || (run.index == 0 && !closed);
+        let (mut moves, mut jobs) = (false, false);
+        for driver in self.drivers().iter() {
+            if !self.driver_aim(driver, target, approach, out) {
+                return;
+            }
+            match driver.arrival() {
+                Arrival::Move => moves = true,
+                Arrival::Job => jobs = true,
+            }
+        }
+        if let Some(run) = self.run.as_mut() {
+            run.phase = if approach {
+                Phase::Approaching
+            } else {
+                Phase::Moving
+            };
+            run.dwell_until = None;
+            run.gimbal_busy = moves;
+            // A goto's galvo holds the point, laser on, until the next
+            // command: nothing to wait for.
+            run.galvo_busy = jobs && !holds;
+        }
+        self.point_finished_if_done(out);
+    }
+
+    /// Aims the gimbal at `target` and sends the servo move; on an
+    /// unreachable target stops with an error notice.
+    pub(in crate::sequencer) fn begin_gimbal_move(
+        &mut self,
+        target: Target,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        let aim = match self.aimer.aim(target.point) {
+            Ok(aim) => aim,
+            Err(e) => {
+                let why = reply_text(format_args!("{e}"));
+                log::warning!("target unreachable: {}", why.as_str());
+                // What happened first: the reason may be cut at the
+                // reply line length.
+                let name = self.run.map_or("goto", |r| r.kind.name());
+                self.notify(
+                    out,
+                    format_args!(
+                        "error: {name} stopped, laser off: point ({}, {}) cm unreachable: {}",
+                        Fixed::<2>(target.point.x_cm),
+                        Fixed::<2>(target.point.y_cm),
+                        why
+                    ),
+                );
+                self.stop("unreachable target", out);
+                return false;
+            }
+        };
+        let interval_ms = self.move_interval_ms(&aim);
+        let deadband_tenths = (self.settings.deadband_deg * 10.0) as u16;
+        let seq = self.send_gimbal_move(&aim, interval_ms, deadband_tenths, out);
+        log::info!(
+            "target ({}, {}) cm -> servo {} {} (0.1 deg) over {} ms",
+            target.point.x_cm,
+            target.point.y_cm,
+            aim.yaw_wire,
+            aim.pitch_wire,
+            interval_ms
+        );
+        if let Some(run) = self.run.as_mut() {
+            run.seq = seq;
+        }
+        self.last_aim = Some((target, aim));
+        true
+    }
+
+    /// Sends the gimbal to `aim` over `interval_ms`, arrival within
+    /// `deadband_tenths` (0.1°), under a new sequence number (returned), and
+    /// notes the move for the laser logic.
+    pub(in crate::sequencer) fn send_gimbal_move(
+        &mut self,
+        aim: &Aim,
+        interval_ms: u16,
+        deadband_tenths: u16,
+        out: &mut dyn ActionSink,
+    ) -> u32 {
+        self.next_seq = self.next_seq.wrapping_add(1);
+        let seq = self.next_seq;
+        out.act(Action::Servo(ServoRequest::Move {
+            seq,
+            yaw_tenths: aim.yaw_wire,
+            pitch_tenths: aim.pitch_wire,
+            interval_ms,
+            ids: (self.settings.yaw.id, self.settings.pitch.id),
+            deadband_tenths,
+            ranges_tenths: faults::servo_ranges_tenths(&self.settings),
+        }));
+        out.act(Action::Note(LaserEvent::GimbalMoveSent));
+        seq
+    }
+
+    /// Travel time for a move at the configured speed, from the largest
+    /// joint change (at least 20 ms, the SDK's minimum ramp).
+    pub(in crate::sequencer) fn move_interval_ms(&self, aim: &Aim) -> u16 {
+        let (from_yaw, from_pitch) = self
+            .measured
+            .or(self.last_aim.map(|(_, a)| (a.yaw_wire, a.pitch_wire)))
+            .unwrap_or((0, 0));
+        let travel_tenths = (i32::from(aim.yaw_wire) - i32::from(from_yaw))
+            .abs()
+            .max((i32::from(aim.pitch_wire) - i32::from(from_pitch)).abs());
+        let travel_deg = f64::from(travel_tenths) / 10.0;
+        let ms = 1000.0 * travel_deg / self.settings.servo_speed_deg_s;
+        (ms as u32).clamp(20, u32::from(u16::MAX)) as u16
+    }
+
+    /// The servo task's report.
+    pub(in crate::sequencer) fn servo_outcome(
+        &mut self,
+        outcome: ServoOutcome,
+        out: &mut dyn ActionSink,
+    ) {
+        let gcode_fault = self.gcode_servo_outcome(&outcome, out);
+        match outcome {
+            ServoOutcome::Recovered { id } => self.servo_recovered(id, out),
+            ServoOutcome::Arrived {
+                seq,
+                yaw_tenths,
+                pitch_tenths,
+            } => self.arrived(seq, (yaw_tenths, pitch_tenths), out),
+            ServoOutcome::Fault { seq, id, fault } => self.servo_fault(seq, id, fault, out),
+            ServoOutcome::Superseded { .. } => {}
+            ServoOutcome::Bus { seq, report } => self.servo_bus_report(seq, report, out),
+        }
+        if gcode_fault {
+            self.stop("servo fault during G-code", out);
+        }
+    }
+
+    /// Both servos arrived at move `seq`, measured at `tenths` (yaw,
+    /// pitch; 0.1°): the dwell starts when it is the current move.
+    fn arrived(&mut self, seq: u32, tenths: (i16, i16), out: &mut dyn ActionSink) {
+        self.measured = Some(tenths);
+        // Both servos answered and arrived: they are alive.
+        self.faults
+            .arrived(self.settings.yaw.id, self.settings.pitch.id);
+        self.start_dwell(seq, out);
+        log::info!("arrived (servo {} {})", tenths.0, tenths.1);
+    }
+
+    /// The pointing actuator (gimbal or stepper) arrived at move `seq`:
+    /// the dwell starts when it is the current move.
+    pub(in crate::sequencer) fn start_dwell(&mut self, seq: u32, out: &mut dyn ActionSink) {
+        let now = self.inputs.now;
+        let dwell_ms = self.settings.dwell_ms;
+        let Some(run) = self.run.as_mut().filter(|r| r.seq == seq) else {
+            return;
+        };
+        run.phase = Phase::Dwelling;
+        out.act(Action::Note(LaserEvent::GimbalArrived));
+        let dwell = if run.kind.pattern().is_some_and(|p| p.is_path()) {
+            0.0
+        } else {
+            dwell_ms
+        };
+        run.dwell_until = Some(now.saturating_add(Duration::from_micros((dwell * 1000.0) as u64)));
+    }
+
+    /// The dwell on the current point ended: next point, next pass, or done.
+    pub(in crate::sequencer) fn dwell_finished(&mut self, out: &mut dyn ActionSink) {
+        if let Some(run) = self.run.as_mut() {
+            run.dwell_until = None;
+            run.gimbal_busy = false;
+        }
+        self.point_finished_if_done(out);
+    }
+
+    /// When every actuator is done with the current point: the next
+    /// point, the next pass, the end — or, for a goto, holding.
+    pub(in crate::sequencer) fn point_finished_if_done(&mut self, out: &mut dyn ActionSink) {
+        let Some(mut run) = self.run else { return };
+        if run.gimbal_busy || run.galvo_busy {
+            return;
+        }
+        run.index += 1;
+        let more = match &mut run.kind {
+            RunKind::Goto(_) => {
+                // A goto holds its point until the next command.
+                if let Some(run) = self.run.as_mut() {
+                    run.phase = Phase::Holding;
+                }
+                return;
+            }
+            RunKind::Grid { pattern, .. } => self
+                .aimer
+                .grid_target(&Pattern::Grid(*pattern), run.index)
+                .is_some(),
+            RunKind::Path { cursor, .. } => cursor.advance(),
+            RunKind::Traced { pattern, .. } => Self::traced_target(pattern, run.index).is_some(),
+            RunKind::Marked { .. } => false,
+        };
+        if !more {
+            run.pass += 1;
+            run.index = 0;
+            if run.kind.once() {
+                self.run = Some(run);
+                self.stop("pattern complete", out);
+                return;
+            }
+            // A new pass takes the path parameters as they are now.
+            if let RunKind::Path {
+                pattern, cursor, ..
+            } = &mut run.kind
+            {
+                let Some(start) = self.path_cursor(pattern) else {
+                    self.run = Some(run);
+                    self.stop("pattern has no points", out);
+                    return;
+                };
+                *cursor = start;
+            }
+        }
+        self.run = Some(run);
+        self.begin_point(out);
+    }
+}
