@@ -18,7 +18,7 @@ pub const RAM_BUDGET_BYTES: u64 = 96 * 1024;
 /// rustup components the project uses (llvm-tools provides `llvm-size`).
 const COMPONENTS: [&str; 3] = ["rustfmt", "clippy", "llvm-tools"];
 /// Crates that build for the host (everything but the firmware binary).
-const HOST_PACKAGES: [&str; 10] = [
+const HOST_PACKAGES: [&str; 11] = [
     "kinematics-core",
     "galvo-planner",
     "fashionstar",
