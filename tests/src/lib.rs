@@ -211,3 +211,26 @@ pub fn lit_between_ns(report: &SimReport, from: &str, to: &str) -> Vec<u64> {
         .filter(|&t| t > (from_us + 1_000) * 1_000 && t < to_us * 1_000)
         .collect()
 }
+
+/// Which angle each servo was commanded to at `t_us` (last sync set-angle
+/// frame before it), 0.1°, in command order.
+pub fn commanded_at(report: &SimReport, t_us: u64) -> Vec<(u8, i16)> {
+    let mut decoder = fashionstar::RequestDecoder::new();
+    let mut targets: Vec<(u8, i16)> = Vec::new();
+    for f in report
+        .recording
+        .frames
+        .iter()
+        .filter(|f| f.direction == laser_sim::recorder::Direction::Tx && f.t_us < t_us)
+    {
+        for &b in &f.bytes {
+            if let Some(Ok(fashionstar::Request::SyncSetAngle(entries))) = decoder.feed(b) {
+                for e in entries {
+                    targets.retain(|(id, _)| *id != e.id);
+                    targets.push((e.id, e.angle_tenths_deg));
+                }
+            }
+        }
+    }
+    targets
+}

@@ -3,11 +3,11 @@
 //! answers again; corrupted angle readings that pass the checksum never
 //! declare an arrival.
 
-use fashionstar::{Request, RequestDecoder, Response, ResponseDecoder};
+use fashionstar::{Response, ResponseDecoder};
 use laser_sim::recorder::Direction;
 use laser_sim::servo_port::{BusFaults, SilentWindow};
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::{XorShift, notice_at, run_with};
+use system_tests::{XorShift, commanded_at, notice_at, run_with};
 
 /// Commands that move the gimbal when it is the target.
 fn needs_gimbal(line: &str) -> bool {
@@ -212,29 +212,6 @@ fn a_dead_servo_gets_no_lit_run_and_refuses_gimbal_commands_until_it_answers() {
         checked_galvo >= 1,
         "{checked_galvo} galvo-only runs checked"
     );
-}
-
-/// Which angle each servo was commanded to at `t_us` (last set-angle frame
-/// before it), 0.1°.
-fn commanded_at(report: &SimReport, t_us: u64) -> Vec<(u8, i16)> {
-    let mut decoder = RequestDecoder::new();
-    let mut targets: Vec<(u8, i16)> = Vec::new();
-    for f in report
-        .recording
-        .frames
-        .iter()
-        .filter(|f| f.direction == Direction::Tx && f.t_us < t_us)
-    {
-        for &b in &f.bytes {
-            if let Some(Ok(Request::SyncSetAngle(entries))) = decoder.feed(b) {
-                for e in entries {
-                    targets.retain(|(id, _)| *id != e.id);
-                    targets.push((e.id, e.angle_tenths_deg));
-                }
-            }
-        }
-    }
-    targets
 }
 
 /// The last angle response of servo `id` before `t_us`: (time, angle as

@@ -21,7 +21,8 @@ pub struct SimArgs {
     /// Script of command lines (`wait <ms>` pauses; `#` comments;
     /// `@stall-read <ms>` stops the host reading replies for a while,
     /// `@type-ahead <line>` types without waiting for the reply, `@button`
-    /// presses the stop button); `-`
+    /// presses the stop button, `@unplug-servo <slot>` / `@plug-servo
+    /// <slot>` unplug and plug back a servo's cable); `-`
     /// reads it from stdin. Without it, piped stdin is the script, and a
     /// terminal or empty stdin runs the demo (writing sim.svg).
     #[arg(long)]
@@ -60,6 +61,12 @@ pub struct SimArgs {
     /// with a valid checksum), `servo-slow:<factor>` (repeatable).
     #[arg(long = "fault")]
     faults: Vec<String>,
+    /// The ids the simulated servos on the bus have at power-up, in slot
+    /// order (yaw, pitch, any more), e.g. `0,0` for two servos as they
+    /// ship (default: the gimbal's ids, 0 and 1). `@unplug-servo <slot>` /
+    /// `@plug-servo <slot>` in the script unplug and plug back a cable.
+    #[arg(long, value_name = "ID,ID,…", value_delimiter = ',')]
+    servo_ids: Vec<u8>,
     /// Run until the script has ended and the sequencer is idle; exit 1 if
     /// any command got `error:` (unless --allow-errors).
     #[arg(long)]
@@ -253,6 +260,7 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
             echo: true,
             galvo_cost_ns_per_sample: args.galvo_cost_ns,
             laser_controls: args.laser_controls,
+            servo_ids: (!args.servo_ids.is_empty()).then(|| args.servo_ids.clone()),
             ..SimOptions::default()
         })
         .map_err(|e| anyhow!("bench options: {e}"))?;
@@ -405,48 +413,4 @@ fn exit_code(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn fault_specs_parse_and_reject_nonsense() {
-        let specs = [
-            "servo-silent:1@2500".to_owned(),
-            "servo-silent:0@100-400".to_owned(),
-            "servo-corrupt:0.05".to_owned(),
-            "servo-forge:0.2".to_owned(),
-            "servo-slow:3".to_owned(),
-        ];
-        let (faults, slow) = parse_faults(&specs).unwrap();
-        assert_eq!(
-            faults.silent,
-            vec![
-                SilentWindow {
-                    id: 1,
-                    from_ms: 2500,
-                    until_ms: None
-                },
-                SilentWindow {
-                    id: 0,
-                    from_ms: 100,
-                    until_ms: Some(400)
-                }
-            ]
-        );
-        assert_eq!(faults.corrupt_probability, 0.05);
-        assert_eq!(faults.forge_probability, 0.2);
-        assert_eq!(slow, 3.0);
-        for bad in [
-            "servo-silent:1",
-            "servo-silent:1@500-400",
-            "servo-silent:1@5-x",
-            "servo-corrupt:2",
-            "servo-forge:-1",
-            "servo-slow:0.5",
-            "gremlins:1",
-            "x",
-        ] {
-            assert!(parse_faults(&[bad.to_owned()]).is_err(), "{bad}");
-        }
-    }
-}
+mod tests;

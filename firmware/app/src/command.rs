@@ -51,6 +51,10 @@ pub static HELP_LINES: &[&str] = &[
     "status                       state, target, faults",
     "version                      firmware version",
     "trace on|off                 laser and run events as notices",
+    "servo scan                   ids answering on the servo bus",
+    "servo ping <id>              is servo <id> there",
+    "servo id <id> <new> [confirm]  re-ID the one servo on the bus",
+    "servo zero <id>              its angle now as the axis zero_deg",
     "help                         this list",
 ];
 
@@ -117,6 +121,50 @@ pub enum Command {
     /// A G-code or `$` line for the grbl layer (answered `ok` once its
     /// motion is queued, `error:N` when refused).
     Grbl(GrblLine),
+    /// Servo bus set-up (refused while something runs).
+    Servo(ServoSetup),
+}
+
+/// The servo bus set-up commands (`servo …`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ServoSetup {
+    /// `servo scan`: every id answering, with angle, voltage, temperature.
+    Scan,
+    /// `servo ping <id>`.
+    Ping(u8),
+    /// `servo id <id> <new> [confirm]`: give the one servo on the bus a
+    /// new id (without `confirm`: say what would be done, change nothing).
+    SetId {
+        /// Its id now.
+        id: u8,
+        /// Its new id (0–254).
+        new_id: u8,
+        /// `confirm` was given.
+        confirmed: bool,
+    },
+    /// `servo zero <id>`: the servo's angle now becomes the `zero_deg` of
+    /// the axis with that id.
+    Zero(u8),
+}
+
+impl fmt::Display for ServoSetup {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            ServoSetup::Scan => f.write_str("servo scan"),
+            ServoSetup::Ping(id) => write!(f, "servo ping {id}"),
+            ServoSetup::SetId {
+                id,
+                new_id,
+                confirmed,
+            } => write!(
+                f,
+                "servo id {id} {new_id}{}",
+                if confirmed { " confirm" } else { "" }
+            ),
+            ServoSetup::Zero(id) => write!(f, "servo zero {id}"),
+        }
+    }
 }
 
 /// Longest accepted command line, bytes (excluding the terminator).
@@ -174,6 +222,7 @@ impl Command {
             Command::Planner(_) => "planner",
             Command::GalvoStatus => "galvo status",
             Command::Grbl(_) => "grbl",
+            Command::Servo(_) => "servo",
         }
     }
 
@@ -188,6 +237,7 @@ impl Command {
                 | Command::Get(_)
                 | Command::Params
                 | Command::GalvoStatus
+                | Command::Servo(_)
         )
     }
 }
@@ -211,6 +261,7 @@ impl fmt::Debug for Command {
             Command::Get(param) => write!(f, "get {}", param.name),
             Command::Grbl(line) => f.write_str(line.as_str()),
             Command::Trace(on) => f.write_str(if *on { "trace on" } else { "trace off" }),
+            Command::Servo(setup) => write!(f, "{setup}"),
             other => f.write_str(other.name()),
         }
     }
@@ -241,6 +292,7 @@ impl PartialEq for Command {
             (Command::Get(a), Command::Get(b)) => a.name == b.name,
             (Command::Grbl(a), Command::Grbl(b)) => a == b,
             (Command::Trace(a), Command::Trace(b)) => a == b,
+            (Command::Servo(a), Command::Servo(b)) => a == b,
             (a, b) => core::mem::discriminant(a) == core::mem::discriminant(b),
         }
     }

@@ -34,9 +34,12 @@
 //! * payload layouts: the same C file (`FSUS_SetServoAngle`,
 //!   `FSUS_SetServoAngleByInterval`, `FSUS_SetServoAngleByVelocity`,
 //!   `FSUS_DampingMode`, `FSUS_QueryServoAngle`, `FSUS_ReadData`,
+//!   `FSUS_WriteData`,
 //!   `FSUS_ServoMonitor`, `FSUS_SyncCommand`) and the MicroPython SDK
 //!   `micro-python/src/uservo.py` (`struct` formats `<BhHH`, `<BhHHHH`,
-//!   `<BH`, `<Bh`, `<BB`, `<BHHHHBih`, sync header `<BBB`).
+//!   `<BH`, `<Bh`, `<BB`, `<BHHHHBih`, sync header `<BBB`; `write_data`
+//!   packs `<BB` then the value bytes, `response_write_data` unpacks
+//!   `<BBB`).
 //! * A length byte of `0xFF` announces a 16-bit length (the SDK uses it only
 //!   for payloads over 255 bytes); such frames exceed [`MAX_PAYLOAD_LEN`]
 //!   and are rejected as [`DecodeError::BadLength`].
@@ -57,7 +60,7 @@ pub use decoder::{Decoded, RequestDecoder, ResponseDecoder, StreamDecoder};
 pub use entry::{SetAngle, SetAngleByInterval, SetAngleByVelocity, SyncEntries};
 pub use message::{Frame, Message};
 pub use request::{MotionCommand, Request};
-pub use response::{Monitor, ReadData, Response};
+pub use response::{Monitor, ReadData, Response, WriteResult};
 pub use wire::{PayloadWriter, checksum};
 
 /// First two bytes of every request frame (controller → servo).
@@ -72,6 +75,9 @@ pub mod code {
     /// Read one entry of the servo's data table: `id, address` → `id,
     /// address, bytes`.
     pub const READ_DATA: u8 = 3;
+    /// Write one entry of the servo's data table: `id, address, bytes` →
+    /// `id, address, result` (1 = written).
+    pub const WRITE_DATA: u8 = 4;
     /// Set angle (single turn): `id, angle, interval, power`; no response.
     pub const SET_ANGLE: u8 = 8;
     /// Damping mode: `id, power`; no response.
@@ -94,8 +100,20 @@ pub const FRAME_OVERHEAD: usize = 5;
 /// Most servos one sync frame may address (the codec's limit, not the
 /// vendor's: two are needed, yaw and pitch).
 pub const MAX_SYNC_SERVOS: usize = 4;
-/// Most data bytes a read-data response may carry.
+/// Most data bytes a read-data response (or a write-data request) may
+/// carry.
 pub const MAX_READ_DATA_LEN: usize = 32;
+
+/// Data-table addresses (`FSUS_PARAM_*` in the SDK's
+/// `fashion_star_uart_servo.h`).
+pub mod address {
+    /// The servo's bus id (`FSUS_PARAM_SERVO_ID`, 1 byte, 0–254; 255 is
+    /// the broadcast address and never assignable).
+    pub const SERVO_ID: u8 = 34;
+}
+
+/// Highest id a servo can be given (255 is the broadcast address).
+pub const MAX_SERVO_ID: u8 = 254;
 /// Longest payload either direction: a sync by interval/velocity frame for
 /// [`MAX_SYNC_SERVOS`] servos (3 + 4 × 11 = 47 bytes).
 pub const MAX_PAYLOAD_LEN: usize = 3 + MAX_SYNC_SERVOS * 11;

@@ -57,6 +57,13 @@ fn request() -> impl Strategy<Value = Request> {
     prop_oneof![
         any::<u8>().prop_map(|id| Request::Ping { id }),
         any::<(u8, u8)>().prop_map(|(id, address)| Request::ReadData { id, address }),
+        (any::<(u8, u8)>(), vec(any::<u8>(), 1..=MAX_READ_DATA_LEN)).prop_map(
+            |((id, address), data)| Request::WriteData {
+                id,
+                address,
+                data: heapless::Vec::from_slice(&data).unwrap(),
+            }
+        ),
         set_angle().prop_map(Request::SetAngle),
         any::<(u8, u16)>().prop_map(|(id, power_mw)| Request::Damping { id, power_mw }),
         any::<u8>().prop_map(|id| Request::QueryAngle { id }),
@@ -97,6 +104,11 @@ fn response() -> impl Strategy<Value = Response> {
                 data: heapless::Vec::from_slice(&data).unwrap(),
             })
         ),
+        any::<(u8, u8, u8)>().prop_map(|(id, address, result)| Response::WriteData(WriteResult {
+            id,
+            address,
+            result
+        })),
     ]
 }
 
@@ -292,8 +304,8 @@ proptest! {
     /// into a message that re-encodes to the same bytes, or (sync frames
     /// with an inconsistent inner layout) reported as `BadSync`.
     #[test]
-    fn any_framed_request_payload(code_idx in 0usize..9, payload in vec(any::<u8>(), 0..=MAX_PAYLOAD_LEN)) {
-        let codes = [1u8, 3, 8, 9, 10, 11, 12, 22, 25];
+    fn any_framed_request_payload(code_idx in 0usize..10, payload in vec(any::<u8>(), 0..=MAX_PAYLOAD_LEN)) {
+        let codes = [1u8, 3, 4, 8, 9, 10, 11, 12, 22, 25];
         let code = codes[code_idx];
         let (lo, hi) = Request::payload_len(code).unwrap();
         let payload = &payload[..payload.len().clamp(0, hi)];
@@ -309,8 +321,8 @@ proptest! {
     }
 
     #[test]
-    fn any_framed_response_payload(code_idx in 0usize..4, payload in vec(any::<u8>(), 0..=MAX_PAYLOAD_LEN)) {
-        let code = [1u8, 3, 10, 22][code_idx];
+    fn any_framed_response_payload(code_idx in 0usize..5, payload in vec(any::<u8>(), 0..=MAX_PAYLOAD_LEN)) {
+        let code = [1u8, 3, 4, 10, 22][code_idx];
         let (lo, hi) = Response::payload_len(code).unwrap();
         let payload = &payload[..payload.len().clamp(0, hi)];
         prop_assume!(payload.len() >= lo);

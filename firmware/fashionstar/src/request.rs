@@ -9,6 +9,7 @@
 //! |---|---|---|
 //! | 1 | ping | `id u8` |
 //! | 3 | read data | `id u8, address u8` |
+//! | 4 | write data | `id u8, address u8, value bytes…` (`FSUS_WriteData`; `uservo.py` `write_data`: `<BB` + content) |
 //! | 8 | set angle | [`SetAngle`] |
 //! | 9 | damping | `id u8, power u16 (mW)` |
 //! | 10 | query angle | `id u8` |
@@ -20,11 +21,13 @@
 //! Sync inner commands modelled here (`FSUS_SyncCommand`): 8 (length 7),
 //! 11 (length 11) and 12 (length 11).
 
+use heapless::Vec;
+
 use crate::entry::{Entry, read_sync, write_sync};
 use crate::wire::{PayloadWriter, Reader};
 use crate::{
-    DecodeError, MAX_PAYLOAD_LEN, Message, REQUEST_HEADER, SetAngle, SetAngleByInterval,
-    SetAngleByVelocity, SyncEntries, code,
+    DecodeError, MAX_PAYLOAD_LEN, MAX_READ_DATA_LEN, Message, REQUEST_HEADER, SetAngle,
+    SetAngleByInterval, SetAngleByVelocity, SyncEntries, code,
 };
 
 /// A request frame (controller → servo).
@@ -44,6 +47,17 @@ pub enum Request {
         /// Data-table address (e.g. 1 voltage, 2 current, 3 power,
         /// 4 temperature, 5 status).
         address: u8,
+    },
+    /// Code 4: write one data-table entry. Answered by
+    /// [`crate::Response::WriteData`].
+    WriteData {
+        /// Servo id.
+        id: u8,
+        /// Data-table address (e.g. [`crate::address::SERVO_ID`]).
+        address: u8,
+        /// The value's bytes (little-endian values, 1 to
+        /// [`MAX_READ_DATA_LEN`]).
+        data: Vec<u8, MAX_READ_DATA_LEN>,
     },
     /// Code 8: move to an angle within a time. No response.
     SetAngle(SetAngle),
@@ -103,6 +117,20 @@ pub enum MotionCommand {
 }
 
 impl Request {
+    /// Code 4 at [`crate::address::SERVO_ID`]: servo `id` takes `new_id`
+    /// as its bus id (the caller keeps `new_id` at most
+    /// [`crate::MAX_SERVO_ID`]).
+    pub fn set_servo_id(id: u8, new_id: u8) -> Self {
+        let mut data = Vec::new();
+        // MAX_READ_DATA_LEN ≥ 1: the push succeeds.
+        let _ = data.push(new_id);
+        Self::WriteData {
+            id,
+            address: crate::address::SERVO_ID,
+            data,
+        }
+    }
+
     /// One sync frame starting a set-angle move on each of `entries`
     /// together; `None` when there are more than [`crate::MAX_SYNC_SERVOS`].
     pub fn sync_set_angle(entries: &[SetAngle]) -> Option<Self> {
@@ -127,6 +155,7 @@ impl Request {
         match self {
             Self::Ping { id }
             | Self::ReadData { id, .. }
+            | Self::WriteData { id, .. }
             | Self::Damping { id, .. }
             | Self::QueryAngle { id }
             | Self::QueryMonitor { id }
@@ -140,13 +169,14 @@ impl Request {
     }
 
     /// Whether the addressed servo answers (ping, read data, query angle,
-    /// query monitor). Motion commands are not answered with the servo's
+    /// write data, query monitor). Motion commands are not answered with the servo's
     /// default settings (`FSUS_IS_RESPONSE_ON 0` in the SDK).
     pub fn expects_response(&self) -> bool {
         matches!(
             self,
             Self::Ping { .. }
                 | Self::ReadData { .. }
+                | Self::WriteData { .. }
                 | Self::QueryAngle { .. }
                 | Self::QueryMonitor { .. }
         )
@@ -187,6 +217,7 @@ impl Message for Request {
         match self {
             Self::Ping { .. } => code::PING,
             Self::ReadData { .. } => code::READ_DATA,
+            Self::WriteData { .. } => code::WRITE_DATA,
             Self::SetAngle(_) => code::SET_ANGLE,
             Self::Damping { .. } => code::DAMPING,
             Self::QueryAngle { .. } => code::QUERY_ANGLE,
@@ -206,6 +237,11 @@ impl Message for Request {
                 w.u8(*id);
                 w.u8(*address);
             }
+            Self::WriteData { id, address, data } => {
+                w.u8(*id);
+                w.u8(*address);
+                w.bytes(data);
+            }
             Self::Damping { id, power_mw } => {
                 w.u8(*id);
                 w.u16(*power_mw);
@@ -224,6 +260,7 @@ impl Message for Request {
         match code {
             code::PING | code::QUERY_ANGLE | code::QUERY_MONITOR => exact(1),
             code::READ_DATA => exact(2),
+            code::WRITE_DATA => Some((3, 2 + MAX_READ_DATA_LEN)),
             code::DAMPING => exact(3),
             code::SET_ANGLE => exact(SetAngle::LEN),
             code::SET_ANGLE_BY_INTERVAL => exact(SetAngleByInterval::LEN),
@@ -254,6 +291,13 @@ impl Message for Request {
                 id: r.u8().ok_or(bad_len)?,
                 address: r.u8().ok_or(bad_len)?,
             },
+            code::WRITE_DATA => {
+                let id = r.u8().ok_or(bad_len)?;
+                let address = r.u8().ok_or(bad_len)?;
+                let data = Vec::from_slice(r.rest()).map_err(|_| bad_len)?;
+                r = Reader::new(&[]);
+                Self::WriteData { id, address, data }
+            }
             code::DAMPING => Self::Damping {
                 id: r.u8().ok_or(bad_len)?,
                 power_mw: r.u16().ok_or(bad_len)?,

@@ -10,6 +10,7 @@
 //! |---|---|---|
 //! | 1 | ping | `id u8` |
 //! | 3 | read data | `id u8, address u8, data…` |
+//! | 4 | write data | `id u8, address u8, result u8` (1 = written; `uservo.py` `response_write_data` `<BBB`, `FSUS_WriteData` reads `content[2]`) |
 //! | 10 | angle | `id u8, angle i16 (0.1°)` |
 //! | 22 | monitor | `id u8, voltage u16 (mV), current u16 (mA), power u16 (mW), temperature u16 (raw ADC), status u8, angle i32 (0.1°), turns i16` |
 
@@ -54,6 +55,25 @@ pub struct ReadData {
     pub data: Vec<u8, MAX_READ_DATA_LEN>,
 }
 
+/// The answer to a write (code 4 response, 3 bytes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WriteResult {
+    /// Servo id (the id the request addressed).
+    pub id: u8,
+    /// Data-table address written.
+    pub address: u8,
+    /// The servo's result byte: 1 when the value was written.
+    pub result: u8,
+}
+
+impl WriteResult {
+    /// Whether the servo reports the value written.
+    pub fn succeeded(&self) -> bool {
+        self.result == 1
+    }
+}
+
 /// A response frame (servo → controller).
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -74,6 +94,8 @@ pub enum Response {
     Monitor(Monitor),
     /// Code 3: a data-table entry.
     ReadData(ReadData),
+    /// Code 4: the result of a write.
+    WriteData(WriteResult),
 }
 
 impl Response {
@@ -83,11 +105,12 @@ impl Response {
             Self::Ping { id } | Self::Angle { id, .. } => *id,
             Self::Monitor(m) => m.id,
             Self::ReadData(d) => d.id,
+            Self::WriteData(w) => w.id,
         }
     }
 
     /// Whether this is the answer to `request` (same kind, same servo, and
-    /// for read data the same address).
+    /// for read and write data the same address).
     pub fn answers(&self, request: &Request) -> bool {
         match (self, request) {
             (Self::Ping { id }, Request::Ping { id: want })
@@ -95,6 +118,9 @@ impl Response {
             (Self::Monitor(m), Request::QueryMonitor { id: want }) => m.id == *want,
             (Self::ReadData(d), Request::ReadData { id, address }) => {
                 d.id == *id && d.address == *address
+            }
+            (Self::WriteData(w), Request::WriteData { id, address, .. }) => {
+                w.id == *id && w.address == *address
             }
             _ => false,
         }
@@ -111,6 +137,7 @@ impl Message for Response {
             Self::Angle { .. } => code::QUERY_ANGLE,
             Self::Monitor(_) => code::QUERY_MONITOR,
             Self::ReadData(_) => code::READ_DATA,
+            Self::WriteData(_) => code::WRITE_DATA,
         }
     }
 
@@ -139,6 +166,11 @@ impl Message for Response {
                 w.u8(d.address);
                 w.bytes(&d.data);
             }
+            Self::WriteData(r) => {
+                w.u8(r.id);
+                w.u8(r.address);
+                w.u8(r.result);
+            }
         }
     }
 
@@ -148,6 +180,7 @@ impl Message for Response {
             code::QUERY_ANGLE => Some((3, 3)),
             code::QUERY_MONITOR => Some((16, 16)),
             code::READ_DATA => Some((2, 2 + MAX_READ_DATA_LEN)),
+            code::WRITE_DATA => Some((3, 3)),
             _ => None,
         }
     }
@@ -188,6 +221,11 @@ impl Message for Response {
                 r = Reader::new(&[]);
                 Self::ReadData(ReadData { id, address, data })
             }
+            code::WRITE_DATA => Self::WriteData(WriteResult {
+                id: r.u8().ok_or(bad_len)?,
+                address: r.u8().ok_or(bad_len)?,
+                result: r.u8().ok_or(bad_len)?,
+            }),
             _ => return Err(DecodeError::UnknownCode { code }),
         };
         r.end().ok_or(bad_len)?;

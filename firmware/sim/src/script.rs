@@ -8,9 +8,12 @@
 //! or hex: `0x18`, `0x9b`, …; no line, no reply awaited), `@button`
 //! presses the board's stop button, `@close` / `@open` close the
 //! console port (unplug: what was not read yet is lost) and open it
-//! again (a new session), and `@interlock open|closed` and `@key off|on`
+//! again (a new session), `@interlock open|closed` and `@key off|on`
 //! set the laser controls' inputs (a script that uses them runs on a
-//! board with the laser controls fitted).
+//! board with the laser controls fitted), and `@unplug-servo <slot>` /
+//! `@plug-servo <slot>` unplug and plug back the cable of a servo on the bus (slots
+//! count from 1 in the order the bus was built: yaw, pitch, then any
+//! more; a servo unplugged hears and answers nothing).
 
 use anyhow::{Context, Result, bail};
 
@@ -31,6 +34,14 @@ pub enum Step {
     StopButton,
     /// Send one grbl realtime byte (no line end, no reply awaited).
     Realtime(u8),
+    /// Unplug (or plug back) the cable of the servo in `slot` (0-based;
+    /// the script counts from 1).
+    ServoCable {
+        /// Slot on the bus, from 0.
+        slot: usize,
+        /// Plugged in after the step.
+        plugged: bool,
+    },
     /// The host closes the port (DTR drops): replies not read yet are
     /// lost, as are lines still awaiting them.
     ClosePort,
@@ -140,11 +151,25 @@ pub fn parse_script(text: &str) -> Result<Vec<Step>> {
                 ["off", "on"],
                 number,
             )?)),
+            Some(word @ ("@unplug-servo" | "@plug-servo")) => {
+                let slot = ms_argument(word, words, number)
+                    .ok()
+                    .and_then(|n| usize::try_from(n).ok())
+                    .filter(|&n| n >= 1)
+                    .with_context(|| {
+                        format!("script line {number}: `{word} <slot>` takes a slot from 1")
+                    })?;
+                steps.push(Step::ServoCable {
+                    slot: slot - 1,
+                    plugged: word == "@plug-servo",
+                });
+            }
             Some(directive) if directive.starts_with('@') => {
                 bail!(
                     "script line {number}: unknown directive {directive:?} \
                      (@stall-read <ms>, @type-ahead <line>, @realtime <byte>, @button, @close, \
-                     @open, @interlock open|closed, @key off|on)"
+                     @open, @interlock open|closed, @key off|on, @unplug-servo <slot>, \
+                     @plug-servo <slot>)"
                 );
             }
             _ => steps.push(Step::Send(line.to_owned())),
@@ -244,6 +269,35 @@ mod tests {
             "@stall-read -5",
             "@type-ahead",
             "@stall 5",
+        ] {
+            let err = parse_script(&format!("stop\n{bad}\n"))
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("line 2"), "{bad}: {err}");
+        }
+    }
+
+    #[test]
+    fn servo_cable_steps_count_slots_from_one() {
+        let steps = parse_script("@unplug-servo 1\n@plug-servo 2\n").unwrap();
+        assert_eq!(
+            steps,
+            vec![
+                Step::ServoCable {
+                    slot: 0,
+                    plugged: false
+                },
+                Step::ServoCable {
+                    slot: 1,
+                    plugged: true
+                }
+            ]
+        );
+        for bad in [
+            "@unplug-servo",
+            "@unplug-servo 0",
+            "@plug-servo x",
+            "@plug-servo 1 2",
         ] {
             let err = parse_script(&format!("stop\n{bad}\n"))
                 .unwrap_err()

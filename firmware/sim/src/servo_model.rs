@@ -18,6 +18,13 @@
 //! * ping, query angle, query monitor (fixed plausible voltage and
 //!   temperature) and read data (addresses 1–5 and 34) are answered;
 //!   motion commands are not (SDK default, no response);
+//! * write data (code 4) to address 34 (`FSUS_PARAM_SERVO_ID`) with one
+//!   byte 0–254 is answered `id, 34, 1` under the old id, and the servo
+//!   answers to the new id from then on (255, the broadcast address, or
+//!   another length is answered with result 0 and changes nothing); other
+//!   addresses are not modelled and not answered;
+//! * two servos with one id (they ship that way) both answer: see
+//!   [`SimServoBus`] for the collision;
 //! * fault injection: a slowness factor (every move takes `factor` times
 //!   longer) and a silent flag (the servo still obeys commands but answers
 //!   nothing, like a broken return line).
@@ -26,8 +33,8 @@ mod bus;
 pub mod motion;
 
 use fashionstar::{
-    Monitor, MotionCommand, ReadData, Request, Response, SetAngle, SetAngleByInterval,
-    SetAngleByVelocity,
+    MAX_SERVO_ID, Monitor, MotionCommand, ReadData, Request, Response, SetAngle,
+    SetAngleByInterval, SetAngleByVelocity, WriteResult, address,
 };
 
 pub use bus::{BusDirection, BusFrame, SimServoBus};
@@ -172,7 +179,27 @@ impl SimServo {
         if self.silent || request.id() != Some(self.id) {
             return None;
         }
+        if let Request::WriteData { address, data, .. } = request {
+            return Some(self.write(*address, data));
+        }
         self.answer(now_us, request)
+    }
+
+    /// A write to the data table: only the id (address 34) is modelled.
+    fn write(&mut self, address: u8, data: &[u8]) -> Response {
+        let id = self.id;
+        let result = match (address, data) {
+            (address::SERVO_ID, &[new_id]) if new_id <= MAX_SERVO_ID => {
+                self.id = new_id;
+                1
+            }
+            _ => 0,
+        };
+        Response::WriteData(WriteResult {
+            id,
+            address,
+            result,
+        })
     }
 
     fn set_angle(&mut self, t: f64, from: f64, c: &SetAngle) {
@@ -258,5 +285,7 @@ impl SimServo {
     }
 }
 
+#[cfg(test)]
+mod setup_tests;
 #[cfg(test)]
 mod tests;

@@ -207,29 +207,48 @@ impl UsbHost {
     }
 }
 
-/// Runs one script step; `@button` presses `button`, `@interlock` and
-/// `@key` set `controls` (the interactive terminal has neither).
-async fn run_step(
-    host: &UsbHost,
-    step: Step,
-    button: Option<&ButtonContacts>,
-    controls: Option<&ControlWiring>,
-) {
+/// What the script's `@` steps reach on the bench: the board's stop
+/// button and the servo bus's cables.
+#[derive(Clone)]
+pub struct Hands {
+    /// The board's stop button (`@button`).
+    pub button: Rc<ButtonContacts>,
+    /// The servo bus (`@unplug-servo`, `@plug-servo`).
+    pub bus: Rc<RefCell<crate::servo_model::SimServoBus>>,
+    /// The laser controls' inputs (`@interlock`, `@key`), on a board
+    /// fitted with them.
+    pub controls: Option<Rc<ControlWiring>>,
+}
+
+/// Runs one script step; `@` steps act through `hands` (the interactive
+/// terminal has none).
+async fn run_step(host: &UsbHost, step: Step, hands: Option<&Hands>) {
     match step {
         Step::Interlock(closed) => {
-            if let Some(controls) = controls {
+            if let Some(controls) = hands.and_then(|h| h.controls.as_deref()) {
                 controls.set_interlock(closed);
             }
         }
         Step::Key(on) => {
-            if let Some(controls) = controls {
+            if let Some(controls) = hands.and_then(|h| h.controls.as_deref()) {
                 controls.set_key(on);
             }
         }
         Step::StopButton => {
-            if let Some(button) = button {
-                button.press();
+            if let Some(hands) = hands {
+                hands.button.press();
             }
+        }
+        Step::ServoCable { slot, plugged } => {
+            let done = hands.is_some_and(|h| h.bus.borrow_mut().set_plugged(slot, plugged));
+            let what = if plugged { "plugged" } else { "unplugged" };
+            // A log line, not the transcript: that holds the console's
+            // lines only.
+            log::info!(
+                "bench: servo in slot {} {}",
+                slot + 1,
+                if done { what } else { "not there" }
+            );
         }
         Step::WaitMs(ms) => Timer::after_millis(ms).await,
         Step::Send(line) => {
@@ -248,15 +267,10 @@ async fn run_step(
 }
 
 /// Types the script: each command line, then waits for its closing reply;
-/// `@button` steps press the board's stop `button`.
-pub async fn script_task(
-    steps: Vec<Step>,
-    host: Rc<UsbHost>,
-    button: Rc<ButtonContacts>,
-    controls: Option<Rc<ControlWiring>>,
-) {
+/// `@` steps act through `hands`.
+pub async fn script_task(steps: Vec<Step>, host: Rc<UsbHost>, hands: Hands) {
     for step in steps {
-        run_step(&host, step, Some(&button), controls.as_deref()).await;
+        run_step(&host, step, Some(&hands)).await;
     }
     host.replies_read().await;
     host.transcript.borrow_mut().script_done = true;
@@ -270,7 +284,7 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
         match lines.try_recv() {
             Ok(line) => {
                 for step in crate::script::parse_script(&line).unwrap_or_default() {
-                    run_step(&host, step, None, None).await;
+                    run_step(&host, step, None).await;
                 }
             }
             Err(std::sync::mpsc::TryRecvError::Empty) => Timer::after_millis(20).await,
@@ -282,13 +296,12 @@ pub async fn interactive_task(lines: std::sync::mpsc::Receiver<String>, host: Rc
 
 /// Starts the simulated host: the script (or the interactive terminal)
 /// typing (from stdin when `interactive`), and the terminal reading;
-/// `@button` presses `button`.
+/// `@` steps act through `hands`.
 pub fn host_tasks(
     interactive: bool,
     script: Vec<Step>,
     host: Rc<UsbHost>,
-    button: Rc<ButtonContacts>,
-    controls: Option<Rc<ControlWiring>>,
+    hands: Hands,
 ) -> impl FnOnce(&Spawner) + 'static {
     move |spawner| {
         if interactive {
@@ -311,7 +324,7 @@ pub fn host_tasks(
                 spawner,
                 "host (script)",
                 TaskKind::Simulator,
-                script_task(script, host.clone(), button, controls),
+                script_task(script, host.clone(), hands),
             );
         }
         executor::spawn_task(
@@ -380,75 +393,4 @@ pub async fn terminal_task(host: Rc<UsbHost>) {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::executor;
-
-    /// A device that answers every line with `ok`.
-    async fn echo_ok_device(host: Rc<UsbHost>) {
-        let mut buf = [0u8; 64];
-        loop {
-            let n = host.to_device.read(&mut buf).await;
-            for _ in buf[..n].iter().filter(|&&b| b == b'\n') {
-                host.from_device.write_all(b"ok\r\n").await;
-            }
-        }
-    }
-
-    #[test]
-    fn interactive_lines_are_typed_in_order_until_the_input_ends() {
-        let host = Rc::new(UsbHost::new(false));
-        let (send, lines) = std::sync::mpsc::channel();
-        for line in ["status", "# a comment", "wait 100", "goto 1 2"] {
-            send.send(line.to_owned()).unwrap();
-        }
-        drop(send);
-        let (h1, h2, h3, stop) = (host.clone(), host.clone(), host.clone(), host.clone());
-        let end = executor::run(
-            false,
-            10_000_000,
-            move |spawner| {
-                executor::spawn(&spawner, interactive_task(lines, h1));
-                executor::spawn(&spawner, terminal_task(h2));
-                executor::spawn(&spawner, echo_ok_device(h3));
-            },
-            move || stop.transcript.borrow().script_done,
-        );
-        assert_eq!(end, executor::RunEnd::Stopped);
-        let transcript = host.transcript.borrow();
-        let lines: Vec<&str> = transcript.lines.iter().map(|(_, l)| l.as_str()).collect();
-        assert_eq!(lines, ["> status", "ok", "> goto 1 2", "ok"]);
-        let goto_at = transcript.lines[2].0;
-        assert!(goto_at >= 100_000, "the wait line waited: {goto_at} µs");
-    }
-
-    #[test]
-    fn a_stalled_terminal_reads_nothing_until_the_stall_ends() {
-        let host = Rc::new(UsbHost::new(false));
-        let steps =
-            crate::script::parse_script("@stall-read 500\n@type-ahead a\nb\nwait 10\nc\n").unwrap();
-        let (h1, h2, h3, stop) = (host.clone(), host.clone(), host.clone(), host.clone());
-        let end = executor::run(
-            false,
-            10_000_000,
-            move |spawner| {
-                let button = Rc::new(ButtonContacts::default());
-                executor::spawn(&spawner, script_task(steps, h1, button, None));
-                executor::spawn(&spawner, terminal_task(h2));
-                executor::spawn(&spawner, echo_ok_device(h3));
-            },
-            move || stop.transcript.borrow().script_done,
-        );
-        assert_eq!(end, executor::RunEnd::Stopped);
-        let transcript = host.transcript.borrow();
-        let lines: Vec<&str> = transcript.lines.iter().map(|(_, l)| l.as_str()).collect();
-        assert_eq!(lines, ["> a", "> b", "ok", "ok", "> c", "ok"]);
-        let first_ok = transcript.lines[2].0;
-        assert!(
-            first_ok >= 500_000,
-            "read during the stall at {first_ok} µs"
-        );
-        assert!(transcript.lines[1].0 < 1_000, "typed during the stall");
-        assert!(transcript.unterminated.is_empty());
-    }
-}
+mod tests;

@@ -35,7 +35,7 @@ use crate::servo_model::SimServoBus;
 use crate::servo_port::SimServoPort;
 use crate::spot::{RecordingLaser, SpotFn, gimbal_spot_cm, spot_sampler};
 use crate::stepper::{PanTiltDrivers, SimStepperDrive, StepperGeometry};
-use crate::usb_host::{UsbHost, host_tasks};
+use crate::usb_host::{Hands, UsbHost, host_tasks};
 
 mod options;
 
@@ -122,10 +122,11 @@ impl World {
             options.laser_controls || options.script.iter().any(|s| s.uses_laser_controls());
         let recording = Rc::new(RefCell::new(Recording::default()));
         let gimbal = options.physical;
-        let bus = Rc::new(RefCell::new(SimServoBus::new(
-            &[gimbal.yaw_id, gimbal.pitch_id],
-            options.slow_factor,
-        )));
+        let ids = options
+            .servo_ids
+            .clone()
+            .unwrap_or_else(|| vec![gimbal.yaw_id, gimbal.pitch_id]);
+        let bus = Rc::new(RefCell::new(SimServoBus::new(&ids, options.slow_factor)));
         let port = Rc::new(SimServoPort::new(
             bus.clone(),
             recording.clone(),
@@ -210,8 +211,11 @@ impl World {
                 options.interactive,
                 options.script.clone(),
                 self.host.clone(),
-                self.button.clone(),
-                self.controls.clone(),
+                Hands {
+                    button: self.button.clone(),
+                    bus: self.bus.clone(),
+                    controls: self.controls.clone(),
+                },
             )),
         };
         let mut sim_spawner = SimSpawner::new(spawner, host_tasks);

@@ -22,7 +22,7 @@ use fashionstar::testing::frame as encode;
 use fashionstar::{
     MAX_FRAME_LEN, MAX_READ_DATA_LEN, MAX_SYNC_SERVOS, Message, Monitor, ReadData, Request,
     Response, SetAngle, SetAngleByInterval, SetAngleByVelocity, StreamDecoder, SyncEntries,
-    checksum,
+    WriteResult, checksum,
 };
 
 use crate::Bytes;
@@ -62,6 +62,7 @@ pub fn response_kind(r: &Response) -> &'static str {
         Response::Angle { .. } => "angle",
         Response::Monitor(_) => "monitor",
         Response::ReadData(_) => "read-data",
+        Response::WriteData(_) => "write-data",
     }
 }
 
@@ -70,6 +71,7 @@ pub fn request_kind(r: &Request) -> &'static str {
     match r {
         Request::Ping { .. } => "ping",
         Request::ReadData { .. } => "read-data",
+        Request::WriteData { .. } => "write-data",
         Request::SetAngle(_) => "set-angle",
         Request::Damping { .. } => "damping",
         Request::QueryAngle { .. } => "query-angle",
@@ -210,7 +212,7 @@ fn entries<T>(b: &mut Bytes<'_>, entry: fn(&mut Bytes<'_>) -> T) -> SyncEntries<
 
 /// A request of every kind the codec models, fields from the bytes.
 fn generated_request(b: &mut Bytes<'_>) -> Request {
-    match b.u8() % 11 {
+    match b.u8() % 12 {
         0 => Request::Ping { id: b.u8() },
         1 => Request::ReadData {
             id: b.u8(),
@@ -227,14 +229,30 @@ fn generated_request(b: &mut Bytes<'_>) -> Request {
         7 => Request::QueryMonitor { id: b.u8() },
         8 => Request::SyncSetAngle(entries(b, set_angle)),
         9 => Request::SyncSetAngleByInterval(entries(b, by_interval)),
+        10 => {
+            let (id, address) = (b.u8(), b.u8());
+            let len = 1 + usize::from(b.u8()) % MAX_READ_DATA_LEN;
+            let mut data = heapless::Vec::new();
+            for _ in 0..len {
+                if data.push(b.u8()).is_err() {
+                    unreachable!("len ≤ MAX_READ_DATA_LEN");
+                }
+            }
+            Request::WriteData { id, address, data }
+        }
         _ => Request::SyncSetAngleByVelocity(entries(b, by_velocity)),
     }
 }
 
 /// A response of every kind the codec models, fields from the bytes.
 fn generated_response(b: &mut Bytes<'_>) -> Response {
-    match b.u8() % 4 {
+    match b.u8() % 5 {
         0 => Response::Ping { id: b.u8() },
+        3 => Response::WriteData(WriteResult {
+            id: b.u8(),
+            address: b.u8(),
+            result: b.u8(),
+        }),
         1 => Response::Angle {
             id: b.u8(),
             angle_tenths_deg: b.u16() as i16,

@@ -101,6 +101,7 @@ fn console_corpus_holds_and_covers_every_command() {
         "set",
         "get",
         "trace",
+        "servo",
     ];
     for name in every {
         assert!(commands.contains(name), "no corpus input parses `{name}`");
@@ -122,7 +123,7 @@ fn servo_protocol_corpus_holds_and_covers_every_frame_kind() {
         .iter()
         .flat_map(|s| s.requests.iter().copied())
         .collect();
-    for kind in ["ping", "angle", "monitor", "read-data"] {
+    for kind in ["ping", "angle", "monitor", "read-data", "write-data"] {
         assert!(
             responses.contains(kind),
             "no corpus frame decodes as response {kind}"
@@ -131,6 +132,7 @@ fn servo_protocol_corpus_holds_and_covers_every_frame_kind() {
     for kind in [
         "ping",
         "read-data",
+        "write-data",
         "set-angle",
         "damping",
         "query-angle",

@@ -229,6 +229,9 @@ pub fn run_scenario(
             BoardStep::Script(Step::Interlock(_) | Step::Key(_)) => {
                 bail!("the interlock and key cannot be switched over the console")
             }
+            BoardStep::Script(Step::ServoCable { .. }) => {
+                bail!("a servo cannot be unplugged over the console")
+            }
             BoardStep::Script(Step::ClosePort | Step::OpenPort) => {
                 bail!("@close/@open: the harness keeps its port open")
             }

@@ -79,6 +79,15 @@ pub fn run_step(machine: &mut Machine, step: &BoardStep, deadline: Instant) -> R
         BoardStep::Script(Step::Realtime(byte)) => machine.send_realtime(*byte)?,
         BoardStep::Script(Step::Interlock(closed)) => machine.set_interlock(*closed)?,
         BoardStep::Script(Step::Key(on)) => machine.set_key(*on)?,
+        BoardStep::Script(Step::ServoCable { slot, plugged }) => {
+            let mut side = machine
+                .servos
+                .lock()
+                .map_err(|_| anyhow::anyhow!("the servo bus thread panicked"))?;
+            if !side.bus.set_plugged(*slot, *plugged) {
+                anyhow::bail!("the servo bus has no slot {}", slot + 1);
+            }
+        }
         BoardStep::Script(Step::ClosePort | Step::OpenPort) => {
             anyhow::bail!("@close/@open: the QEMU board's console is a UART (no port to close)")
         }

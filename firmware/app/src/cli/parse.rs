@@ -2,7 +2,7 @@
 
 use super::args::Args;
 use super::error::{CommandError, word};
-use crate::command::Command;
+use crate::command::{Command, ServoSetup};
 use crate::domain::{Actuator, AimModel, Figure, GridPattern, Pattern, PointCm, Rotation};
 use crate::settings::{JumpPlanner, LaserMode, find_param};
 
@@ -82,6 +82,8 @@ fn parse_command(name: &str, args: &mut Args<'_>) -> Result<Command, CommandErro
             expected: "a parameter name (see 'params')",
             got: word(name),
         })?)
+    } else if is("servo") {
+        Command::Servo(servo_setup(args)?)
     } else if let Some(command) = mode_command(name, args)? {
         command
     } else {
@@ -273,6 +275,59 @@ fn circle(args: &mut Args<'_>) -> Result<Pattern, CommandError> {
 
 /// The next word as one of `choices` (ASCII case-insensitive); `expected`
 /// names them in the error.
+/// A servo bus id as the set-up commands take it (0–254; 255 is the
+/// broadcast address).
+fn servo_id(args: &mut Args<'_>, what: &'static str) -> Result<u8, CommandError> {
+    let id = args.integer(what, 0, i32::from(fashionstar::MAX_SERVO_ID))?;
+    // In 0..=254 by the range check.
+    Ok(u8::try_from(id).unwrap_or(fashionstar::MAX_SERVO_ID))
+}
+
+/// `servo scan|ping <id>|id <id> <new> [confirm]|zero <id>`.
+fn servo_setup(args: &mut Args<'_>) -> Result<ServoSetup, CommandError> {
+    #[derive(Clone, Copy)]
+    enum Verb {
+        Scan,
+        Ping,
+        Id,
+        Zero,
+    }
+    let verb = keyword(
+        args,
+        "scan|ping|id|zero",
+        &[
+            ("scan", Verb::Scan),
+            ("ping", Verb::Ping),
+            ("id", Verb::Id),
+            ("zero", Verb::Zero),
+        ],
+    )?;
+    Ok(match verb {
+        Verb::Scan => ServoSetup::Scan,
+        Verb::Ping => ServoSetup::Ping(servo_id(args, "id")?),
+        Verb::Zero => ServoSetup::Zero(servo_id(args, "id")?),
+        Verb::Id => {
+            let id = servo_id(args, "id")?;
+            let new_id = servo_id(args, "new id")?;
+            let confirmed = match args.next_word() {
+                None => false,
+                Some(w) if w.eq_ignore_ascii_case("confirm") => true,
+                Some(w) => {
+                    return Err(CommandError::InvalidArgument {
+                        expected: "confirm",
+                        got: word(w),
+                    });
+                }
+            };
+            ServoSetup::SetId {
+                id,
+                new_id,
+                confirmed,
+            }
+        }
+    })
+}
+
 fn keyword<T: Copy>(
     args: &mut Args<'_>,
     expected: &'static str,

@@ -58,7 +58,7 @@ mod tests {
     /// Every command word of the product (cli/parse.rs).
     const PRODUCT_WORDS: &[&str] = &[
         "help", "version", "status", "stop", "params", "target", "planner", "galvo", "save",
-        "pattern", "goto", "grid", "laser", "model", "set", "get", "home", "trace", "arm",
+        "pattern", "goto", "grid", "laser", "model", "set", "get", "home", "trace", "arm", "servo",
     ];
 
     #[test]

@@ -76,6 +76,7 @@ impl Core {
                 out.act(Action::Save);
             }
             Command::Grbl(line) => self.grbl_line(line.as_str(), out),
+            Command::Servo(setup) => self.servo_setup(setup, out),
         }
     }
 

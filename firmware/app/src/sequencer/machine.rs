@@ -48,6 +48,12 @@ pub(super) enum Pending {
     },
     /// A save in flight, answered by [`Event::Saved`].
     Save,
+    /// A servo bus set-up job in flight, answered by its
+    /// `ServoOutcome::Bus` reports.
+    ServoBus {
+        /// Its request number.
+        seq: u32,
+    },
 }
 
 /// What follows a pattern check.

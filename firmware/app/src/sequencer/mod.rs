@@ -21,6 +21,7 @@ mod laser;
 mod machine;
 mod report;
 mod run;
+mod servo_setup;
 mod trace;
 
 use embassy_futures::select::{Either, Either3, Either4, select, select3, select4};

@@ -79,15 +79,131 @@ pub enum ServoRequest {
         /// 0.1° (used from now on by the plausibility filter).
         ranges_tenths: [(i16, i16); 2],
     },
+    /// A bus set-up job (console `servo …`): reported with
+    /// [`ServoOutcome::Bus`] lines and one [`BusReport::Done`].
+    Setup {
+        /// Request number.
+        seq: u32,
+        /// What to do.
+        job: BusJob,
+    },
 }
 
 impl ServoRequest {
     /// The request number.
     pub fn seq(&self) -> u32 {
         match self {
-            ServoRequest::Move { seq, .. } => *seq,
+            ServoRequest::Move { seq, .. } | ServoRequest::Setup { seq, .. } => *seq,
         }
     }
+}
+
+/// A servo-bus set-up job (the procedures are in `task/setup.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BusJob {
+    /// Ping every id 0–254, then read the monitor data of each that
+    /// answered.
+    Scan,
+    /// Ping servo `id` and read its monitor data.
+    Ping {
+        /// Bus id.
+        id: u8,
+    },
+    /// Give servo `id` the bus id `new_id` (data-table address 34),
+    /// only when it is the one servo answering on the bus.
+    SetId {
+        /// Its id now.
+        id: u8,
+        /// Its new id (0–254).
+        new_id: u8,
+    },
+    /// Read servo `id`'s angle (for `servo zero`).
+    ReadAngle {
+        /// Bus id.
+        id: u8,
+    },
+}
+
+/// One servo as a scan or ping found it (its monitor data).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ServoReading {
+    /// Bus id.
+    pub id: u8,
+    /// Angle, 0.1°.
+    pub angle_tenths: i32,
+    /// Supply voltage, mV.
+    pub voltage_mv: u16,
+    /// Temperature as the raw NTC ADC value (see
+    /// [`fashionstar::Monitor::temperature_raw`]).
+    pub temperature_raw: u16,
+}
+
+/// What a set-up job reports: zero or more lines, then its end.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BusReport {
+    /// A servo answered (a data line).
+    Servo(ServoReading),
+    /// Servo id `id` answered with garbled frames: more than one servo
+    /// has this id (a data line).
+    Collision {
+        /// Bus id.
+        id: u8,
+    },
+    /// The job ended.
+    Done(BusEnd),
+}
+
+/// How a set-up job ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BusEnd {
+    /// A scan: this many ids answered cleanly, this many garbled.
+    Scanned {
+        /// Ids that answered.
+        answering: u8,
+        /// Ids whose answers collided.
+        collisions: u8,
+    },
+    /// A ping was answered.
+    Answered,
+    /// Servo `id` now answers as `new_id`.
+    IdChanged {
+        /// Its old id.
+        id: u8,
+        /// Its new id.
+        new_id: u8,
+    },
+    /// The angle of a [`BusJob::ReadAngle`], 0.1°.
+    Angle {
+        /// Bus id.
+        id: u8,
+        /// Angle, 0.1°.
+        tenths: i16,
+    },
+    /// Servo `id` did not answer (or only garbled).
+    NoAnswer {
+        /// Bus id.
+        id: u8,
+    },
+    /// `servo id` refused: not exactly one servo (`id`) answers on the
+    /// bus.
+    NotAlone {
+        /// Ids that answered cleanly.
+        answering: u8,
+        /// Ids whose answers collided.
+        collisions: u8,
+    },
+    /// The servo answered the write with a failure result, or did not
+    /// answer as `new_id` afterwards.
+    WriteFailed {
+        /// Its id.
+        id: u8,
+    },
+    /// Writing to the UART failed.
+    BusError,
 }
 
 /// Why a servo is considered faulty. `Debug` prints what `derive(Debug)`
@@ -174,6 +290,13 @@ pub enum ServoOutcome {
     Recovered {
         /// Bus id.
         id: u8,
+    },
+    /// A line or the end of set-up job `seq`.
+    Bus {
+        /// Request number.
+        seq: u32,
+        /// What it reports.
+        report: BusReport,
     },
 }
 

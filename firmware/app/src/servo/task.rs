@@ -26,7 +26,12 @@ use super::plausibility::{IMPLAUSIBLE_RUN, ReadingFilter, Verdict};
 use crate::log;
 
 pub use super::id_set::ServoIdSet;
-pub use super::link::{ServoBusConfig, ServoFault, ServoLink, ServoOutcome, ServoRequest};
+pub use super::link::{
+    BusEnd, BusJob, BusReport, ServoBusConfig, ServoFault, ServoLink, ServoOutcome, ServoReading,
+    ServoRequest,
+};
+
+mod setup;
 
 /// Power limit sent with every move, mW (0 = the servo's own limit).
 const POWER_MW: u16 = 0;
@@ -102,7 +107,9 @@ impl<R: Read, W: Write> ServoBus<R, W> {
                     continue;
                 }
             };
-            last_move = Some(request.seq());
+            if matches!(request, ServoRequest::Move { .. }) {
+                last_move = Some(request.seq());
+            }
             next_health_check = Instant::now() + health_period;
             let outcome = self.serve(request, link).await;
             match outcome {
@@ -156,6 +163,10 @@ impl<R: Read, W: Write> ServoBus<R, W> {
 
     async fn serve(&mut self, request: ServoRequest, link: &ServoLink) -> ServoOutcome {
         match request {
+            ServoRequest::Setup { seq, job } => ServoOutcome::Bus {
+                seq,
+                report: BusReport::Done(self.setup(seq, job, link).await),
+            },
             ServoRequest::Move {
                 seq,
                 yaw_tenths,

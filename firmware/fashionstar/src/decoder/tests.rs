@@ -106,15 +106,15 @@ fn bad_length_is_reported_at_the_length_byte() {
 
 #[test]
 fn unknown_code_frame_is_skipped_whole() {
-    // A write-data response (code 4: id, address, result) is intact but
-    // not modelled: 05+1C+04+03+00+21+01 = 0x4A.
-    let mut bytes = std::vec![0x05, 0x1C, 0x04, 0x03, 0x00, 0x21, 0x01, 0x4A];
+    // A code-5 frame (the SDK's unused "query servo info") is intact but
+    // not modelled: 05+1C+05+03+00+21+01 = 0x4B.
+    let mut bytes = std::vec![0x05, 0x1C, 0x05, 0x03, 0x00, 0x21, 0x01, 0x4B];
     bytes.extend(PING0);
     let mut d = ResponseDecoder::new();
     assert_eq!(
         all(&mut d, &bytes),
         [
-            Err(DecodeError::UnknownCode { code: 4 }),
+            Err(DecodeError::UnknownCode { code: 5 }),
             Ok(Response::Ping { id: 0 })
         ]
     );

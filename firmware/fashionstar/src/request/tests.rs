@@ -38,6 +38,42 @@ fn query_angle_monitor_read_data() {
     );
 }
 
+/// What the SDK's `write_data(servo_id, 34, bytes([new_id]))` sends
+/// (`Packet.pack(4, ustruct.pack('<BB', servo_id, 34) + content)`;
+/// `FSUS_WriteData` builds the same buffer).
+#[test]
+fn write_data_servo_id() {
+    // id 0 → 1: 5E (12+4C) +04+03 = 65; +00+22 = 87; +01 = 88
+    assert_eq!(
+        frame(&Request::set_servo_id(0, 1)),
+        [0x12, 0x4C, 0x04, 0x03, 0x00, 0x22, 0x01, 0x88]
+    );
+    // id 5 → 254: 65 +05 = 6A; +22 = 8C; +FE = 18A → 0x8A
+    assert_eq!(
+        frame(&Request::set_servo_id(5, 254)),
+        [0x12, 0x4C, 0x04, 0x03, 0x05, 0x22, 0xFE, 0x8A]
+    );
+    let r = Request::set_servo_id(0, 1);
+    assert_eq!(r.id(), Some(0));
+    assert!(r.expects_response());
+    assert_eq!(r.motion_for(0), None);
+}
+
+#[test]
+fn write_data_of_two_bytes() {
+    // id 1, address 38 (0x26), value 0x1234 little-endian (34 12):
+    // 5E +04+04 = 66; +01+26 = 8D; +34+12 = D3
+    let r = Request::WriteData {
+        id: 1,
+        address: 38,
+        data: Vec::from_slice(&[0x34, 0x12]).unwrap(),
+    };
+    assert_eq!(
+        frame(&r),
+        [0x12, 0x4C, 0x04, 0x04, 0x01, 0x26, 0x34, 0x12, 0xD3]
+    );
+}
+
 #[test]
 fn set_angle() {
     // id 0, 90.0° = 900 = 0x0384, 500 ms = 0x01F4, power 0:

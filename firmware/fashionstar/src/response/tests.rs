@@ -102,3 +102,33 @@ fn parse_rejects_wrong_lengths_and_codes() {
     assert!(Response::parse(code::READ_DATA, &[0; 2 + MAX_READ_DATA_LEN]).is_ok());
     assert!(Response::parse(code::READ_DATA, &[0; 3 + MAX_READ_DATA_LEN]).is_err());
 }
+
+/// What the SDK's `response_write_data` unpacks (`<BBB`: id, address,
+/// result; `FSUS_WriteData` reads the result at `content[2]`).
+#[test]
+fn write_data() {
+    // id 0, address 34 (0x22), result 1: 05+1C+04+03 = 28; +00+22 = 4A; +01 = 4B
+    let ok = Response::WriteData(WriteResult {
+        id: 0,
+        address: 34,
+        result: 1,
+    });
+    assert_eq!(frame(&ok), [0x05, 0x1C, 0x04, 0x03, 0x00, 0x22, 0x01, 0x4B]);
+    // result 0 (refused): 4A
+    let refused = Response::WriteData(WriteResult {
+        id: 0,
+        address: 34,
+        result: 0,
+    });
+    assert_eq!(
+        frame(&refused),
+        [0x05, 0x1C, 0x04, 0x03, 0x00, 0x22, 0x00, 0x4A]
+    );
+    let Response::WriteData(w) = ok else {
+        unreachable!()
+    };
+    assert!(w.succeeded());
+    assert!(ok.answers(&Request::set_servo_id(0, 1)));
+    assert!(!ok.answers(&Request::set_servo_id(1, 0)));
+    assert!(!ok.answers(&Request::ReadData { id: 0, address: 34 }));
+}

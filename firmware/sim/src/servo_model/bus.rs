@@ -25,10 +25,21 @@ pub struct BusFrame {
     pub bytes: Vec<u8>,
 }
 
-/// Several simulated servos sharing one half-duplex line.
+/// Several simulated servos sharing one half-duplex line, each on its own
+/// cable (slot) that can be unplugged and plugged back.
+///
+/// Two servos with one id (FashionStar servos ship that way) both carry
+/// out what is addressed to it and both answer at once: their answers
+/// collide on the line. The model: the controller receives one frame, the
+/// bytewise AND of the answers (an idle-high line: a 0 bit from either
+/// wins) as long as the longest, with its checksum byte inverted — the two
+/// never start in exact bit alignment, so the collision always fails the
+/// checksum (even for identical answers, such as a ping's).
 #[derive(Default)]
 pub struct SimServoBus {
     servos: Vec<SimServo>,
+    /// Slots whose cable is unplugged (their servos hear and say nothing).
+    unplugged: Vec<bool>,
     decoder: RequestDecoder,
     /// The line is busy with responses until then, µs.
     line_free_at_us: u64,
@@ -50,12 +61,30 @@ impl SimServoBus {
         )
     }
 
-    /// A bus with these servos.
+    /// A bus with these servos (slots 0, 1, … in this order).
     pub fn from_servos(servos: Vec<SimServo>) -> Self {
         Self {
+            unplugged: vec![false; servos.len()],
             servos,
             ..Self::default()
         }
+    }
+
+    /// Unplugs (or plugs back) the cable of the servo in `slot` (0: the
+    /// first servo given); `false` when there is no such slot.
+    pub fn set_plugged(&mut self, slot: usize, plugged: bool) -> bool {
+        match self.unplugged.get_mut(slot) {
+            Some(unplugged) => {
+                *unplugged = !plugged;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The servo in `slot`.
+    pub fn servo_in_slot(&self, slot: usize) -> Option<&SimServo> {
+        self.servos.get(slot)
     }
 
     /// Servo `id`.
@@ -122,13 +151,24 @@ impl SimServoBus {
             direction: BusDirection::Tx,
             bytes: frame,
         });
-        for servo in &mut self.servos {
+        let mut frames: Vec<Vec<u8>> = Vec::new();
+        for (servo, unplugged) in self.servos.iter_mut().zip(&self.unplugged) {
+            if *unplugged {
+                continue;
+            }
             let Some(response) = servo.execute(end_us, request) else {
                 continue;
             };
-            let Ok(frame) = response.to_frame() else {
-                continue;
-            };
+            if let Ok(frame) = response.to_frame() {
+                frames.push(frame.to_vec());
+            }
+        }
+        let frame = match frames.len() {
+            0 => None,
+            1 => frames.pop(),
+            _ => Some(collide(&frames)),
+        };
+        if let Some(frame) = frame {
             let start = (end_us + PROCESSING_DELAY_US).max(self.line_free_at_us);
             self.line_free_at_us = start + wire_time_us(frame.len());
             self.frames.push(BusFrame {
@@ -156,4 +196,21 @@ impl SimServoBus {
     pub fn decode_errors(&self) -> u64 {
         self.decode_errors
     }
+}
+
+/// What the controller receives when `frames` (two or more) are sent at
+/// once: their bytewise AND, as long as the longest, checksum inverted
+/// (see [`SimServoBus`]).
+fn collide(frames: &[Vec<u8>]) -> Vec<u8> {
+    let len = frames.iter().map(Vec::len).max().unwrap_or(0);
+    let mut line = vec![0xFF; len];
+    for frame in frames {
+        for (wire, byte) in line.iter_mut().zip(frame) {
+            *wire &= byte;
+        }
+    }
+    if let Some(checksum) = line.last_mut() {
+        *checksum = !*checksum;
+    }
+    line
 }

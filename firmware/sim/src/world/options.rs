@@ -29,6 +29,11 @@ pub struct SimOptions {
     pub faults: BusFaults,
     /// Servos move this many times slower than commanded (1 = nominal).
     pub slow_factor: f64,
+    /// The ids the servos on the bus have at power-up, in slot order (the
+    /// first drives yaw, the second pitch; `@unplug-servo <slot>` counts
+    /// from 1). `None`: the physical gimbal's `yaw_id` and `pitch_id`.
+    /// `Some(vec![0, 0])` is two servos as they ship.
+    pub servo_ids: Option<Vec<u8>>,
     /// Hard limit on simulated time, ms.
     pub max_time_ms: u64,
     /// Print the terminal transcript on stdout as it happens.
@@ -88,6 +93,7 @@ impl Default for SimOptions {
             until_idle: false,
             faults: BusFaults::default(),
             slow_factor: 1.0,
+            servo_ids: None,
             max_time_ms: 600_000,
             echo: false,
             sample_period_us: 2_000,

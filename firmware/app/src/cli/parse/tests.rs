@@ -205,6 +205,10 @@ fn every_help_line_names_a_command_that_parses_with_its_example() {
         "status",
         "version",
         "trace on",
+        "servo scan",
+        "servo ping 0",
+        "servo id 0 1 confirm",
+        "servo zero 1",
         "help",
     ];
     assert_eq!(examples.len(), HELP_LINES.len());
@@ -217,4 +221,48 @@ fn every_help_line_names_a_command_that_parses_with_its_example() {
         }
         assert!(matches!(parse_line(example), Ok(Some(_))), "{example}");
     }
+}
+
+#[test]
+fn servo_setup_commands_parse_and_bad_ids_are_refused() {
+    use crate::command::ServoSetup;
+    assert_eq!(ok("servo scan"), Command::Servo(ServoSetup::Scan));
+    assert_eq!(ok("SERVO ping 254"), Command::Servo(ServoSetup::Ping(254)));
+    assert_eq!(ok("servo zero 1"), Command::Servo(ServoSetup::Zero(1)));
+    assert_eq!(
+        ok("servo id 0 1"),
+        Command::Servo(ServoSetup::SetId {
+            id: 0,
+            new_id: 1,
+            confirmed: false
+        })
+    );
+    assert_eq!(
+        ok("servo id 0 7 CONFIRM"),
+        Command::Servo(ServoSetup::SetId {
+            id: 0,
+            new_id: 7,
+            confirmed: true
+        })
+    );
+    for bad in [
+        "servo",
+        "servo frob",
+        "servo ping",
+        "servo ping 255",
+        "servo ping -1",
+        "servo id 0",
+        "servo id 0 255 confirm",
+        "servo id 0 1 yes",
+        "servo id 0 1 confirm now",
+        "servo scan 3",
+        "servo zero 1.5",
+    ] {
+        assert!(parse_line(bad).is_err(), "{bad}");
+    }
+    // The command prints back as typed.
+    assert_eq!(
+        std::format!("{:?}", ok("servo id 0 7 confirm")),
+        "servo id 0 7 confirm"
+    );
 }

@@ -455,6 +455,9 @@ impl Harness {
                 assert!(self.core.actuator.uses_gimbal(), "servo move on the galvo");
                 self.move_owed = Some(*seq);
             }
+            Action::Servo(ServoRequest::Setup { .. }) => {
+                assert!(!self.running, "servo set-up while running");
+            }
             Action::Galvo(GalvoRequest::Stop) => {
                 // The loop drops its jobs unreported.
                 self.galvo_room = GALVO_REQUEST_DEPTH - 1;

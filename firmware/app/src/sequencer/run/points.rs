@@ -246,6 +246,7 @@ impl Core {
             } => self.arrived(seq, (yaw_tenths, pitch_tenths), out),
             ServoOutcome::Fault { seq, id, fault } => self.servo_fault(seq, id, fault, out),
             ServoOutcome::Superseded { .. } => {}
+            ServoOutcome::Bus { seq, report } => self.servo_bus_report(seq, report, out),
         }
         if gcode_fault {
             self.stop("servo fault during G-code", out);
