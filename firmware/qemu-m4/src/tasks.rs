@@ -133,10 +133,7 @@ impl Spawn<QemuBoard> for TaskSpawner {
     }
 
     #[cfg(feature = "laser-controls")]
-    fn laser_controls(
-        &mut self,
-        task: LaserControlsTask<crate::controls::ChannelLaserControls>,
-    ) {
+    fn laser_controls(&mut self, task: LaserControlsTask<crate::controls::ChannelLaserControls>) {
         spawned("laser controls", laser_controls(task), &self.0);
     }
 
