@@ -9,10 +9,9 @@ use std::vec::Vec;
 
 use embassy_time::Instant;
 
-use super::super::machine::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
+use super::super::machine::{Action, Core, Event, Inputs, Line};
 use super::NO_CONTROLS;
 use crate::command::{Command, RealtimeRequest};
-use crate::galvo::ScanPhase;
 use crate::grbl::realtime::Realtime;
 use crate::laser_controls::{ControlInputs, ControlsState, ControlsView, LatchCause};
 use crate::sequencer::LaserEvent;
@@ -32,16 +31,7 @@ fn on(core: &mut Core, controls: Option<ControlsView>, event: Event) -> Vec<Acti
 }
 
 fn command(core: &mut Core, controls: Option<ControlsView>, command: Command) -> Vec<Action> {
-    let readings = Readings {
-        galvo: GalvoReadout {
-            phase: ScanPhase::Idle,
-            queued: 0,
-            underruns: 0,
-            halves: 0,
-            refill: None,
-        },
-        implausible_readings: 0,
-    };
+    let readings = crate::sequencer::gcode::tests::READINGS;
     on(core, controls, Event::Command { command, readings })
 }
 

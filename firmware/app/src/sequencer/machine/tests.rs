@@ -7,10 +7,10 @@ use std::vec::Vec;
 
 use embassy_time::Instant;
 
-use super::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
+use super::{Action, Core, Event, Inputs, Line};
 use crate::command::Command;
 use crate::domain::{Actuator, GridPattern, Pattern, PointCm};
-use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest, ScanPhase};
+use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest};
 use crate::sequencer::LaserEvent;
 use crate::servo::task::{ServoOutcome, ServoRequest};
 use crate::settings::{JumpPlanner, LaserMode};
@@ -21,16 +21,7 @@ use crate::text::reply_text;
 const GALVO: bool = true;
 const NO_GALVO: bool = false;
 
-const READINGS: Readings = Readings {
-    galvo: GalvoReadout {
-        phase: ScanPhase::Idle,
-        queued: 0,
-        underruns: 0,
-        halves: 0,
-        refill: None,
-    },
-    implausible_readings: 0,
-};
+use crate::sequencer::gcode::tests::READINGS;
 
 fn on_with(core: &mut Core, ms: u64, galvo: bool, event: Event) -> Vec<Action> {
     let inputs = Inputs {

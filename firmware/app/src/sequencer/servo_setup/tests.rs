@@ -5,20 +5,10 @@ use embassy_time::Instant;
 
 use super::celsius;
 use crate::command::{Command, ServoSetup};
-use crate::galvo::ScanPhase;
-use crate::sequencer::{Action, Core, Event, GalvoReadout, Inputs, Line, Readings};
+use crate::sequencer::{Action, Core, Event, Inputs, Line};
 use crate::servo::task::{BusEnd, BusJob, BusReport, ServoOutcome, ServoReading, ServoRequest};
 
-const READINGS: Readings = Readings {
-    galvo: GalvoReadout {
-        phase: ScanPhase::Idle,
-        queued: 0,
-        underruns: 0,
-        halves: 0,
-        refill: None,
-    },
-    implausible_readings: 0,
-};
+use crate::sequencer::gcode::tests::READINGS;
 
 fn on(core: &mut Core, event: Event) -> Vec<Action> {
     let inputs = Inputs {
