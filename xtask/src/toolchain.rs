@@ -122,12 +122,12 @@ pub fn test() -> Result<()> {
     crate::bench_m4::cargo_in(crate::qemu::MANIFEST, &["fmt", "--check"])?;
 
     let mut clippy_host = vec!["clippy", "--all-targets"];
-    clippy_host.extend(package_args(&HOST_PACKAGES));
+    clippy_host.extend(package_args(HOST_PACKAGES));
     clippy_host.extend(["--", "-D", "warnings"]);
     run("cargo", &clippy_host)?;
 
     let mut clippy_target = vec!["-p", "firmware"];
-    clippy_target.extend(package_args(&TARGET_LIBRARIES));
+    clippy_target.extend(package_args(TARGET_LIBRARIES));
     run("cargo", &target_clippy_args(&clippy_target))?;
     // bench-m4 is a workspace of its own (see its Cargo.toml).
     crate::bench_m4::cargo(&target_clippy_args(&[]))?;
@@ -136,7 +136,7 @@ pub fn test() -> Result<()> {
 
     // The libraries for the target.
     let mut build_libs = vec!["build", "--target", TARGET, "--release"];
-    build_libs.extend(package_args(&TARGET_LIBRARIES));
+    build_libs.extend(package_args(TARGET_LIBRARIES));
     run("cargo", &build_libs)?;
 
     // The per-sample and refill budgets on the target's instruction set,
@@ -146,7 +146,7 @@ pub fn test() -> Result<()> {
 
     // Unit, integration (tests/) and doc tests of every host crate.
     let mut tests = vec!["test"];
-    tests.extend(package_args(&HOST_PACKAGES));
+    tests.extend(package_args(HOST_PACKAGES));
     run_with_env("cargo", &tests, &[("BENCH_M4_JSON", &bench_table)])?;
 
     build_firmware()?;
