@@ -38,11 +38,14 @@ fn measurements(report: &SimReport) -> Vec<MeasuredPoint> {
         .recording
         .dwells
         .iter()
-        .map(|d| MeasuredPoint {
-            x_mm: d.target_cm.0 * 10.0,
-            y_mm: d.target_cm.1 * 10.0,
-            dx_mm: (d.spot_cm.0 - d.target_cm.0) * 10.0,
-            dy_mm: (d.spot_cm.1 - d.target_cm.1) * 10.0,
+        .map(|d| {
+            let ([x_mm, y_mm], [dx_mm, dy_mm]) = (d.target_mm(), d.error_mm());
+            MeasuredPoint {
+                x_mm,
+                y_mm,
+                dx_mm,
+                dy_mm,
+            }
         })
         .collect()
 }

@@ -34,12 +34,7 @@ fn run_grid(setup: &str) -> Vec<([f64; 2], [f64; 2])> {
         .recording
         .dwells
         .iter()
-        .map(|d| {
-            (
-                [d.target_cm.0 * 10.0, d.target_cm.1 * 10.0],
-                [d.spot_cm.0 * 10.0, d.spot_cm.1 * 10.0],
-            )
-        })
+        .map(|d| (d.target_mm(), d.spot_mm()))
         .collect()
 }
 

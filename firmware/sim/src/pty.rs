@@ -121,18 +121,24 @@ pub struct PtyBridge {
     pub to_host: SyncSender<Vec<u8>>,
 }
 
+impl Pty {
+    /// Two handles on the master: one for the reader thread, one for the
+    /// writer thread.
+    fn master_pair(&self) -> Result<(File, File)> {
+        let clone = || {
+            self.master
+                .try_clone()
+                .context("cannot clone the PTY master")
+        };
+        Ok((clone()?, clone()?))
+    }
+}
+
 impl PtyBridge {
     /// Starts the reader and writer threads on `pty`'s master; they end
     /// with the process (or when the master fails).
     pub fn start(pty: &Pty) -> Result<Self> {
-        let mut reader = pty
-            .master
-            .try_clone()
-            .context("cannot clone the PTY master")?;
-        let mut writer = pty
-            .master
-            .try_clone()
-            .context("cannot clone the PTY master")?;
+        let (mut reader, mut writer) = pty.master_pair()?;
         let (host_tx, from_host) = sync_channel::<Vec<u8>>(CHUNKS_IN_FLIGHT);
         let (to_host, device_rx) = sync_channel::<Vec<u8>>(CHUNKS_IN_FLIGHT);
         std::thread::spawn(move || {

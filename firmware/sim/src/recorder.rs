@@ -3,6 +3,8 @@
 
 use std::fmt::Write as _;
 
+use laser_app::domain::units::mm_from_cm;
+
 /// A sample of the simulated laser spot (from the simulated servos' actual
 /// angles through the exact forward kinematics).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -33,6 +35,24 @@ pub struct DwellRecord {
     pub spot_cm: (f64, f64),
     /// Laser state during the dwell.
     pub laser: bool,
+}
+
+impl DwellRecord {
+    /// The commanded board point, mm.
+    pub fn target_mm(&self) -> [f64; 2] {
+        [mm_from_cm(self.target_cm.0), mm_from_cm(self.target_cm.1)]
+    }
+
+    /// Where the spot really was, mm.
+    pub fn spot_mm(&self) -> [f64; 2] {
+        [mm_from_cm(self.spot_cm.0), mm_from_cm(self.spot_cm.1)]
+    }
+
+    /// The spot minus the commanded point, mm (what a calibration measures).
+    pub fn error_mm(&self) -> [f64; 2] {
+        let (target, spot) = (self.target_mm(), self.spot_mm());
+        [spot[0] - target[0], spot[1] - target[1]]
+    }
 }
 
 /// Direction of a frame on the servo bus.
@@ -184,14 +204,8 @@ impl Recording {
     pub fn dwells_csv(&self) -> String {
         let mut out = String::from("x,y,dx,dy\n");
         for d in &self.dwells {
-            let _ = writeln!(
-                out,
-                "{:.4},{:.4},{:.4},{:.4}",
-                d.target_cm.0 * 10.0,
-                d.target_cm.1 * 10.0,
-                (d.spot_cm.0 - d.target_cm.0) * 10.0,
-                (d.spot_cm.1 - d.target_cm.1) * 10.0
-            );
+            let ([x, y], [dx, dy]) = (d.target_mm(), d.error_mm());
+            let _ = writeln!(out, "{x:.4},{y:.4},{dx:.4},{dy:.4}");
         }
         out
     }
@@ -201,7 +215,10 @@ impl Recording {
     pub fn worst_dwell_error_mm(&self) -> Option<f64> {
         self.dwells
             .iter()
-            .map(|d| (d.spot_cm.0 - d.target_cm.0).hypot(d.spot_cm.1 - d.target_cm.1) * 10.0)
+            .map(|d| {
+                let [dx, dy] = d.error_mm();
+                dx.hypot(dy)
+            })
             .reduce(f64::max)
     }
 

@@ -88,12 +88,7 @@ pub fn grid_dwells(
         .recording
         .dwells
         .iter()
-        .map(|d| {
-            (
-                [d.target_cm.0 * 10.0, d.target_cm.1 * 10.0],
-                [d.spot_cm.0 * 10.0, d.spot_cm.1 * 10.0],
-            )
-        })
+        .map(|d| (d.target_mm(), d.spot_mm()))
         .collect())
 }
 

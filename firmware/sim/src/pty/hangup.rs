@@ -21,7 +21,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::time::Duration;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 
 use super::{CHUNKS_IN_FLIGHT, Pty, PtyBridge};
 
@@ -40,14 +40,7 @@ impl PtyBridge {
     /// the caller sends an empty chunk on `to_host` once it has ended the
     /// closed session (its output before that is dropped).
     pub fn start_with_hangups(pty: &mut Pty) -> Result<Self> {
-        let mut reader = pty
-            .master
-            .try_clone()
-            .context("cannot clone the PTY master")?;
-        let mut writer = pty
-            .master
-            .try_clone()
-            .context("cannot clone the PTY master")?;
+        let (mut reader, mut writer) = pty.master_pair()?;
         pty._slave = None;
         let path = pty.path.clone();
         let closes = Arc::new(AtomicU32::new(0));
