@@ -216,11 +216,18 @@ impl<const N: usize> Lookahead<N> {
             };
             next_entry = b.entry_speed;
         }
+        // Forward: every entry reachable from the one before, at most
+        // accelerating and at least braking at the limit. The second bound
+        // only binds after a frozen head entry above what the reverse pass
+        // wanted (a feed override lowered the cruise of a block that is
+        // already faster): the blocks after it then brake at the limit,
+        // above their new cruise, instead of jumping down to it.
         for i in 0..self.len.saturating_sub(1) {
             let Some(&b) = self.block(i) else { continue };
             let reach = reachable_speed(b.entry_speed, b.accel, b.length);
+            let floor = braking_speed(b.entry_speed, b.accel, b.length);
             if let Some(next) = self.block_mut(i + 1) {
-                next.entry_speed = next.entry_speed.min(reach);
+                next.entry_speed = next.entry_speed.min(reach).max(floor);
             }
         }
     }
@@ -229,6 +236,16 @@ impl<const N: usize> Lookahead<N> {
 /// Speed reachable from `speed` over `length` at `accel`: √(v² + 2·a·d).
 pub fn reachable_speed(speed: f64, accel: f64, length: f64) -> f64 {
     libm::sqrt(speed * speed + 2.0 * accel * length)
+}
+
+/// Lowest speed a move entered at `speed` can leave with: braking at
+/// `accel` over `length` (0 when it can stop within it). Units as
+/// [`reachable_speed`]. The square is taken 1e-12 (relative) low, so a
+/// plan that stops exactly within the move (v² = 2·a·d up to rounding)
+/// gives 0, not the √ of a rounding error.
+pub fn braking_speed(speed: f64, accel: f64, length: f64) -> f64 {
+    let (v2, d2) = (speed * speed, 2.0 * accel * length);
+    libm::sqrt((v2 - d2 - 1e-12 * (v2 + d2)).max(0.0))
 }
 
 /// grbl's junction-deviation limit between two unit directions: with θ

@@ -78,6 +78,32 @@ fn collinear_blocks_cruise_through_and_a_break_stops() {
     assert_eq!(p.block(4).unwrap().entry_speed, 0.0);
 }
 
+/// A head frozen faster than the re-planned queue wants (a feed override
+/// lowered the cruise of blocks the spot is already heading into at
+/// speed): the blocks after it brake at the limit from that speed, above
+/// their cruise where they must, never faster than the limit allows.
+#[test]
+fn a_fast_frozen_head_brakes_through_the_next_blocks_at_the_limit() {
+    let mut p = Lookahead::<8>::new(0.01).unwrap();
+    for _ in 0..3 {
+        p.push(10.0, [[1.0, 0.0]; 2], 50.0, A).unwrap();
+    }
+    p.push(200.0, [[1.0, 0.0]; 2], 50.0, A).unwrap();
+    p.limit_head_entry(200.0);
+    let entries: [f64; 4] = core::array::from_fn(|i| p.block(i).unwrap().entry_speed);
+    assert_eq!(entries[0], 200.0);
+    // √(200² − 2·500·10) ≈ 173.2, then 141.4, then 100: above the cruise.
+    for (i, want) in [(1, 173.205), (2, 141.421), (3, 100.0)] {
+        assert!((entries[i] - want).abs() < 1e-3, "{i}: {entries:?}");
+    }
+    for i in 0..p.len() {
+        let b = *p.block(i).unwrap();
+        let exit = p.block(i + 1).map_or(0.0, |n| n.entry_speed);
+        assert!(b.entry_speed * b.entry_speed <= exit * exit + 2.0 * A * b.length + 1e-6);
+        assert!(exit * exit <= b.entry_speed * b.entry_speed + 2.0 * A * b.length + 1e-6);
+    }
+}
+
 proptest! {
     /// Random blocks arrive while the head is taken now and then: every
     /// plan is feasible and ends at rest, and a taken head's successor
