@@ -5,7 +5,7 @@
 
 use core::fmt::{self, Write};
 
-use super::block::{PointMm, SpindleMode};
+use super::block::{PointMm, SpindleMode, clamped_feed_mm_min};
 use super::error::{Alarm, GrblError};
 use super::settings_map::GrblSetting;
 use super::state::{Distance, FeedMode, MotionMode, ParserState, Units};
@@ -79,9 +79,10 @@ pub struct Overrides {
 
 impl Overrides {
     /// `programmed_mm_min` (a block's F, mm/min) with the feed override
-    /// applied, mm/min.
+    /// applied, never below [`MIN_FEED_MM_MIN`](super::block::MIN_FEED_MM_MIN) (grbl's planner clamps
+    /// after the override too: F1 at 10 % still runs at 1 mm/min), mm/min.
     pub fn feed_mm_min(&self, programmed_mm_min: f64) -> f64 {
-        programmed_mm_min * f64::from(self.feed) / 100.0
+        clamped_feed_mm_min(programmed_mm_min * f64::from(self.feed) / 100.0)
     }
 }
 

@@ -129,7 +129,7 @@ impl Motion {
         // The gimbal's speed on its planned profile, when it streams.
         let feed = |f: f64| match stream.is_following() {
             true => stream.speed_mm_s() * 60.0,
-            false => scale(f, ov.feed),
+            false => ov.feed_mm_min(f),
         };
         match current.block {
             Block::Line {

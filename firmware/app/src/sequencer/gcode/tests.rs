@@ -383,3 +383,37 @@ fn the_gimbal_cruises_through_gentle_junctions_and_slows_at_sharp_ones() {
     assert_eq!(end, [30.0, 10.0]);
     assert!(core.gcode.motion.is_idle());
 }
+
+/// Turns the feed override down to its 10 % floor.
+fn feed_override_to_10_percent(core: &mut Core, ms: u64) {
+    for _ in 0..9 {
+        realtime(core, ms, Realtime::FeedOverride(OverrideStep::CoarseMinus));
+    }
+}
+
+#[test]
+fn the_minimum_feed_holds_after_the_feed_override_on_the_galvo() {
+    let mut core = Core::new(Instant::from_millis(0));
+    core.actuator = crate::domain::Actuator::Galvo;
+    feed_override_to_10_percent(&mut core, 1);
+    // F1 at 10 % would be 0.1 mm/min: grbl runs it at its 1 mm/min floor.
+    let out = line(&mut core, 2, "G1 X1 F1 M3 S1000");
+    let (_, speed) = mark_speed(&out).expect("a lit galvo stroke");
+    let speed = speed.expect("a marking speed");
+    assert!((speed - 1.0 / 60.0).abs() < 1e-6, "{speed} mm/s");
+    let report = status(&mut core, 3);
+    assert!(report.contains("|FS:1,1000"), "{report}");
+}
+
+#[test]
+fn the_minimum_feed_holds_after_the_feed_override_on_the_gimbal() {
+    let mut core = Core::new(Instant::from_millis(0));
+    feed_override_to_10_percent(&mut core, 1);
+    assert_eq!(closers(&line(&mut core, 2, "G1 X0.05 F1")), 1);
+    let trace = follow(&mut core, 3);
+    let top = trace.iter().map(|(v, _)| *v).fold(0.0, f64::max);
+    // 1 mm/min, not 0.1: the 0.05 mm take 3 s, not 30 s.
+    assert!((top - 1.0 / 60.0).abs() < 1e-6, "{top} mm/s");
+    let end = trace.last().expect("moved").1;
+    assert!((end[0] - 0.05).abs() < 1e-9 && end[1] == 0.0, "{end:?}");
+}

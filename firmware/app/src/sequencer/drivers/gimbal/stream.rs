@@ -1,6 +1,7 @@
 //! The gimbal driver's stream: one point of the planned profile every period.
 
 use crate::domain::Target;
+use crate::grbl::block::MIN_FEED_MM_MIN;
 use crate::grbl::{Block, PointMm};
 use crate::sequencer::drivers::gimbal::{MIN_TICK_MS, STREAM_PERIOD_MS};
 use crate::sequencer::gcode::queue::{
@@ -66,8 +67,12 @@ impl Core {
         // The exit: the next block's entry while it joins at speed.
         cursor.block.exit_speed = self.stream_exit_speed(&current.block, &cursor);
         let joins = cursor.block.exit_speed > 0.0;
+        // The feed override, never slower than grbl's minimum feed.
+        let nominal_mm_s = cursor.block.nominal_speed.max(1e-9);
         let ov = f64::from(self.gcode.overrides.feed) / 100.0;
-        let scale = ov.min(self.jobs.gimbal.cap_mm_s / cursor.block.nominal_speed.max(1e-9));
+        let scale = ov
+            .max(MIN_FEED_MM_MIN / 60.0 / nominal_mm_s)
+            .min(self.jobs.gimbal.cap_mm_s / nominal_mm_s);
         let dt_ms = STREAM_PERIOD_MS as f64;
         let left = cursor.block.length - cursor.done;
         let over = cursor.advance(dt_ms / 1000.0, scale, braking);
