@@ -179,7 +179,7 @@ fn paths(text: &str) -> Vec<String> {
     while i < bytes.len() {
         let starts = ["crate::", "super::", "self::"]
             .iter()
-            .any(|p| text[i..].starts_with(p))
+            .any(|p| bytes[i..].starts_with(p.as_bytes()))
             && (i == 0 || !is_ident(bytes[i - 1]));
         if !starts {
             i += 1;
