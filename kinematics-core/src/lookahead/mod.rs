@@ -105,8 +105,12 @@ impl Move {
         // Finite and > 0: the bits of +min-subnormal..=+MAX (integer
         // compares; soft-float ones cost ~20 M4 instructions each).
         let positive = |v: f64| v.to_bits().wrapping_sub(1) < f64::MAX.to_bits();
-        // |u|² within 2e-6 of 1 (|u| within 1e-6): no square root.
-        let is_unit = |u: [f64; 2]| libm::fabs(u[0] * u[0] + u[1] * u[1] - 1.0) < 2e-6;
+        // |u|² within 2e-6 of 1 (|u| within 1e-6): no square root, and
+        // in `f32` on the FPU (NaN fails the compare).
+        let is_unit = |u: [f64; 2]| {
+            let (x, y) = (u[0] as f32, u[1] as f32);
+            libm::fabsf(x * x + y * y - 1.0) < 2e-6
+        };
         let same = |a: [f64; 2], b: [f64; 2]| a.map(f64::to_bits) == b.map(f64::to_bits);
         positive(self.length)
             && positive(self.nominal_speed)
@@ -294,17 +298,21 @@ impl<const N: usize, T: Copy> Lookahead<N, T> {
             };
             next_entry = b.entry_speed;
         }
-        // (entry, accel, length) of the block before.
-        let mut before: Option<(f64, f64, f64)> = None;
-        for i in 0..len {
+        // The forward pass, with the block before's entry, acceleration
+        // and length carried along.
+        let Some(head) = self.blocks.get(0) else {
+            return;
+        };
+        let (mut entry, mut accel, mut length) = (head.entry_speed, head.accel, head.length);
+        for i in 1..len {
             let Some(b) = self.blocks.get_mut(i) else {
                 continue;
             };
             // An entry at rest stays at rest: no `√` for it.
-            if let Some((entry, accel, length)) = before.filter(|_| !is_rest(b.entry_speed)) {
+            if !is_rest(b.entry_speed) {
                 b.entry_speed = b.entry_speed.min(reachable_speed(entry, accel, length));
             }
-            before = Some((b.entry_speed, b.accel, b.length));
+            (entry, accel, length) = (b.entry_speed, b.accel, b.length);
         }
     }
 }
