@@ -1,7 +1,9 @@
 //! Path marking with look-ahead (GRBL style) in the board plane.
 //!
 //! Segments (lines and circular arcs, mm) are added to a fixed-capacity
-//! planner buffer (`CAP` blocks, one per segment: 16 or more give a
+//! look-ahead planner (`CAP` blocks, one per segment, the running one
+//! included: kinematics-core's [`Lookahead`], the planner the gimbal and
+//! the stepper plan with too, each block carrying its geometry; 16 or more give a
 //! streamed path GRBL's look-ahead; a caller that loads a whole stroke
 //! before sampling it needs only the stroke's segments). Each block gets a speed cap (the
 //! marking speed; on arcs also `√(a·r/√2)` so the centripetal acceleration
@@ -39,10 +41,11 @@ mod sampler;
 mod segments;
 
 use crate::error::{Error, positive};
-use block::{Block, EMPTY_BLOCK, Exec, IDLE_EXEC};
+use block::{Exec, IDLE_EXEC, Shape};
+pub use kinematics_core::lookahead::junction_speed;
+use kinematics_core::lookahead::{Lookahead, LookaheadError};
 use kinematics_core::numeric::finite;
 pub use rotor::ArcRotor;
-pub use segments::junction_speed;
 
 /// Limits and sample period of the path planner.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -134,9 +137,8 @@ pub enum BlockEnd {
 pub struct PathPlanner<const CAP: usize> {
     limits: MarkLimits,
     feed_mm_s: f64,
-    blocks: [Block; CAP],
-    head: usize,
-    len: usize,
+    /// The blocks not yet running (the running one is in `exec`).
+    plan: Lookahead<CAP, Shape>,
     /// End of the last added geometry.
     pen: [f64; 2],
     /// Whether the next segment starts a new path (after a jump / at start).
@@ -159,12 +161,12 @@ impl<const CAP: usize> PathPlanner<CAP> {
         let () = Self::CAPACITY_OK;
         limits.validate()?;
         let start_mm = finite_point("start_mm", start_mm)?;
+        let plan = Lookahead::new(limits.junction_deviation_mm)
+            .map_err(|e| planner_error(e, limits.junction_deviation_mm))?;
         Ok(Self {
             limits,
             feed_mm_s: limits.speed_mm_s,
-            blocks: [EMPTY_BLOCK; CAP],
-            head: 0,
-            len: 0,
+            plan,
             pen: start_mm,
             next_starts_path: true,
             exec: IDLE_EXEC,
@@ -186,15 +188,15 @@ impl<const CAP: usize> PathPlanner<CAP> {
 
     /// Blocks in the buffer (including the running one).
     pub fn len(&self) -> usize {
-        self.len
+        self.plan.len() + usize::from(self.exec.active)
     }
     /// True when no block is buffered.
     pub fn is_empty(&self) -> bool {
-        self.len == 0
+        self.len() == 0
     }
     /// Free block slots.
     pub fn free_slots(&self) -> usize {
-        CAP - self.len
+        CAP - self.len()
     }
     /// End of the last added segment: where the next one starts, mm.
     pub fn pen_mm(&self) -> [f64; 2] {
@@ -206,35 +208,23 @@ impl<const CAP: usize> PathPlanner<CAP> {
     }
     /// True when nothing is buffered and the spot is at rest.
     pub fn is_idle(&self) -> bool {
-        self.len == 0 && !self.exec.active
+        self.plan.is_empty() && !self.exec.active
     }
+}
 
-    /// Block `i` counted from the head (`None` beyond the buffered ones).
-    fn block(&self, i: usize) -> Option<&Block> {
-        if i < self.len {
-            self.blocks.get((self.head + i) % CAP)
-        } else {
-            None
-        }
-    }
-    fn block_mut(&mut self, i: usize) -> Option<&mut Block> {
-        if i < self.len {
-            self.blocks.get_mut((self.head + i) % CAP)
-        } else {
-            None
-        }
-    }
-
-    fn push(&mut self, b: Block) -> Result<(), Error> {
-        if self.len >= CAP {
-            return Err(Error::BufferFull);
-        }
-        let idx = (self.head + self.len) % CAP;
-        if let Some(slot) = self.blocks.get_mut(idx) {
-            *slot = b;
-        }
-        self.len += 1;
-        Ok(())
+/// The planner's refusal as this crate's error (`value`: what was
+/// offered, mm).
+fn planner_error(e: LookaheadError, value: f64) -> Error {
+    match e {
+        LookaheadError::Full => Error::BufferFull,
+        LookaheadError::InvalidBlock => Error::NotPositive {
+            name: "length_mm",
+            value,
+        },
+        LookaheadError::InvalidConfig => Error::NotPositive {
+            name: "junction_deviation_mm",
+            value,
+        },
     }
 }
 

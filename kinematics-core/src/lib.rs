@@ -29,7 +29,8 @@
 //! | [`frames`] | board ↔ global frames, board offsets and pose | [`BoardFrame`], [`BoardPose`], [`BoardPoint`], [`GlobalPoint`], [`PointMm`] |
 //! | [`gimbal`] | exact (default) and seed gimbal FK/IK, the calibrated chain | [`Gimbal`] (`ik`, `fk`, `ik_wire`, `fk_wire`), [`GimbalModel`], [`JointAngles`], [`gimbal::exact`], [`gimbal::seed`] |
 //! | [`servo`] | joint ↔ servo angle ↔ FashionStar wire value (0.1°) | [`ServoAxis`], [`Direction`], [`WireAngles`] |
-//! | [`lookahead`] | grbl's junction-deviation look-ahead planner, unit-agnostic | [`lookahead::Lookahead`], [`lookahead::SpeedCursor`] |
+//! | [`lookahead`] | grbl's junction-deviation look-ahead planner, unit-agnostic: the one planner of the gimbal, galvo and stepper | [`lookahead::Lookahead`], [`lookahead::SpeedCursor`] |
+//! | [`ring`] | the fixed-capacity ring of the motion pipeline | [`ring::Ring`] |
 //! | [`stepper`] | joint angle ↔ microsteps (0.05625°/step) | [`StepperAxis`] |
 //! | [`galvo`] | two-mirror FK/IK with pincushion, DAC mapping (`f32`/`f64`), the per-sample `f32` map | [`Galvo`], [`GalvoGeometry`], [`DacAxis`], [`MirrorAngles`], [`DacCodes`], [`SampleMap`] |
 //! | [`grid`] | grid geometry, index ↔ board point | [`Grid`], [`GridIndex`] |
@@ -65,6 +66,7 @@ pub mod numeric;
 pub mod path;
 pub mod pattern;
 pub mod real;
+pub mod ring;
 pub mod servo;
 pub mod stepper;
 

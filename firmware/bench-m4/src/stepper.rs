@@ -45,7 +45,7 @@ fn segment(events: u32, starts_block: bool) -> Segment {
 fn loaded(events: u32) -> (SegmentQueue<QUEUE>, StepGenerator) {
     let mut queue = SegmentQueue::new();
     for k in 0..QUEUE {
-        let _ = queue.push(segment(events, k == 0));
+        let _ = queue.push_back(segment(events, k == 0));
     }
     (queue, StepGenerator::new())
 }

@@ -1,4 +1,4 @@
-//! The planner's blocks (one segment each, with its planned speeds) and
+//! What the planner's blocks carry (one segment each: its geometry) and
 //! the running block's frozen `f32` profile.
 
 use super::ArcRotor;
@@ -23,47 +23,26 @@ pub(super) enum Geometry {
     },
 }
 
+/// What a planner block carries beside its planned speeds: its geometry.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Block {
+pub(super) struct Shape {
     pub(super) geom: Geometry,
     pub(super) end: [f64; 2],
-    pub(super) length: f64,
-    /// Speed cap, mm/s.
-    pub(super) v_nominal: f64,
-    /// Tangential acceleration limit, mm/s².
-    pub(super) accel: f64,
-    /// Junction-deviation (and caps) limit on the entry speed.
-    pub(super) max_entry: f64,
-    /// Planned entry speed.
-    pub(super) entry: f64,
-    /// Start and end tangents (unit).
-    pub(super) dir_in: [f64; 2],
-    pub(super) dir_out: [f64; 2],
     /// First block after a jump or of the very first path: enters at rest.
     pub(super) starts_path: bool,
 }
 
-impl Block {
+impl Shape {
     pub(super) fn is_jump(&self) -> bool {
         matches!(self.geom, Geometry::Jump { .. })
     }
-}
 
-pub(super) const EMPTY_BLOCK: Block = Block {
-    geom: Geometry::Jump {
-        from: [0.0; 2],
-        to: [0.0; 2],
-    },
-    end: [0.0; 2],
-    length: 0.0,
-    v_nominal: 0.0,
-    accel: 0.0,
-    max_entry: 0.0,
-    entry: 0.0,
-    dir_in: [0.0; 2],
-    dir_out: [0.0; 2],
-    starts_path: true,
-};
+    /// Whether the block follows the one before without a stop (its
+    /// entry is the one before's exit).
+    pub(super) fn continues_path(&self) -> bool {
+        !self.is_jump() && !self.starts_path
+    }
+}
 
 /// The running block's frozen profile, in `f32` for the per-sample path.
 ///
@@ -112,8 +91,8 @@ pub(super) struct Exec {
     /// block.
     pub(super) base64: f64,
     pub(super) t_total64: f64,
-    /// Frozen exit speed (f64, pins the next block's entry).
-    pub(super) exit: f64,
+    /// The block's planned entry speed, mm/s (f64, diagnostics).
+    pub(super) entry64: f64,
 }
 
 pub(super) const IDLE_EXEC: Exec = Exec {
@@ -143,7 +122,7 @@ pub(super) const IDLE_EXEC: Exec = Exec {
     k: 0,
     base64: 0.0,
     t_total64: 0.0,
-    exit: 0.0,
+    entry64: 0.0,
 };
 
 /// First sample index `j ≥ 1` with `base + j·ts > t` and the time of that

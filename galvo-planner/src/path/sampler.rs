@@ -1,25 +1,28 @@
 //! The per-sample side: freezing the head block's profile and evaluating
 //! it at the sample instants in `f32`.
 
-use super::block::{Geometry, IDLE_EXEC, first_sample_after, trapezoid};
+use super::block::{Geometry, IDLE_EXEC, Shape, first_sample_after, trapezoid};
 use super::{ArcRotor, BlockEnd, MarkSample, PathPlanner};
 use kinematics_core::numeric::clamp;
 
 impl<const CAP: usize> PathPlanner<CAP> {
-    /// Freezes the head block's profile. `base` is the time of the last
-    /// emitted sample relative to the block start (≤ 0).
+    /// Takes the head block from the plan and freezes its profile (the
+    /// plan then keeps the next block's entry at its exit). `base` is the
+    /// time of the last emitted sample relative to the block start (≤ 0).
+    /// Once per block, out of line: it keeps the per-sample path small.
+    #[inline(never)]
     fn freeze_head(&mut self, base: f64) {
-        let Some(b) = self.block(0).copied() else {
+        let Some(b) = self.plan.pop() else {
             return;
         };
         let ts = self.limits.ts_s;
-        let v0 = b.entry;
-        let v1 = self.exit_speed(0);
-        let (a, l, vn) = (b.accel, b.length, b.v_nominal);
+        let v0 = b.entry_speed;
+        let v1 = b.exit_speed;
+        let (a, l, vn) = (b.accel, b.length, b.nominal_speed);
         let (vp, d_acc, t_acc, t_cruise, t_dec) = trapezoid(v0, v1, vn, a, l);
         let mut e = IDLE_EXEC;
         e.active = true;
-        match b.geom {
+        match b.data.geom {
             Geometry::Line { start, unit } => {
                 e.arc = false;
                 e.p0 = [start[0] as f32, start[1] as f32];
@@ -40,7 +43,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
             }
             Geometry::Jump { .. } => {}
         }
-        e.end = [b.end[0] as f32, b.end[1] as f32];
+        e.end = [b.data.end[0] as f32, b.data.end[1] as f32];
         e.length = l as f32;
         e.ts = ts as f32;
         e.v0 = v0 as f32;
@@ -64,15 +67,13 @@ impl<const CAP: usize> PathPlanner<CAP> {
         e.off_decel = od;
         e.j_end = je;
         e.k = 0;
-        e.exit = v1;
+        e.entry64 = v0;
         self.exec = e;
     }
 
-    fn pop_head(&mut self) {
-        if self.len > 0 {
-            self.head = (self.head + 1) % CAP;
-            self.len -= 1;
-        }
+    /// The head block's geometry, if it is not running yet.
+    fn head_shape(&self) -> Option<Shape> {
+        self.plan.block(0).map(|b| b.data)
     }
 
     /// Position and speed in the running block at its sample `j` (< j_end),
@@ -119,12 +120,8 @@ impl<const CAP: usize> PathPlanner<CAP> {
         if self.exec.active {
             return;
         }
-        match self.block(0) {
-            Some(b) if !b.is_jump() => {
-                self.freeze_head(0.0);
-                self.replan();
-            }
-            _ => {}
+        if self.head_shape().is_some_and(|s| !s.is_jump()) {
+            self.freeze_head(0.0);
         }
     }
 
@@ -134,14 +131,14 @@ impl<const CAP: usize> PathPlanner<CAP> {
         let mut carry = 0.0f64;
         loop {
             if !self.exec.active {
-                let Some(b) = self.block(0).copied() else {
+                let Some(shape) = self.head_shape() else {
                     return MarkSample::Idle {
                         x_mm: self.position[0],
                         y_mm: self.position[1],
                     };
                 };
-                if let Geometry::Jump { from, to } = b.geom {
-                    self.pop_head();
+                if let Geometry::Jump { from, to } = shape.geom {
+                    let _ = self.plan.pop();
                     self.position = [to[0] as f32, to[1] as f32];
                     return MarkSample::Jump {
                         from_mm: from,
@@ -149,7 +146,6 @@ impl<const CAP: usize> PathPlanner<CAP> {
                     };
                 }
                 self.freeze_head(carry);
-                self.replan();
             }
             let e = self.exec;
             let j = e.k.saturating_add(1);
@@ -166,10 +162,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
             // This sample lies beyond the running block: carry on into the
             // next block if one is connected (its entry equals our exit),
             // else the path ends here.
-            let continues = self
-                .block(1)
-                .is_some_and(|n| !n.is_jump() && !n.starts_path);
-            self.pop_head();
+            let continues = self.head_shape().is_some_and(|n| n.continues_path());
             self.exec.active = false;
             if !continues {
                 // Path end: one sample exactly on the end point, at rest.
@@ -202,6 +195,8 @@ impl<const CAP: usize> PathPlanner<CAP> {
 
     /// Planned entry speeds of the buffered blocks (diagnostics), mm/s.
     pub fn entry_speeds(&self) -> impl Iterator<Item = f64> + '_ {
-        (0..self.len).filter_map(|i| self.block(i).map(|b| b.entry))
+        let running = self.exec.active.then_some(self.exec.entry64);
+        let queued = (0..self.plan.len()).filter_map(|i| self.plan.block(i).map(|b| b.entry_speed));
+        running.into_iter().chain(queued)
     }
 }

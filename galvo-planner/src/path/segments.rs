@@ -1,9 +1,11 @@
-//! Adding segments (lines, arcs, jumps) and the look-ahead replanning of
-//! the entry speeds.
+//! Adding segments (lines, arcs, jumps) to the look-ahead plan (its
+//! junction speeds and its replanning are kinematics-core's
+//! [`Lookahead`](kinematics_core::lookahead::Lookahead)).
 
-use super::block::{Block, EMPTY_BLOCK, Geometry};
-use super::{PathPlanner, finite_point};
+use super::block::{Geometry, Shape};
+use super::{PathPlanner, finite_point, planner_error};
 use crate::error::Error;
+use kinematics_core::lookahead::Move;
 use kinematics_core::numeric::trig;
 
 impl<const CAP: usize> PathPlanner<CAP> {
@@ -15,13 +17,20 @@ impl<const CAP: usize> PathPlanner<CAP> {
             self.next_starts_path = true;
             return Ok(());
         }
-        let mut b = EMPTY_BLOCK;
-        b.geom = Geometry::Jump {
-            from: self.pen,
-            to: p,
+        if self.len() >= CAP {
+            return Err(Error::BufferFull);
+        }
+        let jump = Shape {
+            geom: Geometry::Jump {
+                from: self.pen,
+                to: p,
+            },
+            end: p,
+            starts_path: true,
         };
-        b.end = p;
-        self.push(b)?;
+        self.plan
+            .push_stop(jump)
+            .map_err(|e| planner_error(e, 0.0))?;
         self.pen = p;
         self.next_starts_path = true;
         Ok(())
@@ -36,26 +45,20 @@ impl<const CAP: usize> PathPlanner<CAP> {
         if length < 1e-9 {
             return Ok(());
         }
-        if self.len >= CAP {
+        if self.len() >= CAP {
             return Err(Error::BufferFull);
         }
         let unit = [dx / length, dy / length];
-        let b = Block {
+        let shape = Shape {
             geom: Geometry::Line {
                 start: self.pen,
                 unit,
             },
             end: p,
-            length,
-            v_nominal: self.feed_mm_s,
-            accel: self.limits.accel_mm_s2,
-            max_entry: 0.0,
-            entry: 0.0,
-            dir_in: unit,
-            dir_out: unit,
             starts_path: self.next_starts_path,
         };
-        self.add_segment(b)
+        let a = self.limits.accel_mm_s2;
+        self.add_segment(shape, Move::new(length, [unit; 2], self.feed_mm_s, a))
     }
 
     /// Marks a circular arc from the pen to `end_mm` around `center_mm`,
@@ -79,7 +82,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
                 end_radius_mm: r1,
             });
         }
-        if self.len >= CAP {
+        if self.len() >= CAP {
             return Err(Error::BufferFull);
         }
         let a0 = libm::atan2(self.pen[1] - c[1], self.pen[0] - c[0]);
@@ -106,7 +109,7 @@ impl<const CAP: usize> PathPlanner<CAP> {
         let a = self.limits.accel_mm_s2;
         let tangent = |ang: f64| [-dir * trig::sin(ang), dir * trig::cos(ang)];
         let v_cap = libm::sqrt(a * r0 * core::f64::consts::FRAC_1_SQRT_2);
-        let b = Block {
+        let shape = Shape {
             geom: Geometry::Arc {
                 center: c,
                 radius: r0,
@@ -114,16 +117,19 @@ impl<const CAP: usize> PathPlanner<CAP> {
                 dir,
             },
             end,
-            length,
-            v_nominal: self.feed_mm_s.min(v_cap),
-            accel: a * core::f64::consts::FRAC_1_SQRT_2,
-            max_entry: 0.0,
-            entry: 0.0,
-            dir_in: tangent(a0),
-            dir_out: tangent(a0 + sweep),
             starts_path: self.next_starts_path,
         };
-        self.add_segment(b)
+        // Tangential acceleration a/√2 (the rest is centripetal); the
+        // junctions are taken at a, as on lines.
+        let mv = Move {
+            length,
+            unit_in: tangent(a0),
+            unit_out: tangent(a0 + sweep),
+            nominal_speed: self.feed_mm_s.min(v_cap),
+            accel: a * core::f64::consts::FRAC_1_SQRT_2,
+            junction_accel: a,
+        };
+        self.add_segment(shape, mv)
     }
 
     /// Adds `points[1..]` as connected lines after a `move_to(points[0])`
@@ -153,103 +159,16 @@ impl<const CAP: usize> PathPlanner<CAP> {
         Ok(used)
     }
 
-    fn add_segment(&mut self, mut b: Block) -> Result<(), Error> {
-        // Junction with the previous block still in the buffer.
-        let prev = if self.len > 0 {
-            self.block(self.len - 1).copied()
-        } else {
-            None
-        };
-        b.max_entry = match prev {
-            Some(p) if !b.starts_path && !p.is_jump() => junction_speed(
-                p.dir_out,
-                b.dir_in,
-                self.limits.accel_mm_s2,
-                self.limits.junction_deviation_mm,
-            )
-            .min(p.v_nominal)
-            .min(b.v_nominal),
-            // New path, after a jump, or everything before has been executed
-            // (the spot is at rest).
-            _ => 0.0,
-        };
-        self.push(b)?;
-        self.pen = b.end;
+    fn add_segment(&mut self, shape: Shape, mv: Move) -> Result<(), Error> {
+        if shape.starts_path {
+            // New path: it starts at rest.
+            self.plan.break_junction();
+        }
+        self.plan
+            .push_move(mv, shape)
+            .map_err(|e| planner_error(e, mv.length))?;
+        self.pen = shape.end;
         self.next_starts_path = false;
-        self.replan();
         Ok(())
-    }
-
-    /// Backward and forward passes over the blocks not yet executing.
-    pub(super) fn replan(&mut self) {
-        let first = usize::from(self.exec.active);
-        if first >= self.len {
-            return;
-        }
-        // The first plannable block's entry is fixed: the running block's
-        // frozen exit speed, or rest.
-        let fixed_entry = match self.block(first) {
-            Some(b) if self.exec.active && !b.starts_path && !b.is_jump() => self.exec.exit,
-            _ => 0.0,
-        };
-        if let Some(b) = self.block_mut(first) {
-            b.entry = fixed_entry;
-        }
-        // Backward pass: exit of the last block is 0.
-        let mut next_entry = 0.0f64;
-        let mut next_connected = false;
-        for i in (first..self.len).rev() {
-            let Some(b) = self.block_mut(i) else { continue };
-            let exit = if next_connected { next_entry } else { 0.0 };
-            if i > first {
-                b.entry = if b.is_jump() || b.starts_path {
-                    0.0
-                } else {
-                    b.max_entry
-                        .min(libm::sqrt(exit * exit + 2.0 * b.accel * b.length))
-                };
-            }
-            next_entry = b.entry;
-            next_connected = !b.is_jump() && !b.starts_path;
-        }
-        // Forward pass.
-        for i in first..self.len.saturating_sub(1) {
-            let (Some(cur), Some(nxt)) = (self.block(i).copied(), self.block(i + 1).copied())
-            else {
-                continue;
-            };
-            if cur.is_jump() || nxt.is_jump() || nxt.starts_path {
-                continue;
-            }
-            let reachable = libm::sqrt(cur.entry * cur.entry + 2.0 * cur.accel * cur.length);
-            if nxt.entry > reachable
-                && let Some(n) = self.block_mut(i + 1)
-            {
-                n.entry = reachable;
-            }
-        }
-    }
-
-    /// Exit speed of block `i` as planned now.
-    pub(super) fn exit_speed(&self, i: usize) -> f64 {
-        match self.block(i + 1) {
-            Some(n) if !n.is_jump() && !n.starts_path => n.entry,
-            _ => 0.0,
-        }
-    }
-}
-
-/// GRBL's junction speed for unit directions `a` (incoming) and `b`
-/// (outgoing): `v² = acc·δ·sin(θ/2)/(1 − sin(θ/2))` with
-/// `cos θ = −a·b`; a reversal gives 0, a straight continuation no limit.
-pub fn junction_speed(a: [f64; 2], b: [f64; 2], accel_mm_s2: f64, deviation_mm: f64) -> f64 {
-    let cos_theta = -(a[0] * b[0] + a[1] * b[1]);
-    if cos_theta > 0.999_999 {
-        0.0
-    } else if cos_theta < -0.999_999 {
-        f64::INFINITY
-    } else {
-        let sin_half = libm::sqrt(0.5 * (1.0 - cos_theta));
-        libm::sqrt(accel_mm_s2 * deviation_mm * sin_half / (1.0 - sin_half))
     }
 }

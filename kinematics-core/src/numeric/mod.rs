@@ -3,6 +3,10 @@
 //! (back-substitution) solve and the `f64` sine and cosine ([`trig`],
 //! used by laser-app too). Each crate maps [`NonFinite`] into its own
 //! error type (`From`), so `finite(v, "x_cm")?` reads the same in both.
+//!
+//! `README.md` in this folder lists every own numeric routine of the
+//! workspace (here and elsewhere), the measured reason it is not libm's,
+//! and its accuracy test.
 
 pub mod trig;
 

@@ -33,8 +33,6 @@ pub enum MotionError {
     MoveTooLong,
     /// The planner queue is full; try again once a block has left.
     QueueFull,
-    /// A queue of capacity 0 was asked for.
-    ZeroCapacity,
     /// Timer frequency 0 or above [`MAX_TIMER_HZ`], or a segment length
     /// not finite or outside 0.1 ms..=100 ms.
     InvalidTiming,

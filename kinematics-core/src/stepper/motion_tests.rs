@@ -382,10 +382,6 @@ fn bad_input_is_refused_and_changes_nothing() {
         Some(MotionError::InvalidJunctionDeviation)
     );
     assert_eq!(
-        Planner::<0>::new(1.0).err(),
-        Some(MotionError::ZeroCapacity)
-    );
-    assert_eq!(
         SegmentPrep::new(0, 0.001).err(),
         Some(MotionError::InvalidTiming)
     );

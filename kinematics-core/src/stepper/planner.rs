@@ -10,13 +10,15 @@
 //! steps), so no axis ever steps faster than the block's rate. The
 //! junction angle is taken between the moves' directions in step space.
 //!
-//! The reverse/forward passes and the junction rule are the unit-agnostic
-//! [`crate::lookahead::Lookahead`] (the G-code gimbal plans through it in
-//! mm); this planner keeps the steps of each block beside it. Planning
-//! uses `f64`; it runs in a low-priority task, never in the step path.
+//! The queue, the reverse/forward passes and the junction rule are the
+//! unit-agnostic [`crate::lookahead::Lookahead`] (the gimbal's G-code and
+//! the galvo's marked paths plan through it in mm); this planner is its
+//! step-space face: each block carries its microsteps and programmed feed
+//! as the plan's data. Planning uses `f64`; it runs in a low-priority
+//! task, never in the step path.
 
 use super::motion::{MotionError, validate_move};
-use crate::lookahead::{Lookahead, LookaheadBlock, LookaheadError};
+use crate::lookahead::{Lookahead, LookaheadBlock, LookaheadError, Move};
 
 /// One requested move: signed microsteps per axis (pan, tilt) and its
 /// limits.
@@ -54,36 +56,35 @@ pub struct PlannedBlock {
     pub feed_rate_steps_per_s: f64,
 }
 
-/// Fixed-capacity look-ahead planner of up to `N` blocks.
+/// What a stepper block carries beside its planned speeds.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct StepData {
+    /// Signed microsteps to move, `[pan, tilt]`.
+    pub steps: [i32; 2],
+    /// The programmed feed before the feed override, steps/s (0: fixed).
+    pub feed_rate_steps_per_s: f64,
+}
+
+/// Fixed-capacity look-ahead planner of up to `N` blocks in step space.
+/// A capacity of 0 does not compile:
+///
+/// ```compile_fail
+/// let _ = kinematics_core::stepper::Planner::<0>::new(1.0);
+/// ```
 #[derive(Debug, Clone)]
 pub struct Planner<const N: usize> {
-    plan: Lookahead<N>,
-    /// Signed microsteps of each queued block, in the plan's ring order.
-    steps: [[i32; 2]; N],
-    /// Feed of each queued block before the override, steps/s (0: fixed).
-    feed: [f64; N],
-    /// Index in `steps` of the head block.
-    head: usize,
+    plan: Lookahead<N, StepData>,
 }
 
 impl<const N: usize> Planner<N> {
     /// An empty planner. `junction_deviation_steps` (≥ 0, steps) is grbl's
     /// junction deviation δ expressed in microsteps.
     ///
-    /// Errors: [`MotionError::InvalidJunctionDeviation`],
-    /// [`MotionError::ZeroCapacity`].
+    /// Errors: [`MotionError::InvalidJunctionDeviation`].
     pub fn new(junction_deviation_steps: f64) -> Result<Self, MotionError> {
-        if N == 0 {
-            return Err(MotionError::ZeroCapacity);
-        }
         let plan = Lookahead::new(junction_deviation_steps)
             .map_err(|_| MotionError::InvalidJunctionDeviation)?;
-        Ok(Self {
-            plan,
-            steps: [[0; 2]; N],
-            feed: [0.0; N],
-            head: 0,
-        })
+        Ok(Self { plan })
     }
 
     /// Number of queued blocks.
@@ -98,16 +99,13 @@ impl<const N: usize> Planner<N> {
 
     /// The `i`-th queued block (0 = next to execute).
     pub fn block(&self, i: usize) -> Option<PlannedBlock> {
-        let b = self.plan.block(i)?;
-        let slot = (self.head + i) % N;
-        let (steps, feed) = (*self.steps.get(slot)?, *self.feed.get(slot)?);
-        Some(Self::planned(steps, feed, b))
+        self.plan.block(i).map(Self::planned)
     }
 
-    fn planned(steps: [i32; 2], feed: f64, b: &LookaheadBlock) -> PlannedBlock {
+    fn planned(b: &LookaheadBlock<StepData>) -> PlannedBlock {
         PlannedBlock {
-            steps,
-            feed_rate_steps_per_s: feed,
+            steps: b.data.steps,
+            feed_rate_steps_per_s: b.data.feed_rate_steps_per_s,
             // Lengths are whole step-event counts (≤ 2³⁰): exact.
             event_count: b.length as u32,
             nominal_rate_steps_per_s: b.nominal_speed,
@@ -133,19 +131,10 @@ impl<const N: usize> Planner<N> {
     ///
     /// Errors: as [`Self::push`].
     pub fn push_feed(&mut self, mv: &StepMove, feed_rate: f64) -> Result<(), MotionError> {
-        let event_count = validate_move(mv)?;
-        if event_count == 0 {
+        if validate_move(mv)? == 0 {
             return Ok(());
         }
-        let slot = (self.head + self.plan.len()) % N;
-        Self::push_plan(&mut self.plan, mv)?;
-        if let Some(s) = self.steps.get_mut(slot) {
-            *s = mv.steps;
-        }
-        if let Some(f) = self.feed.get_mut(slot) {
-            *f = feed_rate;
-        }
-        Ok(())
+        Self::push_plan(&mut self.plan, mv, feed_rate)
     }
 
     /// A new feed override: every queued block at a programmed feed
@@ -158,15 +147,10 @@ impl<const N: usize> Planner<N> {
         };
         let old = self.plan.clone();
         self.plan.clear();
-        for i in 0..old.len() {
-            let slot = (self.head + i) % N;
-            let (Some(b), Some(&steps), Some(&feed)) =
-                (old.block(i), self.steps.get(slot), self.feed.get(slot))
-            else {
-                continue;
-            };
+        for b in (0..old.len()).filter_map(|i| old.block(i)) {
+            let feed = b.data.feed_rate_steps_per_s;
             let mv = StepMove {
-                steps,
+                steps: b.data.steps,
                 nominal_rate_steps_per_s: if feed > 0.0 {
                     rate_of(feed)
                 } else {
@@ -176,27 +160,38 @@ impl<const N: usize> Planner<N> {
             };
             // Re-pushing what was queued: only a refused rate can fail,
             // and then the block keeps its old one.
-            if Self::push_plan(&mut self.plan, &mv).is_err() {
+            if Self::push_plan(&mut self.plan, &mv, feed).is_err() {
                 let mv = StepMove {
                     nominal_rate_steps_per_s: b.nominal_speed,
                     ..mv
                 };
-                let _ = Self::push_plan(&mut self.plan, &mv);
+                let _ = Self::push_plan(&mut self.plan, &mv, feed);
             }
         }
         self.plan.limit_head_entry(entry);
     }
 
     /// Pushes a validated, non-empty move onto the plan.
-    fn push_plan(plan: &mut Lookahead<N>, mv: &StepMove) -> Result<(), MotionError> {
+    fn push_plan(
+        plan: &mut Lookahead<N, StepData>,
+        mv: &StepMove,
+        feed_rate: f64,
+    ) -> Result<(), MotionError> {
         let event_count = validate_move(mv)?;
         let norm = crate::numeric::hypot(f64::from(mv.steps[0]), f64::from(mv.steps[1]));
         let unit = [f64::from(mv.steps[0]) / norm, f64::from(mv.steps[1]) / norm];
-        plan.push(
-            f64::from(event_count),
-            [unit; 2],
-            mv.nominal_rate_steps_per_s,
-            mv.accel_steps_per_s2,
+        let data = StepData {
+            steps: mv.steps,
+            feed_rate_steps_per_s: feed_rate,
+        };
+        plan.push_move(
+            Move::new(
+                f64::from(event_count),
+                [unit; 2],
+                mv.nominal_rate_steps_per_s,
+                mv.accel_steps_per_s2,
+            ),
+            data,
         )
         .map_err(|e| match e {
             LookaheadError::Full => MotionError::QueueFull,
@@ -220,11 +215,7 @@ impl<const N: usize> Planner<N> {
     /// next block's entry rate is then fixed: later blocks can only raise
     /// the speeds of the blocks before them, so that entry stays feasible.
     pub fn pop(&mut self) -> Option<PlannedBlock> {
-        let steps = *self.steps.get(self.head)?;
-        let feed = *self.feed.get(self.head)?;
-        let b = self.plan.pop()?;
-        self.head = (self.head + 1) % N;
-        Some(Self::planned(steps, feed, &b))
+        self.plan.pop().as_ref().map(Self::planned)
     }
 }
 

@@ -135,23 +135,13 @@ const TAKE_BACK: usize = 9;
 mod feed;
 mod take_back;
 
-/// Fixed-capacity ring of prepared segments (prep pushes, the step
-/// generator pops).
-#[derive(Debug, Clone)]
-pub struct SegmentQueue<const N: usize> {
-    items: [Segment; N],
-    head: usize,
-    len: usize,
-}
-
-impl<const N: usize> Default for SegmentQueue<N> {
-    fn default() -> Self {
-        Self::new()
-    }
-}
+/// Fixed-capacity ring of prepared segments (prep pushes at the back,
+/// the step generator pops at the front; the ring wraps by compare, no
+/// division, in the step interrupt).
+pub type SegmentQueue<const N: usize> = crate::ring::Ring<Segment, N>;
 
 impl Segment {
-    /// No steps (a placeholder in empty queue slots).
+    /// No steps (the step generator's state before its first segment).
     pub const EMPTY: Self = Self {
         block: StepBlock {
             steps: [0; 2],
@@ -163,61 +153,6 @@ impl Segment {
         period_ticks: 0,
         speed_permille: 0,
     };
-}
-
-impl<const N: usize> SegmentQueue<N> {
-    /// An empty queue (usable in a `static`).
-    pub const fn new() -> Self {
-        Self {
-            items: [Segment::EMPTY; N],
-            head: 0,
-            len: 0,
-        }
-    }
-
-    /// Drops every prepared segment.
-    pub fn clear(&mut self) {
-        self.len = 0;
-    }
-
-    /// Number of prepared segments.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-    /// Whether no segment is prepared.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-    /// Whether no further segment fits.
-    pub fn is_full(&self) -> bool {
-        self.len == N
-    }
-    /// Appends a segment; gives it back when full.
-    pub fn push(&mut self, seg: Segment) -> Result<(), Segment> {
-        if self.len == N {
-            return Err(seg);
-        }
-        let Some(slot) = self.items.get_mut((self.head + self.len) % N) else {
-            return Err(seg);
-        };
-        *slot = seg;
-        self.len += 1;
-        Ok(())
-    }
-    /// Takes the oldest segment.
-    pub fn pop(&mut self) -> Option<Segment> {
-        if self.len == 0 {
-            return None;
-        }
-        let seg = *self.items.get(self.head)?;
-        // Wrap by compare, not `%`: this runs in the step interrupt.
-        self.head += 1;
-        if self.head == N {
-            self.head = 0;
-        }
-        self.len -= 1;
-        Some(seg)
-    }
 }
 
 /// The block being cut and where the cutting is.
@@ -369,7 +304,7 @@ impl SegmentPrep {
                 break;
             };
             // Not full (checked above): the push succeeds.
-            if queue.push(seg).is_ok() {
+            if queue.push_back(seg).is_ok() {
                 added += 1;
             }
         }

@@ -98,7 +98,7 @@ impl StepGenerator {
     /// is prepared (the timer should stop).
     pub fn tick<const Q: usize>(&mut self, queue: &mut SegmentQueue<Q>) -> Option<StepTick> {
         if self.left == 0 {
-            let Some(seg) = queue.pop() else {
+            let Some(seg) = queue.pop_front() else {
                 self.speed_permille = 0;
                 return None;
             };

@@ -161,7 +161,7 @@ impl Running {
                 break;
             };
             // Room checked above; only the step timer takes from the queue.
-            if link.with_queue(|q| q.push(segment)).is_ok() {
+            if link.with_queue(|q| q.push_back(segment)).is_ok() {
                 added += 1;
             }
         }

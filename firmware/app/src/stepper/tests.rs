@@ -21,7 +21,7 @@ fn drain(motion: &mut StepperMotion, link: &StepperLink) -> Vec<[i32; 2]> {
             let Some(seg) = motion.next_segment() else {
                 break;
             };
-            link.with_queue(|q| q.push(seg)).unwrap();
+            link.with_queue(|q| q.push_back(seg)).unwrap();
         }
         if link.step_tick().is_none() {
             if motion.is_planned_out() {
@@ -163,7 +163,7 @@ fn halt_drops_everything_prepared() {
             let Some(seg) = motion.next_segment() else {
                 break;
             };
-            link.with_queue(|q| q.push(seg)).unwrap();
+            link.with_queue(|q| q.push_back(seg)).unwrap();
         }
         link.step_tick().unwrap();
     }
@@ -192,7 +192,7 @@ fn stop_decelerates_to_rest_short_of_the_target() {
             let Some(seg) = motion.next_segment() else {
                 break;
             };
-            link.with_queue(|q| q.push(seg)).unwrap();
+            link.with_queue(|q| q.push_back(seg)).unwrap();
         }
         link.step_tick().unwrap();
     }
@@ -253,7 +253,7 @@ fn drain_timed(motion: &mut StepperMotion, link: &StepperLink) -> (Vec<[i32; 2]>
             let Some(seg) = motion.next_segment() else {
                 break;
             };
-            link.with_queue(|q| q.push(seg)).unwrap();
+            link.with_queue(|q| q.push_back(seg)).unwrap();
         }
         let Some(tick) = link.step_tick() else {
             if motion.is_planned_out() {

@@ -6,24 +6,16 @@
 use super::super::planner::Planner;
 use super::{Cutting, Profile, Segment, SegmentPrep, SegmentQueue, StepBlock, TAKE_BACK};
 
-impl<const N: usize> SegmentQueue<N> {
-    /// The newest segment.
-    fn last_mut(&mut self) -> Option<&mut Segment> {
-        let i = (self.head + self.len.checked_sub(1)?) % N;
-        self.items.get_mut(i)
-    }
-}
-
 /// Adds `events` of `block` to the runs taken back: a new run when the
 /// block starts there (`starts`) or nothing is taken back yet, else onto
 /// the newest run.
 fn add_run(back: &mut SegmentQueue<TAKE_BACK>, block: StepBlock, events: u32, starts: bool) {
-    if !starts && let Some(last) = back.last_mut() {
+    if !starts && let Some(last) = back.back_mut() {
         last.events += events;
         return;
     }
     // One run per prepared segment at most, plus the generator's: fits.
-    let _ = back.push(Segment {
+    let _ = back.push_back(Segment {
         block,
         starts_block: starts,
         events,
@@ -47,14 +39,13 @@ impl SegmentPrep {
         queue: &mut SegmentQueue<Q>,
     ) {
         let (block, period) = executing;
-        let Some(period) = period.or_else(|| queue.items.get(queue.head).map(|s| s.period_ticks))
-        else {
+        let Some(period) = period.or_else(|| queue.front().map(|s| s.period_ticks)) else {
             return self.hold(planner);
         };
         let mut back = SegmentQueue::new();
         add_run(&mut back, block, 0, false);
         let mut left = 0;
-        while let Some(seg) = queue.pop() {
+        while let Some(seg) = queue.pop_front() {
             add_run(&mut back, seg.block, seg.events, seg.starts_block);
             left += u64::from(seg.events);
         }
@@ -81,7 +72,7 @@ impl SegmentPrep {
     /// left, decelerating from the hold's rate.
     pub(super) fn resume_taken_back(&mut self) -> Option<Cutting> {
         loop {
-            let run = self.taken_back.pop()?;
+            let run = self.taken_back.pop_front()?;
             if run.events == 0 {
                 continue;
             }

@@ -192,7 +192,7 @@ impl GalvoLoop {
                     .count(),
                 Err(_) => 0,
             };
-            if !self.steps.push_back(step) {
+            if self.steps.push_back(step).is_err() {
                 break;
             }
             self.work.bisection_axes += bisected as u32;
@@ -209,7 +209,7 @@ impl GalvoLoop {
     /// Steps at the front of [`Self::steps`] already started: the running
     /// one (0 or 1).
     pub(super) fn started(&self) -> usize {
-        usize::from(self.running && self.steps.len() > 0)
+        usize::from(self.running && !self.steps.is_empty())
     }
 
     /// Samples the refill held dark because the step it needed was not
