@@ -9,8 +9,9 @@
 use laser_sim::physics::PhysicalGalvo;
 use laser_sim::safety::{SafetyInputs, ViolationKind, check, check_inputs, report_text};
 use laser_sim::script::DEMO_SCRIPT;
-use laser_sim::world::SimReport;
-use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_to_idle};
+use laser_sim::servo_port::{BusFaults, SilentWindow};
+use laser_sim::world::{SimOptions, SimReport};
+use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_to_idle, run_with};
 
 /// Whether `inputs` break the figure rule.
 fn off_figure(inputs: &SafetyInputs<'_>) -> bool {
@@ -110,6 +111,47 @@ fn the_demo_and_every_pattern_keep_to_their_figures() {
     for (script, pointing, galvo) in scripts {
         let report = run_safe(script, galvo && !pointing);
         judged(&report, script, pointing, galvo);
+    }
+}
+
+/// The shared scenarios (`tests/scenarios/`) that draw, run in the
+/// simulator as `xtask scenario` runs them there.
+#[test]
+fn the_shared_scenarios_keep_to_their_figures() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    // (scenario, the gimbal judged, the galvo judged)
+    for (name, pointing, galvo) in [
+        ("grid", true, false),
+        ("switch", true, false),
+        ("galvo_tuning", false, true),
+        ("interlock", true, false),
+        ("silent_servo", true, false),
+    ] {
+        let script = std::fs::read_to_string(root.join(format!("{name}.txt")))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let faults = if name == "silent_servo" {
+            // `#! fault servo-silent:1@2500`
+            BusFaults {
+                silent: vec![SilentWindow {
+                    id: 1,
+                    from_ms: 2500,
+                    until_ms: None,
+                }],
+                ..BusFaults::default()
+            }
+        } else {
+            BusFaults::default()
+        };
+        assert!(name != "silent_servo" || script.contains("servo-silent:1@2500"));
+        let report = run_with(
+            &script,
+            SimOptions {
+                faults,
+                ..SimOptions::default()
+            },
+        );
+        assert_safe_allowing(&report, UNTIL_STEP_FIXES);
+        judged(&report, name, pointing, galvo);
     }
 }
 
