@@ -93,7 +93,9 @@ pub struct SimArgs {
     max_time_s: Option<f64>,
     /// Check the safety invariants after the run (laser dark within 1 ms
     /// of stop/fault/button/underrun, never lit while moving, one reply
-    /// per line, no task step over 1 ms of CPU time); print every
+    /// per line, no task step over 1 ms of CPU time, lit samples on the
+    /// G-code path and on the patterns' figures, motions ending in time,
+    /// the laser controls; docs/safety-checker.md); print every
     /// violation and exit 1 on any.
     #[arg(long)]
     check_safety: bool,

@@ -24,6 +24,10 @@
 //! * **(e) on the G-code path** ([`ViolationKind::OffPath`]) and **(f)
 //!   motions end in time** ([`ViolationKind::LateMotion`]): see
 //!   [`conformance`] for the rules and their stated tolerances.
+//! * **(h) patterns on their figure** ([`ViolationKind::OffFigure`]):
+//!   every lit sample of a `pattern`, `goto` or `grid` run lies within the
+//!   spot's tolerance of the figure modelled from the transcript
+//!   (`pattern_check.rs`, `pattern_model.rs`, `pattern_figure.rs`).
 //! * **(g) the laser controls** ([`ViolationKind::LitWithoutControls`],
 //!   on a board with them): no laser lit while the interlock is open or
 //!   the key off, without the emission indicator on for the emission
@@ -43,6 +47,9 @@ mod dark;
 mod gcode_model;
 mod gcode_piece;
 mod moving;
+mod pattern_check;
+mod pattern_figure;
+mod pattern_model;
 mod replies;
 mod steps;
 mod timeline;
@@ -62,6 +69,7 @@ pub use conformance::{DURATION_SLACK_S, RAPID_MIN_MM_S};
 use controls::laser_controls_obeyed;
 use dark::dark_after_stops;
 use moving::{galvo_jumps_dark, gimbal_dwell_mode, gimbal_travel_dark};
+use pattern_check::patterns_on_their_figure;
 use replies::one_reply_per_line;
 use steps::short_steps;
 pub use steps::{NOISE_RUNS, steady_steps};
@@ -107,6 +115,9 @@ pub enum ViolationKind {
     /// (g) A laser lit while the interlock was open or the key off, before
     /// the emission indicator's delay, or without a reset since.
     LitWithoutControls,
+    /// (h) A lit sample of a `pattern`, `goto` or `grid` run off its
+    /// figure.
+    OffFigure,
 }
 
 impl ViolationKind {
@@ -122,6 +133,7 @@ impl ViolationKind {
             ViolationKind::OffPath => "off-path",
             ViolationKind::LateMotion => "late-motion",
             ViolationKind::LitWithoutControls => "lit-without-controls",
+            ViolationKind::OffFigure => "off-figure",
         }
     }
 }
@@ -303,6 +315,7 @@ pub fn check_inputs(inputs: &SafetyInputs<'_>) -> Vec<Violation> {
         ViolationKind::LitWithoutControls,
         laser_controls_obeyed(inputs, &timeline),
     );
+    add(ViolationKind::OffFigure, patterns_on_their_figure(inputs));
     all
 }
 

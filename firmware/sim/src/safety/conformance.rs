@@ -38,10 +38,10 @@ impl Spot {
 }
 
 /// One spot's samples: (t µs, board mm, lit), in time order.
-type Samples = Vec<(u64, [f64; 2], bool)>;
+pub(super) type Samples = Vec<(u64, [f64; 2], bool)>;
 
 /// The pointing actuator's (gimbal/stepper) and the galvo's samples.
-fn samples(inputs: &SafetyInputs<'_>) -> (Samples, Samples) {
+pub(super) fn samples(inputs: &SafetyInputs<'_>) -> (Samples, Samples) {
     let pointing = inputs
         .spot
         .iter()
@@ -59,7 +59,7 @@ fn samples(inputs: &SafetyInputs<'_>) -> (Samples, Samples) {
 }
 
 /// The samples of `spot` in `[from, until)`.
-fn window(samples: &Samples, from: u64, until: u64) -> &[(u64, [f64; 2], bool)] {
+pub(super) fn window(samples: &Samples, from: u64, until: u64) -> &[(u64, [f64; 2], bool)] {
     let a = samples.partition_point(|s| s.0 < from);
     let b = samples.partition_point(|s| s.0 < until);
     &samples[a..b.max(a)]

@@ -33,6 +33,20 @@ impl Piece {
         }
     }
 
+    /// Where it starts, mm.
+    pub(super) fn start(&self) -> [f64; 2] {
+        match *self {
+            Piece::Line { a, .. } => a,
+            Piece::Arc {
+                centre,
+                radius,
+                start_rad,
+                ..
+            } => on_circle(centre, radius, start_rad),
+            Piece::Point(p) => p,
+        }
+    }
+
     /// Where it ends, mm.
     pub(super) fn end(&self) -> [f64; 2] {
         match *self {
