@@ -197,6 +197,7 @@ pub fn on_qemu(elf: &Path, scenario: &Scenario) -> Result<Outcome> {
         echo: false,
         echo_log: false,
         console_tee: None,
+        pelco: None,
     };
     let steps = parse_board_script(&scenario.script)?;
     let run = run_board(
@@ -257,6 +258,16 @@ pub fn run_on_qemu() -> Result<()> {
     );
     if let Err(e) = verdict {
         failures.push(format!("--pty console: {e:#}"));
+    }
+    let started = std::time::Instant::now();
+    let verdict = crate::qemu::check_pelco_port(&plain);
+    println!(
+        "the PELCO port on QEMU: {} ({:.1} s)",
+        if verdict.is_ok() { "ok" } else { "FAILED" },
+        started.elapsed().as_secs_f64()
+    );
+    if let Err(e) = verdict {
+        failures.push(format!("PELCO port: {e:#}"));
     }
     let started = std::time::Instant::now();
     let verdict = crate::hil::check_on_qemu(&plain);
