@@ -329,24 +329,13 @@ fn servo_uart(
     rx_pin: Peri<'static, PA3>,
     tx_pin: Peri<'static, PA2>,
 ) -> (BufferedUartTx<'static>, BufferedUartRx<'static>) {
-    let mut uart_config = usart::Config::default();
-    uart_config.baudrate = SERVO_BAUD;
     static SERVO_TX_BUFFER: StaticCell<[u8; SERVO_BUFFER_BYTES]> = StaticCell::new();
     static SERVO_RX_BUFFER: StaticCell<[u8; SERVO_BUFFER_BYTES]> = StaticCell::new();
-    let tx_buffer = SERVO_TX_BUFFER.init([0; SERVO_BUFFER_BYTES]);
-    let rx_buffer = SERVO_RX_BUFFER.init([0; SERVO_BUFFER_BYTES]);
-    match BufferedUart::new(
-        usart,
-        rx_pin,
-        tx_pin,
-        tx_buffer,
-        rx_buffer,
-        Irqs,
-        uart_config,
-    ) {
-        Ok(uart) => uart.split(),
-        Err(_) => defmt::panic!("USART2 configuration rejected"),
-    }
+    let buffers = (
+        SERVO_TX_BUFFER.init([0; SERVO_BUFFER_BYTES]).as_mut_slice(),
+        SERVO_RX_BUFFER.init([0; SERVO_BUFFER_BYTES]).as_mut_slice(),
+    );
+    buffered_uart(usart, rx_pin, tx_pin, buffers, SERVO_BAUD)
 }
 
 /// The PELCO port: USART3 (PB10 TX, PB11 RX), interrupt-driven both ways,
@@ -360,12 +349,34 @@ fn pelco_uart(
     de_pin: Peri<'static, PB12>,
 ) -> (Rs485Tx, BufferedUartRx<'static>) {
     let de = Output::new(de_pin, Level::Low, Speed::Low);
-    let mut uart_config = usart::Config::default();
-    uart_config.baudrate = 9600;
     static PELCO_TX_BUFFER: StaticCell<[u8; PELCO_BUFFER_BYTES]> = StaticCell::new();
     static PELCO_RX_BUFFER: StaticCell<[u8; PELCO_BUFFER_BYTES]> = StaticCell::new();
-    let tx_buffer = PELCO_TX_BUFFER.init([0; PELCO_BUFFER_BYTES]);
-    let rx_buffer = PELCO_RX_BUFFER.init([0; PELCO_BUFFER_BYTES]);
+    let buffers = (
+        PELCO_TX_BUFFER.init([0; PELCO_BUFFER_BYTES]).as_mut_slice(),
+        PELCO_RX_BUFFER.init([0; PELCO_BUFFER_BYTES]).as_mut_slice(),
+    );
+    let (tx, rx) = buffered_uart(usart, rx_pin, tx_pin, buffers, 9600);
+    (Rs485Tx { tx, de }, rx)
+}
+
+/// A USART, interrupt-driven and buffered both ways (`buffers`: transmit,
+/// receive), at `baud` 8N1, split into its halves.
+fn buffered_uart<T: usart::Instance>(
+    usart: Peri<'static, T>,
+    rx_pin: Peri<'static, impl usart::RxPin<T>>,
+    tx_pin: Peri<'static, impl usart::TxPin<T>>,
+    buffers: (&'static mut [u8], &'static mut [u8]),
+    baud: u32,
+) -> (BufferedUartTx<'static>, BufferedUartRx<'static>)
+where
+    Irqs: embassy_stm32::interrupt::typelevel::Binding<
+            T::Interrupt,
+            usart::BufferedInterruptHandler<T>,
+        >,
+{
+    let mut uart_config = usart::Config::default();
+    uart_config.baudrate = baud;
+    let (tx_buffer, rx_buffer) = buffers;
     match BufferedUart::new(
         usart,
         rx_pin,
@@ -375,11 +386,8 @@ fn pelco_uart(
         Irqs,
         uart_config,
     ) {
-        Ok(uart) => {
-            let (tx, rx) = uart.split();
-            (Rs485Tx { tx, de }, rx)
-        }
-        Err(_) => defmt::panic!("USART3 configuration rejected"),
+        Ok(uart) => uart.split(),
+        Err(_) => defmt::panic!("USART configuration rejected ({} baud)", baud),
     }
 }
 

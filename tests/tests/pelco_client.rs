@@ -98,7 +98,7 @@ fn console(link: &Path, line: &str) -> Vec<String> {
 /// positions the library decoded, and `pelco status`.
 fn drive(dialect: &str) -> (SimReport, Vec<[f64; 2]>, Vec<String>) {
     let dir = installed();
-    laser_sim::logger::init("debug".parse().unwrap());
+    laser_sim::logger::init("warn".parse().unwrap());
     let work = std::env::temp_dir().join(format!("pelco-client-{}-{dialect}", std::process::id()));
     std::fs::create_dir_all(&work).unwrap();
     let pelco_link = work.join("pelco");
