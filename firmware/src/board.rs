@@ -387,7 +387,7 @@ where
         uart_config,
     ) {
         Ok(uart) => uart.split(),
-        Err(_) => defmt::panic!("USART configuration rejected ({} baud)", baud),
+        Err(_) => defmt::panic!("USART configuration rejected"),
     }
 }
 
