@@ -16,6 +16,7 @@
 //! | stepper tilt STEP / DIR | PE11 TIM1_CH2 (AF1, one-pulse) / PE12 GPIO |
 //! | stepper ENABLE (both)   | PE13 (polarity a parameter; released = the idle level) |
 //! | stepper limit switches  | PE7 pan, PE8 tilt (pull-up inputs, normally-open switch to GND: low = pressed) |
+//! | PELCO port USART3 (RS-485) | PB10 TX, PB11 RX (interrupt-driven, buffered; baud `pelco.baud`, 8N1), PB12 driver enable (high while sending, `rs485.rs`) — `docs/pelco.md` |
 //!
 //! Flash: the image in sectors 0–6 (≤ 384 KiB), the saved settings in
 //! sectors 10 and 11 (`settings_flash`, `memory.x`).
@@ -32,7 +33,9 @@ use embassy_stm32::exti::ExtiInput;
 use embassy_stm32::flash::{self, Flash};
 use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::interrupt::Priority;
-use embassy_stm32::peripherals::{PA2, PA3, PA11, PA12, USART2, USB_OTG_FS};
+use embassy_stm32::peripherals::{
+    PA2, PA3, PA11, PA12, PB10, PB11, PB12, USART2, USART3, USB_OTG_FS,
+};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::usart::{self, BufferedUart, BufferedUartRx, BufferedUartTx};
 use embassy_stm32::{Peri, bind_interrupts, exti, pac, peripherals, usb};
@@ -49,11 +52,13 @@ use crate::parts::{
     IndependentDog, LaserControlPins, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UsbDtr,
     UserButton,
 };
+use crate::rs485::Rs485Tx;
 use crate::settings_flash::{FlashSettings, settings_store};
 
 bind_interrupts!(struct Irqs {
     OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
     USART2 => usart::BufferedInterruptHandler<peripherals::USART2>;
+    USART3 => usart::BufferedInterruptHandler<peripherals::USART3>;
     DMA1_STREAM5 => HalfInterrupt;
     EXTI0 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI0>;
     EXTI1 => exti::InterruptHandler<embassy_stm32::interrupt::typelevel::EXTI1>;
@@ -67,6 +72,9 @@ const USB_PACKET_BYTES: u16 = 64;
 const SERVO_BAUD: u32 = 115_200;
 /// Servo UART software buffers, bytes each way.
 const SERVO_BUFFER_BYTES: usize = 256;
+/// PELCO UART software buffers, bytes each way (a frame is 7 or 8; a
+/// keyboard repeats its frames every ~50–100 ms).
+const PELCO_BUFFER_BYTES: usize = 64;
 
 /// Priority of the galvo executor's interrupt: below every peripheral
 /// interrupt (P0: the DMA half interrupt, USART2, USB, the time driver),
@@ -147,6 +155,11 @@ pub struct Stm32Board {
     pub stepper: TimerStepper,
     /// Remote interlock (PD1), key switch (PD2), emission indicator (PD3).
     pub laser_controls: LaserControlPins,
+    /// The PELCO port: USART3 receive (PB11).
+    pub pelco_rx: BufferedUartRx<'static>,
+    /// The PELCO port: USART3 transmit (PB10) with the RS-485 driver
+    /// enable (PB12).
+    pub pelco_tx: Rs485Tx,
 }
 
 impl Board for Stm32Board {
@@ -161,6 +174,8 @@ impl Board for Stm32Board {
     type StopButton = UserButton;
     type Watchdog = IndependentDog;
     type LaserControls = LaserControlPins;
+    type PelcoRx = BufferedUartRx<'static>;
+    type PelcoTx = Rs485Tx;
 
     fn into_parts(self) -> Parts<Self> {
         Parts {
@@ -175,6 +190,7 @@ impl Board for Stm32Board {
             stop_button: self.button,
             watchdog: self.watchdog,
             laser_controls: Some(self.laser_controls),
+            pelco: Some((self.pelco_rx, self.pelco_tx)),
         }
     }
 }
@@ -199,6 +215,7 @@ pub fn init(spawner: Spawner) -> Stm32Board {
     let (usb_device, console) = usb_console(p.USB_OTG_FS, p.PA12, p.PA11);
     spawner.spawn(defmt::unwrap!(crate::tasks::usb_device(usb_device)));
     let (servo_tx, servo_rx) = servo_uart(p.USART2, p.PA3, p.PA2);
+    let (pelco_tx, pelco_rx) = pelco_uart(p.USART3, p.PB11, p.PB10, p.PB12);
     enable_cycle_counter();
     // The HardFault handler's hand-written register addresses.
     defmt::assert!(
@@ -254,6 +271,8 @@ pub fn init(spawner: Spawner) -> Stm32Board {
             key: ExtiInput::new(p.PD2, p.EXTI2, Pull::Up, Irqs),
             indicator: Output::new(p.PD3, Level::Low, Speed::Low),
         },
+        pelco_rx,
+        pelco_tx,
     }
 }
 
@@ -310,12 +329,54 @@ fn servo_uart(
     rx_pin: Peri<'static, PA3>,
     tx_pin: Peri<'static, PA2>,
 ) -> (BufferedUartTx<'static>, BufferedUartRx<'static>) {
-    let mut uart_config = usart::Config::default();
-    uart_config.baudrate = SERVO_BAUD;
     static SERVO_TX_BUFFER: StaticCell<[u8; SERVO_BUFFER_BYTES]> = StaticCell::new();
     static SERVO_RX_BUFFER: StaticCell<[u8; SERVO_BUFFER_BYTES]> = StaticCell::new();
-    let tx_buffer = SERVO_TX_BUFFER.init([0; SERVO_BUFFER_BYTES]);
-    let rx_buffer = SERVO_RX_BUFFER.init([0; SERVO_BUFFER_BYTES]);
+    let buffers = (
+        SERVO_TX_BUFFER.init([0; SERVO_BUFFER_BYTES]).as_mut_slice(),
+        SERVO_RX_BUFFER.init([0; SERVO_BUFFER_BYTES]).as_mut_slice(),
+    );
+    buffered_uart(usart, rx_pin, tx_pin, buffers, SERVO_BAUD)
+}
+
+/// The PELCO port: USART3 (PB10 TX, PB11 RX), interrupt-driven both ways,
+/// at the default 9600 baud 8N1 until the port task sets the saved
+/// `pelco.baud`; PB12 drives the RS-485 transceiver's DE and /RE (low:
+/// receiving).
+fn pelco_uart(
+    usart: Peri<'static, USART3>,
+    rx_pin: Peri<'static, PB11>,
+    tx_pin: Peri<'static, PB10>,
+    de_pin: Peri<'static, PB12>,
+) -> (Rs485Tx, BufferedUartRx<'static>) {
+    let de = Output::new(de_pin, Level::Low, Speed::Low);
+    static PELCO_TX_BUFFER: StaticCell<[u8; PELCO_BUFFER_BYTES]> = StaticCell::new();
+    static PELCO_RX_BUFFER: StaticCell<[u8; PELCO_BUFFER_BYTES]> = StaticCell::new();
+    let buffers = (
+        PELCO_TX_BUFFER.init([0; PELCO_BUFFER_BYTES]).as_mut_slice(),
+        PELCO_RX_BUFFER.init([0; PELCO_BUFFER_BYTES]).as_mut_slice(),
+    );
+    let (tx, rx) = buffered_uart(usart, rx_pin, tx_pin, buffers, 9600);
+    (Rs485Tx { tx, de }, rx)
+}
+
+/// A USART, interrupt-driven and buffered both ways (`buffers`: transmit,
+/// receive), at `baud` 8N1, split into its halves.
+fn buffered_uart<T: usart::Instance>(
+    usart: Peri<'static, T>,
+    rx_pin: Peri<'static, impl usart::RxPin<T>>,
+    tx_pin: Peri<'static, impl usart::TxPin<T>>,
+    buffers: (&'static mut [u8], &'static mut [u8]),
+    baud: u32,
+) -> (BufferedUartTx<'static>, BufferedUartRx<'static>)
+where
+    Irqs: embassy_stm32::interrupt::typelevel::Binding<
+            T::Interrupt,
+            usart::BufferedInterruptHandler<T>,
+        >,
+{
+    let mut uart_config = usart::Config::default();
+    uart_config.baudrate = baud;
+    let (tx_buffer, rx_buffer) = buffers;
     match BufferedUart::new(
         usart,
         rx_pin,
@@ -326,7 +387,7 @@ fn servo_uart(
         uart_config,
     ) {
         Ok(uart) => uart.split(),
-        Err(_) => defmt::panic!("USART2 configuration rejected"),
+        Err(_) => defmt::panic!("USART configuration rejected"),
     }
 }
 

@@ -15,6 +15,7 @@ mod galvo_dac;
 mod laser_pwm;
 mod panic;
 mod parts;
+mod rs485;
 mod settings_flash;
 mod tasks;
 

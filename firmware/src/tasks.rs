@@ -13,8 +13,8 @@ use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::usart::{BufferedUartRx, BufferedUartTx};
 use embassy_usb::UsbDevice;
 use laser_app::app::{
-    ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, SequencerTask, ServoBusTask, Spawn,
-    StopButtonTask, WatchdogTask,
+    ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, PelcoTask, SequencerTask,
+    ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::galvo::GalvoMemory;
 
@@ -26,6 +26,7 @@ use crate::laser_pwm::LaserPin;
 use crate::parts::{
     IndependentDog, LaserControlPins, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton,
 };
+use crate::rs485::Rs485Tx;
 use crate::settings_flash::FlashSettings;
 use laser_app::stepper::{StepPulseTask, StepperTask};
 
@@ -121,6 +122,13 @@ async fn laser_controls(task: LaserControlsTask<LaserControlPins>) -> ! {
     task.run().await
 }
 
+/// The PELCO port on USART3 (RS-485): frames from a CCTV keyboard or PTZ
+/// software as the product's commands.
+#[embassy_executor::task]
+async fn pelco(task: PelcoTask<BufferedUartRx<'static>, Rs485Tx>) -> ! {
+    task.run().await
+}
+
 /// Spawns the task bodies on the embassy executors (each task's pool holds
 /// one: the wiring spawns each once).
 pub struct TaskSpawner {
@@ -174,5 +182,9 @@ impl Spawn<Stm32Board> for TaskSpawner {
         // interlock darkens the laser without waiting for a thread-mode
         // task's step to end.
         self.galvo.spawn(defmt::unwrap!(laser_controls(task)));
+    }
+
+    fn pelco(&mut self, task: PelcoTask<BufferedUartRx<'static>, Rs485Tx>) {
+        self.thread.spawn(defmt::unwrap!(pelco(task)));
     }
 }

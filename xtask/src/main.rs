@@ -66,7 +66,8 @@ enum Command {
     /// Real G-code senders (PyPI's grbl-streamer and pygrbl-streamer,
     /// npm's cncjs headless; installed into target/senders when missing)
     /// stream a laser CAM job to the simulator through its PTY console,
-    /// in real time (~3 min).
+    /// and a PELCO-D client (PyPI's pyptzcontroller) drives its PELCO
+    /// port's PTY in PELCO-D and PELCO-P, in real time (~4 min).
     Senders,
 }
 
@@ -100,6 +101,8 @@ fn main() -> ExitCode {
                 "system-tests",
                 "--test",
                 "gcode_senders",
+                "--test",
+                "pelco_client",
                 "--",
                 "--ignored",
                 "--test-threads",

@@ -12,6 +12,7 @@ mod board_log;
 mod defmt_log;
 mod machine;
 mod measure;
+mod pelco;
 mod pty;
 mod script;
 mod servo_bus;
@@ -32,6 +33,7 @@ use laser_sim::recorder::{Recording, SpotSample};
 pub use board_log::{BoardEvent, BoardLog, LogLine, parse_line};
 pub use defmt_log::check_channel as check_defmt_channel;
 pub use machine::{Machine, MachineOptions};
+pub use pelco::check_port as check_pelco_port;
 pub use pty::{check_console as check_pty_console, with_board_on_pty};
 pub use script::{BoardStep, parse_board_script, split_at_resets};
 use script::{run_steps, wait_until_idle};
@@ -83,6 +85,11 @@ pub struct QemuArgs {
     /// until Ctrl-C or --max-time-s.
     #[arg(long, num_args = 0..=1, default_missing_value = "", conflicts_with_all = ["script", "interactive"])]
     pty: Option<PathBuf>,
+    /// The board's PELCO port (UART4, the STM32 board's RS-485 USART3) on
+    /// a raw pseudo-terminal for a PELCO-D / PELCO-P client (its path is
+    /// printed; with PATH also a symlink to it).
+    #[arg(long, num_args = 0..=1, default_missing_value = "")]
+    pelco_pty: Option<PathBuf>,
     /// Print the board's log channel on stderr.
     #[arg(long)]
     log: bool,
@@ -334,8 +341,22 @@ pub fn run(args: QemuArgs) -> Result<ExitCode> {
         echo: true,
         echo_log: args.log,
         console_tee: None,
+        pelco: None,
     };
     let mut open_pty = None;
+    let pelco_pty = match &args.pelco_pty {
+        Some(link) => {
+            let link = (!link.as_os_str().is_empty()).then_some(link.as_path());
+            let (pty, bridge) = pty::open(link)?;
+            eprintln!("xtask qemu: PELCO port on {}", pty.path.display());
+            options.pelco = Some(machine::PelcoWire {
+                to_host: bridge.to_host,
+                from_host: Arc::new(std::sync::Mutex::new(bridge.from_host)),
+            });
+            Some(pty)
+        }
+        None => None,
+    };
     let drive = if let Some(link) = &args.pty {
         let link = (!link.as_os_str().is_empty()).then_some(link.as_path());
         let (pty, bridge) = pty::open(link)?;
@@ -364,7 +385,7 @@ pub fn run(args: QemuArgs) -> Result<ExitCode> {
         Duration::from_secs_f64(max_time_s),
         args.trace.is_some(),
     )?;
-    drop(open_pty);
+    drop((open_pty, pelco_pty));
     write_outputs(&args, &run)?;
     eprintln!(
         "xtask qemu: ended at t = {:.3} s; {} boots, {} servo frames, {} laser switches, {} error replies",

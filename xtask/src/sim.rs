@@ -87,6 +87,12 @@ pub struct SimArgs {
     /// until Ctrl-C / SIGTERM (or --max-time-s), then writes the outputs.
     #[arg(long, num_args = 0..=1, default_missing_value = "", conflicts_with_all = ["script", "interactive"])]
     pty: Option<PathBuf>,
+    /// Serve the board's PELCO port (the RS-485 UART: PELCO-D / PELCO-P
+    /// frames) on a pseudo-terminal for a PTZ client or a CCTV keyboard's
+    /// adapter; prints the device path, and makes PATH a symlink to it
+    /// when given. Real time (implies --realtime); usually with --pty.
+    #[arg(long, num_args = 0..=1, default_missing_value = "")]
+    pelco_pty: Option<PathBuf>,
     /// Stop after this much simulated time, s (default 600; no limit with
     /// --interactive or --pty).
     #[arg(long)]
@@ -253,7 +259,16 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
         .apply(SimOptions {
             script,
             pty,
-            realtime: args.realtime || args.interactive || args.pty.is_some(),
+            pelco_pty: args
+                .pelco_pty
+                .as_ref()
+                .map(|link| laser_sim::pelco_port::PelcoPtyOptions {
+                    link: (!link.as_os_str().is_empty()).then(|| link.clone()),
+                }),
+            realtime: args.realtime
+                || args.interactive
+                || args.pty.is_some()
+                || args.pelco_pty.is_some(),
             interactive: args.interactive,
             until_idle,
             faults,

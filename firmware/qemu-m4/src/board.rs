@@ -7,6 +7,7 @@
 //! | servo bus (FashionStar)| UART1 0x4000_5000 (IRQ 2/3)                 |
 //! | log channel, stop button | UART2 0x4000_6000 (IRQ 4/5)               |
 //! | defmt logs (`defmt-log`) | UART3 0x4000_7000 (polled)                |
+//! | PELCO port (PELCO-D/P)  | UART4 0x4000_9000 (IRQ 20/21)             |
 //! | embassy-time          | APB timers 0/1 0x4000_0000/0x4000_1000 (IRQ 8/9) |
 //! | watchdog              | CMSDK watchdog 0x4000_8000 (NMI, then reset) |
 //! | laser pin, LEDs       | reported on the log channel                  |
@@ -22,7 +23,7 @@ use laser_app::app::{Board, Parts};
 
 use crate::parts::{CmsdkWatchdog, LASER_GATE, LaserPin, ReportedLeds, UartButton, UartConsole};
 use crate::settings_ram::{RamSettings, settings_store};
-use crate::uart::{UART0, UART1, UART2, Uart};
+use crate::uart::{UART0, UART1, UART2, UART4, Uart};
 
 /// The board's parts, configured (laser off).
 pub struct QemuBoard {
@@ -30,6 +31,7 @@ pub struct QemuBoard {
     servo: Uart,
     button: UartButton,
     settings: RamSettings,
+    pelco: Uart,
 }
 
 impl Board for QemuBoard {
@@ -52,6 +54,8 @@ impl Board for QemuBoard {
     type LaserControls = laser_app::app::NoLaserControls;
     #[cfg(feature = "laser-controls")]
     type LaserControls = crate::controls::ChannelLaserControls;
+    type PelcoRx = Uart;
+    type PelcoTx = Uart;
 
     fn into_parts(self) -> Parts<Self> {
         Parts {
@@ -72,12 +76,13 @@ impl Board for QemuBoard {
             laser_controls: None,
             #[cfg(feature = "laser-controls")]
             laser_controls: Some(crate::controls::ChannelLaserControls { shown: None }),
+            pelco: Some((self.pelco, self.pelco)),
         }
     }
 }
 
 /// Brings the board up (the log channel is up already): the console and
-/// servo UARTs and the settings store.
+/// servo UARTs, the PELCO port's and the settings store.
 pub fn init() -> QemuBoard {
     let console = Uart::start(&UART0);
     QemuBoard {
@@ -90,5 +95,6 @@ pub fn init() -> QemuBoard {
             rx: Uart::start(&UART2),
         },
         settings: settings_store(),
+        pelco: Uart::start(&UART4),
     }
 }

@@ -1,8 +1,8 @@
 //! The MPS2 AN386's interrupt lines this board uses and its vector table
 //! (`__INTERRUPTS`, which cortex-m-rt's `device` feature expects from the
 //! device crate; this board has none). Lines as QEMU's `mps2-an386` wires
-//! them: UART n receive at 2n and transmit at 2n + 1 (n = 0..2), APB timer
-//! 0 at 8, timer 1 at 9.
+//! them: UART n receive at 2n and transmit at 2n + 1 (n = 0..2), UART3 at
+//! 18/19, UART4 at 20/21, APB timer 0 at 8, timer 1 at 9.
 
 use cortex_m::interrupt::InterruptNumber;
 use cortex_m::peripheral::NVIC;
@@ -23,6 +23,10 @@ pub enum Irq {
     Uart2Rx = 4,
     /// UART2 byte sent.
     Uart2Tx = 5,
+    /// UART4 (PELCO port) byte received.
+    Uart4Rx = 20,
+    /// UART4 byte sent.
+    Uart4Tx = 21,
     /// APB timer 0 wrapped (the time base's upper bits).
     Timer0 = 8,
     /// APB timer 1 reached zero (the alarm).
@@ -66,6 +70,8 @@ pub static __INTERRUPTS: [Vector; 32] = {
     table[Irq::Uart1Tx as usize] = crate::uart::uart1_tx;
     table[Irq::Uart2Rx as usize] = crate::uart::uart2_rx;
     table[Irq::Uart2Tx as usize] = crate::uart::uart2_tx;
+    table[Irq::Uart4Rx as usize] = crate::uart::uart4_rx;
+    table[Irq::Uart4Tx as usize] = crate::uart::uart4_tx;
     table[Irq::Timer0 as usize] = crate::time_driver::timer0_wrapped;
     table[Irq::Timer1 as usize] = crate::time_driver::timer1_alarm;
     #[cfg(feature = "galvo-dac")]

@@ -7,7 +7,7 @@ use embassy_executor::Spawner;
 #[cfg(not(feature = "galvo-dac"))]
 use laser_app::app::NoGalvoDac;
 use laser_app::app::{
-    ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, NoStepper, SequencerTask,
+    ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, NoStepper, PelcoTask, SequencerTask,
     ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::stepper::{StepPulseTask, StepperTask};
@@ -30,6 +30,11 @@ async fn servo_bus(task: ServoBusTask<Uart, Uart>) -> ! {
 #[cfg(feature = "laser-controls")]
 #[embassy_executor::task]
 async fn laser_controls(task: LaserControlsTask<crate::controls::ChannelLaserControls>) -> ! {
+    task.run().await
+}
+
+#[embassy_executor::task]
+async fn pelco(task: PelcoTask<Uart, Uart>) -> ! {
     task.run().await
 }
 
@@ -139,5 +144,9 @@ impl Spawn<QemuBoard> for TaskSpawner {
 
     fn watchdog(&mut self, task: WatchdogTask<CmsdkWatchdog>) {
         spawned("watchdog", watchdog(task), &self.0);
+    }
+
+    fn pelco(&mut self, task: PelcoTask<Uart, Uart>) {
+        spawned("pelco", pelco(task), &self.0);
     }
 }

@@ -182,6 +182,11 @@ pub static UART1: UartState = UartState::new(0x4000_5000, Irq::Uart1Rx, Irq::Uar
 pub static UART3: UartState = UartState::new(0x4000_7000, Irq::Uart2Rx, Irq::Uart2Tx);
 /// UART2: the log channel (out) and the stop button (in).
 pub static UART2: UartState = UartState::new(0x4000_6000, Irq::Uart2Rx, Irq::Uart2Tx);
+/// UART4: the PELCO port (the STM32 board's RS-485 USART3).
+pub static UART4: UartState = UartState::new(0x4000_9000, Irq::Uart4Rx, Irq::Uart4Tx);
+
+/// The peripheral clock the baud divisor divides, Hz.
+const PCLK_HZ: u32 = 25_000_000;
 
 /// A UART, started (115200 baud as far as QEMU cares, both directions on,
 /// receive interrupt on).
@@ -202,6 +207,15 @@ impl Uart {
         interrupts::enable(state.rx_irq);
         interrupts::enable(state.tx_irq);
         Self { state }
+    }
+}
+
+impl laser_app::pelco::PelcoLine for Uart {
+    /// Sets the divisor for `baud` (QEMU sends at host speed whatever it
+    /// is; the register holds what a real CMSDK UART would need).
+    fn set_baud(&mut self, baud: u32) {
+        let divisor = PCLK_HZ.checked_div(baud).unwrap_or(BAUD_DIVISOR).max(16);
+        self.state.regs.bauddiv().write(divisor);
     }
 }
 
@@ -312,4 +326,12 @@ pub unsafe extern "C" fn uart2_rx() {
 /// UART2 transmit interrupt.
 pub unsafe extern "C" fn uart2_tx() {
     UART2.on_tx();
+}
+/// UART4 receive interrupt.
+pub unsafe extern "C" fn uart4_rx() {
+    UART4.on_rx();
+}
+/// UART4 transmit interrupt.
+pub unsafe extern "C" fn uart4_tx() {
+    UART4.on_tx();
 }

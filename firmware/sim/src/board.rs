@@ -13,6 +13,7 @@
 //! | stepper STEP/DIR/ENABLE | the driver models ([`SimStepperDrive`]), or none |
 //! | LEDs, button, watchdog | recorded models ([`crate::panel`])       |
 //! | interlock, key, emission indicator | script-set inputs, recorded indicator ([`crate::controls`]), or none |
+//! | PELCO port (RS-485 UART) | a PTY ([`crate::pelco_port`], `--pelco-pty`), or none |
 
 use std::cell::Cell;
 use std::convert::Infallible;
@@ -21,7 +22,7 @@ use std::rc::Rc;
 use embassy_executor::Spawner;
 use laser_app::app::{
     Board, Console, ConsoleTask, GalvoTask, HostPresence, IndicatorTask, LaserControlsTask, Parts,
-    SequencerTask, ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
+    PelcoTask, SequencerTask, ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
 };
 use laser_app::settings::store::FlashSettingsStore;
 use laser_app::stepper::{StepPulseTask, StepperTask};
@@ -30,6 +31,7 @@ use crate::controls::SimLaserControls;
 use crate::dac::SimDac;
 use crate::executor::{TaskKind, spawn_task};
 use crate::panel::{SimLeds, SimStopButton, SimWatchdog};
+use crate::pelco_port::{PelcoRx, PelcoTx};
 use crate::servo_port::{PortHandle, SimServoPort};
 use crate::spot::RecordingLaser;
 use crate::stepper::SimStepperDrive;
@@ -58,6 +60,8 @@ pub struct SimBoard {
     pub watchdog: SimWatchdog,
     /// The laser controls, if the board has them.
     pub laser_controls: Option<SimLaserControls>,
+    /// The PELCO port, if the run has one (`--pelco-pty`).
+    pub pelco: Option<(PelcoRx, PelcoTx)>,
 }
 
 impl Board for SimBoard {
@@ -72,6 +76,8 @@ impl Board for SimBoard {
     type StopButton = SimStopButton;
     type Watchdog = SimWatchdog;
     type LaserControls = SimLaserControls;
+    type PelcoRx = PelcoRx;
+    type PelcoTx = PelcoTx;
 
     fn into_parts(self) -> Parts<Self> {
         Parts {
@@ -90,6 +96,7 @@ impl Board for SimBoard {
             stop_button: self.stop_button,
             watchdog: self.watchdog,
             laser_controls: self.laser_controls,
+            pelco: self.pelco,
         }
     }
 }
@@ -242,6 +249,10 @@ impl Spawn<SimBoard> for SimSpawner {
 
     fn laser_controls(&mut self, task: LaserControlsTask<SimLaserControls>) {
         self.firmware("laser controls", task.run());
+    }
+
+    fn pelco(&mut self, task: PelcoTask<PelcoRx, PelcoTx>) {
+        self.firmware("pelco", task.run());
     }
 }
 

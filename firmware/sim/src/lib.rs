@@ -15,6 +15,7 @@ pub mod logger;
 #[cfg(unix)]
 pub mod on_pty;
 pub mod panel;
+pub mod pelco_port;
 pub mod physics;
 #[cfg(unix)]
 pub mod pty;

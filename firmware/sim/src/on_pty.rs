@@ -26,10 +26,15 @@ pub struct SimOnPty {
 
 impl SimOnPty {
     /// Starts `options` (its `pty` and `realtime` set here) with the
-    /// console on a PTY linked at `link`; returns once the link exists.
+    /// console on a PTY linked at `link`; returns once the link exists
+    /// (and the PELCO port's, when `options` asks for one with a link).
     pub fn start(link: PathBuf, options: SimOptions) -> Result<Self> {
         let stop = Arc::new(AtomicBool::new(false));
         let _ = std::fs::remove_file(&link);
+        let pelco_link = options.pelco_pty.as_ref().and_then(|p| p.link.clone());
+        if let Some(pelco) = &pelco_link {
+            let _ = std::fs::remove_file(pelco);
+        }
         let options = SimOptions {
             pty: Some(PtyOptions {
                 link: Some(link.clone()),
@@ -40,12 +45,14 @@ impl SimOnPty {
         };
         let thread = std::thread::spawn(move || run(options));
         let started = Instant::now();
-        while !link.exists() {
-            if started.elapsed() > START_LIMIT || thread.is_finished() {
-                stop.store(true, Ordering::Relaxed);
-                bail!("the simulator's PTY did not appear at {}", link.display());
+        for link in std::iter::once(&link).chain(&pelco_link) {
+            while !link.exists() {
+                if started.elapsed() > START_LIMIT || thread.is_finished() {
+                    stop.store(true, Ordering::Relaxed);
+                    bail!("the simulator's PTY did not appear at {}", link.display());
+                }
+                std::thread::sleep(Duration::from_millis(10));
             }
-            std::thread::sleep(Duration::from_millis(10));
         }
         Ok(Self { link, stop, thread })
     }

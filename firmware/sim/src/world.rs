@@ -103,6 +103,8 @@ struct World {
     stepper: Rc<RefCell<PanTiltDrivers>>,
     /// Where the pointing actuator's spot is at a time (µs), cm.
     spot: SpotFn,
+    /// What crossed the PELCO port.
+    pelco: crate::pelco_port::SharedTraffic,
 }
 
 impl World {
@@ -152,6 +154,7 @@ impl World {
             bus,
             port,
             gimbal,
+            pelco: Default::default(),
         }
     }
 
@@ -198,6 +201,7 @@ impl World {
                     options.stepper_switches,
                 )
             }),
+            pelco: pelco_port(options, &self.pelco),
         }
     }
 
@@ -255,6 +259,7 @@ impl World {
             panel: self.panel_at_end(end_time_us),
             stepper: self.stepper_at_end(end_time_us),
             laser_controls: self.controls.as_ref().map(|c| c.record()),
+            pelco: self.pelco.borrow().clone(),
         }
     }
 
@@ -290,6 +295,22 @@ impl World {
         panel.watchdog = panel.watchdog.at_end(end_time_us);
         panel
     }
+}
+
+/// The PELCO port the run asks for, on its PTY (none, with the reason on
+/// stderr, when the PTY cannot be opened).
+fn pelco_port(
+    options: &SimOptions,
+    traffic: &crate::pelco_port::SharedTraffic,
+) -> Option<(crate::pelco_port::PelcoRx, crate::pelco_port::PelcoTx)> {
+    #[cfg(unix)]
+    if let Some(pty) = &options.pelco_pty {
+        return crate::pelco_port::open_on_pty(pty, traffic.clone())
+            .map_err(|e| eprintln!("xtask sim: no PELCO port: {e:#}"))
+            .ok();
+    }
+    let _ = (options, traffic);
+    None
 }
 
 /// The pointing actuator's spot: the stepper's (from its counted steps)

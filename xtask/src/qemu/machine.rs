@@ -1,4 +1,4 @@
-//! One run of the emulated board: QEMU started on the image with its four
+//! One run of the emulated board: QEMU started on the image with its five
 //! UARTs and its monitor on Unix sockets this process listens on, and the
 //! threads that serve them (console terminal, servo bus, log channel).
 
@@ -7,7 +7,7 @@ use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::mpsc::SyncSender;
+use std::sync::mpsc::{Receiver, SyncSender};
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -49,6 +49,18 @@ pub struct MachineOptions {
     pub echo_log: bool,
     /// Also send the console's output here (the `--pty` bridge).
     pub console_tee: Option<SyncSender<Vec<u8>>>,
+    /// The PELCO port's bytes to and from a client (the `--pelco-pty`
+    /// bridge); none: the port is connected but silent.
+    pub pelco: Option<PelcoWire>,
+}
+
+/// The PELCO port (UART4) joined to a client's byte channels.
+#[derive(Debug, Clone)]
+pub struct PelcoWire {
+    /// The board's bytes, for the client.
+    pub to_host: SyncSender<Vec<u8>>,
+    /// The client's bytes, for the board.
+    pub from_host: Arc<Mutex<Receiver<Vec<u8>>>>,
 }
 
 /// A running emulated board.
@@ -56,6 +68,8 @@ pub struct Machine {
     child: Child,
     dir: PathBuf,
     console: UnixStream,
+    /// The PELCO port (UART4).
+    pelco: UnixStream,
     log_input: UnixStream,
     monitor: UnixStream,
     /// The console terminal.
@@ -119,6 +133,8 @@ fn spawn_qemu(elf: &Path, sockets: &[(&str, PathBuf)]) -> Result<Child> {
             "chardev:uart2",
             "-serial",
             "chardev:uart3",
+            "-serial",
+            "chardev:uart4",
             "-mon",
             "chardev=mon,mode=readline",
         ])
@@ -128,11 +144,44 @@ fn spawn_qemu(elf: &Path, sockets: &[(&str, PathBuf)]) -> Result<Child> {
     cmd.spawn().context("could not start qemu-system-arm")
 }
 
+/// Joins the PELCO port's socket to `wire`: the board's bytes to the
+/// client (a thread the socket's shutdown ends), the client's to the board
+/// (a thread that ends with the client's channel).
+fn wire_pelco(
+    pelco: &UnixStream,
+    wire: PelcoWire,
+    threads: &mut Vec<JoinHandle<()>>,
+) -> Result<()> {
+    let (mut reader, mut writer) = (pelco.try_clone()?, pelco.try_clone()?);
+    let to_host = wire.to_host;
+    threads.push(std::thread::spawn(move || {
+        let mut buf = [0u8; 256];
+        while let Ok(n) = std::io::Read::read(&mut reader, &mut buf) {
+            if n == 0 || to_host.send(buf[..n].to_vec()).is_err() {
+                return;
+            }
+        }
+    }));
+    std::thread::spawn(move || {
+        loop {
+            let bytes = match wire.from_host.lock() {
+                Ok(from_host) => from_host.recv(),
+                Err(_) => return,
+            };
+            match bytes {
+                Ok(bytes) if writer.write_all(&bytes).is_ok() => {}
+                _ => return,
+            }
+        }
+    });
+    Ok(())
+}
+
 impl Machine {
     /// Starts QEMU on `elf` and waits for the board to boot.
     pub fn start(elf: &Path, options: &MachineOptions) -> Result<Self> {
         let dir = socket_dir()?;
-        let names = ["uart0", "uart1", "uart2", "uart3", "mon"];
+        let names = ["uart0", "uart1", "uart2", "uart3", "uart4", "mon"];
         let mut sockets = Vec::new();
         let mut listeners = Vec::new();
         for name in names {
@@ -153,8 +202,9 @@ impl Machine {
                 }
             }
         }
-        let [console, servo, log, defmt, monitor] = <[UnixStream; 5]>::try_from(streams)
-            .map_err(|_| anyhow::anyhow!("five sockets expected"))?;
+        let [console, servo, log, defmt, pelco, monitor] = <[UnixStream; 6]>::try_from(streams)
+            .map_err(|_| anyhow::anyhow!("six sockets expected"))?;
+
         let elf_bytes =
             std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
         let terminal: SharedTerminal = Arc::new((
@@ -173,6 +223,9 @@ impl Machine {
             damaged: Vec::new(),
         }));
         let mut threads = Vec::new();
+        if let Some(wire) = &options.pelco {
+            wire_pelco(&pelco, wire.clone(), &mut threads)?;
+        }
         let (term, reader) = (terminal.clone(), console.try_clone()?);
         let tee = options.console_tee.clone();
         threads.push(std::thread::spawn(move || {
@@ -193,6 +246,7 @@ impl Machine {
             child,
             dir,
             console,
+            pelco,
             log_input: log,
             monitor,
             terminal,
@@ -204,6 +258,15 @@ impl Machine {
         };
         machine.wait_for_boot(1)?;
         Ok(machine)
+    }
+
+    /// A second handle on the PELCO port's socket (UART4): bytes written
+    /// reach the board's PELCO task, its replies are read here (only when
+    /// the run has no [`MachineOptions::pelco`] wire).
+    pub fn pelco_port(&self) -> Result<UnixStream> {
+        self.pelco
+            .try_clone()
+            .context("cannot clone the PELCO socket")
     }
 
     /// Host µs since QEMU started.
@@ -348,7 +411,7 @@ impl Machine {
     pub fn stop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
-        for stream in [&self.console, &self.log_input, &self.monitor] {
+        for stream in [&self.console, &self.pelco, &self.log_input, &self.monitor] {
             let _ = stream.shutdown(std::net::Shutdown::Both);
         }
         for thread in self.threads.drain(..) {

@@ -10,6 +10,7 @@ use embedded_io_async::{Read, Write};
 
 use crate::galvo::{DacSample, DacStream, Half, Underrun};
 use crate::laser_controls::ControlInputs;
+use crate::pelco::PelcoLine;
 use crate::sequencer::{LaserSwitch, SettingsStore};
 use crate::stepper::{DriverSignals, StepperDrive};
 
@@ -197,6 +198,46 @@ impl StepperDrive for NoStepper {
     }
 }
 
+/// The PELCO port of a board that has none: no value of this type exists,
+/// so [`Parts::pelco`] is always `None` and no PELCO task runs (`pelco
+/// status` says so).
+#[derive(Debug)]
+pub enum NoPelcoPort {}
+
+impl embedded_io_async::ErrorType for NoPelcoPort {
+    type Error = core::convert::Infallible;
+}
+
+impl Read for NoPelcoPort {
+    async fn read(&mut self, _buf: &mut [u8]) -> Result<usize, Self::Error> {
+        match *self {}
+    }
+}
+
+impl Write for NoPelcoPort {
+    async fn write(&mut self, _buf: &[u8]) -> Result<usize, Self::Error> {
+        match *self {}
+    }
+
+    async fn flush(&mut self) -> Result<(), Self::Error> {
+        match *self {}
+    }
+}
+
+impl PelcoLine for NoPelcoPort {
+    fn set_baud(&mut self, _baud: u32) {
+        match *self {}
+    }
+}
+
+impl crate::pelco::PelcoTask<NoPelcoPort, NoPelcoPort> {
+    /// A board without a PELCO port never gets this task: its spawner's
+    /// `pelco` hook is this.
+    pub fn unreachable(self) -> ! {
+        match self.rx {}
+    }
+}
+
 /// A board: the types of its parts, and the parts themselves
 /// ([`Board::into_parts`]), configured and with the laser off.
 pub trait Board {
@@ -224,6 +265,13 @@ pub trait Board {
     /// The interlock, key switch and emission indicator
     /// ([`NoLaserControls`] on a board without them).
     type LaserControls: LaserControls;
+    /// Bytes from the PELCO bus (RS-485 receive; [`NoPelcoPort`] on a
+    /// board without the port).
+    type PelcoRx: Read;
+    /// Bytes to the PELCO bus (the board drives the RS-485 driver enable
+    /// around them: high from the first byte written until `flush` has
+    /// seen the last one leave).
+    type PelcoTx: Write + PelcoLine;
 
     /// Hands the parts over to the application.
     fn into_parts(self) -> Parts<Self>
@@ -257,4 +305,7 @@ pub struct Parts<B: Board + ?Sized> {
     /// The laser controls (indicator off), when the board has them: then
     /// no laser emits until they are armed.
     pub laser_controls: Option<B::LaserControls>,
+    /// The PELCO port's receive and transmit halves, when the board has
+    /// one (else no PELCO task runs).
+    pub pelco: Option<(B::PelcoRx, B::PelcoTx)>,
 }

@@ -5,6 +5,7 @@
 //! it, so the simulator runs the target's task graph.
 //!
 //! ```text
+//!   PELCO port ─▶ PELCO ─┐ (quiet commands)
 //! console port ─▶ console ─CommandLink─▶ sequencer ─ServoLink─▶ servo bus ─▶ servo UART
 //!                      stop button ─┘     │  │  ├─GalvoLink─▶ galvo loop ─▶ galvo DAC (if any)
 //!                                         │  │  └─StepperLink─▶ stepper task ─▶ step timer ─▶ STEP/DIR (if any)
@@ -20,7 +21,7 @@ mod tasks;
 
 pub use self::board::{
     Board, Console, HostPresence, Indicators, LaserControls, Leds, NoGalvoDac, NoHangUp,
-    NoLaserControls, NoStepper, Parts, StopButton, Watchdog,
+    NoLaserControls, NoPelcoPort, NoStepper, Parts, StopButton, Watchdog,
 };
 pub use self::controls::{CONTROLS_POLL, LaserControlsTask};
 pub use self::tasks::{
@@ -28,6 +29,7 @@ pub use self::tasks::{
     ServoBusTask, StopButtonTask, WATCHDOG_CHECK_PERIOD, WATCHDOG_TIMEOUT_US, WatchdogTask,
     leds_at,
 };
+pub use crate::pelco::{PelcoLine, PelcoTask};
 
 use crate::command::CommandLink;
 use crate::galvo::GalvoLink;
@@ -91,14 +93,18 @@ pub trait Spawn<B: Board> {
     /// The laser controls (only called when the board has them; a board
     /// with [`NoLaserControls`] answers [`LaserControlsTask::unreachable`]).
     fn laser_controls(&mut self, task: LaserControlsTask<B::LaserControls>);
+    /// The PELCO port (only called when the board has one; a board with
+    /// [`NoPelcoPort`] answers [`PelcoTask::unreachable`]).
+    fn pelco(&mut self, task: PelcoTask<B::PelcoRx, B::PelcoTx>);
 }
 
 /// Builds the whole task set from `board` and `links` and spawns it
 /// through `spawner`, in dataflow order: console, servo bus, sequencer,
 /// galvo loop (when the board has a DAC), step timer and stepper task
 /// (when it has stepper outputs), then the LEDs, the stop button, the
-/// watchdog and the laser controls (when it has them: the gate is
-/// forbidden before anything is spawned).
+/// watchdog, the laser controls (when it has them: the gate is
+/// forbidden before anything is spawned) and the PELCO port (when it has
+/// one).
 pub fn wire<B: Board>(board: B, links: Links, spawner: &mut impl Spawn<B>) {
     let parts = board.into_parts();
     if parts.laser_controls.is_some() {
@@ -156,6 +162,14 @@ pub fn wire<B: Board>(board: B, links: Links, spawner: &mut impl Spawn<B>) {
             link: links.controls,
             gate: links.gate,
             command: links.command,
+        });
+    }
+    if let Some((rx, tx)) = parts.pelco {
+        spawner.pelco(PelcoTask {
+            rx,
+            tx,
+            link: links.command,
+            status: links.status,
         });
     }
 }

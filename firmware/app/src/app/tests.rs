@@ -83,6 +83,10 @@ impl crate::stepper::StepperDrive for Part {
     }
 }
 
+impl crate::pelco::PelcoLine for Sink {
+    fn set_baud(&mut self, _baud: u32) {}
+}
+
 impl Indicators for Part {
     fn show(&mut self, _leds: Leds) {}
 }
@@ -105,7 +109,8 @@ impl Watchdog for Part {
 }
 
 /// A board whose parts all carry its number; with or without a galvo DAC
-/// (and stepper outputs and laser controls, which come with it here).
+/// (and stepper outputs, laser controls and a PELCO port, which come with
+/// it here).
 struct TestBoard {
     id: u8,
     has_dac: bool,
@@ -123,6 +128,8 @@ impl Board for TestBoard {
     type StopButton = Part;
     type Watchdog = Part;
     type LaserControls = Part;
+    type PelcoRx = &'static [u8];
+    type PelcoTx = Sink;
 
     fn into_parts(self) -> Parts<Self> {
         let part = Part(self.id);
@@ -142,6 +149,7 @@ impl Board for TestBoard {
             stop_button: part,
             watchdog: part,
             laser_controls: self.has_dac.then_some(part),
+            pelco: self.has_dac.then_some((&b"pelco"[..], Sink)),
         }
     }
 }
@@ -183,6 +191,10 @@ impl Spawn<TestBoard> for Spawned {
     }
     fn laser_controls(&mut self, task: LaserControlsTask<Part>) {
         self.0.push(("laser controls", task.controls));
+    }
+    fn pelco(&mut self, task: crate::pelco::PelcoTask<&'static [u8], Sink>) {
+        assert_eq!(task.rx, b"pelco");
+        self.0.push(("pelco", Part(u8::MAX - 2)));
     }
 }
 
@@ -231,6 +243,7 @@ fn every_task_gets_its_part_once_in_dataflow_order() {
             ("stop button", p),
             ("watchdog", p),
             ("laser controls", p),
+            ("pelco", Part(u8::MAX - 2)),
         ]
     );
     assert!(
@@ -240,7 +253,7 @@ fn every_task_gets_its_part_once_in_dataflow_order() {
 }
 
 #[test]
-fn a_board_without_a_galvo_dac_or_steppers_runs_no_galvo_or_stepper_task() {
+fn a_board_without_a_galvo_dac_steppers_or_pelco_port_runs_none_of_their_tasks() {
     let names: Vec<_> = wired(TestBoard {
         id: 3,
         has_dac: false,

@@ -19,7 +19,7 @@ pub mod speed;
 pub mod task;
 
 pub use self::session::{Request, Session, View};
-pub use self::task::PelcoTask;
+pub use self::task::{PelcoLine, PelcoTask};
 pub use crate::command::PelcoStatus;
 
 #[cfg(test)]

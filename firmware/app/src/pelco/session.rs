@@ -183,7 +183,8 @@ impl Session {
             });
             let from = point(m.planned, view.oq_cm);
             let to = point(next, view.oq_cm);
-            let chord_mm = 10.0 * libm::hypot(to.x_cm - from.x_cm, to.y_cm - from.y_cm);
+            let chord_mm =
+                10.0 * kinematics_core::numeric::hypot(to.x_cm - from.x_cm, to.y_cm - from.y_cm);
             if chord_mm < 1e-3 {
                 // At the limit: nothing to queue, held until a stop.
                 m.planned_until_ms = view.now_ms + LEAD_MS;

@@ -5,6 +5,9 @@
 //! y = √(x² + OQ²)·tan(tilt). The same angles whichever actuator aims, so
 //! a preset or an absolute position means the same spot on every one.
 
+use kinematics_core::numeric::hypot;
+use kinematics_core::numeric::trig::sin_cos;
+
 use crate::domain::PointCm;
 
 /// Largest |pan| and |tilt| a PELCO command may ask, deg (beyond it the
@@ -15,7 +18,7 @@ pub const MAX_ANGLE_DEG: f64 = 80.0;
 /// board.
 pub fn angles_deg(p: PointCm, oq_cm: f64) -> [f64; 2] {
     let pan = libm::atan2(p.x_cm, oq_cm);
-    let tilt = libm::atan2(p.y_cm, libm::hypot(p.x_cm, oq_cm));
+    let tilt = libm::atan2(p.y_cm, hypot(p.x_cm, oq_cm));
     [pan.to_degrees(), tilt.to_degrees()]
 }
 
@@ -23,8 +26,14 @@ pub fn angles_deg(p: PointCm, oq_cm: f64) -> [f64; 2] {
 /// ±[`MAX_ANGLE_DEG`]), cm.
 pub fn point(angles_deg: [f64; 2], oq_cm: f64) -> PointCm {
     let [pan, tilt] = angles_deg.map(|a| a.clamp(-MAX_ANGLE_DEG, MAX_ANGLE_DEG).to_radians());
-    let x = oq_cm * libm::tan(pan);
-    let y = libm::hypot(x, oq_cm) * libm::tan(tilt);
+    // tan as sin / cos: the firmware's own trig (libm's tan is 4.5 KB of
+    // flash more); |angle| ≤ 80° keeps cos away from 0.
+    let tan = |a: f64| {
+        let (sin, cos) = sin_cos(a);
+        sin / cos
+    };
+    let x = oq_cm * tan(pan);
+    let y = hypot(x, oq_cm) * tan(tilt);
     PointCm::new(x, y)
 }
 

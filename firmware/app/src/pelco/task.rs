@@ -19,9 +19,20 @@ use crate::status::StatusBoard;
 const POLL: Duration = Duration::from_millis(1);
 /// Longest wait for a command's reply before the port gives up on it.
 const REPLY_TIMEOUT: Duration = Duration::from_secs(2);
+/// Longest wait for the status to show a goto's point.
+const SHOW_LIMIT: Duration = Duration::from_millis(100);
 /// Most requests one frame or tick gives (stop + goto, or the jogs of
 /// [`super::session::LEAD_MS`]).
 const MAX_REQUESTS: usize = 4;
+
+/// The PELCO port's line (on a board, the transmit half of its UART): the
+/// baud rate, set by the port task once it has read the saved
+/// `pelco.baud`.
+pub trait PelcoLine {
+    /// Runs the line at `baud` (one of
+    /// [`PELCO_BAUDS`](crate::settings::PELCO_BAUDS)), 8N1.
+    fn set_baud(&mut self, baud: u32);
+}
 
 /// The PELCO port: its receive and transmit halves and the links.
 pub struct PelcoTask<R, W> {
@@ -39,15 +50,22 @@ pub struct PelcoTask<R, W> {
 #[derive(Debug, Clone, Copy)]
 struct PortSettings {
     address: u8,
+    baud: u32,
     timeout_s: f64,
     oq_cm: f64,
 }
 
-impl<R: Read, W: Write> PelcoTask<R, W> {
-    /// Reads its settings, then serves the bus forever.
+impl<R: Read, W: Write + PelcoLine> PelcoTask<R, W> {
+    /// Reads its settings, sets the line's baud rate, then serves the bus
+    /// forever.
     pub async fn run(mut self) -> ! {
         let settings = self.settings().await;
-        log::info!("pelco: address {}", settings.address);
+        self.tx.set_baud(settings.baud);
+        log::info!(
+            "pelco: address {} at {} baud",
+            settings.address,
+            settings.baud
+        );
         let mut decoder = Decoder::new(settings.address);
         let mut session = Session::new();
         session.set_motion_timeout_ms((settings.timeout_s * 1000.0) as u64);
@@ -101,8 +119,11 @@ impl<R: Read, W: Write> PelcoTask<R, W> {
         match request {
             Request::Command(command) => {
                 let reply = send_quietly(self.link, command).await;
-                if reply.is_some_and(|r| r.closed != Some(true)) {
+                let done = reply.is_some_and(|r| r.closed == Some(true));
+                if !done {
                     log::debug!("pelco: {} refused", command.name());
+                } else if let Command::Goto(point) = command {
+                    self.until_shown(point).await;
                 }
             }
             Request::JogCancel => {
@@ -123,6 +144,26 @@ impl<R: Read, W: Write> PelcoTask<R, W> {
         }
     }
 
+    /// Waits until the status shows `point` as the aimed point (the
+    /// sequencer publishes it after the goto's reply, once its servo
+    /// moves are out), at most [`SHOW_LIMIT`]: the next frame's angles
+    /// (an absolute tilt after an absolute pan keeps the new pan) start
+    /// from it.
+    async fn until_shown(&self, point: crate::domain::PointCm) {
+        let deadline = Instant::now() + SHOW_LIMIT;
+        while Instant::now() < deadline {
+            if self
+                .status
+                .snapshot()
+                .target
+                .is_some_and(|(t, _)| t.point == point)
+            {
+                return;
+            }
+            Timer::after(POLL).await;
+        }
+    }
+
     /// The port's settings, read like `get` does.
     async fn settings(&self) -> PortSettings {
         let defaults = crate::settings::Settings::default();
@@ -136,8 +177,10 @@ impl<R: Read, W: Write> PelcoTask<R, W> {
                 .unwrap_or(default)
         };
         let address = read("pelco.address", f64::from(defaults.pelco.address)).await;
+        let baud = read("pelco.baud", defaults.pelco.baud).await;
         PortSettings {
             address: (address as u8).max(1),
+            baud: baud_of(baud),
             timeout_s: read("pelco.timeout_s", defaults.pelco.motion_timeout_s).await,
             oq_cm: read("oq_cm", defaults.oq_cm).await,
         }
@@ -167,8 +210,19 @@ pub async fn send_quietly(link: &CommandLink, command: Command) -> Option<QuietR
     None
 }
 
+/// The line rate of the `pelco.baud` value `value` (the default 9600 for
+/// one the port does not run at: the parameter's range check keeps them
+/// out of the settings).
+fn baud_of(value: f64) -> u32 {
+    crate::settings::PELCO_BAUDS
+        .into_iter()
+        .find(|b| f64::from(*b) == value)
+        .unwrap_or(9600)
+}
+
 /// The value of a `get` line (`name = value  # help …`).
 fn param_value(line: &str) -> Option<f64> {
     let (_, rest) = line.split_once('=')?;
-    rest.split_whitespace().next()?.parse().ok()
+    // The firmware's own parser: core's would link its 10 KB table.
+    crate::text::decimal::parse_f64(rest.split_whitespace().next()?.as_bytes())
 }

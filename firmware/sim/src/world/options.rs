@@ -82,6 +82,10 @@ pub struct SimOptions {
     /// (real time; the run ends when its stop flag is set).
     #[cfg(unix)]
     pub pty: Option<crate::pty::PtyOptions>,
+    /// The board's PELCO port on a pseudo-terminal (real time: set
+    /// `realtime` too); none without.
+    #[cfg(unix)]
+    pub pelco_pty: Option<crate::pelco_port::PelcoPtyOptions>,
 }
 
 impl Default for SimOptions {
@@ -112,6 +116,8 @@ impl Default for SimOptions {
             laser_controls: false,
             #[cfg(unix)]
             pty: None,
+            #[cfg(unix)]
+            pelco_pty: None,
         }
     }
 }
@@ -148,6 +154,8 @@ pub struct SimReport {
     pub stepper: PanTiltDrivers,
     /// What the laser controls did, on a board with them.
     pub laser_controls: Option<ControlsRecord>,
+    /// What crossed the PELCO port (nothing on a run without one).
+    pub pelco: crate::pelco_port::PelcoTraffic,
 }
 
 impl SimReport {

@@ -190,6 +190,30 @@ fn jog_cancel_brakes_on_the_path_and_the_parser_follows() {
     assert!((core.gcode.parser.position.x_mm - stopped - 1.0).abs() < 1e-9);
 }
 
+#[test]
+fn jog_cancel_between_joined_jogs_leaves_the_parser_where_the_gimbal_is() {
+    // Two jogs that join at speed (a PELCO port's continuous move); the
+    // cancel lands after the first one's last tick reached its end and
+    // before the second was taken: the next jog must start where the
+    // gimbal is, not at the cancelled one's end.
+    let mut core = Core::new(Instant::from_millis(0));
+    line(&mut core, 1, "$J=G91 X2 F600");
+    line(&mut core, 2, "$J=G91 X2 F600");
+    let (mut ms, mut pending) = (2, None);
+    while core.gcode.motion.current.is_none_or(|c| c.index == 0) {
+        assert!(pump_step(&mut core, &mut ms, &mut pending).is_some());
+    }
+    realtime(&mut core, ms, Realtime::JogCancel);
+    let (ms, _) = pump(&mut core, ms, |_| false);
+    assert!(status(&mut core, ms + 500).starts_with("<Idle|"));
+    let at = core.gcode.motion.position;
+    assert!(
+        (at.x_mm - 2.0).abs() < 1e-9,
+        "at the first jog's end: {at:?}"
+    );
+    assert_eq!(core.gcode.parser.position, at);
+}
+
 /// grbl's `error:N` closer in `actions`, if any.
 fn grbl_error_code(actions: &[Action]) -> Option<u8> {
     actions.iter().find_map(|a| match a {

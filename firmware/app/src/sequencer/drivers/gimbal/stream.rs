@@ -115,8 +115,10 @@ impl Core {
     #[inline(never)]
     pub(in crate::sequencer) fn stream_block_done(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
+        let mut cancelled = false;
         if let Some(c) = motion.current.take() {
             motion.position = point_at(&c.block, 1, 1);
+            cancelled = c.cancelled;
         }
         let next = motion.queue.front().copied();
         match next.filter(|b| planned_length(b).is_some()) {
@@ -131,6 +133,11 @@ impl Core {
             }
             None => {
                 self.jobs.gimbal.cursor = None;
+                if cancelled {
+                    // A jog cancel between this block's end and the next:
+                    // the parser had gone on to the dropped jogs' ends.
+                    self.grbl_sync_position();
+                }
                 self.grbl_advance(out);
             }
         }
