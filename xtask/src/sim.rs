@@ -87,6 +87,11 @@ pub struct SimArgs {
     /// until Ctrl-C / SIGTERM (or --max-time-s), then writes the outputs.
     #[arg(long, num_args = 0..=1, default_missing_value = "", conflicts_with_all = ["script", "interactive"])]
     pty: Option<PathBuf>,
+    /// Publish where the spot really lands and whether the laser is lit
+    /// to FILE (default with `--pty LINK`: `LINK.spot`), one line replaced
+    /// as it changes: what `cargo xtask calib camera --camera sim` renders.
+    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "")]
+    spot_feed: Option<PathBuf>,
     /// Stop after this much simulated time, s (default 600; no limit with
     /// --interactive or --pty).
     #[arg(long)]
@@ -246,6 +251,14 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
             stop,
         }
     });
+    let spot_feed = match (&args.spot_feed, &args.pty) {
+        (Some(file), _) if !file.as_os_str().is_empty() => Some(file.clone()),
+        (Some(_), Some(link)) if !link.as_os_str().is_empty() => {
+            Some(laser_sim::spot_feed::beside(link))
+        }
+        (Some(_), _) => bail!("--spot-feed needs a FILE, or --pty with a LINK"),
+        (None, _) => None,
+    };
     let bench = args.bench.build();
     let options = bench
         .apply(SimOptions {
@@ -261,6 +274,7 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
             galvo_cost_ns_per_sample: args.galvo_cost_ns,
             laser_controls: args.laser_controls,
             servo_ids: (!args.servo_ids.is_empty()).then(|| args.servo_ids.clone()),
+            spot_feed,
             ..SimOptions::default()
         })
         .map_err(|e| anyhow!("bench options: {e}"))?;

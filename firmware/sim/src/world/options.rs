@@ -82,6 +82,10 @@ pub struct SimOptions {
     /// (real time; the run ends when its stop flag is set).
     #[cfg(unix)]
     pub pty: Option<crate::pty::PtyOptions>,
+    /// Publish where the spot really is to this file
+    /// ([`crate::spot_feed`]: what a virtual camera outside the
+    /// simulator renders).
+    pub spot_feed: Option<std::path::PathBuf>,
 }
 
 impl Default for SimOptions {
@@ -112,6 +116,7 @@ impl Default for SimOptions {
             laser_controls: false,
             #[cfg(unix)]
             pty: None,
+            spot_feed: None,
         }
     }
 }
