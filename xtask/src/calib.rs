@@ -193,6 +193,8 @@ pub(super) mod frames;
 mod intrinsics;
 mod online;
 mod picture;
+#[cfg(feature = "webcam")]
+mod webcam;
 
 #[cfg(test)]
 mod tests;
