@@ -44,7 +44,7 @@ enum CalibCommand {
     Target(camera::TargetArgs),
     /// Measure the spot with a camera (offline frames, or online driving
     /// the board) and fit the error model; `calib camera intrinsics`: the lens.
-    Camera(camera::CameraArgs),
+    Camera(Box<camera::CameraArgs>),
     /// Render the simulator's grid run as virtual-camera frames.
     Frames(frames::FramesArgs),
 }

@@ -90,8 +90,8 @@ pub struct SimArgs {
     /// Publish where the spot really lands and whether the laser is lit
     /// to FILE (default with `--pty LINK`: `LINK.spot`), one line replaced
     /// as it changes: what `cargo xtask calib camera --camera sim` renders.
-    #[arg(long, value_name = "FILE", num_args = 0..=1, default_missing_value = "")]
-    spot_feed: Option<PathBuf>,
+    #[arg(long, value_name = "FILE", num_args = 0..=1)]
+    spot_feed: Option<Option<PathBuf>>,
     /// Stop after this much simulated time, s (default 600; no limit with
     /// --interactive or --pty).
     #[arg(long)]
@@ -252,8 +252,8 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
         }
     });
     let spot_feed = match (&args.spot_feed, &args.pty) {
-        (Some(file), _) if !file.as_os_str().is_empty() => Some(file.clone()),
-        (Some(_), Some(link)) if !link.as_os_str().is_empty() => {
+        (Some(Some(file)), _) => Some(file.clone()),
+        (Some(None), Some(link)) if !link.as_os_str().is_empty() => {
             Some(laser_sim::spot_feed::beside(link))
         }
         (Some(_), _) => bail!("--spot-feed needs a FILE, or --pty with a LINK"),
