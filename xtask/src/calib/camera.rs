@@ -19,16 +19,16 @@ pub struct TargetArgs {
     /// Where to write the board: `.svg`, or `.pdf` (page at the board's
     /// size; print at 100 %).
     #[arg(long)]
-    out: PathBuf,
+    pub(super) out: PathBuf,
     /// Grid pitch, mm (SPEC §4.1).
     #[arg(long, default_value_t = 19.16)]
-    pitch_mm: f64,
+    pub(super) pitch_mm: f64,
     /// Grid half-width in cells.
     #[arg(long, default_value_t = 6)]
-    xi_max: i32,
+    pub(super) xi_max: i32,
     /// Grid half-height in cells.
     #[arg(long, default_value_t = 4)]
-    yi_max: i32,
+    pub(super) yi_max: i32,
 }
 
 /// `calib camera`: offline (`--images DIR --points CSV`), online

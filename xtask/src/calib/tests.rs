@@ -369,3 +369,22 @@ fn the_readme_example_measurements_fit() {
         12
     );
 }
+
+#[test]
+fn the_target_is_written_as_svg_or_pdf_by_its_extension() {
+    for (name, magic) in [("board.svg", "<svg"), ("board.pdf", "%PDF-")] {
+        let out = tmp(name);
+        let a = camera::TargetArgs {
+            out: out.clone(),
+            pitch_mm: 19.16,
+            xi_max: 6,
+            yi_max: 4,
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&camera::target_command(&a).unwrap()).unwrap();
+        assert_eq!(json["tags"], 14);
+        let bytes = std::fs::read(&out).unwrap();
+        std::fs::remove_file(&out).ok();
+        assert!(bytes.starts_with(magic.as_bytes()), "{name}");
+    }
+}
