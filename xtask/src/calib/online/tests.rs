@@ -1,4 +1,5 @@
 use std::path::PathBuf;
+use std::time::Duration;
 
 use laser_sim::bench::BenchBuild;
 use laser_sim::on_pty::SimOnPty;
@@ -127,4 +128,95 @@ fn a_missing_camera_refuses_before_the_board_is_touched() {
     ] {
         assert!(!tmp(f).exists(), "{f} written on refusal");
     }
+}
+
+/// `get err.dx.c0` on the console at `port`.
+fn model_c0(port: &Path) -> String {
+    let mut console = crate::serial::Console::open(port).unwrap();
+    let (data, _) = console
+        .command("get err.dx.c0", Duration::from_secs(10))
+        .unwrap();
+    data.concat()
+}
+
+/// Without `--apply` the board keeps its own model and nothing is saved;
+/// a point whose spot the camera does not see refuses the run naming the
+/// point, puts the model back and writes nothing.
+#[test]
+fn without_apply_or_on_refusal_the_board_keeps_its_model() {
+    let link = tmp("console-keep");
+    let sim = SimOnPty::start(
+        link.clone(),
+        SimOptions {
+            max_time_ms: 600_000,
+            spot_feed: Some(beside(&link)),
+            ..SimOptions::default()
+        },
+    )
+    .expect("the simulator starts");
+    {
+        let mut console = crate::serial::Console::open(&sim.link).unwrap();
+        let (_, closer) = console
+            .command("set err.dx.c0 1.25", Duration::from_secs(10))
+            .unwrap();
+        assert_eq!(closer, "ok");
+    }
+    // A camera that never sees the spot: a feed with the beam off the board.
+    let dark_feed = tmp("dark.spot");
+    std::fs::write(&dark_feed, "off-board 0\n").unwrap();
+    let mut blind = online_args(&sim.link, "blind");
+    blind.spot_feed = Some(dark_feed.clone());
+    blind.settle_ms = 50;
+    blind.frames_per_point = 1;
+    let refused = run_command(&blind);
+    let after_refusal = model_c0(&sim.link);
+
+    let mut a = online_args(&sim.link, "keep");
+    a.every = 4;
+    a.frames_per_point = 1;
+    a.settle_ms = 100;
+    let kept = run_command(&a);
+    let after_run = model_c0(&sim.link);
+    let report = sim.finish();
+
+    let e = refused.unwrap_err();
+    assert!(
+        e.contains("point 1 of 117 (-114.96, 76.64) mm: no laser spot found"),
+        "{e}"
+    );
+    assert!(
+        after_refusal.starts_with("err.dx.c0 = 1.25 "),
+        "{after_refusal}"
+    );
+    for f in [
+        "blind-err.txt",
+        "blind-report.json",
+        "blind-errors.svg",
+        "blind-errors.png",
+    ] {
+        assert!(!tmp(f).exists(), "{f} written on refusal");
+    }
+    let json: serde_json::Value = serde_json::from_str(&kept.unwrap()).unwrap();
+    assert_eq!(json["applied"], false);
+    assert_eq!(json["frames"], 30);
+    assert!(json.get("after").is_none(), "{json}");
+    assert!(
+        json["after_predicted"]["worst_mm"].as_f64().unwrap() < 0.5,
+        "{json}"
+    );
+    assert!(after_run.starts_with("err.dx.c0 = 1.25 "), "{after_run}");
+    assert!(
+        report.saved_settings.is_none(),
+        "nothing saved without --apply"
+    );
+    for f in [
+        "keep-err.txt",
+        "keep-report.json",
+        "keep-errors.svg",
+        "keep-errors.png",
+    ] {
+        let _ = std::fs::remove_file(tmp(f));
+    }
+    let _ = std::fs::remove_file(dark_feed);
+    let _ = std::fs::remove_file(beside(&link));
 }
