@@ -40,10 +40,11 @@ pub struct CalibArgs {
 enum CalibCommand {
     /// Fit the error model to measured points; prints JSON.
     Fit(FitArgs),
-    /// Write the printable camera target (SVG, print at 100 %).
+    /// Write the printable camera target (SVG or PDF, print at 100 %).
     Target(camera::TargetArgs),
-    /// Measure the spot in camera frames and fit the error model.
-    Camera(camera::CameraArgs),
+    /// Measure the spot with a camera (offline frames, or online driving
+    /// the board) and fit the error model; `calib camera intrinsics`: the lens.
+    Camera(Box<camera::CameraArgs>),
     /// Render the simulator's grid run as virtual-camera frames.
     Frames(frames::FramesArgs),
 }
@@ -187,7 +188,13 @@ fn axis_summary(axis: &str, f: &AxisFit) -> String {
 }
 
 pub(crate) mod camera;
-mod frames;
+mod capture;
+pub(super) mod frames;
+mod intrinsics;
+mod online;
+mod picture;
+#[cfg(feature = "webcam")]
+mod webcam;
 
 #[cfg(test)]
 mod tests;

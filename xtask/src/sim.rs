@@ -93,6 +93,11 @@ pub struct SimArgs {
     /// when given. Real time (implies --realtime); usually with --pty.
     #[arg(long, num_args = 0..=1, default_missing_value = "")]
     pelco_pty: Option<PathBuf>,
+    /// Publish where the spot really lands and whether the laser is lit
+    /// to FILE (default with `--pty LINK`: `LINK.spot`), one line replaced
+    /// as it changes: what `cargo xtask calib camera --camera sim` renders.
+    #[arg(long, value_name = "FILE", num_args = 0..=1)]
+    spot_feed: Option<Option<PathBuf>>,
     /// Stop after this much simulated time, s (default 600; no limit with
     /// --interactive or --pty).
     #[arg(long)]
@@ -254,6 +259,14 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
             stop,
         }
     });
+    let spot_feed = match (&args.spot_feed, &args.pty) {
+        (Some(Some(file)), _) => Some(file.clone()),
+        (Some(None), Some(link)) if !link.as_os_str().is_empty() => {
+            Some(laser_sim::spot_feed::beside(link))
+        }
+        (Some(_), _) => bail!("--spot-feed needs a FILE, or --pty with a LINK"),
+        (None, _) => None,
+    };
     let bench = args.bench.build();
     let options = bench
         .apply(SimOptions {
@@ -278,6 +291,7 @@ fn prepare(args: &SimArgs) -> Result<Prepared> {
             galvo_cost_ns_per_sample: args.galvo_cost_ns,
             laser_controls: args.laser_controls,
             servo_ids: (!args.servo_ids.is_empty()).then(|| args.servo_ids.clone()),
+            spot_feed,
             ..SimOptions::default()
         })
         .map_err(|e| anyhow!("bench options: {e}"))?;

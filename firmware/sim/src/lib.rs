@@ -25,6 +25,7 @@ pub mod script;
 pub mod servo_model;
 pub mod servo_port;
 pub mod spot;
+pub mod spot_feed;
 pub mod stepper;
 pub mod usb_host;
 pub mod world;

@@ -237,6 +237,19 @@ impl World {
                 options.sample_period_us,
             ),
         );
+        if let Some(path) = &options.spot_feed {
+            executor::spawn_task(
+                &spawner,
+                "spot feed",
+                TaskKind::Simulator,
+                crate::spot_feed::spot_feed(
+                    path.clone(),
+                    self.spot.clone(),
+                    self.recording.clone(),
+                    options.sample_period_us,
+                ),
+            );
+        }
     }
 
     /// What the run produced, ended by `end`.

@@ -175,6 +175,27 @@ impl Camera {
     }
 }
 
+/// Camera positions (board mm) around the reference camera from which a
+/// user views the target for the intrinsics (equivalently: holds the
+/// printed board at different tilts), each looking at the board origin.
+pub const INTRINSICS_VIEW_EYES: [[f64; 3]; 5] = [
+    [-90.0, -170.0, 440.0],
+    [120.0, -140.0, 450.0],
+    [-150.0, 90.0, 430.0],
+    [40.0, 160.0, 460.0],
+    [0.0, -30.0, 520.0],
+];
+
+impl Camera {
+    /// This camera moved to `eye` (board mm), looking at the board origin.
+    pub fn from_eye(&self, eye: [f64; 3]) -> Option<Camera> {
+        Some(Camera {
+            pose: Pose::looking_at(eye, [0.0, 0.0, 0.0])?,
+            ..*self
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

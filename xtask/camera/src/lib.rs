@@ -16,6 +16,7 @@ pub mod markers;
 pub mod measure;
 pub mod noise;
 pub mod offline;
+pub mod print;
 pub mod render;
 pub mod spot;
 pub mod target;

@@ -223,6 +223,58 @@ impl TargetLayout {
         on_bar || on_tick
     }
 
+    /// The printed ink as rectangles `[x, y, width, height]` (board mm,
+    /// `x, y` the lower left corner): tag cells, grid crosses, the scale
+    /// bar and its 10 mm ticks. Exactly where [`TargetLayout::reflectance`] is ink.
+    pub fn ink_rects(&self) -> Vec<[f64; 4]> {
+        let mut rects = Vec::new();
+        for t in &self.tags {
+            let cell = t.cell_mm();
+            for row in 0..10 {
+                for col in 0..10 {
+                    if t.is_ink(col, row) {
+                        let x = t.centre_mm[0] + (col as f64 - 5.0) * cell;
+                        let top = t.centre_mm[1] - (row as f64 - 5.0) * cell;
+                        rects.push([x, top - cell, cell, cell]);
+                    }
+                }
+            }
+        }
+        let (a, l) = (CROSS_ARM_MM, CROSS_LINE_MM);
+        for [x, y] in self.grid_points_mm() {
+            rects.push([x - a, y - l / 2.0, 2.0 * a, l]);
+            rects.push([x - l / 2.0, y - a, l, 2.0 * a]);
+        }
+        let ([bx, by], len) = self.scale_bar;
+        rects.push([bx, by - BAR_MM / 2.0, len, BAR_MM]);
+        for k in 0..=(len / 10.0) as u32 {
+            let x = bx + f64::from(k) * 10.0 - CROSS_LINE_MM / 2.0;
+            rects.push([x, by, CROSS_LINE_MM, 4.0]);
+        }
+        rects
+    }
+
+    /// The printed captions: `(x, y, size, text)`, baseline start in board
+    /// mm, font size in mm.
+    pub fn captions(&self) -> Vec<(f64, f64, f64, String)> {
+        let ([bx, by], _) = self.scale_bar;
+        let mut captions = vec![(
+            bx,
+            by - 6.0,
+            3.5,
+            "100 mm: check this bar after printing (print at 100 %, no scaling)".to_owned(),
+        )];
+        for t in &self.tags {
+            captions.push((
+                t.centre_mm[0] - t.size_mm / 2.0,
+                t.centre_mm[1] - t.size_mm * 10.0 / 16.0 - 2.5,
+                2.5,
+                format!("tag36h11 #{}", t.id),
+            ));
+        }
+        captions
+    }
+
     /// The board as an SVG at true scale (1 user unit = 1 mm; print at 100 %).
     pub fn svg(&self) -> String {
         let [x0, y0, x1, y1] = self.extent_mm;
@@ -240,66 +292,20 @@ impl TargetLayout {
             -y1
         );
         let _ = writeln!(s, "<g fill=\"black\" stroke=\"none\">");
-        for t in &self.tags {
-            let cell = t.cell_mm();
-            for row in 0..10 {
-                for col in 0..10 {
-                    if t.is_ink(col, row) {
-                        let x = t.centre_mm[0] + (col as f64 - 5.0) * cell;
-                        let y = -t.centre_mm[1] + (row as f64 - 5.0) * cell;
-                        let _ = writeln!(
-                            s,
-                            "<rect x=\"{x:.4}\" y=\"{y:.4}\" width=\"{cell:.4}\" height=\"{cell:.4}\"/>"
-                        );
-                    }
-                }
-            }
-        }
-        for [x, y] in self.grid_points_mm() {
-            let (a, l) = (CROSS_ARM_MM, CROSS_LINE_MM);
+        for [x, y, w, h] in self.ink_rects() {
             let _ = writeln!(
                 s,
-                "<rect x=\"{:.4}\" y=\"{:.4}\" width=\"{:.4}\" height=\"{l:.4}\"/>",
-                x - a,
-                -y - l / 2.0,
-                2.0 * a
-            );
-            let _ = writeln!(
-                s,
-                "<rect x=\"{:.4}\" y=\"{:.4}\" width=\"{l:.4}\" height=\"{:.4}\"/>",
-                x - l / 2.0,
-                -y - a,
-                2.0 * a
-            );
-        }
-        let ([bx, by], len) = self.scale_bar;
-        let _ = writeln!(
-            s,
-            "<rect x=\"{bx:.4}\" y=\"{:.4}\" width=\"{len:.4}\" height=\"{BAR_MM:.4}\"/>",
-            -by - BAR_MM / 2.0
-        );
-        for k in 0..=(len / 10.0) as u32 {
-            let x = bx + f64::from(k) * 10.0 - CROSS_LINE_MM / 2.0;
-            let _ = writeln!(
-                s,
-                "<rect x=\"{x:.4}\" y=\"{:.4}\" width=\"{CROSS_LINE_MM:.4}\" height=\"4\"/>",
-                -by - 4.0
+                "<rect x=\"{x:.4}\" y=\"{:.4}\" width=\"{w:.4}\" height=\"{h:.4}\"/>",
+                -(y + h)
             );
         }
         let _ = writeln!(s, "</g>");
-        let _ = writeln!(
-            s,
-            "<g font-family=\"sans-serif\" font-size=\"3.5\" fill=\"#555\">\n\
-             <text x=\"{bx:.3}\" y=\"{:.3}\">100 mm: check this bar after printing (print at 100 %, no scaling)</text>",
-            -by + 6.0
-        );
-        for t in &self.tags {
+        let _ = writeln!(s, "<g font-family=\"sans-serif\" fill=\"#555\">");
+        for (x, y, size, text) in self.captions() {
             let _ = writeln!(
                 s,
-                "<text x=\"{:.3}\" y=\"{:.3}\" font-size=\"2.5\">tag36h11 #{}</text>",
-                t.centre_mm[0] - t.size_mm / 2.0,
-                -t.centre_mm[1] + t.size_mm * 10.0 / 16.0 + 2.5,
-                t.id
+                "<text x=\"{x:.3}\" y=\"{:.3}\" font-size=\"{size}\">{text}</text>",
+                -y
             );
         }
         let _ = writeln!(s, "</g>\n</svg>");

@@ -289,8 +289,8 @@ fn offline_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("camera/tests/data/offline")
 }
 
-fn camera_args(images: &Path, points: &Path, out: &str) -> camera::CameraArgs {
-    camera::CameraArgs::for_test(
+fn camera_args(images: &Path, points: &Path, out: &str) -> camera::CameraRunArgs {
+    camera::CameraRunArgs::for_test(
         images,
         points,
         &tmp(&format!("{out}-err.txt")),
@@ -305,8 +305,7 @@ fn camera_args(images: &Path, points: &Path, out: &str) -> camera::CameraArgs {
 fn offline_camera_mode_fits_the_committed_frames() {
     let dir = offline_dir();
     let a = camera_args(&dir, &dir.join("points.csv"), "ok");
-    let json: serde_json::Value =
-        serde_json::from_str(&camera::camera_command(&a).unwrap()).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&camera::run_command(&a).unwrap()).unwrap();
     assert_eq!(json["frames"], 11);
     assert_eq!(json["markers"].as_array().unwrap().len(), 14);
     assert!(json["reprojection_px"].as_f64().unwrap() < 0.3);
@@ -342,7 +341,7 @@ fn offline_camera_mode_refuses_bad_input_and_writes_nothing() {
     ] {
         std::fs::write(&csv, text).unwrap();
         let a = camera_args(&dir, &csv, "bad");
-        let err = camera::camera_command(&a).unwrap_err();
+        let err = camera::run_command(&a).unwrap_err();
         assert!(err.contains(expect), "{err}");
         for f in ["bad-err.txt", "bad-report.json", "bad-errors.svg"] {
             assert!(!tmp(f).exists(), "{f} written on refusal");
@@ -369,4 +368,23 @@ fn the_readme_example_measurements_fit() {
             .count(),
         12
     );
+}
+
+#[test]
+fn the_target_is_written_as_svg_or_pdf_by_its_extension() {
+    for (name, magic) in [("board.svg", "<svg"), ("board.pdf", "%PDF-")] {
+        let out = tmp(name);
+        let a = camera::TargetArgs {
+            out: out.clone(),
+            pitch_mm: 19.16,
+            xi_max: 6,
+            yi_max: 4,
+        };
+        let json: serde_json::Value =
+            serde_json::from_str(&camera::target_command(&a).unwrap()).unwrap();
+        assert_eq!(json["tags"], 14);
+        let bytes = std::fs::read(&out).unwrap();
+        std::fs::remove_file(&out).ok();
+        assert!(bytes.starts_with(magic.as_bytes()), "{name}");
+    }
 }

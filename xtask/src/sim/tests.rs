@@ -41,3 +41,27 @@ fn fault_specs_parse_and_reject_nonsense() {
         assert!(parse_faults(&[bad.to_owned()]).is_err(), "{bad}");
     }
 }
+
+#[derive(clap::Parser)]
+struct Cli {
+    #[command(flatten)]
+    args: SimArgs,
+}
+
+#[test]
+fn the_spot_feed_is_the_named_file_and_needs_one_without_a_pty_link() {
+    use clap::Parser as _;
+    let parse = |extra: &[&str]| {
+        let argv = ["sim", "--interactive"].iter().chain(extra).copied();
+        Cli::try_parse_from(argv).unwrap().args
+    };
+    let named = prepare(&parse(&["--spot-feed", "/tmp/feed"])).unwrap();
+    assert_eq!(named.options.spot_feed, Some(PathBuf::from("/tmp/feed")));
+    assert_eq!(prepare(&parse(&[])).unwrap().options.spot_feed, None);
+    let e = prepare(&parse(&["--spot-feed"])).err().unwrap().to_string();
+    assert!(e.contains("--spot-feed needs a FILE"), "{e}");
+    assert_eq!(
+        laser_sim::spot_feed::beside(Path::new("/tmp/laser")),
+        PathBuf::from("/tmp/laser.spot")
+    );
+}

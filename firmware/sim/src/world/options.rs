@@ -86,6 +86,10 @@ pub struct SimOptions {
     /// `realtime` too); none without.
     #[cfg(unix)]
     pub pelco_pty: Option<crate::pelco_port::PelcoPtyOptions>,
+    /// Publish where the spot really is to this file
+    /// ([`crate::spot_feed`]: what a virtual camera outside the
+    /// simulator renders).
+    pub spot_feed: Option<std::path::PathBuf>,
 }
 
 impl Default for SimOptions {
@@ -118,6 +122,7 @@ impl Default for SimOptions {
             pty: None,
             #[cfg(unix)]
             pelco_pty: None,
+            spot_feed: None,
         }
     }
 }

@@ -1,28 +1,9 @@
 use super::*;
-use crate::camera::{Camera, Intrinsics, Pose};
+use crate::camera::{Camera, INTRINSICS_VIEW_EYES, Intrinsics};
 use crate::homography::fit_homography;
 use crate::markers::{MarkerDetector, correspondences};
 use crate::render::{Exposure, VirtualCamera};
 use crate::target::{GridSpec, TargetLayout};
-
-/// Views of the target from around the reference camera (as a user
-/// holding the printed board at different tilts).
-fn eyes() -> [[f64; 3]; 5] {
-    [
-        [-90.0, -170.0, 440.0],
-        [120.0, -140.0, 450.0],
-        [-150.0, 90.0, 430.0],
-        [40.0, 160.0, 460.0],
-        [0.0, -30.0, 520.0],
-    ]
-}
-
-fn camera_at(eye: [f64; 3], k1: f64) -> Camera {
-    Camera {
-        pose: Pose::looking_at(eye, [0.0, 0.0, 0.0]).unwrap(),
-        ..Camera::reference(k1)
-    }
-}
 
 /// Worst board-plane error (mm) of mapping every grid point's image
 /// through the homography fitted to the markers, with or without undistortion.
@@ -65,9 +46,9 @@ fn zhang_recovers_the_lens_and_removes_half_a_percent_of_distortion() {
     let mut det = MarkerDetector::new(1280, 720).unwrap();
     let mut views = Vec::new();
     let mut cams = Vec::new();
-    for (i, eye) in eyes().into_iter().enumerate() {
+    for (i, eye) in INTRINSICS_VIEW_EYES.into_iter().enumerate() {
         let vc = VirtualCamera {
-            camera: camera_at(eye, k1),
+            camera: Camera::reference(k1).from_eye(eye).unwrap(),
             layout: layout.clone(),
             exposure: Exposure::default(),
         };
