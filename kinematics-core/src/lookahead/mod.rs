@@ -283,12 +283,19 @@ impl<const N: usize, T: Copy> Lookahead<N, T> {
         let mut next_entry = 0.0_f64;
         let frozen = self.frozen_head_entry;
         let len = self.blocks.len();
+        // Whether the frozen head cannot brake to the entry the reverse
+        // pass wants for the block after it (see the forward pass).
+        let mut brake_through = false;
         for i in (0..len).rev() {
             let Some(b) = self.blocks.get_mut(i) else {
                 continue;
             };
             b.entry_speed = match (i, frozen) {
-                (0, Some(frozen)) => frozen,
+                (0, Some(frozen)) => {
+                    brake_through = i + 1 < len
+                        && at_least_braking(next_entry, frozen, b.accel, b.length) > next_entry;
+                    frozen
+                }
                 // From rest (a stop, a break, the first block): no `√`
                 // (soft-float on the M4) for min(0, reach) = 0.
                 _ if is_rest(b.max_entry_speed) => b.max_entry_speed,
@@ -300,11 +307,12 @@ impl<const N: usize, T: Copy> Lookahead<N, T> {
         }
         // The forward pass, with the block before's entry, acceleration
         // and length carried along: every entry reachable from the one
-        // before, at most accelerating and at least braking at the limit.
-        // The second bound only binds after a frozen head entry above what
-        // the reverse pass wanted (a feed override lowered the cruise of
-        // blocks the spot is already heading into faster): they then brake
-        // at the limit, above their new cruise, instead of jumping down.
+        // before. After a frozen head entry above what the reverse pass
+        // wanted (a feed override lowered the cruise of blocks the spot is
+        // already heading into faster), also at least what braking at the
+        // limit leaves: those blocks brake above their new cruise instead
+        // of jumping down to it, until the plan is met again. (Checked
+        // only then: soft-float squares cost ~800 M4 instructions a block.)
         let Some(head) = self.blocks.get(0) else {
             return;
         };
@@ -316,7 +324,11 @@ impl<const N: usize, T: Copy> Lookahead<N, T> {
             // An entry at rest stays at rest: no `√` for it.
             if !is_rest(b.entry_speed) {
                 let reached = b.entry_speed.min(reachable_speed(entry, accel, length));
-                b.entry_speed = at_least_braking(reached, entry, accel, length);
+                b.entry_speed = reached;
+                if brake_through {
+                    b.entry_speed = at_least_braking(reached, entry, accel, length);
+                    brake_through = b.entry_speed > reached;
+                }
             }
             (entry, accel, length) = (b.entry_speed, b.accel, b.length);
         }
