@@ -2,13 +2,13 @@
 //! stroke) are written once by the prep stage and used where they lie by
 //! the refill, never copied in it.
 
-use super::{PREP_DEPTH, Prepared};
+use super::state::{PREP_DEPTH, Prepared};
 
 /// Slots: the running step and [`PREP_DEPTH`] prepared ones.
 const SLOTS: usize = PREP_DEPTH + 1;
 
 /// A ring of prepared steps, oldest first.
-pub(in crate::galvo::scan) struct StepRing {
+pub(super) struct StepRing {
     slots: [Option<Prepared>; SLOTS],
     head: usize,
     len: usize,
@@ -17,7 +17,7 @@ pub(in crate::galvo::scan) struct StepRing {
 impl StepRing {
     /// Empty. Each slot is set to `None` where it lies (its tag only), not
     /// copied from a constant image of a few KB in flash per slot.
-    pub(in crate::galvo::scan) fn new() -> Self {
+    pub(super) fn new() -> Self {
         Self {
             slots: core::array::from_fn(|_| None),
             head: 0,
@@ -26,12 +26,12 @@ impl StepRing {
     }
 
     /// Steps held.
-    pub(in crate::galvo::scan) fn len(&self) -> usize {
+    pub(super) fn len(&self) -> usize {
         self.len
     }
 
     /// The `i`-th step, oldest first.
-    pub(in crate::galvo::scan) fn get(&self, i: usize) -> Option<&Prepared> {
+    pub(super) fn get(&self, i: usize) -> Option<&Prepared> {
         if i >= self.len {
             return None;
         }
@@ -39,7 +39,7 @@ impl StepRing {
     }
 
     /// The `i`-th step, oldest first.
-    pub(in crate::galvo::scan) fn get_mut(&mut self, i: usize) -> Option<&mut Prepared> {
+    pub(super) fn get_mut(&mut self, i: usize) -> Option<&mut Prepared> {
         if i >= self.len {
             return None;
         }
@@ -47,12 +47,12 @@ impl StepRing {
     }
 
     /// The newest step.
-    pub(in crate::galvo::scan) fn back(&self) -> Option<&Prepared> {
+    pub(super) fn back(&self) -> Option<&Prepared> {
         self.get(self.len.checked_sub(1)?)
     }
 
     /// Appends a step; `false` (dropped) when full.
-    pub(in crate::galvo::scan) fn push_back(&mut self, step: Prepared) -> bool {
+    pub(super) fn push_back(&mut self, step: Prepared) -> bool {
         if self.len >= SLOTS {
             return false;
         }
@@ -67,7 +67,7 @@ impl StepRing {
     }
 
     /// Drops the oldest step (in place: no copy).
-    pub(in crate::galvo::scan) fn drop_front(&mut self) {
+    pub(super) fn drop_front(&mut self) {
         if self.len > 0 {
             if let Some(slot) = self.slots.get_mut(self.head) {
                 *slot = None;
@@ -78,7 +78,7 @@ impl StepRing {
     }
 
     /// Drops every step.
-    pub(in crate::galvo::scan) fn clear(&mut self) {
+    pub(super) fn clear(&mut self) {
         while self.len > 0 {
             self.drop_front();
         }
