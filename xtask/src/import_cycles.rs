@@ -174,17 +174,22 @@ fn without_tests(text: &str) -> String {
 }
 
 /// Every path in `text` that starts with `crate::`, `super::` or
-/// `self::`, with `use` groups (`a::{b, c::d}`) expanded one level.
+/// `self::` (not a `pub(in …)` visibility), with `use` groups
+/// (`a::{b, c::d}`) expanded one level.
 fn paths(text: &str) -> Vec<String> {
     let mut out = Vec::new();
     let bytes = text.as_bytes();
     let is_ident = |b: u8| b.is_ascii_alphanumeric() || b == b'_';
     let mut i = 0;
     while i < bytes.len() {
+        // A visibility (`pub(in crate::a)`) names a module but imports
+        // nothing.
+        let visibility = bytes[..i].trim_ascii_end().ends_with(b"(in");
         let starts = ["crate::", "super::", "self::"]
             .iter()
             .any(|p| bytes[i..].starts_with(p.as_bytes()))
-            && (i == 0 || !is_ident(bytes[i - 1]));
+            && (i == 0 || !is_ident(bytes[i - 1]))
+            && !visibility;
         if !starts {
             i += 1;
             continue;
