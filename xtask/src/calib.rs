@@ -44,7 +44,7 @@ enum CalibCommand {
     Target(camera::TargetArgs),
     /// Measure the spot with a camera (offline frames, or online driving
     /// the board) and fit the error model; `calib camera intrinsics`: the lens.
-    Camera(Box<camera::CameraArgs>),
+    Camera(Box<CameraArgs>),
     /// Render the simulator's grid run as virtual-camera frames.
     Frames(frames::FramesArgs),
 }
@@ -91,7 +91,7 @@ pub fn run(args: CalibArgs) -> anyhow::Result<ExitCode> {
     Ok(emit(match args.command {
         CalibCommand::Fit(a) => fit_command(&a),
         CalibCommand::Target(a) => camera::target_command(&a),
-        CalibCommand::Camera(a) => camera::camera_command(&a),
+        CalibCommand::Camera(a) => camera_command(&a),
         CalibCommand::Frames(a) => frames::frames_command(&a),
     }))
 }
@@ -189,6 +189,7 @@ fn axis_summary(axis: &str, f: &AxisFit) -> String {
 
 pub(crate) mod camera;
 mod capture;
+mod frame_source;
 pub(super) mod frames;
 mod intrinsics;
 mod online;
@@ -198,3 +199,38 @@ mod webcam;
 
 #[cfg(test)]
 mod tests;
+
+/// `calib camera`: offline (`--images DIR --points CSV`), online
+/// (`--port DEVICE --camera DEVICE|sim`), or `calib camera intrinsics`.
+#[derive(clap::Args, Debug)]
+#[command(args_conflicts_with_subcommands = true)]
+pub struct CameraArgs {
+    #[command(subcommand)]
+    sub: Option<CameraSub>,
+    #[command(flatten)]
+    run: camera::CameraRunArgs,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum CameraSub {
+    /// The camera's intrinsics and radial distortion from several views of
+    /// the target (Zhang's method), for `calib camera --intrinsics FILE`.
+    Intrinsics(intrinsics::IntrinsicsArgs),
+}
+
+/// `calib camera`: `intrinsics`, or a calibration run offline or online.
+fn camera_command(a: &CameraArgs) -> Result<String, String> {
+    match (&a.sub, &a.run) {
+        (Some(CameraSub::Intrinsics(i)), _) => intrinsics::intrinsics_command(i),
+        (None, run) => run_command(run),
+    }
+}
+
+/// `calib camera` offline or online, as the arguments say.
+pub(crate) fn run_command(a: &camera::CameraRunArgs) -> Result<String, String> {
+    match (&a.port, &a.images, &a.points) {
+        (Some(port), _, _) => online::online_command(a, port),
+        (None, Some(images), Some(points)) => camera::offline_command(a, images, points),
+        _ => Err("give --images DIR --points CSV (offline) or --port DEVICE --camera DEVICE|sim (online)".into()),
+    }
+}

@@ -5,6 +5,7 @@ mod bench_m4;
 mod calib;
 mod doctor;
 mod fuzz;
+mod gate;
 mod hil;
 #[cfg(test)]
 mod import_cycles;
@@ -80,7 +81,7 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     let result = match cli.command {
-        Command::Test => toolchain::test().map(|()| ExitCode::SUCCESS),
+        Command::Test => gate::test().map(|()| ExitCode::SUCCESS),
         Command::Build => toolchain::build_firmware().map(|_| ExitCode::SUCCESS),
         Command::Doctor(args) => doctor::run(args),
         Command::BenchM4 => bench_m4::bench_m4().map(|_table| ExitCode::SUCCESS),
@@ -88,6 +89,8 @@ fn main() -> ExitCode {
         Command::Size => toolchain::size().map(|()| ExitCode::SUCCESS),
         Command::Sim(args) => sim::run_sim(args),
         Command::Hil(args) => hil::run(args),
+        // The scenarios on the QEMU board are the gate's part there.
+        Command::Qemu(args) if args.scenarios => gate::run_on_qemu().map(|()| ExitCode::SUCCESS),
         Command::Qemu(args) => qemu::run(args),
         Command::Kin(args) => kin::run(args),
         Command::Calib(args) => calib::run(args),

@@ -96,7 +96,7 @@ pub struct QemuArgs {
     /// Run the scenarios of tests/scenarios on the board and check them,
     /// as `cargo xtask test` does (no other option applies).
     #[arg(long, conflicts_with_all = ["script", "interactive"])]
-    scenarios: bool,
+    pub scenarios: bool,
     /// The board with its galvo DAC stream (a timer interrupt consumes the
     /// galvo loop's double buffer at the sample rate): `target galvo`
     /// works, and the galvo loop runs on the emulated M4.
@@ -302,9 +302,6 @@ pub fn run_board(
 
 /// Runs `cargo xtask qemu`.
 pub fn run(args: QemuArgs) -> Result<ExitCode> {
-    if args.scenarios {
-        return crate::scenario::run_on_qemu().map(|()| ExitCode::SUCCESS);
-    }
     if args.measure {
         return measure::measure().map(|()| ExitCode::SUCCESS);
     }

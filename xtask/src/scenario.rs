@@ -10,7 +10,7 @@ mod checks;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use laser_sim::recorder::SequencerEvent;
 use laser_sim::servo_port::BusFaults;
 use laser_sim::world::{SimOptions, run};
@@ -209,88 +209,6 @@ pub fn on_qemu(elf: &Path, scenario: &Scenario) -> Result<Outcome> {
         false,
     )?;
     Ok(Outcome::from(run))
-}
-
-/// `cargo xtask test`'s part on the emulated board: builds the image and
-/// runs every scenario on both boards (the simulator first: a failure
-/// there is the application's, not the board's).
-pub fn run_on_qemu() -> Result<()> {
-    let scenarios = all()?;
-    let plain = crate::qemu::build_image()?;
-    let galvo = if scenarios.iter().any(|s| s.galvo_dac) {
-        Some(crate::qemu::build_image_with(&["galvo-dac"], false)?)
-    } else {
-        None
-    };
-    let controls = if scenarios.iter().any(|s| s.laser_controls) {
-        Some(crate::qemu::build_image_with(&["laser-controls"], false)?)
-    } else {
-        None
-    };
-    let mut failures = Vec::new();
-    for scenario in scenarios {
-        let elf = match (&galvo, &controls) {
-            (Some(image), _) if scenario.galvo_dac => image,
-            (_, Some(image)) if scenario.laser_controls => image,
-            _ => &plain,
-        };
-        if let Err(e) = on_simulator(&scenario).and_then(|o| check(&scenario.name, &o)) {
-            failures.push(format!("{} (simulator): {e:#}", scenario.name));
-        }
-        let started = std::time::Instant::now();
-        let verdict = on_qemu(elf, &scenario).and_then(|o| check(&scenario.name, &o));
-        println!(
-            "scenario {:<16} on QEMU: {} ({:.1} s)",
-            scenario.name,
-            if verdict.is_ok() { "ok" } else { "FAILED" },
-            started.elapsed().as_secs_f64()
-        );
-        if let Err(e) = verdict {
-            failures.push(format!("{}: {e:#}", scenario.name));
-        }
-    }
-    timed_check(&mut failures, "the --pty console", || {
-        crate::qemu::check_pty_console(&plain)
-    });
-    timed_check(&mut failures, "the PELCO port", || {
-        crate::qemu::check_pelco_port(&plain)
-    });
-    let started = std::time::Instant::now();
-    let verdict = crate::hil::check_on_qemu(&plain);
-    match &verdict {
-        Ok(rows) => print!(
-            "cargo xtask hil on the QEMU board's PTY: ok\n{}",
-            crate::hil::table(rows)
-        ),
-        Err(_) => println!("cargo xtask hil on the QEMU board's PTY: FAILED"),
-    }
-    println!("  ({:.1} s)", started.elapsed().as_secs_f64());
-    if let Err(e) = verdict {
-        failures.push(format!("hil on QEMU: {e:#}"));
-    }
-    timed_check(&mut failures, "the defmt log channel", || {
-        crate::qemu::build_image_with(&["defmt-log"], true)
-            .and_then(|elf| crate::qemu::check_defmt_channel(&elf))
-    });
-    if !failures.is_empty() {
-        bail!("scenarios failed:\n{}", failures.join("\n"));
-    }
-    Ok(())
-}
-
-/// Runs one end-to-end check on QEMU, prints `<what> on QEMU: ok|FAILED
-/// (<s>)` and adds a failure to `failures`.
-fn timed_check(failures: &mut Vec<String>, what: &str, check: impl FnOnce() -> Result<()>) {
-    let started = std::time::Instant::now();
-    let verdict = check();
-    println!(
-        "{what} on QEMU: {} ({:.1} s)",
-        if verdict.is_ok() { "ok" } else { "FAILED" },
-        started.elapsed().as_secs_f64()
-    );
-    if let Err(e) = verdict {
-        failures.push(format!("{}: {e:#}", what.trim_start_matches("the ")));
-    }
 }
 
 #[cfg(test)]

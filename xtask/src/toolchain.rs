@@ -18,7 +18,7 @@ pub const RAM_BUDGET_BYTES: u64 = 96 * 1024;
 /// rustup components the project uses (llvm-tools provides `llvm-size`).
 const COMPONENTS: [&str; 3] = ["rustfmt", "clippy", "llvm-tools"];
 /// Crates that build for the host (everything but the firmware binary).
-const HOST_PACKAGES: &[&str] = &[
+pub const HOST_PACKAGES: &[&str] = &[
     "kinematics-core",
     "galvo-planner",
     "fashionstar",
@@ -32,7 +32,7 @@ const HOST_PACKAGES: &[&str] = &[
     "fuzz-props",
 ];
 /// `no_std` crates that must also build for the target.
-const TARGET_LIBRARIES: &[&str] = &[
+pub const TARGET_LIBRARIES: &[&str] = &[
     "kinematics-core",
     "galvo-planner",
     "fashionstar",
@@ -97,80 +97,6 @@ pub fn ensure_toolchain() -> Result<()> {
         }
     }
     Ok(())
-}
-
-fn package_args<'a>(packages: &[&'a str]) -> Vec<&'a str> {
-    packages.iter().flat_map(|p| ["-p", *p]).collect()
-}
-
-/// `cargo clippy` for the firmware target in release, with `packages`
-/// (`-p` arguments; none: the manifest's own package), warnings as errors.
-fn target_clippy_args<'a>(packages: &[&'a str]) -> Vec<&'a str> {
-    let mut args = vec!["clippy", "--target", TARGET, "--release"];
-    args.extend_from_slice(packages);
-    args.extend(["--", "-D", "warnings"]);
-    args
-}
-
-/// The property tests' seed in `cargo xtask test` when `PROPTEST_RNG_SEED`
-/// is not set: the gate is deterministic; failures found under other seeds
-/// are kept in `proptest-regressions/` and replayed first.
-const PROPTEST_SEED: u64 = 20_261_204;
-
-/// `cargo xtask test`: the whole gate, in the order a reviewer would run it
-/// (ends on QEMU: `bench-m4`, the M4 budgets, then the shared scenarios on
-/// the emulated board, `firmware/qemu-m4`).
-pub fn test() -> Result<()> {
-    ensure_toolchain()?;
-    run("cargo", &["fmt", "--all", "--check"])?;
-    crate::bench_m4::cargo(&["fmt", "--check"])?;
-    crate::bench_m4::cargo_in(crate::qemu::MANIFEST, &["fmt", "--check"])?;
-
-    let mut clippy_host = vec!["clippy", "--all-targets"];
-    clippy_host.extend(package_args(HOST_PACKAGES));
-    clippy_host.extend(["--", "-D", "warnings"]);
-    run("cargo", &clippy_host)?;
-
-    let mut clippy_target = vec!["-p", "firmware"];
-    clippy_target.extend(package_args(TARGET_LIBRARIES));
-    run("cargo", &target_clippy_args(&clippy_target))?;
-    // bench-m4 is a workspace of its own (see its Cargo.toml).
-    crate::bench_m4::cargo(&target_clippy_args(&[]))?;
-    // So is the QEMU board (firmware/qemu-m4/Cargo.toml).
-    crate::bench_m4::cargo_in(crate::qemu::MANIFEST, &target_clippy_args(&[]))?;
-
-    // The libraries for the target.
-    let mut build_libs = vec!["build", "--target", TARGET, "--release"];
-    build_libs.extend(package_args(TARGET_LIBRARIES));
-    run("cargo", &build_libs)?;
-
-    // The per-sample and refill budgets on the target's instruction set,
-    // before the host tests: the simulator's M4 cost model is checked
-    // against this run's table (`tests/tests/galvo_cost.rs`).
-    let bench_table = crate::bench_m4::bench_m4()?;
-
-    // Unit, integration (tests/) and doc tests of every host crate, the
-    // property tests from one seed (a gate gives the same answer twice; a
-    // new seed explores: `PROPTEST_RNG_SEED=N cargo xtask test`).
-    let seed = std::env::var("PROPTEST_RNG_SEED").unwrap_or_else(|_| PROPTEST_SEED.to_string());
-    println!("proptest seed {seed} (PROPTEST_RNG_SEED=<u64> for another)");
-    let mut tests = vec!["test"];
-    tests.extend(package_args(HOST_PACKAGES));
-    run_with_env(
-        "cargo",
-        &tests,
-        &[
-            ("BENCH_M4_JSON", bench_table.as_os_str()),
-            ("PROPTEST_RNG_SEED", seed.as_ref()),
-        ],
-    )?;
-
-    build_firmware()?;
-    size()?;
-
-    // The shared scenarios on the emulated Cortex-M4F (the simulator runs
-    // them in xtask's tests above).
-    crate::scenario::run_on_qemu()
 }
 
 /// Installs flip-link, the firmware's linker wrapper (`.cargo/config.toml`:

@@ -27,12 +27,16 @@ use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::signal::Signal;
 use heapless::Deque;
 
+pub use self::dropped::Dropped;
+use self::dropped::dropped_notice;
+pub use self::line::{LineKind, OutLine};
+use self::quiet::Quiet;
 pub use self::quiet::QuietReply;
 use crate::text::{REPLY_LINE_LEN, ReplyText, reply_text};
 
 mod dropped;
-pub use dropped::Dropped;
-use dropped::dropped_notice;
+mod line;
+mod quiet;
 
 /// Size of the outbound queue, bytes (lines are stored with a 2-byte
 /// header). Holds the longest reply (`params`, about 5.5 KiB stored) with
@@ -60,71 +64,17 @@ pub const DATA_LIMIT: usize = NOTICE_LIMIT - 4 * (LINE_ENTRY_MAX + MARKER_ENTRY)
 /// long replies wait for the queue to drain instead).
 pub const REPLY_ROOM: usize = 1024;
 
-/// What a queued line is; decides how it is printed and its priority.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum LineKind {
-    /// A data line of the current reply (printed as is).
-    Data,
-    /// The reply's closing `ok`.
-    Ok,
-    /// The reply's closing `error: <text>`.
-    Error,
-    /// An unsolicited notice, printed in brackets: `[<text>]`.
-    Notice,
-    /// The closing `error:<text>` of a G-code or `$` line (grbl's form,
-    /// no space: the text is grbl's error number).
-    GrblError,
-}
-
-impl LineKind {
-    /// Whether this line closes a reply.
-    pub fn is_closer(self) -> bool {
-        matches!(self, LineKind::Ok | LineKind::Error | LineKind::GrblError)
-    }
-
-    fn code(self) -> u8 {
-        match self {
-            LineKind::Data => 0,
-            LineKind::Ok => 1,
-            LineKind::Error => 2,
-            LineKind::Notice => 3,
-            LineKind::GrblError => 4,
-        }
-    }
-
-    fn from_code(code: u8) -> Option<Self> {
-        match code {
-            0 => Some(LineKind::Data),
-            1 => Some(LineKind::Ok),
-            2 => Some(LineKind::Error),
-            3 => Some(LineKind::Notice),
-            4 => Some(LineKind::GrblError),
-            _ => None,
-        }
-    }
-
-    /// Bytes of the queue this kind may fill.
-    fn limit(self) -> usize {
-        match self {
-            LineKind::Data => DATA_LIMIT,
-            LineKind::Notice => NOTICE_LIMIT,
-            LineKind::Ok | LineKind::Error | LineKind::GrblError => OUTBOUND_BYTES,
-        }
+/// Bytes of the queue a `kind` line may fill.
+fn limit(kind: LineKind) -> usize {
+    match kind {
+        LineKind::Data => DATA_LIMIT,
+        LineKind::Notice => NOTICE_LIMIT,
+        LineKind::Ok | LineKind::Error | LineKind::GrblError => OUTBOUND_BYTES,
     }
 }
 
 /// Entry code of a drop marker.
 const MARKER_CODE: u8 = 0xff;
-
-/// One line taken from the queue for writing.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct OutLine {
-    /// What it is.
-    pub kind: LineKind,
-    /// Its text (without `error: `, brackets or line end).
-    pub text: ReplyText,
-}
 
 struct Queue {
     bytes: Deque<u8, OUTBOUND_BYTES>,
@@ -139,10 +89,9 @@ struct Queue {
     orphaned: bool,
     /// Lines taken by the writer (wrapping): the host reads while it grows.
     taken: u32,
-    /// The command in flight is quiet (see [`Outbound::begin_quiet_command`]).
-    quiet: bool,
-    /// The reply of the last quiet command, kept from the host.
-    quiet_reply: QuietReply,
+    /// The quiet command in flight, if any, and the last one's reply
+    /// (see [`Outbound::begin_quiet_command`]).
+    quiet: Quiet,
 }
 
 impl Queue {
@@ -156,11 +105,7 @@ impl Queue {
             awaiting_close: false,
             orphaned: false,
             taken: 0,
-            quiet: false,
-            quiet_reply: QuietReply {
-                data: ReplyText::new(),
-                closed: None,
-            },
+            quiet: Quiet::new(),
         }
     }
 
@@ -191,7 +136,7 @@ impl Queue {
             MARKER_ENTRY
         };
         let needed = marker + HEADER + text.len();
-        if self.bytes.len() + needed > kind.limit() {
+        if self.bytes.len() + needed > limit(kind) {
             self.dropped.count(kind);
             return false;
         }
@@ -322,7 +267,7 @@ impl Outbound {
             if kind.is_closer() {
                 q.awaiting_close = false;
             }
-            quiet = q.keep_quiet(kind, text);
+            quiet = q.quiet.keep(kind, text);
             quiet || q.push(kind, text)
         });
         if quiet {
@@ -416,6 +361,27 @@ impl Outbound {
         self.with(|q| q.awaiting_close)
     }
 
+    /// Marks a command from another task than the console (the PELCO
+    /// port) as dispatched, when no command is in flight: its data lines
+    /// and closer are kept from the host ([`Outbound::take_quiet_reply`]),
+    /// and the console waits for its closer like for one of its own.
+    /// `false` (nothing marked) while another command is in flight.
+    pub fn begin_quiet_command(&self) -> bool {
+        self.with(|q| {
+            if q.awaiting_close {
+                return false;
+            }
+            q.awaiting_close = true;
+            q.quiet.begin();
+            true
+        })
+    }
+
+    /// The reply of the last quiet command once it is closed (taken once).
+    pub fn take_quiet_reply(&self) -> Option<QuietReply> {
+        self.with(|q| q.quiet.take_reply())
+    }
+
     /// Waits until `ready` holds, re-checking whenever room is freed or a
     /// reply closes.
     pub async fn wait_until(&self, mut ready: impl FnMut(&Self) -> bool) {
@@ -431,6 +397,5 @@ impl Default for Outbound {
     }
 }
 
-mod quiet;
 #[cfg(test)]
 mod tests;

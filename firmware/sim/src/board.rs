@@ -33,10 +33,10 @@ use crate::executor::{TaskKind, spawn_task};
 use crate::panel::{SimLeds, SimStopButton, SimWatchdog};
 use crate::pelco_port::{PelcoRx, PelcoTx};
 use crate::servo_port::{PortHandle, SimServoPort};
+use crate::settings_flash::SettingsFlash;
 use crate::spot::RecordingLaser;
 use crate::stepper::SimStepperDrive;
 use crate::usb_host::UsbHost;
-use crate::world::SettingsFlash;
 
 /// The simulated board's parts.
 pub struct SimBoard {

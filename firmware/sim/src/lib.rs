@@ -24,6 +24,7 @@ pub mod safety;
 pub mod script;
 pub mod servo_model;
 pub mod servo_port;
+pub mod settings_flash;
 pub mod spot;
 pub mod spot_feed;
 pub mod stepper;

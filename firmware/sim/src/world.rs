@@ -17,16 +17,14 @@ use laser_app::galvo::{GalvoConfig, GalvoLink};
 use laser_app::laser_controls::ControlsLink;
 use laser_app::sequencer::SettingsStore;
 use laser_app::servo::task::ServoLink;
-use laser_app::settings::store::FlashSettingsStore;
 use laser_app::status::{Activity, Phase, StatusBoard};
 use laser_app::stepper::StepperLink;
-use sequential_storage::map::MapConfig;
 
 use crate::board::{SimBoard, SimSpawner};
 use crate::controls::{ControlWiring, SimLaserControls};
 use crate::dac::{DacRecording, SimDac};
 use crate::executor::{self, RunEnd, TaskKind};
-use crate::flash::{FlashTiming, SimFlash};
+use crate::flash::FlashTiming;
 use crate::laser::{GatedLaserPin, recorded_gate};
 use crate::panel::{ButtonContacts, PanelRecord, SharedPanel, SimLeds, SimStopButton, SimWatchdog};
 use crate::physics::PhysicalGimbal;
@@ -41,40 +39,13 @@ mod options;
 
 pub use options::{SimOptions, SimReport};
 
+pub use crate::settings_flash::{
+    SETTINGS_FLASH_OFFSET, SETTINGS_SECTOR_BYTES, SETTINGS_SECTORS, SettingsFlash,
+    load_settings_record, settings_store,
+};
+
 /// Samples per galvo DAC half buffer (1.28 ms at 100 kHz).
 pub const GALVO_HALF_LEN: usize = 128;
-
-/// Bytes per sector of the settings flash (the STM32F407's sectors 10 and
-/// 11 are 128 KiB each).
-pub const SETTINGS_SECTOR_BYTES: usize = 128 * 1024;
-/// The settings flash as the target has it: sectors 10 and 11.
-pub type SettingsFlash = SimFlash<SETTINGS_SECTOR_BYTES>;
-/// Offset of the settings sectors from the start of flash (0x080C_0000).
-pub const SETTINGS_FLASH_OFFSET: u32 = 0x000C_0000;
-/// Sectors the settings use.
-pub const SETTINGS_SECTORS: usize = 2;
-
-/// The settings store over `flash`, laid out as on the target.
-pub fn settings_store(flash: SettingsFlash) -> FlashSettingsStore<SettingsFlash> {
-    FlashSettingsStore::new(
-        flash,
-        const {
-            MapConfig::new(
-                SETTINGS_FLASH_OFFSET
-                    ..SETTINGS_FLASH_OFFSET + (SETTINGS_SECTORS * SETTINGS_SECTOR_BYTES) as u32,
-            )
-        },
-    )
-}
-
-/// The record a boot from `image` (the settings sectors) loads, if any.
-pub fn load_settings_record(image: Vec<u8>) -> Option<Vec<u8>> {
-    let mut store = settings_store(SettingsFlash::from_image(SETTINGS_FLASH_OFFSET, image));
-    let mut record = vec![0u8; laser_app::settings::MAX_RECORD_LEN];
-    let n = embassy_futures::block_on(store.load(&mut record));
-    record.truncate(n);
-    (n > 0).then_some(record)
-}
 
 fn is_idle(status: &StatusBoard) -> bool {
     let s = status.snapshot();

@@ -31,24 +31,6 @@ pub struct TargetArgs {
     pub(super) yi_max: i32,
 }
 
-/// `calib camera`: offline (`--images DIR --points CSV`), online
-/// (`--port DEVICE --camera DEVICE|sim`), or `calib camera intrinsics`.
-#[derive(clap::Args, Debug)]
-#[command(args_conflicts_with_subcommands = true)]
-pub struct CameraArgs {
-    #[command(subcommand)]
-    sub: Option<CameraSub>,
-    #[command(flatten)]
-    run: CameraRunArgs,
-}
-
-#[derive(clap::Subcommand, Debug)]
-enum CameraSub {
-    /// The camera's intrinsics and radial distortion from several views of
-    /// the target (Zhang's method), for `calib camera --intrinsics FILE`.
-    Intrinsics(super::intrinsics::IntrinsicsArgs),
-}
-
 /// `calib camera` without a subcommand.
 #[derive(clap::Args, Debug, Clone)]
 pub struct CameraRunArgs {
@@ -311,23 +293,12 @@ fn residuals(report: &FitReport, points: &[MeasuredPoint]) -> Result<Vec<(f64, f
         .collect()
 }
 
-pub(crate) fn camera_command(a: &CameraArgs) -> Result<String, String> {
-    match (&a.sub, &a.run) {
-        (Some(CameraSub::Intrinsics(i)), _) => super::intrinsics::intrinsics_command(i),
-        (None, run) => run_command(run),
-    }
-}
-
-/// `calib camera` offline or online, as the arguments say.
-pub(crate) fn run_command(a: &CameraRunArgs) -> Result<String, String> {
-    match (&a.port, &a.images, &a.points) {
-        (Some(port), _, _) => super::online::online_command(a, port),
-        (None, Some(images), Some(points)) => offline_command(a, images, points),
-        _ => Err("give --images DIR --points CSV (offline) or --port DEVICE --camera DEVICE|sim (online)".into()),
-    }
-}
-
-fn offline_command(a: &CameraRunArgs, images: &Path, points_csv: &Path) -> Result<String, String> {
+/// `calib camera --images DIR --points CSV`: the offline mode.
+pub(crate) fn offline_command(
+    a: &CameraRunArgs,
+    images: &Path,
+    points_csv: &Path,
+) -> Result<String, String> {
     let text = std::fs::read_to_string(points_csv)
         .map_err(|e| format!("cannot read {}: {e}", points_csv.display()))?;
     let rows = read_frame_list(&text).map_err(|e| format!("{}: {e}", points_csv.display()))?;

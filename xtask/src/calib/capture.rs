@@ -9,11 +9,7 @@ use camera_calib::render::{Exposure, LaserSpot, Scene, VirtualCamera};
 use camera_calib::target::TargetLayout;
 use laser_sim::spot_feed::{FeedSample, beside};
 
-/// A camera looking at the board.
-pub trait FrameSource {
-    /// The mean of `n` exposures taken from now on (grey levels).
-    fn capture(&mut self, n: usize) -> Result<GrayImage, String>;
-}
+pub use super::frame_source::FrameSource;
 
 /// The simulator's virtual camera: renders the printed target and the
 /// spot where the simulator's spot feed says it really is (when lit).

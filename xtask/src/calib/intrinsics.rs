@@ -12,6 +12,7 @@ use camera_calib::image::GrayImage;
 use camera_calib::intrinsics::fit_intrinsics;
 use camera_calib::markers::{MarkerDetector, correspondences};
 use camera_calib::measure::MIN_MARKERS;
+use camera_calib::target::{GridSpec, TargetLayout};
 use serde::{Deserialize, Serialize};
 
 /// `calib camera intrinsics`
@@ -99,7 +100,11 @@ pub(super) fn load_png(path: &Path) -> Result<GrayImage, String> {
 
 /// Runs `calib camera intrinsics`.
 pub fn intrinsics_command(a: &IntrinsicsArgs) -> Result<String, String> {
-    let layout = super::camera::layout(a.pitch_mm, 6, 4)?;
+    let layout = TargetLayout::for_grid(GridSpec {
+        pitch_mm: a.pitch_mm,
+        xi_max: 6,
+        yi_max: 4,
+    })?;
     let mut files: Vec<PathBuf> = std::fs::read_dir(&a.views)
         .map_err(|e| format!("cannot read {}: {e}", a.views.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))

@@ -305,7 +305,7 @@ fn camera_args(images: &Path, points: &Path, out: &str) -> camera::CameraRunArgs
 fn offline_camera_mode_fits_the_committed_frames() {
     let dir = offline_dir();
     let a = camera_args(&dir, &dir.join("points.csv"), "ok");
-    let json: serde_json::Value = serde_json::from_str(&camera::run_command(&a).unwrap()).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&run_command(&a).unwrap()).unwrap();
     assert_eq!(json["frames"], 11);
     assert_eq!(json["markers"].as_array().unwrap().len(), 14);
     assert!(json["reprojection_px"].as_f64().unwrap() < 0.3);
@@ -341,7 +341,7 @@ fn offline_camera_mode_refuses_bad_input_and_writes_nothing() {
     ] {
         std::fs::write(&csv, text).unwrap();
         let a = camera_args(&dir, &csv, "bad");
-        let err = camera::run_command(&a).unwrap_err();
+        let err = run_command(&a).unwrap_err();
         assert!(err.contains(expect), "{err}");
         for f in ["bad-err.txt", "bad-report.json", "bad-errors.svg"] {
             assert!(!tmp(f).exists(), "{f} written on refusal");

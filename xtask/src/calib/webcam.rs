@@ -13,7 +13,7 @@ use v4l::io::traits::CaptureStream;
 use v4l::video::Capture;
 use v4l::{Device, FourCC};
 
-use super::capture::FrameSource;
+use super::frame_source::FrameSource;
 
 /// Buffers the driver fills in turn (also the stale frames dropped
 /// before each capture).

@@ -9,10 +9,14 @@ use core::fmt;
 
 pub use kinematics_core::{Pattern as GridPattern, Rotation};
 
+pub use self::stroke::{Segment, Segments, Stroke};
 pub use self::stroke_cm::StrokeCm;
 use super::point::PointCm;
 use super::units::Unit;
 use crate::text::Shortest;
+
+mod stroke;
+mod stroke_cm;
 
 /// A figure drawn as a path, board cm.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,71 +69,6 @@ pub enum Pattern {
     Grid(GridPattern),
     /// A drawn path: no dwell between its points.
     Path(Figure),
-}
-
-/// One piece of a stroke, in the stroke's unit.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Segment {
-    /// Straight line to `to`.
-    Line {
-        /// End point `[x, y]`.
-        to: [f64; 2],
-    },
-    /// Circular arc to `end` about `centre`; `end` equal to the start is a
-    /// full circle.
-    Arc {
-        /// End point `[x, y]`.
-        end: [f64; 2],
-        /// Centre `[x, y]`.
-        centre: [f64; 2],
-        /// Direction.
-        rotation: Rotation,
-    },
-}
-
-mod stroke_cm;
-
-/// Most segments of one stroke.
-const STROKE_SEGMENTS: usize = 4;
-
-/// Segments of one stroke.
-pub type Segments = heapless::Vec<Segment, STROKE_SEGMENTS>;
-
-/// A stroke: drawn without a break from `start` through its segments, in
-/// the [`Unit`] it was built in.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Stroke {
-    /// Start point `[x, y]`.
-    pub start: [f64; 2],
-    /// What is drawn from the start, in order.
-    pub segments: Segments,
-}
-
-impl Stroke {
-    fn lines(start: [f64; 2], points: impl IntoIterator<Item = [f64; 2]>) -> Self {
-        Self {
-            start,
-            segments: points.into_iter().map(|to| Segment::Line { to }).collect(),
-        }
-    }
-
-    /// The rectangle through opposite corners `a`, `b`, from `a`.
-    fn rect(a: [f64; 2], b: [f64; 2]) -> Self {
-        Self::lines(a, [[b[0], a[1]], b, [a[0], b[1]], a])
-    }
-
-    /// The full circle about `centre` of radius `radius` from its top.
-    fn circle(centre: [f64; 2], radius: f64, rotation: Rotation) -> Self {
-        let top = [centre[0], centre[1] + radius];
-        Self {
-            start: top,
-            segments: Segments::from_iter([Segment::Arc {
-                end: top,
-                centre,
-                rotation,
-            }]),
-        }
-    }
 }
 
 impl Figure {

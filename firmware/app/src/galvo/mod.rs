@@ -23,7 +23,8 @@ mod cost;
 mod scan;
 
 pub use cost::{CostModel, LoopWork, M4_COST};
-pub use scan::{GalvoConfig, GalvoError, GalvoLoop, GalvoMemory, MAX_HALF_LEN, ScanPhase};
+pub use scan::memory::GalvoMemory;
+pub use scan::{GalvoConfig, GalvoError, GalvoLoop, MAX_HALF_LEN, ScanPhase};
 
 use core::sync::atomic::{AtomicBool, AtomicU8, AtomicU32, Ordering};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;

@@ -2,7 +2,7 @@
 
 use core::fmt;
 
-use super::{LineKind, OutLine};
+use super::line::{LineKind, OutLine};
 use crate::text::reply_text;
 
 /// Lines dropped because the queue was full.

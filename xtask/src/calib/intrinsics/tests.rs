@@ -2,8 +2,9 @@ use camera_calib::image::GrayImage;
 use camera_calib::offline::{measure_frames, read_frame_list};
 
 use super::*;
-use crate::calib::camera::{CameraRunArgs, run_command};
+use crate::calib::camera::CameraRunArgs;
 use crate::calib::frames::{FramesArgs, frames_command};
+use crate::calib::run_command;
 
 fn tmp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("xtask-intrinsics-{}-{name}", std::process::id()))

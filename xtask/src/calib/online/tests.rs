@@ -7,7 +7,7 @@ use laser_sim::spot_feed::beside;
 use laser_sim::world::SimOptions;
 
 use super::*;
-use crate::calib::camera::run_command;
+use crate::calib::run_command;
 
 fn tmp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("xtask-online-{}-{name}", std::process::id()))

@@ -15,7 +15,7 @@
 
 use super::super::point::PointCm;
 use super::super::units::Unit;
-use super::{STROKE_SEGMENTS, Stroke};
+use super::stroke::{STROKE_SEGMENTS, Segment, Stroke};
 
 /// One stroke drawn without a break: from a start through up to
 /// [`Self::MAX_SEGMENTS`] straight lines, board cm in `f32` (0.1 µm at
@@ -119,7 +119,7 @@ impl StrokeCm {
     pub(super) fn bounds(&self, unit: Unit) -> ([f64; 2], [f64; 2]) {
         let stroke = self.in_unit(unit);
         let ends = stroke.segments.iter().map(|s| match *s {
-            super::Segment::Line { to } | super::Segment::Arc { end: to, .. } => to,
+            Segment::Line { to } | Segment::Arc { end: to, .. } => to,
         });
         ends.fold((stroke.start, stroke.start), |(lo, hi), [x, y]| {
             ([lo[0].min(x), lo[1].min(y)], [hi[0].max(x), hi[1].max(y)])

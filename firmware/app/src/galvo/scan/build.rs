@@ -5,9 +5,10 @@
 use galvo_planner::XyIntegrator;
 use kinematics_core::SampleMap;
 
-use super::mark::Motion;
-use super::prep::StepRing;
-use super::{GalvoConfig, GalvoError, GalvoLoop, prep};
+use super::planning::Planning;
+use super::ring::StepRing;
+use super::state::{JumpCodes, Motion, Trace};
+use super::{GalvoConfig, GalvoError, GalvoLoop};
 use crate::galvo::{DacSample, DacStream, LoopWork};
 
 pub(super) fn samples_for(us: u32, ts_s: f64) -> u32 {
@@ -24,14 +25,14 @@ impl GalvoLoop {
     /// It plans jumps with every method, in `f64` where the method needs
     /// it (a host); a board's loop is built by [`Self::for_dac`].
     pub fn new(config: GalvoConfig) -> Result<Self, GalvoError> {
-        Self::with_planning(config, prep::Planning::HOST)
+        Self::with_planning(config, Planning::HOST)
     }
 
     /// [`Self::new`] for the loop that feeds `D`, planning jumps as its
     /// board can ([`DacStream::F64_PLANNING`]); also
     /// [`GalvoError::SeedTooSlow`] for `planner seed` where it cannot.
     pub fn for_dac<D: DacStream>(config: GalvoConfig) -> Result<Self, GalvoError> {
-        let planning = prep::Planning::of::<D>();
+        let planning = Planning::of::<D>();
         planning.check(config.method)?;
         Self::with_planning(config, planning)
     }
@@ -46,7 +47,7 @@ impl GalvoLoop {
         config: GalvoConfig,
     ) -> Result<&mut Self, GalvoError> {
         *slot = None;
-        let planning = prep::Planning::of::<D>();
+        let planning = Planning::of::<D>();
         planning.check(config.method)?;
         let galvo = Self::placed(slot, config, planning)?;
         let disc = galvo.disc;
@@ -58,7 +59,7 @@ impl GalvoLoop {
         slot.as_mut().ok_or(GalvoError::Planner)
     }
 
-    fn with_planning(config: GalvoConfig, planning: prep::Planning) -> Result<Self, GalvoError> {
+    fn with_planning(config: GalvoConfig, planning: Planning) -> Result<Self, GalvoError> {
         let mut slot = None;
         Self::placed(&mut slot, config, planning)?;
         let galvo = slot.as_mut().ok_or(GalvoError::Planner)?;
@@ -75,7 +76,7 @@ impl GalvoLoop {
     fn placed(
         slot: &mut Option<Self>,
         config: GalvoConfig,
-        planning: prep::Planning,
+        planning: Planning,
     ) -> Result<&mut Self, GalvoError> {
         let angles_rad = [0.0, 0.0];
         let disc = config
@@ -96,7 +97,7 @@ impl GalvoLoop {
             mirrors: XyIntegrator::IDLE,
             steps: StepRing::new(),
             running: false,
-            jump_codes: prep::JumpCodes::EMPTY,
+            jump_codes: JumpCodes::EMPTY,
             jump_cursor: None,
             active_end_rad: angles_rad,
             unprepared_samples: 0,
@@ -115,7 +116,7 @@ impl GalvoLoop {
             off_delay_samples: samples_for(config.laser_off_delay_us, ts),
             jump_planning: planning,
             joining: None,
-            trace: super::trace::Trace::default(),
+            trace: Trace::default(),
             config,
         }))
     }

@@ -6,7 +6,7 @@ use kinematics_core::PointMm;
 use kinematics_core::SampleMap;
 
 use super::build::samples_for;
-use super::mark::Motion;
+use super::state::Motion;
 use super::{Active, GalvoConfig, GalvoError, GalvoLoop, Job, ScanPhase};
 use crate::domain::Unit;
 use crate::galvo::{DacSample, GalvoEvent, GalvoRequest};

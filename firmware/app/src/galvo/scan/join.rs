@@ -12,18 +12,10 @@
 
 use kinematics_core::PointMm;
 
+use super::state::Joining;
 use super::{GalvoLoop, Job, ScanPhase};
 use crate::domain::{Figure, Segment, StrokeCm, Unit};
 use crate::galvo::GalvoEvent;
-
-/// A continuation joined to the running stroke, not reached yet.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Joining {
-    seq: u32,
-    job: Job,
-    /// Planner blocks it added (the last ones in the planner).
-    blocks: u8,
-}
 
 /// The continuation stroke of `job`, if it is one.
 fn continuation(job: &Job) -> Option<&StrokeCm> {

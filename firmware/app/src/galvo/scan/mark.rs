@@ -5,19 +5,10 @@
 use kinematics_core::PointMm;
 
 use super::runs::{BLOCK, write_codes};
+use super::state::Motion;
 use super::{GalvoError, GalvoLoop, ScanPhase};
 use crate::domain::{Figure, Unit};
 use crate::galvo::{DacSample, GalvoEvent};
-
-/// The spot while marking or braking: position (mm) and its change over
-/// the last sample (mm per sample).
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Motion {
-    pub(super) position_mm: [f32; 2],
-    pub(super) step_mm: [f32; 2],
-    /// Speed lost per braking sample, mm per sample (accel · Ts²).
-    pub(super) brake_mm: f32,
-}
 
 impl GalvoLoop {
     /// DAC codes of a board position (mm).

@@ -15,144 +15,12 @@
 //! jump and drops the prepared steps if it broke.
 
 use galvo_planner::blocks::{PRECOMPUTED_JUMP, jump_angles};
-use galvo_planner::{
-    Discrete, JumpSync, MarkLimits, Method, MethodKind, PathPlanner, XyJump, plan_xy_jump,
-    plan_xy_jump_f32,
-};
+use galvo_planner::{MarkLimits, MethodKind, PathPlanner, XyJump};
 use kinematics_core::PointMm;
 
-use super::{GalvoError, GalvoLoop, INTEGRATOR_CAPACITY, Job, MARK_BLOCKS};
+use super::state::{JumpCodes, LoadedStroke, PREP_DEPTH, Prepared};
+use super::{GalvoError, GalvoLoop, Job};
 use crate::domain::{Rotation, Segment, Unit};
-use crate::galvo::DacStream;
-
-/// Steps prepared ahead of the refill (a step takes at least the laser
-/// delays and its jump; four cover a half buffer of the shortest jobs).
-pub(super) const PREP_DEPTH: usize = 4;
-
-/// How the loop plans a two-axis jump from, to (rad) with a method.
-type XyPlanner = fn(&Discrete<3>, [f64; 2], [f64; 2], Method) -> Result<XyJump<3>, GalvoError>;
-
-/// The jump planning a board affords ([`DacStream::F64_PLANNING`]). Set
-/// only where the board's type is known ([`Self::of`]), so a board
-/// without `f64` planning links none of the `f64` planners.
-#[derive(Clone, Copy)]
-pub(super) struct Planning {
-    /// Bisection and the `f64` fallback are allowed.
-    f64: bool,
-    pub(super) plan: XyPlanner,
-}
-
-impl Planning {
-    /// A host: every method, `f64` where it needs it.
-    pub(super) const HOST: Self = Self {
-        f64: true,
-        plan: plan_any,
-    };
-    /// A single-precision FPU (the M4F): time-optimal in `f32` only.
-    pub(super) const F32: Self = Self {
-        f64: false,
-        plan: plan_f32,
-    };
-
-    /// The planning of the board that feeds `D`.
-    pub(super) fn of<D: DacStream>() -> Self {
-        if D::F64_PLANNING {
-            Self::HOST
-        } else {
-            Self::F32
-        }
-    }
-
-    /// `Err` when `method` does not fit this board:
-    /// [`GalvoError::SeedTooSlow`] for bisection.
-    pub(super) fn check(&self, method: Method) -> Result<(), GalvoError> {
-        match method {
-            _ if self.f64 => Ok(()),
-            Method::TimeOptimal => Ok(()),
-            Method::Bisection(_) => Err(GalvoError::SeedTooSlow),
-            _ => Err(GalvoError::Planner),
-        }
-    }
-}
-
-/// Both axes, any method ([`Planning::HOST`]).
-fn plan_any(
-    disc: &Discrete<3>,
-    from_rad: [f64; 2],
-    to_rad: [f64; 2],
-    method: Method,
-) -> Result<XyJump<3>, GalvoError> {
-    let sync = JumpSync::Independent;
-    plan_xy_jump(
-        disc,
-        disc,
-        from_rad,
-        to_rad,
-        method,
-        sync,
-        INTEGRATOR_CAPACITY,
-    )
-    .map_err(|_| GalvoError::Planner)
-}
-
-/// Both axes time-optimal in `f32`, no `f64` fallback ([`Planning::F32`]).
-fn plan_f32(
-    disc: &Discrete<3>,
-    from_rad: [f64; 2],
-    to_rad: [f64; 2],
-    method: Method,
-) -> Result<XyJump<3>, GalvoError> {
-    Planning::F32.check(method)?;
-    plan_xy_jump_f32(disc, disc, from_rad, to_rad, INTEGRATOR_CAPACITY)
-        .map_err(|_| GalvoError::Planner)
-}
-
-/// A stroke loaded into the look-ahead path planner, or why it was refused.
-pub(super) type LoadedStroke = Result<PathPlanner<MARK_BLOCKS>, GalvoError>;
-
-/// A jump's DAC codes, sample by sample.
-#[derive(Debug, Clone)]
-pub(super) struct JumpCodes {
-    /// Samples of the jump.
-    pub(super) len: usize,
-    /// `[x, y]` codes; the first `len` are the jump's.
-    pub(super) codes: [[u16; 2]; PRECOMPUTED_JUMP],
-}
-
-impl JumpCodes {
-    /// No samples.
-    pub(super) const EMPTY: Self = Self {
-        len: 0,
-        codes: [[0; 2]; PRECOMPUTED_JUMP],
-    };
-}
-
-/// One prepared step: the jump to its start and, for a stroke, the loaded
-/// path planner.
-#[derive(Debug, Clone)]
-pub(super) struct Prepared {
-    pub(super) seq: u32,
-    pub(super) job: Job,
-    pub(super) stroke: usize,
-    /// Whether this step starts a queued job (its stroke 0).
-    starts_job: bool,
-    /// Both axes' jump plans, or why the jump was refused.
-    pub(super) jump: Result<XyJump<3>, GalvoError>,
-    /// The jump's DAC codes, computed here when it is short enough
-    /// (the refill copies them instead of stepping the integrator).
-    pub(super) jump_codes: Option<JumpCodes>,
-    /// The stroke, for a path step.
-    pub(super) marker: Option<LoadedStroke>,
-    /// Mirror angles where this step leaves the mirrors, rad.
-    pub(super) end_rad: [f64; 2],
-}
-
-impl Prepared {
-    /// Whether the job goes on after this step (the step was planned).
-    fn continues(&self) -> bool {
-        self.jump.is_ok() && !matches!(self.marker, Some(Err(_)))
-    }
-}
 
 /// What comes after a step of `job`: its next stroke, if it has one.
 fn next_stroke(job: &Job, stroke: usize) -> Option<usize> {
@@ -388,8 +256,5 @@ impl GalvoLoop {
     }
 }
 
-mod ring;
 #[cfg(test)]
 mod tests;
-
-pub(super) use ring::StepRing;

@@ -7,7 +7,7 @@
 use galvo_planner::blocks::LoopIntegrator;
 use galvo_planner::{Error as PlannerError, XyJump};
 
-use super::prep::JumpCodes;
+use super::state::JumpCodes;
 use super::{GalvoLoop, ScanPhase};
 use crate::galvo::{DacSample, GalvoEvent};
 

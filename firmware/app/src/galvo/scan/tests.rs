@@ -6,9 +6,10 @@ use galvo_planner::{JumpSync, Method, XyIntegrator, plan_xy_jump};
 use kinematics_core::{Galvo, MirrorAngles, PointMm};
 
 use super::build::samples_for;
+use super::types::{INTEGRATOR_CAPACITY, MARK_BLOCKS};
 use super::*;
-use crate::domain::PointCm;
-use crate::galvo::GalvoRequest;
+use crate::domain::{Figure, PointCm};
+use crate::galvo::{GalvoMemory, GalvoRequest};
 
 /// Runs the loop in 128-sample halves until `until` says stop (at most
 /// 1 s of samples); returns every sample and every event with the index

@@ -6,24 +6,15 @@
 //! ([`GalvoEvent::Stopped`]), so a G-code feed hold resumes from there
 //! instead of marking the stroke again.
 
+use super::state::HALVES;
 use super::{GalvoLoop, Job, ScanPhase};
 use crate::domain::Figure;
 use crate::galvo::{GalvoEvent, GalvoLink, MarkStop};
 
-/// Halves noted (the newest first).
-const HALVES: usize = 4;
 /// The note of the half the DAC output when the gate closed, as the loop
 /// sees the close (at the start of its next half): two halves before the
 /// newest, whose output began while the loop computed the newest.
 const LIT_HALF: usize = 2;
-
-/// The notes, and a stop's report waiting for the mirrors to rest.
-#[derive(Debug, Clone, Copy, Default)]
-pub(super) struct Trace {
-    halves: [Option<MarkStop>; HALVES],
-    /// `Some`: a stop is to be reported, with this note.
-    due: Option<Option<MarkStop>>,
-}
 
 impl GalvoLoop {
     /// After a computed half: notes where the stroke being marked is (a

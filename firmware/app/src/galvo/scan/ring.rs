@@ -2,7 +2,7 @@
 //! stroke) are written once by the prep stage and used where they lie by
 //! the refill, never copied in it.
 
-use super::{PREP_DEPTH, Prepared};
+use super::state::{PREP_DEPTH, Prepared};
 
 /// Slots: the running step and [`PREP_DEPTH`] prepared ones.
 const SLOTS: usize = PREP_DEPTH + 1;
