@@ -7,7 +7,9 @@ use kinematics_core::numeric::clamp;
 
 impl<const CAP: usize> PathPlanner<CAP> {
     /// Freezes the head block's profile. `base` is the time of the last
-    /// emitted sample relative to the block start (≤ 0).
+    /// emitted sample relative to the block start (≤ 0). Once per block,
+    /// in `f64`: kept out of line, out of the per-sample path.
+    #[inline(never)]
     fn freeze_head(&mut self, base: f64) {
         let Some(b) = self.block(0).copied() else {
             return;
@@ -122,7 +124,6 @@ impl<const CAP: usize> PathPlanner<CAP> {
         match self.block(0) {
             Some(b) if !b.is_jump() => {
                 self.freeze_head(0.0);
-                self.replan();
             }
             _ => {}
         }
@@ -149,7 +150,6 @@ impl<const CAP: usize> PathPlanner<CAP> {
                     };
                 }
                 self.freeze_head(carry);
-                self.replan();
             }
             let e = self.exec;
             let j = e.k.saturating_add(1);

@@ -40,7 +40,7 @@ pub struct Measured {
     pub worst_input: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub inputs_tried: Option<u32>,
-    /// "enforced", or "reported, not yet met (…)".
+    /// "enforced" for a row with a budget.
     pub status: Option<String>,
     pub over_budget: bool,
 }
@@ -164,7 +164,6 @@ fn measured(id: &str, instructions: f64) -> Measured {
         inputs_tried: None,
         status: budget.map(|(_, _, e)| match e {
             Enforcement::Enforced => "enforced".to_owned(),
-            Enforcement::Pending(work) => format!("reported, not yet met ({work})"),
         }),
         over_budget: budget.is_some_and(|(b, _, e)| e == Enforcement::Enforced && us > b),
     }

@@ -211,22 +211,20 @@ fn a_sweep_reports_its_worst_input_and_is_enforced_on_it() {
         Some("(-80.109,136.229)->(-80.261,140.839) mm")
     );
     assert!(!plan.over_budget);
-    // 413 ticks: 16 520 instructions, 128 µs of the 100 µs: shown with
-    // its input and the pending work, not a failure (the budget is not
-    // met yet on the sweep's worst; see budgets.rs).
+    // 413 ticks: 16 520 instructions, 128 µs of the 100 µs: a failure
+    // that names the input.
     let over = OUT.replace("bench sweep.plan.xy 300 1", "bench sweep.plan.xy 413 1");
     let r = parse(&over).unwrap();
     let plan = r.rows.iter().find(|m| m.id == "sweep.plan.xy").unwrap();
-    assert!(plan.share.unwrap() > 1.0 && !plan.over_budget);
+    assert!(plan.share.unwrap() > 1.0 && plan.over_budget);
+    assert_eq!(plan.status.as_deref(), Some("enforced"));
+    let err = check(&r).unwrap_err().to_string();
     assert!(
-        plan.status
-            .as_deref()
-            .unwrap()
-            .starts_with("reported, not yet met")
+        err.contains("sweep.plan.xy") && err.contains("(-80.109,136.229)"),
+        "{err}"
     );
-    assert!(check(&r).is_ok());
     // 1100 ticks per half: 343.75 instructions per sample, over the
-    // 25 % (323) allowed for corners; enforced, with the input named.
+    // 20 % (258); enforced, with the input named.
     let over = OUT.replace(
         "bench sweep.stroke.steady 800 128",
         "bench sweep.stroke.steady 1100 128",
