@@ -17,6 +17,7 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench stepper.step_tick.event 100 50\nbench stepper.step_tick.event_one_pulse 100 50\n\
     bench stepper.step_tick.segment 20 8\n\
     bench sweep.plan.xy 300 1\n\
+    median sweep.plan.xy 130 1\n\
     worst sweep.plan.xy 3000 (-80.109,136.229)->(-80.261,140.839) mm\n\
     bench sweep.stroke.steady 800 128\n\
     worst sweep.stroke.steady 200 input 58: (33.489,-55.039) (32.483,-52.896)\n\
@@ -206,6 +207,14 @@ fn a_sweep_reports_its_worst_input_and_is_enforced_on_it() {
     let r = parse(OUT).unwrap();
     let plan = r.rows.iter().find(|m| m.id == "sweep.plan.xy").unwrap();
     assert_eq!(plan.inputs_tried, Some(3000));
+    // The median input: 130 ticks, 5 200 instructions.
+    assert_eq!(plan.median_instructions, Some(5200.0));
+    let steady = r
+        .rows
+        .iter()
+        .find(|m| m.id == "sweep.stroke.steady")
+        .unwrap();
+    assert_eq!(steady.median_instructions, None);
     assert_eq!(
         plan.worst_input.as_deref(),
         Some("(-80.109,136.229)->(-80.261,140.839) mm")
