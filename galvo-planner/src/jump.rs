@@ -164,24 +164,6 @@ pub fn plan_xy_jump_f32<const S: usize>(
     })
 }
 
-/// [`plan_xy_jump_f32`] written into `out` in place: both axes solved
-/// first, then both plans written field by field, no whole plan moved
-/// (on the M4F the by-value return's copy alone costs ~900 instructions).
-/// On an error `out` is unchanged.
-pub fn plan_xy_jump_f32_into<const S: usize>(
-    disc_x: &Discrete<S>,
-    disc_y: &Discrete<S>,
-    from_rad: [f64; 2],
-    to_rad: [f64; 2],
-    capacity: usize,
-    out: &mut XyJump<S>,
-) -> Result<(), Error> {
-    let [x, y] = solve_xy_f32(disc_x, disc_y, from_rad, to_rad, capacity)?;
-    out.x.set_fast(disc_x, x);
-    out.y.set_fast(disc_y, y);
-    Ok(())
-}
-
 /// Both axes' `f32` moves, solved.
 #[inline(always)]
 fn solve_xy_f32<const S: usize>(

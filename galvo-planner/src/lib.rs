@@ -134,9 +134,7 @@ mod test_support;
 pub use bisection::BisectionConfig;
 pub use error::Error;
 pub use integrator::{Integrator, XyIntegrator};
-pub use jump::{
-    JumpSync, Method, plan_jump, plan_xy_jump, plan_xy_jump_f32, plan_xy_jump_f32_into,
-};
+pub use jump::{JumpSync, Method, plan_jump, plan_xy_jump, plan_xy_jump_f32};
 pub use model::{Discrete, FlexParams, LinearModel, ModelKind, RigidParams};
 pub use path::{ArcRotor, BlockEnd, MarkLimits, MarkSample, PathPlanner};
 pub use plan::{JumpPlan, MethodKind, PlanInfo, XyJump};

@@ -174,32 +174,6 @@ impl<const S: usize> JumpPlan<S> {
         }
     }
 
-    /// [`Self::fast`] written over `self` field by field, in place: a
-    /// plan is ~540 bytes (its copy of the model ~280), and on the M4F
-    /// moving whole plans cost more than the planning's soft-float work.
-    pub(crate) fn set_fast(&mut self, disc: &Discrete<S>, mv: FastMove) {
-        let model = disc.model();
-        self.disc = *disc;
-        self.z0 = model.rest_state(mv.from_rad);
-        self.info = PlanInfo::None;
-        match mv.law {
-            Some(law) => {
-                self.z1 = model.rest_state(mv.to_rad);
-                self.samples = law.n;
-                self.law = InputLaw::Fast(law);
-                self.method = MethodKind::TimeOptimal;
-                self.max_abs_u_v = law.peak_abs_u_v(disc.u_max_v());
-            }
-            None => {
-                self.z1 = self.z0;
-                self.samples = 0;
-                self.law = InputLaw::Hold;
-                self.method = MethodKind::Hold;
-                self.max_abs_u_v = 0.0;
-            }
-        }
-    }
-
     /// The same plan reported as made by `method` with `info`.
     pub(crate) fn relabel(mut self, method: MethodKind, info: PlanInfo) -> Self {
         self.method = method;

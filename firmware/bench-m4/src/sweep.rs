@@ -1,10 +1,9 @@
 //! Seeded random sweeps: the dearest input of many, not a chosen one.
 //!
 //! * `sweep.plan.xy`: [`JUMPS`] two-axis jumps planned as the loop plans
-//!   them on the M4F (`plan_xy_jump_f32_into`, into the jump before): a
-//!   third anywhere to anywhere in the DAC's range, a third tiny (1 LSB
-//!   to ~8 mm, log-uniform, one or both axes) from anywhere, a third tiny
-//!   from near the field's edge.
+//!   them on the M4F (`plan_xy_jump_f32`): a third anywhere to anywhere
+//!   in the DAC's range, a third tiny (1 LSB to ~8 mm, log-uniform, one
+//!   or both axes) from anywhere, a third tiny from near the field's edge.
 //! * `sweep.stroke.*`: [`STROKES`] G-code-like strokes with close corners
 //!   ([`sweep_strokes`](crate::sweep_strokes)).
 //!
@@ -17,7 +16,7 @@
 use core::fmt::Write;
 use core::hint::black_box;
 
-use galvo_planner::{plan_xy_jump_f32, plan_xy_jump_f32_into};
+use galvo_planner::plan_xy_jump_f32;
 use kinematics_core::Galvo;
 
 use crate::harness::{Bench, CAPACITY, reference_plant_at_10us, window};
@@ -179,10 +178,6 @@ pub fn jump_sweep(b: &mut Bench) {
         ]
     };
     let mut rng = Rng::new(SEED);
-    // The loop's prep stage plans each jump into the one it planned before.
-    let Ok(mut jump) = plan_xy_jump_f32(&disc, &disc, [0.0; 2], [0.0; 2], CAPACITY) else {
-        return b.fail(id, "no resting jump");
-    };
     let mut worst = (0u32, JumpInput::default());
     let mut figures = [(0u32, 1u32); JUMPS as usize];
     let mut planned = 0;
@@ -192,8 +187,11 @@ pub fn jump_sweep(b: &mut Bench) {
         let (from, to) = (rad(input.from), rad(input.to));
         let mut ok = true;
         let ticks = window(|| {
-            ok = plan_xy_jump_f32_into(&disc, &disc, from, to, CAPACITY, &mut jump).is_ok();
-            black_box(&jump);
+            ok = plan_xy_jump_f32(&disc, &disc, from, to, CAPACITY)
+                .map(|p| {
+                    black_box(&p);
+                })
+                .is_ok();
         });
         if !ok {
             failed += 1;

@@ -170,31 +170,3 @@ fn the_f32_only_xy_jump_is_the_time_optimal_one_or_refused() {
     ));
     assert!(plan_xy_jump_f32(&d, &d, [f64::NAN, 0.0], [0.1; 2], 1000).is_err());
 }
-
-/// Planning in place gives the plan planned by value, whatever `out`
-/// held before (another move, another model's plan, a hold), and an
-/// error leaves `out` as it was.
-#[test]
-fn the_f32_xy_jump_in_place_is_the_one_by_value() {
-    let d = rigid(10e-6);
-    let other = rigid(20e-6);
-    let mut out = plan_xy_jump_f32(&other, &other, [0.1, -0.1], [0.0, 0.2], 1000).expect("plan");
-    let moves = [
-        ([0.0, 0.0], [0.001 * DEG, -0.002 * DEG]),
-        ([0.05, -0.2], [-0.15, 0.1]),
-        ([0.1, 0.1], [0.1, 0.1]),
-        ([0.2, -0.2], [0.2, -0.2 + 1e-4]),
-        ([-0.21, 0.0], [0.21, -0.05]),
-    ];
-    for (from, to) in moves {
-        let by_value = plan_xy_jump_f32(&d, &d, from, to, 1000).expect("by value");
-        plan_xy_jump_f32_into(&d, &d, from, to, 1000, &mut out).expect("in place");
-        assert_eq!(out, by_value, "{from:?} -> {to:?}");
-        assert_eq!(out.x.info(), by_value.x.info());
-    }
-    let before = out;
-    let bad = plan_xy_jump_f32_into(&d, &d, [f64::NAN, 0.0], [0.1; 2], 1000, &mut out);
-    assert!(bad.is_err());
-    assert!(plan_xy_jump_f32_into(&d, &d, [0.0; 2], [0.3, 0.3], 3, &mut out).is_err());
-    assert_eq!(out, before, "unchanged on an error");
-}

@@ -34,10 +34,9 @@ const PLANNING: Enforcement = Enforcement::Enforced;
 /// profiled on QEMU, 2 400 of them moved the two 536-byte `JumpPlan`s
 /// through `Result`s by value and 2 100 were soft-float `f64` bookkeeping
 /// (rest states, `BangBang`'s `f64` switch times, `OptimalInfo`). Both
-/// axes are now solved first and their plans written in place into the
-/// prep stage's jump (`plan_xy_jump_f32_into`), and the plan keeps the
-/// `f32` solution (`bang_bang::FastLaw`), deriving the `f64` law and
-/// diagnostics only when asked: 10 080 on the same jump (78 µs).
+/// axes are now solved first and their plans built once, and the plan
+/// keeps the `f32` solution (`bang_bang::FastLaw`), deriving the `f64`
+/// law and diagnostics only when asked: 11 840 on the same jump (92 µs).
 const SWEPT_PLANNING: Enforcement = Enforcement::Enforced;
 /// The refill steps only what the prep stage prepared (galvo/scan/prep.rs):
 /// met, enforced.
@@ -301,7 +300,7 @@ pub const ROWS: &[Row] = &[
     // already run, so 200 seeded strokes with 0.2-2 mm segments, 0.3-1.5
     // mm hairpins, arc chords and reversals reached 266 instructions per
     // sample (20.6 %). A block change now only freezes the new block's
-    // profile (path/sampler.rs; the same samples, bit for bit): 242.
+    // profile (path/sampler.rs; the same samples, bit for bit): 241.
     Row {
         id: "sweep.stroke.steady",
         what: "loop, marking: worst half of a seeded sweep of strokes with close corners, hairpins, arc chords, reversals",

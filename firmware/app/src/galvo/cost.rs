@@ -90,28 +90,28 @@ pub const M4_COST: CostModel = CostModel {
     // `integrator.xy.step` + `galvo.sample_map.angles_to_codes` (200 + 103
     // = 303: kinematics-core built at opt-level "s"), rounded up.
     jump_stepped: 305,
-    // `loop.arc_r40.steady` (237.19, the dearest of the marking rows),
+    // `loop.arc_r40.steady` (236.25, the dearest of the marking rows),
     // rounded up.
-    marked: 238,
+    marked: 237,
     // `loop.jump.refill`, the whole half that starts a jump (its samples
     // included: an upper bound; the bench measures it to one
     // 40-instruction timer tick, which moves with what else the image
-    // links: one tick of margin over the 9 520–9 560 measured).
-    step_started: 9_600,
-    // `loop.jump.prep` (59 120), one 40-instruction timer tick of margin.
-    point_prepared: 59_160,
-    // `loop.stroke.prep` (61 920): the dearest stroke step, a jump and a
+    // links: one tick of margin over the 9 520 measured).
+    step_started: 9_560,
+    // `loop.jump.prep` (63 200), one 40-instruction timer tick of margin.
+    point_prepared: 63_240,
+    // `loop.stroke.prep` (66 840): the dearest stroke step, a jump and a
     // G-code stroke of four lines (its open end needs its own IK); one
     // 40-instruction timer tick of margin. A G-code piece joined to the
     // stroke being marked (`loop.join.prep`, 21 280) is charged as one.
-    stroke_prepared: 61_960,
+    stroke_prepared: 66_880,
     // `plan.seed.0.1deg` (1.572 M), rounded up: the cheapest bisection
     // plan, a lower bound for any jump.
     bisection_axis: 1_580_000,
     // `loop.reconfigure`.
     rebuild: 4_560,
     // `loop.new`.
-    model_sampled: 374_160,
+    model_sampled: 371_080,
     cpi: 1.3,
     clock_hz: 168e6,
 };
@@ -151,10 +151,10 @@ mod tests {
             marked: 128,
             ..LoopWork::default()
         };
-        // 400 + 128 · 238 instructions at CPI 1.3, 168 MHz: ≈ 239 µs.
-        assert_eq!(M4_COST.instructions(&marking), 400 + 128 * 238);
+        // 400 + 128 · 237 instructions at CPI 1.3, 168 MHz: ≈ 238 µs.
+        assert_eq!(M4_COST.instructions(&marking), 400 + 128 * 237);
         let ns = M4_COST.ns(&marking);
-        assert!((238_000..240_000).contains(&ns), "{ns}");
+        assert!((237_000..239_000).contains(&ns), "{ns}");
         // Under half the 1.28 ms window, as the bench's budget says.
         assert!(ns < 640_000);
         assert_eq!(M4_COST.ns(&LoopWork::default()), 0);

@@ -5,7 +5,7 @@ use core::fmt;
 use core::sync::atomic::Ordering;
 
 use galvo_planner::blocks::LoopIntegrator;
-use galvo_planner::{Discrete, Method, RigidParams, XyJump};
+use galvo_planner::{Discrete, Method, RigidParams};
 use kinematics_core::{Galvo, PointMm, SampleMap};
 
 use self::mark::Motion;
@@ -171,9 +171,6 @@ pub struct GalvoLoop {
     off_delay_samples: u32,
     /// How jumps are planned on this board ([`DacStream::F64_PLANNING`]).
     jump_planning: prep::Planning,
-    /// The prep stage's last jump plan, planned into in place (each plan
-    /// overwrites all of it, model included) and copied into its step.
-    planned_jump: XyJump<3>,
     /// A continuation stroke joined to the running one, its `Done` due
     /// when the sampler reaches its blocks ([`join`]).
     joining: Option<join::Joining>,

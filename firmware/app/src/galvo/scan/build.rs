@@ -114,7 +114,6 @@ impl GalvoLoop {
             on_delay_samples: samples_for(config.laser_on_delay_us, ts),
             off_delay_samples: samples_for(config.laser_off_delay_us, ts),
             jump_planning: planning,
-            planned_jump: prep::resting_jump(&disc, angles_rad)?,
             joining: None,
             trace: super::trace::Trace::default(),
             config,

@@ -17,7 +17,7 @@
 use galvo_planner::blocks::{PRECOMPUTED_JUMP, jump_angles};
 use galvo_planner::{
     Discrete, JumpSync, MarkLimits, Method, MethodKind, PathPlanner, XyJump, plan_xy_jump,
-    plan_xy_jump_f32, plan_xy_jump_f32_into,
+    plan_xy_jump_f32,
 };
 use kinematics_core::PointMm;
 
@@ -29,10 +29,8 @@ use crate::galvo::DacStream;
 /// delays and its jump; four cover a half buffer of the shortest jobs).
 pub(super) const PREP_DEPTH: usize = 4;
 
-/// How the loop plans a two-axis jump from, to (rad) with a method, into
-/// the jump it passes (unchanged on an error).
-type XyPlanner =
-    fn(&Discrete<3>, [f64; 2], [f64; 2], Method, &mut XyJump<3>) -> Result<(), GalvoError>;
+/// How the loop plans a two-axis jump from, to (rad) with a method.
+type XyPlanner = fn(&Discrete<3>, [f64; 2], [f64; 2], Method) -> Result<XyJump<3>, GalvoError>;
 
 /// The jump planning a board affords ([`DacStream::F64_PLANNING`]). Set
 /// only where the board's type is known ([`Self::of`]), so a board
@@ -83,10 +81,9 @@ fn plan_any(
     from_rad: [f64; 2],
     to_rad: [f64; 2],
     method: Method,
-    out: &mut XyJump<3>,
-) -> Result<(), GalvoError> {
+) -> Result<XyJump<3>, GalvoError> {
     let sync = JumpSync::Independent;
-    *out = plan_xy_jump(
+    plan_xy_jump(
         disc,
         disc,
         from_rad,
@@ -95,28 +92,18 @@ fn plan_any(
         sync,
         INTEGRATOR_CAPACITY,
     )
-    .map_err(|_| GalvoError::Planner)?;
-    Ok(())
+    .map_err(|_| GalvoError::Planner)
 }
 
-/// Both axes time-optimal in `f32`, no `f64` fallback ([`Planning::F32`]),
-/// planned in place.
+/// Both axes time-optimal in `f32`, no `f64` fallback ([`Planning::F32`]).
 fn plan_f32(
     disc: &Discrete<3>,
     from_rad: [f64; 2],
     to_rad: [f64; 2],
     method: Method,
-    out: &mut XyJump<3>,
-) -> Result<(), GalvoError> {
+) -> Result<XyJump<3>, GalvoError> {
     Planning::F32.check(method)?;
-    plan_xy_jump_f32_into(disc, disc, from_rad, to_rad, INTEGRATOR_CAPACITY, out)
-        .map_err(|_| GalvoError::Planner)
-}
-
-/// The jump the prep stage plans into ([`GalvoLoop::planned_jump`]) when
-/// the loop is built: both axes holding at `at_rad` on `disc`.
-pub(super) fn resting_jump(disc: &Discrete<3>, at_rad: [f64; 2]) -> Result<XyJump<3>, GalvoError> {
-    plan_xy_jump_f32(disc, disc, at_rad, at_rad, INTEGRATOR_CAPACITY)
+    plan_xy_jump_f32(disc, disc, from_rad, to_rad, INTEGRATOR_CAPACITY)
         .map_err(|_| GalvoError::Planner)
 }
 
@@ -233,7 +220,7 @@ impl GalvoLoop {
 
     /// Plans the step after the last prepared one (or after the running
     /// step), if there is one.
-    fn next_unprepared_step(&mut self) -> Option<Prepared> {
+    fn next_unprepared_step(&self) -> Option<Prepared> {
         let (after, start_rad) = match (self.steps.back(), self.active) {
             (Some(last), _) => (
                 Some((last.seq, last.job, last.stroke, last.continues())),
@@ -266,7 +253,7 @@ impl GalvoLoop {
     /// Plans the jump from `start_rad` to step `stroke` of `job` and loads
     /// the stroke.
     fn plan_step(
-        &mut self,
+        &self,
         seq: u32,
         job: Job,
         stroke: usize,
@@ -286,42 +273,31 @@ impl GalvoLoop {
                 None => (Err(GalvoError::Planner), None, None),
             },
         };
-        // The jump's target (rad), its plan written in place into
-        // `planned_jump` (a plan is ~1 KB; the f32 planner writes it
-        // field by field), then copied into the step.
-        let target_rad = target_mm.and_then(|target| self.angles_for(target));
-        let planned = target_rad.and_then(|target_rad| {
-            let plan = self.jump_planning.plan;
-            let method = self.config.method;
-            plan(
-                &self.disc,
-                start_rad,
-                target_rad,
-                method,
-                &mut self.planned_jump,
-            )
-            .map(|()| target_rad)
+        let jump = target_mm.and_then(|target| {
+            let target_rad = self.angles_for(target)?;
+            (self.jump_planning.plan)(&self.disc, start_rad, target_rad, self.config.method)
+                .map(|jump| (jump, target_rad))
         });
-        let end_rad = match (planned, &marker, end_mm) {
+        let end_rad = match (&jump, &marker, end_mm) {
             (Err(_), _, _) => start_rad,
             // Where the path sampler lands: the stroke's end in f32 (a
             // closed stroke whose start is exact in f32 ends at its start:
             // the same IK, not computed twice).
-            (Ok(target_rad), Some(Ok(_)), Some([x, y])) => {
+            (Ok((_, target_rad)), Some(Ok(_)), Some([x, y])) => {
                 let end = PointMm {
                     x_mm: f64::from(x as f32),
                     y_mm: f64::from(y as f32),
                 };
                 if Ok(end) == target_mm {
-                    target_rad
+                    *target_rad
                 } else {
                     self.angles_for(end).unwrap_or(start_rad)
                 }
             }
-            (Ok(target_rad), _, _) => target_rad,
+            (Ok((_, target_rad)), _, _) => *target_rad,
         };
-        let jump_codes = match planned {
-            Ok(_) => self.jump_codes(&self.planned_jump),
+        let jump_codes = match &jump {
+            Ok((jump, _)) => self.jump_codes(jump),
             Err(_) => None,
         };
         Prepared {
@@ -330,7 +306,7 @@ impl GalvoLoop {
             stroke,
             starts_job,
             jump_codes,
-            jump: planned.map(|_| self.planned_jump),
+            jump: jump.map(|(jump, _)| jump),
             marker,
             end_rad,
         }
