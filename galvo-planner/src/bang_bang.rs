@@ -134,24 +134,129 @@ impl BangBang {
             + overlap(a, b, self.s2, end);
         self.sign * self.u_max_v * avg
     }
+}
 
-    /// Largest `|u_k|` over the plan, V, from the few samples that are not
-    /// saturated (no pass over the samples).
-    pub(crate) fn peak_abs_u_v(&self) -> f64 {
-        let last = self.n.saturating_sub(1);
-        if last >= 3 && libm::fabs(self.v_last) <= self.u_max_v {
-            // At most two of the first n−1 ≥ 3 samples hold a switch: one
-            // is saturated, and nothing exceeds Umax.
-            return self.u_max_v;
-        }
-        let saturated = (0..last).len()
-            > usize::from(self.k1 < last) + usize::from(self.k2 < last && self.k2 != self.k1);
-        let mut peak = if saturated { self.u_max_v } else { 0.0 };
-        for k in [self.k1, self.k2, last] {
-            if k < self.n {
-                peak = peak.max(libm::fabs(self.u_v(k)));
-            }
-        }
-        peak
+/// The shape of an `f32` plan, as the single-precision planner solved it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum FastShape {
+    /// The 3-sample dead-beat input for the positive move, reversed
+    /// (index 0 is the last sample), V.
+    DeadBeat([f32; 3]),
+    /// The sampled bang-bang: switch points counted from the end
+    /// (`σ1 ≥ σ2 ≥ 1`, samples) and the last sample's value `w` in units
+    /// of Umax, for the positive move.
+    BangBang { sigma1: f32, sigma2: f32, w: f32 },
+}
+
+/// The input law of a plan from the single-precision planner
+/// ([`fast_optimal`](crate::fast_optimal)), kept in the `f32` it was
+/// solved in: planning does no soft-float `f64` work on the M4F. The
+/// `f64` [`BangBang`] law, the inputs and the [`OptimalInfo`] are derived
+/// from it when asked, bit for bit what the planner used to store.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct FastLaw {
+    /// Samples `N`.
+    pub(crate) n: usize,
+    /// The move is negative (every input's sign flipped).
+    pub(crate) negative: bool,
+    /// The continuous-time optimum's length `N*`, samples.
+    pub(crate) n_star: f32,
+    /// The continuous optimum's switch points from the end `(σ1, σ2)`,
+    /// samples, when Newton found it.
+    pub(crate) cont: Option<(f32, f32)>,
+    /// Sample period, s.
+    pub(crate) ts_s: f32,
+    pub(crate) shape: FastShape,
+}
+
+impl FastLaw {
+    fn sign(&self) -> f64 {
+        if self.negative { -1.0 } else { 1.0 }
     }
+
+    /// The dead-beat inputs in sample order, V (`None` for a bang-bang).
+    pub(crate) fn dead_beat_u_v(&self) -> Option<[f64; 3]> {
+        let FastShape::DeadBeat(u) = self.shape else {
+            return None;
+        };
+        let sign = self.sign();
+        Some(core::array::from_fn(|j| {
+            sign * f64::from(*u.get(2 - j).unwrap_or(&0.0))
+        }))
+    }
+
+    /// The `f64` bang-bang law (`None` for the dead-beat input);
+    /// `u_max_v` the model's voltage limit, V.
+    pub(crate) fn bang_bang(&self, u_max_v: f64) -> Option<BangBang> {
+        let FastShape::BangBang { sigma1, sigma2, w } = self.shape else {
+            return None;
+        };
+        let nf = self.n as f64;
+        let (s1, s2) = (nf - f64::from(sigma1), nf - f64::from(sigma2));
+        Some(BangBang::new(
+            self.n,
+            s1,
+            s2,
+            f64::from(w) * u_max_v,
+            u_max_v,
+            self.sign(),
+        ))
+    }
+
+    /// Largest `|u_k|`, V: Umax for a bang-bang (`N ≥ 4` and `|w| ≤ 1`
+    /// by construction: at most two switch samples, one saturated), the
+    /// largest dead-beat input otherwise.
+    pub(crate) fn peak_abs_u_v(&self, u_max_v: f64) -> f64 {
+        match self.shape {
+            FastShape::DeadBeat(u) => f64::from(u.iter().fold(0.0f32, |p, x| {
+                let a = x.abs();
+                if p > a { p } else { a }
+            })),
+            FastShape::BangBang { .. } => u_max_v,
+        }
+    }
+
+    /// The planner's diagnostics; `u_max_v` the voltage limit, V.
+    pub(crate) fn info(&self, u_max_v: f64) -> OptimalInfo {
+        let ts = self.ts_s;
+        let continuous = self.cont.map(|(sigma1, sigma2)| ContinuousOptimum {
+            time_s: f64::from(self.n_star * ts),
+            switches_s: (
+                f64::from((self.n_star - sigma1) * ts),
+                f64::from((self.n_star - sigma2) * ts),
+            ),
+        });
+        let samples_lower_bound = if continuous.is_some() {
+            let c = libm::ceilf(self.n_star - 1e-4);
+            if c >= 1.0 { c as usize } else { 1 }
+        } else {
+            0
+        };
+        let mut info = OptimalInfo {
+            structure: OptimalStructure::DeadBeat,
+            continuous,
+            samples_lower_bound,
+            switch_samples: (0.0, 0.0),
+            last_sample_v: 0.0,
+            single_precision: true,
+        };
+        if let Some(bb) = self.bang_bang(u_max_v) {
+            info.structure = OptimalStructure::BangBang;
+            info.switch_samples = (bb.s1, bb.s2);
+            info.last_sample_v = bb.sign * bb.v_last;
+        }
+        info
+    }
+}
+
+/// A move the single-precision planner solved: from rest at `from_rad`
+/// to rest at `to_rad` (rad) with `law`, or a hold at `from_rad` (`law`
+/// `None`: nothing to move). A few words: the two-axis planner solves
+/// both axes before it builds either plan, so no whole plan (~540 bytes)
+/// passes through a `Result`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct FastMove {
+    pub(crate) from_rad: f64,
+    pub(crate) to_rad: f64,
+    pub(crate) law: Option<FastLaw>,
 }

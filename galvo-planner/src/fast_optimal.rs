@@ -42,12 +42,11 @@
 
 mod newton;
 
-use crate::bang_bang::{BangBang, ContinuousOptimum, OptimalInfo, OptimalStructure};
+use crate::bang_bang::{FastLaw, FastMove, FastShape};
 use crate::error::Error;
-use crate::linalg::Vector;
 use crate::model::Discrete;
 use crate::optimal::{RigidMove, plan_time_optimal, rigid_move};
-use crate::plan::{InputLaw, JumpPlan, MethodKind, PlanInfo};
+use crate::plan::JumpPlan;
 use crate::rigid_modes::{Mode, hi, lo};
 #[cfg(test)]
 pub(crate) use newton::ITERATIONS;
@@ -236,9 +235,10 @@ pub fn plan_time_optimal_fast<const S: usize>(
     to_rad: f64,
     capacity: usize,
 ) -> Result<JumpPlan<S>, Error> {
-    plan_f32_or(disc, from_rad, to_rad, capacity, |_| {
-        plan_time_optimal(disc, from_rad, to_rad, capacity)
-    })
+    match solve(disc, from_rad, to_rad, capacity)? {
+        Ok(mv) => Ok(JumpPlan::fast(disc, mv)),
+        Err(_) => plan_time_optimal(disc, from_rad, to_rad, capacity),
+    }
 }
 
 /// [`plan_time_optimal_fast`] without its `f64` fallback, for a CPU with
@@ -253,122 +253,82 @@ pub fn plan_time_optimal_f32<const S: usize>(
     to_rad: f64,
     capacity: usize,
 ) -> Result<JumpPlan<S>, Error> {
-    plan_f32_or(disc, from_rad, to_rad, capacity, Err)
+    solve_f32(disc, from_rad, to_rad, capacity).map(|mv| JumpPlan::fast(disc, mv))
 }
 
-/// The `f32` plan, or `fallback` with why it does not apply.
+/// The move [`plan_time_optimal_f32`] plans, solved but not yet written
+/// into a plan (a few words: the two-axis planner writes both plans in
+/// place once both axes are solved).
 #[inline(always)]
-fn plan_f32_or<const S: usize>(
+pub(crate) fn solve_f32<const S: usize>(
     disc: &Discrete<S>,
     from_rad: f64,
     to_rad: f64,
     capacity: usize,
-    fallback: impl FnOnce(Error) -> Result<JumpPlan<S>, Error>,
-) -> Result<JumpPlan<S>, Error> {
+) -> Result<FastMove, Error> {
+    solve(disc, from_rad, to_rad, capacity)?
+}
+
+/// The `f32` solution, `Ok(Err(why))` where the `f32` form does not
+/// apply (the fallback's cue), `Err` for bad input.
+#[inline(always)]
+fn solve<const S: usize>(
+    disc: &Discrete<S>,
+    from_rad: f64,
+    to_rad: f64,
+    capacity: usize,
+) -> Result<Result<FastMove, Error>, Error> {
     let RigidMove::Move {
         from_rad,
         to_rad,
-        z0,
-        z1,
         capacity,
+        ..
     } = rigid_move(disc, from_rad, to_rad, capacity)?
     else {
-        return Ok(JumpPlan::hold(disc, disc.model().rest_state(from_rad)));
+        return Ok(Ok(FastMove {
+            from_rad,
+            to_rad: from_rad,
+            law: None,
+        }));
     };
     let delta = to_rad - from_rad;
-    let (d, sign) = if delta < 0.0 {
-        (-delta, -1.0)
+    let (d, negative) = if delta < 0.0 {
+        (-delta, true)
     } else {
-        (delta, 1.0)
+        (delta, false)
     };
     let Some(fast) = disc.rigid_modes() else {
-        return fallback(Error::UnsupportedModel);
+        return Ok(Err(Error::UnsupportedModel));
     };
     let modes = fast.modes;
-    let u_max = disc.u_max_v();
-    let u_max32 = fast.u_max_v;
     // M = S0/Umax = D·Kt/(Ts·Umax), samples.
     let m = (d as f32) * fast.m_per_rad;
     if !(m.is_finite() && m > 0.0) || m > 1.0e6 {
-        return fallback(Error::NoConvergence);
+        return Ok(Err(Error::NoConvergence));
     }
-    let Some(sol) = fast_plan(&modes, m, u_max32, capacity)? else {
-        return fallback(Error::NoConvergence);
+    let Some(sol) = fast_plan(&modes, m, fast.u_max_v, capacity)? else {
+        return Ok(Err(Error::NoConvergence));
     };
-    solution_plan(disc, (z0, z1), sign, u_max, fast.ts_s, sol)
-}
-
-/// The plan of an `f32` solution, moving in the direction `sign`, with its
-/// diagnostics (`ts` the sample period, s, in `f32`).
-#[inline(always)]
-fn solution_plan<const S: usize>(
-    disc: &Discrete<S>,
-    (z0, z1): (Vector<S>, Vector<S>),
-    sign: f64,
-    u_max: f64,
-    ts: f32,
-    sol: FastSolution,
-) -> Result<JumpPlan<S>, Error> {
-    let continuous = sol.cont.map(|s| ContinuousOptimum {
-        time_s: f64::from(sol.n_star * ts),
-        switches_s: (
-            f64::from((sol.n_star - s.sigma1) * ts),
-            f64::from((sol.n_star - s.sigma2) * ts),
-        ),
-    });
-    let samples_lower_bound = if continuous.is_some() {
-        let c = libm::ceilf(sol.n_star - 1e-4);
-        if c >= 1.0 { c as usize } else { 1 }
-    } else {
-        0
+    let shape = match sol.kind {
+        FastKind::DeadBeat(u) => FastShape::DeadBeat(u),
+        FastKind::BangBang(s, w) => FastShape::BangBang {
+            sigma1: s.sigma1,
+            sigma2: s.sigma2,
+            w,
+        },
     };
-    let mut info = OptimalInfo {
-        structure: OptimalStructure::BangBang,
-        continuous,
-        samples_lower_bound,
-        switch_samples: (0.0, 0.0),
-        last_sample_v: 0.0,
-        single_precision: true,
-    };
-    let n = sol.n;
-    match sol.kind {
-        FastKind::DeadBeat(u) => {
-            info.structure = OptimalStructure::DeadBeat;
-            let u64: [f64; 3] =
-                core::array::from_fn(|j| sign * f64::from(*u.get(2 - j).unwrap_or(&0.0)));
-            let peak = u.iter().fold(0.0f32, |p, x| hi(p, x.abs()));
-            Ok(JumpPlan::with_peak(
-                disc,
-                z0,
-                z1,
-                3,
-                InputLaw::Explicit3 { u_v: u64 },
-                MethodKind::TimeOptimal,
-                PlanInfo::Optimal(info),
-                f64::from(peak),
-            ))
-        }
-        FastKind::BangBang(s, w) => {
-            let nf = n as f64;
-            let s1 = nf - f64::from(s.sigma1);
-            let s2 = nf - f64::from(s.sigma2);
-            let v = f64::from(w) * u_max;
-            info.switch_samples = (s1, s2);
-            info.last_sample_v = sign * v;
-            let law = BangBang::new(n, s1, s2, v, u_max, sign);
-            let peak = law.peak_abs_u_v();
-            Ok(JumpPlan::with_peak(
-                disc,
-                z0,
-                z1,
-                n,
-                InputLaw::BangBang(law),
-                MethodKind::TimeOptimal,
-                PlanInfo::Optimal(info),
-                peak,
-            ))
-        }
-    }
+    Ok(Ok(FastMove {
+        from_rad,
+        to_rad,
+        law: Some(FastLaw {
+            n: sol.n,
+            negative,
+            n_star: sol.n_star,
+            cont: sol.cont.map(|s| (s.sigma1, s.sigma2)),
+            ts_s: fast.ts_s,
+            shape,
+        }),
+    }))
 }
 
 #[cfg(test)]

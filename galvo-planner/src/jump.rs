@@ -2,8 +2,10 @@
 //! [`Method`] and plans both mirror axes of a jump. The plan type itself
 //! lives below the planners, in [`plan`](crate::plan).
 
+use crate::bang_bang::FastMove;
 use crate::bisection::{self, BisectionConfig};
 use crate::error::Error;
+use crate::fast_optimal::solve_f32;
 use crate::min_energy;
 use crate::model::Discrete;
 use crate::plan::{JumpPlan, MethodKind, XyJump};
@@ -155,23 +157,39 @@ pub fn plan_xy_jump_f32<const S: usize>(
     to_rad: [f64; 2],
     capacity: usize,
 ) -> Result<XyJump<S>, Error> {
+    let [x, y] = solve_xy_f32(disc_x, disc_y, from_rad, to_rad, capacity)?;
+    Ok(XyJump {
+        x: JumpPlan::fast(disc_x, x),
+        y: JumpPlan::fast(disc_y, y),
+    })
+}
+
+/// Both axes' `f32` moves, solved.
+#[inline(always)]
+fn solve_xy_f32<const S: usize>(
+    disc_x: &Discrete<S>,
+    disc_y: &Discrete<S>,
+    from_rad: [f64; 2],
+    to_rad: [f64; 2],
+    capacity: usize,
+) -> Result<[FastMove; 2], Error> {
     if disc_x.ts_s() != disc_y.ts_s() {
         return Err(Error::InvalidSamplePeriod {
             ts_s: disc_y.ts_s(),
         });
     }
-    let plan = |disc, from: f64, to: f64| {
-        crate::fast_optimal::plan_time_optimal_f32(
+    let solve = |disc, from: f64, to: f64| {
+        solve_f32(
             disc,
             finite(from, "from_rad")?,
             finite(to, "to_rad")?,
             capacity,
         )
     };
-    Ok(XyJump {
-        x: plan(disc_x, from_rad[0], to_rad[0])?,
-        y: plan(disc_y, from_rad[1], to_rad[1])?,
-    })
+    Ok([
+        solve(disc_x, from_rad[0], to_rad[0])?,
+        solve(disc_y, from_rad[1], to_rad[1])?,
+    ])
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 //! the sample buffer, and a plan that needs more samples than the capacity
 //! given to the planner is refused with [`Error::CapacityExceeded`].
 
-use crate::bang_bang::{BangBang, OptimalInfo};
+use crate::bang_bang::{BangBang, FastLaw, FastMove, OptimalInfo};
 use crate::error::Error;
 use crate::linalg::{Vector, at, dot, mat_vec, vec_add, vec_scale};
 use crate::model::Discrete;
@@ -78,8 +78,9 @@ pub(crate) enum InputLaw<const S: usize> {
     MinEnergy { lambda: Vector<S> },
     /// Sample-averaged bang-bang with a free last sample.
     BangBang(BangBang),
-    /// Three explicit samples (the dead-beat input), V, in sample order.
-    Explicit3 { u_v: [f64; 3] },
+    /// The single-precision planner's bang-bang or dead-beat input, in
+    /// the `f32` it was solved in (its diagnostics derived from it).
+    Fast(FastLaw),
     /// Inverse-dynamics voltage of a profile plus a minimum-norm correction
     /// `(Ad^{N−1−k}·Bd)ᵀ·λ` that makes it land exactly.
     Profile { profile: Profile, lambda: Vector<S> },
@@ -154,6 +155,25 @@ impl<const S: usize> JumpPlan<S> {
         )
     }
 
+    /// The plan of a move the single-precision planner solved.
+    pub(crate) fn fast(disc: &Discrete<S>, mv: FastMove) -> Self {
+        let model = disc.model();
+        let z0 = model.rest_state(mv.from_rad);
+        match mv.law {
+            Some(law) => Self {
+                disc: *disc,
+                z0,
+                z1: model.rest_state(mv.to_rad),
+                samples: law.n,
+                law: InputLaw::Fast(law),
+                method: MethodKind::TimeOptimal,
+                max_abs_u_v: law.peak_abs_u_v(disc.u_max_v()),
+                info: PlanInfo::None,
+            },
+            None => Self::hold(disc, z0),
+        }
+    }
+
     /// The same plan reported as made by `method` with `info`.
     pub(crate) fn relabel(mut self, method: MethodKind, info: PlanInfo) -> Self {
         self.method = method;
@@ -199,8 +219,11 @@ impl<const S: usize> JumpPlan<S> {
         self.max_abs_u_v <= self.disc.u_max_v()
     }
     /// Planner diagnostics.
-    pub fn info(&self) -> &PlanInfo {
-        &self.info
+    pub fn info(&self) -> PlanInfo {
+        match &self.law {
+            InputLaw::Fast(law) => PlanInfo::Optimal(law.info(self.disc.u_max_v())),
+            _ => self.info,
+        }
     }
 
     /// Calls `f(k, u_k)` for every sample, in the order k = N−1, N−2, …, 0
@@ -221,9 +244,15 @@ impl<const S: usize> JumpPlan<S> {
                     f(k, bb.u_v(k));
                 }
             }
-            InputLaw::Explicit3 { u_v } => {
-                for k in (0..n.min(3)).rev() {
-                    f(k, u_v.get(k).copied().unwrap_or(0.0));
+            InputLaw::Fast(law) => {
+                match (law.bang_bang(self.disc.u_max_v()), law.dead_beat_u_v()) {
+                    (Some(bb), _) => (0..n).rev().for_each(|k| f(k, bb.u_v(k))),
+                    (None, u_v) => {
+                        let u_v = u_v.unwrap_or_default();
+                        for k in (0..n.min(3)).rev() {
+                            f(k, u_v.get(k).copied().unwrap_or(0.0));
+                        }
+                    }
                 }
             }
             InputLaw::Profile { profile, lambda } => {
@@ -245,6 +274,10 @@ impl<const S: usize> JumpPlan<S> {
     pub fn for_each_input_rev_f32(&self, mut f: impl FnMut(usize, f32)) {
         match &self.law {
             InputLaw::BangBang(bb) => bb.for_each_rev_f32(f),
+            InputLaw::Fast(law) => match law.bang_bang(self.disc.u_max_v()) {
+                Some(bb) => bb.for_each_rev_f32(f),
+                None => self.for_each_input_rev(|k, u| f(k, u as f32)),
+            },
             _ => self.for_each_input_rev(|k, u| f(k, u as f32)),
         }
     }

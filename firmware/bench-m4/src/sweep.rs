@@ -7,7 +7,8 @@
 //! * `sweep.stroke.*`: [`STROKES`] G-code-like strokes with close corners
 //!   ([`sweep_strokes`](crate::sweep_strokes)).
 //!
-//! Each sweep prints the worst case as a `bench` line and its input as
+//! Each sweep prints the worst case as a `bench` line, the median input's
+//! figure as `median <id> <ticks> <units>` and the worst input as
 //! `worst <id> <inputs tried> <input…>`; `cargo xtask bench-m4` checks the
 //! budget on the worst and shows its input. The seed is fixed: every run
 //! tries the same inputs, so the figures are reproducible.
@@ -69,6 +70,18 @@ impl Rng {
     /// Uniform in `0..n`.
     pub fn below(&mut self, n: u32) -> u32 {
         (((self.next_u64() >> 32) * u64::from(n)) >> 32) as u32
+    }
+}
+
+/// Prints the median of `figures` (timer ticks, units), by ticks per
+/// unit, as `median <id> <ticks> <units>` (sorts `figures`).
+pub fn report_median(b: &mut Bench, id: &str, figures: &mut [(u32, u32)]) {
+    figures.sort_unstable_by(|p, q| {
+        (u64::from(p.0) * u64::from(q.1)).cmp(&(u64::from(q.0) * u64::from(p.1)))
+    });
+    if let Some((ticks, units)) = figures.get(figures.len() / 2) {
+        let _ = writeln!(b.out, "median {id} {ticks} {units}");
+        b.out.flush();
     }
 }
 
@@ -166,6 +179,8 @@ pub fn jump_sweep(b: &mut Bench) {
     };
     let mut rng = Rng::new(SEED);
     let mut worst = (0u32, JumpInput::default());
+    let mut figures = [(0u32, 1u32); JUMPS as usize];
+    let mut planned = 0;
     let mut failed = 0u32;
     for i in 0..JUMPS {
         let input = jump_input(&mut rng, i);
@@ -184,12 +199,19 @@ pub fn jump_sweep(b: &mut Bench) {
             describe_jump(&mut b.out, &galvo, &input);
             let _ = writeln!(b.out);
             b.out.flush();
-        } else if ticks > worst.0 {
-            worst = (ticks, input);
+        } else {
+            if let Some(slot) = figures.get_mut(planned) {
+                *slot = (ticks, 1);
+                planned += 1;
+            }
+            if ticks > worst.0 {
+                worst = (ticks, input);
+            }
         }
     }
     b.failures += failed;
     b.report(id, worst.0, 1);
+    report_median(b, id, figures.get_mut(..planned).unwrap_or_default());
     let _ = write!(b.out, "worst {id} {JUMPS} ");
     describe_jump(&mut b.out, &galvo, &worst.1);
     let _ = writeln!(b.out);

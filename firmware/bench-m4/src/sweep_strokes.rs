@@ -16,7 +16,7 @@ use laser_app::galvo::{DacSample, GalvoLoop, GalvoRequest, ScanPhase};
 
 use crate::galvo_loop::{JobCost, m4_loop, measure_job, settle};
 use crate::harness::{Bench, HALF, Name};
-use crate::sweep::{Rng, SEED};
+use crate::sweep::{Rng, SEED, report_median};
 
 /// Mixed into [`SEED`] for this sweep.
 const STROKE_SEED: u64 = 0x5eed;
@@ -173,6 +173,9 @@ pub fn stroke_sweep(b: &mut Bench) {
     let mut rng = Rng::new(SEED ^ STROKE_SEED);
     // The dearest of each figure: (ticks, units, input).
     let mut worst: [Option<(u32, u32, StrokeInput)>; 3] = [None; 3];
+    // Every input's figures (ticks, units), for the medians.
+    let mut all = [[(0u32, 1u32); STROKES as usize]; 3];
+    let mut counted = [0usize; 3];
     let (mut tried, mut waited) = (0u32, 0u32);
     for i in 0..4 * STROKES {
         if tried == STROKES {
@@ -191,8 +194,17 @@ pub fn stroke_sweep(b: &mut Bench) {
             Some((cost.refill, 1)),
             cost.prep,
         ];
-        for (slot, figure) in worst.iter_mut().zip(figures) {
+        for (((slot, figure), list), count) in worst
+            .iter_mut()
+            .zip(figures)
+            .zip(all.iter_mut())
+            .zip(counted.iter_mut())
+        {
             let Some((t, n)) = figure else { continue };
+            if let Some(entry) = list.get_mut(*count) {
+                *entry = (t, n);
+                *count += 1;
+            }
             if slot.is_none_or(|(wt, wn, _)| {
                 u64::from(t) * u64::from(wn) > u64::from(wt) * u64::from(n)
             }) {
@@ -211,13 +223,19 @@ pub fn stroke_sweep(b: &mut Bench) {
         "note {id}: {waited} of {tried} inputs waited for an unprepared piece"
     );
     let mut name = Name::new();
-    for (suffix, slot) in [".steady", ".refill", ".prep"].into_iter().zip(worst) {
+    let medians = all.iter_mut().zip(counted);
+    for ((suffix, slot), (list, count)) in [".steady", ".refill", ".prep"]
+        .into_iter()
+        .zip(worst)
+        .zip(medians)
+    {
         name.set(id, suffix);
         let Some((ticks, units, input)) = slot else {
             b.fail(name.as_str(), "no stroke measured");
             continue;
         };
         b.report(name.as_str(), ticks, units);
+        report_median(b, name.as_str(), list.get_mut(..count).unwrap_or_default());
         let _ = write!(b.out, "worst {} {tried} ", name.as_str());
         describe(&mut b.out, &input);
         let _ = writeln!(b.out);

@@ -8,7 +8,7 @@ use crate::test_support::{DEG, STEPS_DEG, assert_lands, flex, rigid, simulate};
 
 fn bisection_info<const S: usize>(plan: &JumpPlan<S>) -> BisectionInfo {
     match plan.info() {
-        PlanInfo::Bisection(i) => *i,
+        PlanInfo::Bisection(i) => i,
         other => panic!("not a bisection plan: {other:?}"),
     }
 }

@@ -1,7 +1,9 @@
 extern crate std;
 
 use super::*;
+use crate::bang_bang::OptimalStructure;
 use crate::jump::{Method, plan_jump};
+use crate::plan::PlanInfo;
 use crate::rigid_modes::expm1_f32;
 use crate::test_support::{DEG, assert_lands, rigid};
 use std::println;
@@ -103,4 +105,49 @@ fn newton_iterations_bounded_from_one_lsb_to_full_field() {
         worst.0,
         worst.1
     );
+}
+
+/// The `f32` plan keeps its law in `f32` and derives the rest: its peak
+/// voltage (not measured over the inputs) is the largest input, its `f32`
+/// inputs are its `f64` ones rounded, and its diagnostics match its
+/// inputs (dead-beat: 3 samples; bang-bang: switch samples and last
+/// sample), over moves from 0.3 LSB to the full field, both directions.
+#[test]
+fn f32_law_derives_peak_inputs_and_info() {
+    let d = rigid(10e-6);
+    let lsb = 12.5 * DEG / 2047.5;
+    let (mut dead_beat, mut bang_bang) = (0, 0);
+    let mut k = 0.3;
+    while k < 4095.0 {
+        for (from, sign) in [(0.0, 1.0), (0.2, -1.0), (-0.2, 1.0)] {
+            let p = plan_time_optimal_f32(&d, from, from + sign * k * lsb, 1024).expect("plan");
+            let u = crate::test_support::inputs(&p);
+            let peak = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            assert_eq!(p.max_abs_u_v(), peak, "{k} LSB: peak");
+            p.for_each_input_rev_f32(|j, v| {
+                assert_eq!(v, u[j] as f32, "{k} LSB: f32 input {j}");
+            });
+            let PlanInfo::Optimal(info) = p.info() else {
+                panic!("{k} LSB: no optimal info");
+            };
+            assert!(info.single_precision);
+            match info.structure {
+                OptimalStructure::DeadBeat => {
+                    dead_beat += 1;
+                    assert_eq!(p.samples(), 3);
+                }
+                OptimalStructure::BangBang => {
+                    bang_bang += 1;
+                    let (s1, s2) = info.switch_samples;
+                    assert!(0.0 <= s1 && s1 <= s2 && s2 <= p.samples() as f64);
+                    assert_eq!(info.last_sample_v, u[p.samples() - 1], "{k} LSB");
+                    let lower = info.samples_lower_bound;
+                    assert!(lower <= p.samples() && p.samples() <= lower + 4, "{k} LSB");
+                }
+                other => panic!("{k} LSB: {other:?}"),
+            }
+        }
+        k *= 1.05;
+    }
+    assert!(dead_beat > 0 && bang_bang > 0, "{dead_beat} {bang_bang}");
 }

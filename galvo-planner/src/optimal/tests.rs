@@ -208,7 +208,7 @@ fn facet_infeasible(d: &Discrete<3>, dist: f64, m: usize) -> bool {
 
 fn optimal_info(plan: &JumpPlan<3>) -> OptimalInfo {
     match plan.info() {
-        PlanInfo::Optimal(i) => *i,
+        PlanInfo::Optimal(i) => i,
         other => panic!("not a time-optimal plan: {other:?}"),
     }
 }

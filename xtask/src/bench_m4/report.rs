@@ -40,7 +40,10 @@ pub struct Measured {
     pub worst_input: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub inputs_tried: Option<u32>,
-    /// "enforced", or "reported, not yet met (…)".
+    /// For a sweep's row: the median input's instructions per unit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub median_instructions: Option<f64>,
+    /// "enforced" for a row with a budget.
     pub status: Option<String>,
     pub over_budget: bool,
 }
@@ -93,10 +96,17 @@ pub fn parse(output: &str) -> Result<Report> {
             }
             ["bench", id, ticks, units] => {
                 let k = ipt.context("bench line before calibration")?;
-                let ticks: f64 = ticks.parse().with_context(|| format!("ticks of {id}"))?;
-                let units: f64 = units.parse().with_context(|| format!("units of {id}"))?;
-                let instructions = ((ticks - overhead_ticks).max(0.0) * k) / units.max(1.0);
+                let instructions = per_unit(id, ticks, units, k, overhead_ticks)?;
                 rows.push(measured(id, instructions));
+            }
+            ["median", id, ticks, units] => {
+                let k = ipt.context("median line before calibration")?;
+                let instructions = per_unit(id, ticks, units, k, overhead_ticks)?;
+                let row = rows
+                    .iter_mut()
+                    .find(|m: &&mut Measured| m.id == *id)
+                    .with_context(|| format!("median of {id} before its bench line"))?;
+                row.median_instructions = Some(instructions);
             }
             ["worst", id, tried, input @ ..] => {
                 let row = rows
@@ -141,6 +151,15 @@ pub fn parse(output: &str) -> Result<Report> {
     })
 }
 
+/// Instructions per unit of a window of `ticks` timer ticks over `units`
+/// repetitions (`k` instructions per tick, less the empty window's
+/// `overhead_ticks`).
+fn per_unit(id: &str, ticks: &str, units: &str, k: f64, overhead_ticks: f64) -> Result<f64> {
+    let ticks: f64 = ticks.parse().with_context(|| format!("ticks of {id}"))?;
+    let units: f64 = units.parse().with_context(|| format!("units of {id}"))?;
+    Ok(((ticks - overhead_ticks).max(0.0) * k) / units.max(1.0))
+}
+
 fn measured(id: &str, instructions: f64) -> Measured {
     let row = all_rows().find(|r| r.id == id);
     let (what, unit) = match (row, plan_row(id)) {
@@ -162,9 +181,9 @@ fn measured(id: &str, instructions: f64) -> Measured {
         share,
         worst_input: None,
         inputs_tried: None,
+        median_instructions: None,
         status: budget.map(|(_, _, e)| match e {
             Enforcement::Enforced => "enforced".to_owned(),
-            Enforcement::Pending(work) => format!("reported, not yet met ({work})"),
         }),
         over_budget: budget.is_some_and(|(b, _, e)| e == Enforcement::Enforced && us > b),
     }
@@ -201,7 +220,10 @@ pub fn print(report: &Report) {
             budget
         );
         if let (Some(input), Some(tried)) = (&m.worst_input, m.inputs_tried) {
-            println!("{:<34}   worst of {tried}: {input}", "");
+            let median = m
+                .median_instructions
+                .map_or(String::new(), |i| format!(" (median {i:.0})"));
+            println!("{:<34}   worst of {tried}{median}: {input}", "");
         }
     }
 }

@@ -17,6 +17,7 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench stepper.step_tick.event 100 50\nbench stepper.step_tick.event_one_pulse 100 50\n\
     bench stepper.step_tick.segment 20 8\n\
     bench sweep.plan.xy 300 1\n\
+    median sweep.plan.xy 130 1\n\
     worst sweep.plan.xy 3000 (-80.109,136.229)->(-80.261,140.839) mm\n\
     bench sweep.stroke.steady 800 128\n\
     worst sweep.stroke.steady 200 input 58: (33.489,-55.039) (32.483,-52.896)\n\
@@ -206,27 +207,33 @@ fn a_sweep_reports_its_worst_input_and_is_enforced_on_it() {
     let r = parse(OUT).unwrap();
     let plan = r.rows.iter().find(|m| m.id == "sweep.plan.xy").unwrap();
     assert_eq!(plan.inputs_tried, Some(3000));
+    // The median input: 130 ticks, 5 200 instructions.
+    assert_eq!(plan.median_instructions, Some(5200.0));
+    let steady = r
+        .rows
+        .iter()
+        .find(|m| m.id == "sweep.stroke.steady")
+        .unwrap();
+    assert_eq!(steady.median_instructions, None);
     assert_eq!(
         plan.worst_input.as_deref(),
         Some("(-80.109,136.229)->(-80.261,140.839) mm")
     );
     assert!(!plan.over_budget);
-    // 413 ticks: 16 520 instructions, 128 µs of the 100 µs: shown with
-    // its input and the pending work, not a failure (the budget is not
-    // met yet on the sweep's worst; see budgets.rs).
+    // 413 ticks: 16 520 instructions, 128 µs of the 100 µs: a failure
+    // that names the input.
     let over = OUT.replace("bench sweep.plan.xy 300 1", "bench sweep.plan.xy 413 1");
     let r = parse(&over).unwrap();
     let plan = r.rows.iter().find(|m| m.id == "sweep.plan.xy").unwrap();
-    assert!(plan.share.unwrap() > 1.0 && !plan.over_budget);
+    assert!(plan.share.unwrap() > 1.0 && plan.over_budget);
+    assert_eq!(plan.status.as_deref(), Some("enforced"));
+    let err = check(&r).unwrap_err().to_string();
     assert!(
-        plan.status
-            .as_deref()
-            .unwrap()
-            .starts_with("reported, not yet met")
+        err.contains("sweep.plan.xy") && err.contains("(-80.109,136.229)"),
+        "{err}"
     );
-    assert!(check(&r).is_ok());
     // 1100 ticks per half: 343.75 instructions per sample, over the
-    // 25 % (323) allowed for corners; enforced, with the input named.
+    // 20 % (258); enforced, with the input named.
     let over = OUT.replace(
         "bench sweep.stroke.steady 800 128",
         "bench sweep.stroke.steady 1100 128",

@@ -90,20 +90,21 @@ pub const M4_COST: CostModel = CostModel {
     // `integrator.xy.step` + `galvo.sample_map.angles_to_codes` (200 + 103
     // = 303: kinematics-core built at opt-level "s"), rounded up.
     jump_stepped: 305,
-    // `loop.arc_r40.steady` (the dearer of line and arc).
-    marked: 256,
+    // `loop.arc_r40.steady` (236.25, the dearest of the marking rows),
+    // rounded up.
+    marked: 237,
     // `loop.jump.refill`, the whole half that starts a jump (its samples
     // included: an upper bound; the bench measures it to one
     // 40-instruction timer tick, which moves with what else the image
     // links: one tick of margin over the 9 520 measured).
     step_started: 9_560,
-    // `loop.jump.prep`.
-    point_prepared: 66_320,
-    // `loop.stroke.prep` (75 720–75 760): the dearest stroke step, a jump and a
+    // `loop.jump.prep` (63 200), one 40-instruction timer tick of margin.
+    point_prepared: 63_240,
+    // `loop.stroke.prep` (66 840): the dearest stroke step, a jump and a
     // G-code stroke of four lines (its open end needs its own IK); one
     // 40-instruction timer tick of margin. A G-code piece joined to the
-    // stroke being marked (`loop.join.prep`, 25 320) is charged as one.
-    stroke_prepared: 75_800,
+    // stroke being marked (`loop.join.prep`, 21 280) is charged as one.
+    stroke_prepared: 66_880,
     // `plan.seed.0.1deg` (1.572 M), rounded up: the cheapest bisection
     // plan, a lower bound for any jump.
     bisection_axis: 1_580_000,
@@ -150,10 +151,10 @@ mod tests {
             marked: 128,
             ..LoopWork::default()
         };
-        // 400 + 128 · 256 instructions at CPI 1.3, 168 MHz: ≈ 257 µs.
-        assert_eq!(M4_COST.instructions(&marking), 400 + 128 * 256);
+        // 400 + 128 · 237 instructions at CPI 1.3, 168 MHz: ≈ 238 µs.
+        assert_eq!(M4_COST.instructions(&marking), 400 + 128 * 237);
         let ns = M4_COST.ns(&marking);
-        assert!((256_000..258_000).contains(&ns), "{ns}");
+        assert!((237_000..239_000).contains(&ns), "{ns}");
         // Under half the 1.28 ms window, as the bench's budget says.
         assert!(ns < 640_000);
         assert_eq!(M4_COST.ns(&LoopWork::default()), 0);
