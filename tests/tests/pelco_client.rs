@@ -12,7 +12,7 @@
 use std::path::Path;
 use std::process::Command;
 
-use laser_app::command::Command as Product;
+use laser_app::command::{Command as Product, PresetCommand};
 use laser_app::domain::PointCm;
 use laser_app::pelco::sight::{angles_deg, point};
 use laser_app::pelco::{Request, Session, View};
@@ -123,30 +123,43 @@ fn pyptzcontroller_frames_drive_the_session_and_read_its_replies() {
             _ => None,
         })
         .collect();
-    // Preset 5 (the spot), then pan 25.5 / tilt 10° down, pan 12.25 / tilt
-    // 7.5° up (each keeps the spot's other angle: the spot does not move
-    // in this replay).
-    assert_eq!(gotos.len(), 5);
-    // Presets are kept in f32 cm: 10 nm at this distance.
-    let recalled = gotos[0];
-    assert!((recalled.x_cm - spot.x_cm).abs() < 1e-5 && (recalled.y_cm - spot.y_cm).abs() < 1e-5);
+    // Presets are the product's preset commands (kept in the settings
+    // store, see settings_sim.rs); pan 25.5 / tilt 10° down, pan 12.25 /
+    // tilt 7.5° up (each keeps the spot's other angle: the spot does not
+    // move in this replay).
+    let presets: Vec<PresetCommand> = requests
+        .iter()
+        .filter_map(|(_, r)| match r {
+            Request::Command(Product::Preset(c)) => Some(*c),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        presets,
+        [
+            PresetCommand::Set(5),
+            PresetCommand::Goto(5),
+            PresetCommand::Clear(5)
+        ]
+    );
+    assert_eq!(gotos.len(), 4);
     let angle = |p: PointCm| angles_deg(p, OQ_CM);
     let close = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-6 && (a[1] - b[1]).abs() < 1e-6;
-    assert!(close(angle(gotos[1]), [25.5, 4.5]), "{:?}", angle(gotos[1]));
+    assert!(close(angle(gotos[0]), [25.5, 4.5]), "{:?}", angle(gotos[0]));
     assert!(
-        close(angle(gotos[2]), [-12.0, -10.0]),
+        close(angle(gotos[1]), [-12.0, -10.0]),
+        "{:?}",
+        angle(gotos[1])
+    );
+    assert!(
+        close(angle(gotos[2]), [12.25, 4.5]),
         "{:?}",
         angle(gotos[2])
     );
     assert!(
-        close(angle(gotos[3]), [12.25, 4.5]),
+        close(angle(gotos[3]), [-12.0, 7.5]),
         "{:?}",
         angle(gotos[3])
-    );
-    assert!(
-        close(angle(gotos[4]), [-12.0, 7.5]),
-        "{:?}",
-        angle(gotos[4])
     );
     let laser: Vec<LaserMode> = requests
         .iter()

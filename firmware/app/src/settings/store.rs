@@ -21,7 +21,9 @@
 //! preset is written or cleared at once ([`SettingsStore::save_preset`]),
 //! with the same guarantee (a cut leaves the old or the new preset), and
 //! read when it is called ([`SettingsStore::load_preset`]). When a sector
-//! fills, the map moves the live presets with the newest record.
+//! fills, the map moves the live presets with the newest record. While a
+//! record of the earlier layout is there, presets are refused until the
+//! first `save` has migrated it.
 
 use core::ops::Range;
 
@@ -29,7 +31,9 @@ use embedded_storage_async::nor_flash::{MultiwriteNorFlash, NorFlash};
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapStorage};
 
-use super::presets::{PRESET_VALUE_LEN, StoreKey, decode_preset, encode_preset, is_preset};
+use super::presets::{
+    PRESET_VALUE_LEN, StoreKey, decode_preset, encode_preset, is_preset, savable,
+};
 use super::record::{MAX_RECORD_LEN, intact_record_len};
 use crate::domain::PointCm;
 use crate::log;
@@ -142,17 +146,6 @@ impl<F: MultiwriteNorFlash> FlashSettingsStore<F> {
         Ok(())
     }
 
-    /// Moves a record in the earlier layout into the map (the steps, and
-    /// the guarantee, of the first `save`), so that the map owns the whole
-    /// range before anything else is written; nothing when there is none.
-    async fn migrate_legacy(&mut self) -> Result<(), &'static str> {
-        let mut record = [0u8; ITEM_BUFFER_LEN];
-        match self.read_legacy(&mut record).await {
-            Some(len) => self.save(record.get(..len).unwrap_or(&[])).await,
-            None => Ok(()),
-        }
-    }
-
     /// Retires the record in the earlier layout by clearing its magic word
     /// (the map already holds the new record behind it).
     async fn retire_legacy(&mut self) -> Result<(), &'static str> {
@@ -255,8 +248,15 @@ impl<F: MultiwriteNorFlash> SettingsStore for FlashSettingsStore<F> {
         if !is_preset(n) {
             return Err("no such preset (1-255)");
         }
-        self.migrate_legacy().await?;
+        if point.is_some_and(|p| !savable(p)) {
+            return Err("preset point beyond the board limit");
+        }
         let mut item = [0u8; ITEM_BUFFER_LEN];
+        if self.read_legacy(&mut item).await.is_some() {
+            // The map does not own the range yet: the first `save`
+            // migrates the record, presets come after it.
+            return Err("settings in an earlier firmware's layout: save them first");
+        }
         let value = point.map(encode_preset);
         let bytes: &[u8] = value.as_ref().map_or(&[], |v| &v[..]);
         debug_assert!(bytes.len() <= PRESET_VALUE_LEN);
