@@ -32,7 +32,7 @@ use super::speed::rate_deg_s;
 use crate::command::{Command, GrblLine, PresetCommand};
 use crate::domain::PointCm;
 use crate::settings::{LaserMode, is_preset};
-use crate::text::{ReplyText, Shortest};
+use crate::text::{Fixed, ReplyText};
 
 /// Length of one jog of a continuous move, ms.
 pub const CHUNK_MS: u64 = 50;
@@ -235,16 +235,18 @@ fn hundredths(deg: f64) -> u16 {
 }
 
 /// The jog to board point `to` at `feed_mm_min`: absolute, machine
-/// coordinates, mm, to the µm.
+/// coordinates, mm, to the µm. Three fixed decimals by integer arithmetic
+/// (not the shortest form, whose exact digits cost ~60 000 M4 instructions
+/// a number: a move frame's two jogs took 2.9 ms on the M4, see
+/// `docs/pelco.md`).
 fn jog_line(to: PointCm, feed_mm_min: f64) -> Option<GrblLine> {
-    let um = |v: f64| libm::round(v * 1000.0) / 1000.0;
     let mut text = ReplyText::new();
     write!(
         text,
         "$J=G53G90G21X{}Y{}F{}",
-        Shortest(um(to.x_cm * 10.0)),
-        Shortest(um(to.y_cm * 10.0)),
-        Shortest(um(feed_mm_min))
+        Fixed::<3>(to.x_cm * 10.0),
+        Fixed::<3>(to.y_cm * 10.0),
+        Fixed::<3>(feed_mm_min)
     )
     .ok()?;
     GrblLine::new(&text)
