@@ -3,10 +3,13 @@
 //! step of a `save` — cleanly between steps, or tearing the step (a partly
 //! programmed word, a partly erased sector). After every cut, a boot loads
 //! exactly the old or the new record, never nothing or garbage, and the
-//! store takes the next save.
+//! store takes the next save. Presets (items of the same map) likewise:
+//! a cut while a preset is set or cleared boots the old or the new preset,
+//! the settings record and the other presets untouched.
 
 use embassy_futures::block_on;
 use embedded_storage_async::nor_flash::{NorFlash, ReadNorFlash};
+use laser_app::domain::PointCm;
 use laser_app::settings::store::{FlashSettingsStore, SettingsStore};
 use laser_app::settings::{RECORD_LEN, Settings};
 use laser_sim::flash::{PowerCut, SimFlash, Tear};
@@ -184,6 +187,15 @@ impl SettingsStore for EraseAndRewrite {
         padded.resize(record.len().next_multiple_of(4), 0xFF);
         self.0.write(at, &padded).await.map_err(|_| "write")
     }
+
+    // The earlier scheme had no presets.
+    async fn load_preset(&mut self, _n: u8) -> Option<PointCm> {
+        None
+    }
+
+    async fn save_preset(&mut self, _n: u8, _p: Option<PointCm>) -> Result<(), &'static str> {
+        Err("no presets")
+    }
 }
 
 #[test]
@@ -325,4 +337,144 @@ fn a_second_cut_while_the_boot_repairs_the_flash_still_boots_old_or_new() {
     }
     assert!(repairs > 0, "some cuts leave the boot something to repair");
     eprintln!("boots that repair the flash: {repairs}");
+}
+
+/// One write to the store: a settings record, or preset n set (`Some`) or
+/// cleared.
+#[derive(Clone)]
+enum Write {
+    Record(Vec<u8>),
+    Preset(u8, Option<PointCm>),
+}
+
+impl Write {
+    fn apply<S: SettingsStore>(&self, s: &mut S) -> Result<(), &'static str> {
+        match self {
+            Write::Record(r) => block_on(s.save(r)),
+            Write::Preset(n, p) => block_on(s.save_preset(*n, *p)),
+        }
+    }
+}
+
+/// Presets the preset tests use (the scaled sectors hold a record and a
+/// few dozen presets).
+const PRESETS_TRIED: u8 = 4;
+
+/// A distinct board point number `i`, cm (exact in f32, as saved).
+fn spot(i: u32) -> PointCm {
+    PointCm::new(f64::from(i % 200) * 0.5 - 30.0, 17.25 - f64::from(i % 64))
+}
+
+/// What a boot reads: the record and presets 1..=[`PRESETS_TRIED`].
+fn boot_all(image: Vec<u8>) -> (Vec<u8>, Vec<Option<PointCm>>) {
+    let mut s = store(Flash::from_image(BASE, image));
+    let mut record = vec![0u8; RECORD_LEN];
+    let n = block_on(s.load(&mut record));
+    record.truncate(n);
+    let presets = (1..=PRESETS_TRIED)
+        .map(|k| block_on(s.load_preset(k)))
+        .collect();
+    (record, presets)
+}
+
+/// `writes` in order on `image`, uncut; the image afterwards.
+fn written(image: Vec<u8>, writes: &[Write]) -> Vec<u8> {
+    let flash = Flash::from_image(BASE, image);
+    let mut s = store(flash.clone());
+    for w in writes {
+        w.apply(&mut s).expect("write without a power cut");
+    }
+    flash.image()
+}
+
+/// Cuts `write` (of preset `n`, to `new`) on `image` at every step, in every
+/// way: each boot loads the record and every other preset as they were,
+/// and preset `n` old or new; a second boot agrees, and the next preset
+/// write lands. Returns the cut points tried and whether the write erased
+/// a sector (a hand-over).
+fn check_every_preset_cut(image: &[u8], n: u8, new: Option<PointCm>) -> (u64, bool) {
+    let before = boot_all(image.to_vec());
+    let write = Write::Preset(n, new);
+    let uncut = Flash::from_image(BASE, image.to_vec());
+    write
+        .apply(&mut store(uncut.clone()))
+        .expect("uncut preset write");
+    let (ops, erased) = (uncut.ops(), uncut.stats().erases > 0);
+    let mut after_uncut = before.clone();
+    after_uncut.1[usize::from(n - 1)] = new;
+    assert_eq!(boot_all(uncut.image()), after_uncut, "uncut write loads");
+    let mut tried = 0;
+    for at_op in 0..ops {
+        for tear in Tear::ALL {
+            tried += 1;
+            let at = format!("preset {n} cut at op {at_op}/{ops} ({tear:?})");
+            let flash = Flash::from_image(BASE, image.to_vec())
+                .with_power_cut(Some(PowerCut { at_op, tear }));
+            assert!(
+                write.apply(&mut store(flash.clone())).is_err(),
+                "{at}: no error"
+            );
+            let cut = flash.image();
+            let loaded = boot_all(cut.clone());
+            assert!(
+                loaded == before || loaded == after_uncut,
+                "{at}: booted {loaded:?}"
+            );
+            // The boot may repair; a second boot agrees, the next write lands.
+            let rebooted = Flash::from_image(BASE, cut);
+            let mut s = store(rebooted.clone());
+            let mut record = vec![0u8; RECORD_LEN];
+            block_on(s.load(&mut record));
+            assert_eq!(boot_all(rebooted.image()), loaded, "{at}: second boot");
+            let next = spot(999);
+            block_on(s.save_preset(n, Some(next))).unwrap_or_else(|e| panic!("{at}: {e}"));
+            let (record, presets) = boot_all(rebooted.image());
+            assert_eq!(record, loaded.0, "{at}: the record after the next write");
+            assert_eq!(presets[usize::from(n - 1)], Some(next), "{at}: next write");
+        }
+    }
+    (tried, erased)
+}
+
+#[test]
+fn a_cut_at_any_step_of_a_preset_write_boots_the_old_or_the_new_preset() {
+    // A store with records and presets interleaved, cut while presets are
+    // set, changed and cleared at every fill level of a sector, through
+    // the hand-overs to the other sector.
+    let mut history = vec![Write::Record(record(1))];
+    let (mut cuts, mut handovers) = (0, 0);
+    for i in 0..120u32 {
+        let n = 1 + (i % u32::from(PRESETS_TRIED)) as u8;
+        let new = (i % 5 != 4).then(|| spot(i));
+        let image = written(erased(), &history);
+        let (tried, erased) = check_every_preset_cut(&image, n, new);
+        cuts += tried;
+        handovers += u64::from(erased);
+        history.push(Write::Preset(n, new));
+        if i % 40 == 39 {
+            history.push(Write::Record(record(10 + i)));
+        }
+    }
+    assert!(handovers > 0, "some preset writes hand the sector over");
+    eprintln!("preset writes: {cuts} cut points (step x tear), {handovers} hand-overs");
+}
+
+#[test]
+fn a_preset_write_on_a_record_of_the_earlier_layout_is_refused_until_a_save() {
+    let old = record(7);
+    let mut raw = old.clone();
+    raw.resize(old.len().next_multiple_of(4), 0xFF);
+    let image = legacy_image(&raw, 0xFF);
+    let flash = Flash::from_image(BASE, image.clone());
+    let refused = block_on(store(flash.clone()).save_preset(2, Some(spot(5))));
+    assert!(refused.is_err(), "{refused:?}");
+    assert_eq!(flash.image(), image, "nothing written");
+    // After the migrating save, presets are written.
+    let image = written(image, &[Write::Record(record(8))]);
+    let (cuts, _) = check_every_preset_cut(&image, 2, Some(spot(5)));
+    assert!(cuts > 0);
+    let image = written(image, &[Write::Preset(2, Some(spot(5)))]);
+    let (record_now, presets) = boot_all(written(image, &[Write::Record(record(9))]));
+    assert_eq!(record_now, record(9));
+    assert_eq!(presets[1], Some(spot(5)));
 }

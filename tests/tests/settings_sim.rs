@@ -154,3 +154,71 @@ fn a_save_on_the_target_geometry_programs_a_few_hundred_words_and_rarely_erases(
     // settings/stepper.rs and settings/pelco.rs).
     assert!(saves_before_erase > 170, "{saves_before_erase}");
 }
+
+/// Where `status` says the spot aims, e.g. `(5.500, -3.250) cm`.
+fn status_target(report: &SimReport) -> String {
+    terminal_lines(report)
+        .into_iter()
+        .rev()
+        .find_map(|l| l.strip_prefix("target: ").map(str::to_owned))
+        .unwrap_or_else(|| panic!("no target line: {:?}", terminal_lines(report)))
+}
+
+/// Aims with the gimbal at (5.5, −3.25) cm, holds, and sets preset 7.
+const SET_PRESET_7: &str = "goto 5.5 -3.25\nwait 3000\npreset set 7\n";
+
+#[test]
+fn a_preset_survives_a_reset_and_one_set_on_the_gimbal_is_called_on_the_stepper() {
+    // No `save`: setting a preset writes it at once.
+    let first = run_with(&format!("{SET_PRESET_7}stop\n"), SimOptions::default());
+    assert_eq!(reply_to(&first, "preset set 7").1, "ok");
+    let second = boot_from(
+        first.settings_flash.clone(),
+        "preset goto 3\ntarget stepper\npreset goto 7\nwait 3000\nstatus\n",
+    );
+    assert_eq!(reply_to(&second, "preset goto 3").1, "error: no preset 3");
+    assert_eq!(reply_to(&second, "preset goto 7").1, "ok");
+    assert_eq!(status_target(&second), "(5.500, -3.250) cm");
+    // The stepper's spot, from its counted steps, is there.
+    let spot = second
+        .recording
+        .dwells
+        .last()
+        .expect("the stepper arrived")
+        .spot_cm;
+    let err_mm = 10.0 * (spot.0 - 5.5).hypot(spot.1 + 3.25);
+    assert!(err_mm < 0.5, "{spot:?}: {err_mm} mm");
+    // Cleared, it is gone after the next reset too.
+    let third = boot_from(second.settings_flash.clone(), "preset clear 7\n");
+    assert_eq!(reply_to(&third, "preset clear 7").1, "ok");
+    let fourth = boot_from(third.settings_flash.clone(), "preset goto 7\n");
+    assert_eq!(reply_to(&fourth, "preset goto 7").1, "error: no preset 7");
+}
+
+#[test]
+fn a_power_cut_while_a_preset_is_set_boots_without_it_or_with_it() {
+    let uncut = run_with(SET_PRESET_7, SimOptions::default());
+    let steps = uncut.settings_flash_stats.word_writes + uncut.settings_flash_stats.erases;
+    assert!(steps >= 3, "a preset is a few words: {steps}");
+    let (mut without, mut with) = (0, 0);
+    for at_op in 0..steps {
+        for tear in Tear::ALL {
+            let cut = run_with(
+                SET_PRESET_7,
+                SimOptions {
+                    settings_flash_cut: Some(PowerCut { at_op, tear }),
+                    ..SimOptions::default()
+                },
+            );
+            let (_, reply) = reply_to(&cut, "preset set 7");
+            assert!(reply.starts_with("error:"), "op {at_op} {tear:?}: {reply}");
+            let rebooted = boot_from(cut.settings_flash, "preset goto 7\nwait 3000\nstatus\n");
+            match reply_to(&rebooted, "preset goto 7").1.as_str() {
+                "error: no preset 7" => without += 1,
+                "ok" if status_target(&rebooted) == "(5.500, -3.250) cm" => with += 1,
+                other => panic!("cut at op {at_op} ({tear:?}): {other}"),
+            }
+        }
+    }
+    assert!(without > 0 && with > 0, "without {without}, with {with}");
+}

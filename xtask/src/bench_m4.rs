@@ -18,6 +18,7 @@
 //! budgets apply to it (see `docs/bench-m4-sweeps.md`).
 
 mod budgets;
+mod pelco_rows;
 pub(crate) mod qemu;
 mod report;
 mod stepper_rows;

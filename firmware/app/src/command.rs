@@ -38,6 +38,7 @@ pub static HELP_LINES: &[&str] = &[
     "home                         home the stepper on its switches",
     "goto <x_cm> <y_cm>           aim at a board point",
     "grid <xi> <yi>               aim at a grid point",
+    "preset set|clear|goto <n>    board point preset n (1-255), saved at once",
     "laser on|off|auto|dwell      laser mode",
     "model exact|seed             gimbal kinematic model",
     "target gimbal|galvo|both     which actuator draws",
@@ -123,6 +124,34 @@ pub enum Command {
     Grbl(GrblLine),
     /// Servo bus set-up (refused while something runs).
     Servo(ServoSetup),
+    /// A preset: a board point kept in the settings store (also PELCO's).
+    Preset(PresetCommand),
+}
+
+/// The preset commands (`preset …`, PELCO's set / clear / go to preset).
+/// Presets are numbered 1–255 and hold a board point (cm), the same spot
+/// whichever actuator aims; setting and clearing write the settings
+/// store at once (no `save`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum PresetCommand {
+    /// `preset set <n>`: the spot's board point (the last one aimed)
+    /// becomes preset n.
+    Set(u8),
+    /// `preset clear <n>`: forget preset n.
+    Clear(u8),
+    /// `preset goto <n>`: aim at preset n and hold it, as `goto`.
+    Goto(u8),
+}
+
+impl fmt::Display for PresetCommand {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            PresetCommand::Set(n) => write!(f, "preset set {n}"),
+            PresetCommand::Clear(n) => write!(f, "preset clear {n}"),
+            PresetCommand::Goto(n) => write!(f, "preset goto {n}"),
+        }
+    }
 }
 
 /// The servo bus set-up commands (`servo …`).
@@ -223,6 +252,7 @@ impl Command {
             Command::GalvoStatus => "galvo status",
             Command::Grbl(_) => "grbl",
             Command::Servo(_) => "servo",
+            Command::Preset(_) => "preset",
         }
     }
 
@@ -262,6 +292,7 @@ impl fmt::Debug for Command {
             Command::Grbl(line) => f.write_str(line.as_str()),
             Command::Trace(on) => f.write_str(if *on { "trace on" } else { "trace off" }),
             Command::Servo(setup) => write!(f, "{setup}"),
+            Command::Preset(preset) => write!(f, "{preset}"),
             other => f.write_str(other.name()),
         }
     }
@@ -293,6 +324,7 @@ impl PartialEq for Command {
             (Command::Grbl(a), Command::Grbl(b)) => a == b,
             (Command::Trace(a), Command::Trace(b)) => a == b,
             (Command::Servo(a), Command::Servo(b)) => a == b,
+            (Command::Preset(a), Command::Preset(b)) => a == b,
             (a, b) => core::mem::discriminant(a) == core::mem::discriminant(b),
         }
     }

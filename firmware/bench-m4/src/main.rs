@@ -30,6 +30,7 @@ mod galvo_loop;
 mod harness;
 mod kinematics;
 mod path;
+mod pelco;
 mod planning;
 mod semihosting;
 mod stepper;
@@ -69,6 +70,7 @@ fn main() -> ! {
     stepper::stepper(&mut b);
     sweep::jump_sweep(&mut b);
     sweep_strokes::stroke_sweep(&mut b);
+    pelco::pelco(&mut b);
 
     let _ = writeln!(b.out, "done {}", b.failures);
     b.out.flush();

@@ -82,25 +82,31 @@ impl Decoder {
             *slot = byte;
             self.len += 1;
         }
-        let protocol = Protocol::from_sync(self.buf[0])?;
-        if self.len < protocol.frame_len() {
-            return None;
-        }
-        match Frame::parse(self.buf.get(..self.len).unwrap_or(&[])) {
-            Some(frame) => {
-                self.len = 0;
-                if frame.address == protocol.wire_address(self.address) {
-                    self.counters.frames = self.counters.frames.wrapping_add(1);
-                    Some(frame)
-                } else {
-                    self.counters.other_addresses = self.counters.other_addresses.wrapping_add(1);
-                    None
-                }
+        // A run as long as its dialect's frame is judged at once; after a
+        // bad one, the run found behind it may already be whole (a stray
+        // PELCO-P sync byte just before a PELCO-D frame).
+        loop {
+            let protocol = Protocol::from_sync(*self.buf.first()?)?;
+            if self.len < protocol.frame_len() {
+                return None;
             }
-            None => {
-                self.counters.bad_checksums = self.counters.bad_checksums.wrapping_add(1);
-                self.resync();
-                None
+            match Frame::parse(self.buf.get(..protocol.frame_len()).unwrap_or(&[])) {
+                Some(frame) => {
+                    self.len = 0;
+                    if frame.address == protocol.wire_address(self.address) {
+                        self.counters.frames = self.counters.frames.wrapping_add(1);
+                        return Some(frame);
+                    }
+                    self.counters.other_addresses = self.counters.other_addresses.wrapping_add(1);
+                    return None;
+                }
+                None => {
+                    self.counters.bad_checksums = self.counters.bad_checksums.wrapping_add(1);
+                    self.resync();
+                    if self.len == 0 {
+                        return None;
+                    }
+                }
             }
         }
     }
@@ -131,6 +137,9 @@ impl Decoder {
 
 #[cfg(test)]
 mod tests {
+    extern crate std;
+    use std::vec::Vec;
+
     use super::*;
     use crate::Command;
 
@@ -162,6 +171,21 @@ mod tests {
         assert_eq!(frames(&mut d, other.as_slice()), 0);
         let c = d.counters();
         assert_eq!((c.frames, c.bad_checksums, c.other_addresses), (0, 1, 1));
+    }
+
+    #[test]
+    fn a_stray_pelco_p_sync_before_a_pelco_d_frame_does_not_hide_it() {
+        // A0 then a whole PELCO-D frame: the 8-byte PELCO-P run is bad,
+        // the PELCO-D frame behind its sync byte is whole at once.
+        let mut d = Decoder::new(1);
+        let good = Command::QueryPan.frame(Protocol::D, 1);
+        let mut got = Vec::new();
+        d.decode(&[0xA0], |f| got.push(f));
+        d.decode(good.encode().as_slice(), |f| got.push(f));
+        assert_eq!(got, std::vec![good]);
+        let c = d.counters();
+        assert_eq!((c.frames, c.bad_checksums, c.discarded_bytes), (1, 1, 1));
+        assert_eq!(d.buffered(), 0);
     }
 
     #[test]

@@ -12,6 +12,7 @@ pub mod calib;
 pub mod console;
 pub mod grbl;
 pub mod pelco;
+pub mod pelco_junk;
 pub mod record;
 pub mod servo;
 

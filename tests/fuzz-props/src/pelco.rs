@@ -8,8 +8,11 @@
 //! * every delivered frame is for the decoder's device and re-encodes to
 //!   bytes that occur, in order, in the input (the decoder invents
 //!   nothing);
-//! * every byte is accounted for: frames and foreign frames take their
-//!   length, bad runs and garbage are counted as discarded;
+//! * every byte is accounted for, exactly as a whole-input scan of the
+//!   spec counts it ([`crate::pelco_junk::model`]);
+//! * garbage, wrong checksums, truncated frames and foreign frames between
+//!   good frames change neither the frames nor the session's commands, and
+//!   are counted ([`crate::pelco_junk::junk_changes_nothing`]);
 //! * after any input, an idle line (zeros) empties the decoder and the
 //!   next valid frame decodes exactly (resync);
 //! * a generated command encodes to a well-formed frame of its dialect's
@@ -20,6 +23,7 @@ use std::collections::BTreeSet;
 use pelco::{Command, Counters, Decoder, Frame, MAX_FRAME_LEN, Protocol};
 
 use crate::Bytes;
+use crate::pelco_junk::{JunkSummary, check_model, junk_changes_nothing};
 
 /// What one input exercised.
 #[derive(Debug, Default)]
@@ -28,6 +32,8 @@ pub struct Summary {
     pub commands: BTreeSet<String>,
     /// The decoder's counts over the raw bytes.
     pub counters: Counters,
+    /// Good frames and junk the junk property built from the bytes.
+    pub junk: JunkSummary,
 }
 
 /// Runs the codec properties on `data`; panics when one fails.
@@ -79,9 +85,9 @@ pub fn check(data: &[u8]) -> Summary {
         rest = &rest[at + raw.as_slice().len()..];
     }
 
-    // Every byte accounted for.
-    let framed: usize = frames.iter().map(|f| f.protocol.frame_len()).sum();
-    assert!(framed + counters.discarded_bytes as usize + whole.buffered() <= data.len());
+    // Every byte accounted for, as the spec's scan counts it.
+    assert_eq!(check_model(data), counters);
+    let junk = junk_changes_nothing(data);
 
     // Resync: idle line, then a valid frame.
     whole.decode(&[0u8; 2 * MAX_FRAME_LEN], |_| {});
@@ -97,6 +103,7 @@ pub fn check(data: &[u8]) -> Summary {
             .map(|f| format!("{}:{}", f.protocol.name(), Command::of(f).name()))
             .collect(),
         counters,
+        junk,
     }
 }
 

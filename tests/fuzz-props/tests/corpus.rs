@@ -246,4 +246,15 @@ fn pelco_corpus_holds_and_covers_every_command_in_both_dialects() {
         bad > 0 && foreign > 0,
         "the corpus has no bad or foreign frames"
     );
+    // The junk property saw every kind of junk between good frames.
+    let junk = all.iter().fold([0; 4], |mut sum, s| {
+        for (t, n) in sum.iter_mut().zip(s.junk.junk) {
+            *t += n;
+        }
+        sum
+    });
+    assert!(
+        junk.iter().all(|n| *n > 0),
+        "junk (garbage, wrong checksum, truncated, other address): {junk:?}"
+    );
 }

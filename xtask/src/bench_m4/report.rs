@@ -5,11 +5,13 @@ use anyhow::{Context, Result, bail};
 use serde::Serialize;
 
 use super::budgets::{Enforcement, ROWS, Row, plan_row};
+use super::pelco_rows::PELCO_ROWS;
 use super::stepper_rows::STEPPER_ROWS;
 
-/// Every row with a description: the galvo's and the stepper's.
+/// Every row with a description: the galvo's, the stepper's, the PELCO
+/// port's.
 fn all_rows() -> impl Iterator<Item = &'static Row> {
-    ROWS.iter().chain(STEPPER_ROWS)
+    ROWS.iter().chain(STEPPER_ROWS).chain(PELCO_ROWS)
 }
 
 /// STM32F407 core clock, MHz.

@@ -25,6 +25,10 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     worst sweep.stroke.refill 200 input 58: (33.489,-55.039) (32.483,-52.896)\n\
     bench sweep.stroke.prep 2000 1\n\
     worst sweep.stroke.prep 200 input 6: (-44.691,-53.845) (-45.054,-54.270)\n\
+    bench pelco.frame.move 1656 1\nbench pelco.frame.set_pan 479 1\n\
+    bench pelco.frame.query_pan 237 1\nbench pelco.frame.goto_preset 236 1\n\
+    bench sweep.pelco.frame 1930 1\n\
+    worst sweep.pelco.frame 2000 A00000120106AF1A (P move) at (21.64,29.03) cm\n\
     done 0\n";
 
 #[test]
@@ -109,6 +113,15 @@ fn an_enforced_budget_over_fails() {
     assert_eq!(m.status.as_deref(), Some("enforced"));
     let err = check(&r).unwrap_err().to_string();
     assert!(err.contains("loop.jump.steady"), "{err}");
+    // A PELCO frame over a quarter of a 19 200-baud frame time (911 µs):
+    // 5000 ticks, 200 000 instructions (1.5 ms), fails, with its input.
+    let pelco = OUT.replace(
+        "bench sweep.pelco.frame 1930 1",
+        "bench sweep.pelco.frame 5000 1",
+    );
+    let err = check(&parse(&pelco).unwrap()).unwrap_err().to_string();
+    assert!(err.contains("sweep.pelco.frame"), "{err}");
+    assert!(err.contains("A00000120106AF1A"), "{err}");
 }
 
 fn manifest(path: &str) -> toml::Table {

@@ -56,6 +56,16 @@ impl SettingsStore for Part {
     async fn save(&mut self, _record: &[u8]) -> Result<(), &'static str> {
         Ok(())
     }
+    async fn load_preset(&mut self, _n: u8) -> Option<crate::domain::PointCm> {
+        None
+    }
+    async fn save_preset(
+        &mut self,
+        _n: u8,
+        _point: Option<crate::domain::PointCm>,
+    ) -> Result<(), &'static str> {
+        Ok(())
+    }
 }
 
 impl DacStream for Part {

@@ -2,12 +2,11 @@
 
 use super::args::Args;
 use super::error::{CommandError, word};
-use crate::command::{Command, ServoSetup};
+use crate::command::{Command, PresetCommand, ServoSetup};
 use crate::domain::{Actuator, AimModel, Figure, GridPattern, Pattern, PointCm, Rotation};
 use crate::settings::{JumpPlanner, LaserMode, find_param};
 
-/// Largest board coordinate accepted anywhere, cm.
-pub const BOARD_LIMIT_CM: f64 = 200.0;
+pub use crate::domain::BOARD_LIMIT_CM;
 
 /// Smallest extent of a drawn figure, cm: a line's length, a rect's sides
 /// (as a circle's radius and the tuning figure's size).
@@ -84,6 +83,8 @@ fn parse_command(name: &str, args: &mut Args<'_>) -> Result<Command, CommandErro
         })?)
     } else if is("servo") {
         Command::Servo(servo_setup(args)?)
+    } else if is("preset") {
+        Command::Preset(preset(args)?)
     } else if let Some(command) = mode_command(name, args)? {
         command
     } else {
@@ -139,6 +140,21 @@ fn mode_command(name: &str, args: &mut Args<'_>) -> Result<Option<Command>, Comm
         return Ok(None);
     };
     Ok(Some(command))
+}
+
+/// `preset set|clear|goto <n>`, n 1–255.
+fn preset(args: &mut Args<'_>) -> Result<PresetCommand, CommandError> {
+    let make: fn(u8) -> PresetCommand = keyword(
+        args,
+        "set|clear|goto",
+        &[
+            ("set", PresetCommand::Set as fn(u8) -> PresetCommand),
+            ("clear", PresetCommand::Clear),
+            ("goto", PresetCommand::Goto),
+        ],
+    )?;
+    let n = args.integer("preset number", 1, i32::from(crate::settings::MAX_PRESET))?;
+    Ok(make(n as u8))
 }
 
 fn point(args: &mut Args<'_>, x: &'static str, y: &'static str) -> Result<PointCm, CommandError> {

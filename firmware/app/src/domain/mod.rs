@@ -25,7 +25,7 @@ pub use check::{MAX_PROBES, PatternCheck, check_pattern, check_target};
 pub use error::PatternError;
 pub use figure::{Figure, GridPattern, Pattern, Rotation, Segment, Segments, Stroke, StrokeCm};
 pub use path::{PathCursor, pass_points};
-pub use point::PointCm;
+pub use point::{BOARD_LIMIT_CM, PointCm};
 pub use units::Unit;
 
 #[cfg(test)]

@@ -5,6 +5,10 @@ use kinematics_core::{BoardPoint, PointMm};
 
 use super::units::{galvo_mm_from_cm, mm_from_cm};
 
+/// Largest board coordinate magnitude accepted anywhere (command line,
+/// saved presets), cm.
+pub const BOARD_LIMIT_CM: f64 = 200.0;
+
 /// A board point, cm (board frame: x right, y up, origin at Q).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

@@ -7,13 +7,16 @@
 //! | pan/tilt at speed             | `$J=G53G90G21X…Y…F…` jogs of [`CHUNK_MS`] each, kept [`LEAD_MS`] ahead, at the [`speed`](super::speed) table's rate along the line of sight |
 //! | stop (both axes 0 / no bits)  | jog cancel (grbl 0x85)                    |
 //! | zoom / focus / iris / camera  | nothing (a frame without pan/tilt bits is a stop) |
-//! | set preset n (1–255)          | the spot's board point kept as preset n   |
-//! | clear preset n                | preset n forgotten                        |
-//! | go to preset n                | `goto x y` of the preset                  |
+//! | set preset n (1–255)          | `preset set n` (the spot's board point, saved at once) |
+//! | clear preset n                | `preset clear n`                          |
+//! | go to preset n                | jog cancel, then `preset goto n`          |
 //! | set / clear aux 1             | `laser on` / `laser off`                  |
 //! | remote reset                  | `stop` (motion stopped, laser off)        |
 //! | absolute pan / tilt (0x4B/4D) | `goto` of the point at that angle, the other axis kept |
 //! | query pan / tilt (0x51/0x53)  | a 0x59 / 0x5B reply of the spot's angle   |
+//!
+//! Presets live in the settings store, not here (see
+//! `crate::sequencer::presets`): the session keeps no table of them.
 //!
 //! Angles are those of the line of sight ([`super::sight`]); the spot's
 //! position is the last aimed board point the sequencer published. On the
@@ -26,18 +29,16 @@ use ::pelco::{Command as Pelco, Frame, Motion, PanDirection, TiltDirection};
 
 use super::sight::{MAX_ANGLE_DEG, angles_deg, point};
 use super::speed::rate_deg_s;
-use crate::command::{Command, GrblLine};
+use crate::command::{Command, GrblLine, PresetCommand};
 use crate::domain::PointCm;
-use crate::settings::LaserMode;
-use crate::text::{ReplyText, Shortest};
+use crate::settings::{LaserMode, is_preset};
+use crate::text::{Fixed, ReplyText};
 
 /// Length of one jog of a continuous move, ms.
 pub const CHUNK_MS: u64 = 50;
 /// How far ahead of now the jogs are queued, ms (a new speed or a stop
 /// takes effect within this, plus the actuator's braking).
 pub const LEAD_MS: u64 = 100;
-/// Presets: numbers 1–255.
-pub const PRESETS: usize = 255;
 
 /// What the session asks of the port task.
 #[derive(Debug, Clone, PartialEq)]
@@ -76,7 +77,6 @@ struct Move {
 
 /// The session state.
 pub struct Session {
-    presets: [Option<[f32; 2]>; PRESETS],
     moving: Option<Move>,
     /// Motion timeout, ms (0: off).
     timeout_ms: u64,
@@ -89,10 +89,9 @@ impl Default for Session {
 }
 
 impl Session {
-    /// No presets, at rest, no motion timeout.
+    /// At rest, no motion timeout.
     pub const fn new() -> Self {
         Self {
-            presets: [None; PRESETS],
             moving: None,
             timeout_ms: 0,
         }
@@ -108,12 +107,6 @@ impl Session {
         self.moving.is_some()
     }
 
-    /// Preset `n` (1–255), board point, cm.
-    pub fn preset(&self, n: u8) -> Option<PointCm> {
-        let [x, y] = (*self.presets.get(usize::from(n).checked_sub(1)?)?)?;
-        Some(PointCm::new(f64::from(x), f64::from(y)))
-    }
-
     /// When [`Session::on_tick`] is next due, ms: when only
     /// `LEAD_MS − CHUNK_MS` of jogs remain queued.
     pub fn next_tick_ms(&self) -> Option<u64> {
@@ -127,21 +120,16 @@ impl Session {
         let reply = |c: Pelco| Request::Reply(c.frame(frame.protocol, frame.address));
         match Pelco::of(frame) {
             Pelco::Motion(m) => self.motion(m, here, view, out),
-            Pelco::SetPreset(n) => {
-                if let (Some(slot), Some(p)) = (self.slot(n), view.at) {
-                    *slot = Some([p.x_cm as f32, p.y_cm as f32]);
-                }
+            // Preset 0 does not exist: ignored, as an unknown command.
+            Pelco::SetPreset(n) if is_preset(n) => {
+                out(Request::Command(Command::Preset(PresetCommand::Set(n))))
             }
-            Pelco::ClearPreset(n) => {
-                if let Some(slot) = self.slot(n) {
-                    *slot = None;
-                }
+            Pelco::ClearPreset(n) if is_preset(n) => {
+                out(Request::Command(Command::Preset(PresetCommand::Clear(n))))
             }
-            Pelco::GotoPreset(n) => {
-                if let Some(p) = self.preset(n) {
-                    self.stop(out);
-                    out(Request::Command(Command::Goto(p)));
-                }
+            Pelco::GotoPreset(n) if is_preset(n) => {
+                self.stop(out);
+                out(Request::Command(Command::Preset(PresetCommand::Goto(n))));
             }
             Pelco::SetAux(1) => out(Request::Command(Command::Laser(LaserMode::Auto))),
             Pelco::ClearAux(1) => out(Request::Command(Command::Laser(LaserMode::Off))),
@@ -158,7 +146,10 @@ impl Session {
             }
             Pelco::QueryPan => out(reply(Pelco::PanPosition(hundredths(here[0])))),
             Pelco::QueryTilt => out(reply(Pelco::TiltPosition(hundredths(-here[1])))),
-            Pelco::SetAux(_)
+            Pelco::SetPreset(_)
+            | Pelco::ClearPreset(_)
+            | Pelco::GotoPreset(_)
+            | Pelco::SetAux(_)
             | Pelco::ClearAux(_)
             | Pelco::PanPosition(_)
             | Pelco::TiltPosition(_)
@@ -237,10 +228,6 @@ impl Session {
         self.stop(out);
         out(Request::Command(Command::Goto(point(angles, view.oq_cm))));
     }
-
-    fn slot(&mut self, n: u8) -> Option<&mut Option<[f32; 2]>> {
-        self.presets.get_mut(usize::from(n).checked_sub(1)?)
-    }
 }
 
 /// An angle on the wire, hundredths of a degree.
@@ -249,16 +236,18 @@ fn hundredths(deg: f64) -> u16 {
 }
 
 /// The jog to board point `to` at `feed_mm_min`: absolute, machine
-/// coordinates, mm, to the µm.
+/// coordinates, mm, to the µm. Three fixed decimals by integer arithmetic
+/// (not the shortest form, whose exact digits cost ~60 000 M4 instructions
+/// a number: a move frame's two jogs took 2.9 ms on the M4, see
+/// `docs/pelco.md`).
 fn jog_line(to: PointCm, feed_mm_min: f64) -> Option<GrblLine> {
-    let um = |v: f64| libm::round(v * 1000.0) / 1000.0;
     let mut text = ReplyText::new();
     write!(
         text,
         "$J=G53G90G21X{}Y{}F{}",
-        Shortest(um(to.x_cm * 10.0)),
-        Shortest(um(to.y_cm * 10.0)),
-        Shortest(um(feed_mm_min))
+        Fixed::<3>(to.x_cm * 10.0),
+        Fixed::<3>(to.y_cm * 10.0),
+        Fixed::<3>(feed_mm_min)
     )
     .ok()?;
     GrblLine::new(&text)

@@ -7,7 +7,7 @@ use embassy_time::{Duration, Instant, Timer};
 use embedded_io_async::{Read, Write};
 
 use super::session::{Request, Session, View};
-use crate::command::{Command, CommandLink, RealtimeRequest};
+use crate::command::{Command, CommandLink, PresetCommand, RealtimeRequest};
 use crate::grbl::realtime::Realtime;
 use crate::log;
 use crate::outbound::{LineKind, QuietReply};
@@ -110,7 +110,7 @@ impl<R: Read, W: Write + PelcoLine> PelcoTask<R, W> {
     fn view(&self, settings: PortSettings) -> View {
         View {
             now_ms: Instant::now().as_millis(),
-            at: self.status.snapshot().target.map(|(t, _)| t.point),
+            at: self.aimed(),
             oq_cm: settings.oq_cm,
         }
     }
@@ -118,12 +118,19 @@ impl<R: Read, W: Write + PelcoLine> PelcoTask<R, W> {
     async fn carry_out(&mut self, request: Request) {
         match request {
             Request::Command(command) => {
+                let before = self.aimed();
                 let reply = send_quietly(self.link, command).await;
-                let done = reply.is_some_and(|r| r.closed == Some(true));
+                let done = reply.as_ref().is_some_and(|r| r.closed == Some(true));
                 if !done {
-                    log::debug!("pelco: {} refused", command.name());
+                    let why = reply.as_ref().map_or("no reply", |r| r.data.as_str());
+                    log::debug!("pelco: {} refused: {}", command.name(), why);
                 } else if let Command::Goto(point) = command {
-                    self.until_shown(point).await;
+                    self.until_shown(|aimed| aimed == Some(point)).await;
+                } else if let Command::Preset(PresetCommand::Goto(_)) = command {
+                    // The preset's point is in the settings flash: wait
+                    // for the aim to change (or the limit, when the spot
+                    // is there already).
+                    self.until_shown(|aimed| aimed != before).await;
                 }
             }
             Request::JogCancel => {
@@ -144,24 +151,24 @@ impl<R: Read, W: Write + PelcoLine> PelcoTask<R, W> {
         }
     }
 
-    /// Waits until the status shows `point` as the aimed point (the
-    /// sequencer publishes it after the goto's reply, once its servo
+    /// Waits until `shown` holds for the point the status shows as aimed
+    /// (the sequencer publishes it after a goto's reply, once its servo
     /// moves are out), at most [`SHOW_LIMIT`]: the next frame's angles
     /// (an absolute tilt after an absolute pan keeps the new pan) start
     /// from it.
-    async fn until_shown(&self, point: crate::domain::PointCm) {
+    async fn until_shown(&self, shown: impl Fn(Option<crate::domain::PointCm>) -> bool) {
         let deadline = Instant::now() + SHOW_LIMIT;
         while Instant::now() < deadline {
-            if self
-                .status
-                .snapshot()
-                .target
-                .is_some_and(|(t, _)| t.point == point)
-            {
+            if shown(self.aimed()) {
                 return;
             }
             Timer::after(POLL).await;
         }
+    }
+
+    /// The board point the status shows as aimed, if any.
+    fn aimed(&self) -> Option<crate::domain::PointCm> {
+        self.status.snapshot().target.map(|(t, _)| t.point)
     }
 
     /// The port's settings, read like `get` does.

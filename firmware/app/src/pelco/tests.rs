@@ -12,7 +12,7 @@ use super::session::{CHUNK_MS, LEAD_MS};
 use super::sight::{angles_deg, point};
 use super::speed::rate_deg_s;
 use super::*;
-use crate::command::Command;
+use crate::command::{Command, PresetCommand};
 use crate::domain::PointCm;
 use crate::settings::LaserMode;
 
@@ -156,28 +156,38 @@ fn motion_timeout_stops_a_silent_bus() {
     assert_eq!(cancelled_at, Some(300));
 }
 
+fn preset(c: PresetCommand) -> Vec<Request> {
+    vec![Request::Command(Command::Preset(c))]
+}
+
 #[test]
-fn presets_set_recall_and_clear() {
+fn presets_are_the_products_preset_commands_in_both_dialects() {
     let mut s = Session::new();
     let a = PointCm::new(12.5, -7.25);
-    assert!(on_frame(&mut s, frame(Pelco::SetPreset(3)), view(0, Some(a))).is_empty());
-    let recall = on_frame(&mut s, frame(Pelco::GotoPreset(3)), view(10, None));
-    assert_eq!(recall, vec![Request::Command(Command::Goto(a))]);
-    assert!(on_frame(&mut s, frame(Pelco::GotoPreset(4)), view(20, None)).is_empty());
-    on_frame(&mut s, frame(Pelco::ClearPreset(3)), view(30, None));
-    assert!(on_frame(&mut s, frame(Pelco::GotoPreset(3)), view(40, None)).is_empty());
-    // Preset 0 does not exist; 255 does.
-    on_frame(&mut s, frame(Pelco::SetPreset(0)), view(50, Some(a)));
-    assert_eq!(s.preset(0), None);
-    on_frame(&mut s, frame(Pelco::SetPreset(255)), view(60, Some(a)));
-    assert_eq!(s.preset(255), Some(a));
+    let set = on_frame(&mut s, frame(Pelco::SetPreset(3)), view(0, Some(a)));
+    assert_eq!(set, preset(PresetCommand::Set(3)));
+    let p = Pelco::GotoPreset(255).frame(Protocol::P, 0);
+    assert_eq!(
+        on_frame(&mut s, p, view(10, None)),
+        preset(PresetCommand::Goto(255))
+    );
+    let clear = on_frame(&mut s, frame(Pelco::ClearPreset(1)), view(30, None));
+    assert_eq!(clear, preset(PresetCommand::Clear(1)));
+    // Preset 0 does not exist: nothing is asked.
+    for c in [
+        Pelco::SetPreset(0),
+        Pelco::ClearPreset(0),
+        Pelco::GotoPreset(0),
+    ] {
+        assert!(on_frame(&mut s, frame(c), view(50, Some(a))).is_empty());
+    }
+    assert!(!s.is_moving());
 }
 
 #[test]
 fn recall_during_a_move_cancels_the_jog_first() {
     let mut s = Session::new();
     let a = PointCm::new(1.0, 2.0);
-    on_frame(&mut s, frame(Pelco::SetPreset(1)), view(0, Some(a)));
     on_frame(
         &mut s,
         moving(PanDirection::Right, TiltDirection::Stop, 8, 0),
@@ -186,8 +196,12 @@ fn recall_during_a_move_cancels_the_jog_first() {
     let recall = on_frame(&mut s, frame(Pelco::GotoPreset(1)), view(20, Some(a)));
     assert_eq!(
         recall,
-        vec![Request::JogCancel, Request::Command(Command::Goto(a))]
+        vec![
+            Request::JogCancel,
+            Request::Command(Command::Preset(PresetCommand::Goto(1)))
+        ]
     );
+    assert!(!s.is_moving());
 }
 
 #[test]

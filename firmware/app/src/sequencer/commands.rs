@@ -77,6 +77,7 @@ impl Core {
             }
             Command::Grbl(line) => self.grbl_line(line.as_str(), out),
             Command::Servo(setup) => self.servo_setup(setup, out),
+            Command::Preset(preset) => self.preset(preset, out),
         }
     }
 
@@ -175,7 +176,7 @@ impl Core {
     }
 
     /// Aims at one target and holds it; refuses unreachable targets.
-    fn goto(&mut self, target: Target, out: &mut dyn ActionSink) {
+    pub(super) fn goto(&mut self, target: Target, out: &mut dyn ActionSink) {
         match check_target(&self.aimer, self.actuator, &target) {
             Ok(()) => {
                 self.start(Start::Goto(target), out);

@@ -3,6 +3,7 @@
 //! [`ActionSink`], console [`Line`]s).
 
 use crate::command::Command;
+use crate::domain::PointCm;
 use crate::galvo::{GalvoConfig, GalvoEvent, GalvoRequest, RefillTime, ScanPhase};
 use crate::sequencer::laser::LaserEvent;
 use crate::servo::task::{ServoOutcome, ServoRequest};
@@ -37,9 +38,17 @@ pub enum Event {
     Tick,
     /// Continue the pending pattern check (after [`Action::Yield`]).
     CheckStep,
-    /// The result of [`Action::Save`]; `Err` carries a message for the
-    /// user.
+    /// The result of [`Action::Save`] or [`Action::SavePreset`]; `Err`
+    /// carries a message for the user.
     Saved(Result<(), &'static str>),
+    /// The answer to [`Action::LoadPreset`]: preset `n`'s board point, if
+    /// one is saved.
+    PresetLoaded {
+        /// The preset's number.
+        n: u8,
+        /// Its board point, cm.
+        point: Option<PointCm>,
+    },
     /// The settings record read at boot, decoded.
     SettingsLoaded(Result<LoadedRecord, RecordError>),
     /// The master laser gate refused the gimbal laser: someone else (the
@@ -136,6 +145,17 @@ pub enum Action {
     /// Save the settings ([`Core::settings`](crate::sequencer::machine::Core::settings)); answer with
     /// [`Event::Saved`].
     Save,
+    /// Save board point `point` as preset `n` (`None`: clear it) in the
+    /// settings store; answer with [`Event::Saved`].
+    SavePreset {
+        /// The preset's number, 1–255.
+        n: u8,
+        /// Its board point, cm (`None`: cleared).
+        point: Option<PointCm>,
+    },
+    /// Read preset `n` from the settings store; answer with
+    /// [`Event::PresetLoaded`].
+    LoadPreset(u8),
     /// Let the other tasks run, then send [`Event::CheckStep`].
     Yield,
 }

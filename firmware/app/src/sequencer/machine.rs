@@ -14,7 +14,7 @@
 //! something before their reply: a pattern check runs a few points per
 //! [`Event::CheckStep`] (the shell yields in between so the other tasks
 //! run, [`Action::Yield`]), and a save waits for the store
-//! ([`Action::Save`], then [`Event::Saved`]). The shell feeds nothing else
+//! ([`Action::Save`], then [`Event::Saved`]; a preset's likewise). The shell feeds nothing else
 //! in between; should something else arrive, a pending check is finished
 //! at once first, so every command still gets exactly one reply.
 
@@ -46,8 +46,12 @@ pub(super) enum Pending {
         /// What follows when it is done.
         then: AfterCheck,
     },
-    /// A save in flight, answered by [`Event::Saved`].
+    /// A save (of the settings or a preset) in flight, answered by
+    /// [`Event::Saved`].
     Save,
+    /// A preset call waiting for the store, answered by
+    /// [`Event::PresetLoaded`] for that preset.
+    Preset(u8),
     /// A servo bus set-up job in flight, answered by its
     /// `ServoOutcome::Bus` reports.
     ServoBus {
@@ -164,6 +168,7 @@ impl Core {
             Event::Tick => self.heartbeat = self.heartbeat.wrapping_add(1),
             Event::CheckStep => self.check_step(CHECKS_PER_STEP, out),
             Event::Saved(result) => self.saved(result, out),
+            Event::PresetLoaded { n, point } => self.preset_loaded(n, point, out),
             Event::SettingsLoaded(loaded) => self.settings_loaded(loaded, out),
             Event::GateLost => self.gate_lost = true,
             Event::Realtime(request) => self.grbl_realtime(request, out),

@@ -19,6 +19,7 @@ mod gcode;
 mod io;
 mod laser;
 mod machine;
+mod presets;
 mod report;
 mod run;
 mod servo_setup;
@@ -114,7 +115,7 @@ struct Io<'a, L: LaserSwitch, S: SettingsStore> {
 }
 
 /// What the shell does after applying the actions of one event.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 enum FollowUp {
     /// Wait for the next event.
     Nothing,
@@ -122,6 +123,10 @@ enum FollowUp {
     Yield,
     /// Save the settings, then report the result.
     Save,
+    /// Save (or clear) a preset, then report the result.
+    SavePreset(u8, Option<crate::domain::PointCm>),
+    /// Read a preset, then hand it to the core.
+    LoadPreset(u8),
 }
 
 impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
@@ -285,7 +290,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
     }
 
     /// Does what the last actions asked for (yield during a pattern check,
-    /// save the settings) and hands the result to the core.
+    /// save the settings, save or read a preset) and hands the result to the core.
     async fn follow(&mut self, follow_up: FollowUp) -> FollowUp {
         let event = match follow_up {
             FollowUp::Nothing => return FollowUp::Nothing,
@@ -297,6 +302,13 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 let record = self.core.settings().to_record();
                 Event::Saved(self.io.store.save(&record).await)
             }
+            FollowUp::SavePreset(n, point) => {
+                Event::Saved(self.io.store.save_preset(n, point).await)
+            }
+            FollowUp::LoadPreset(n) => Event::PresetLoaded {
+                n,
+                point: self.io.store.load_preset(n).await,
+            },
         };
         self.dispatch(event)
     }
@@ -412,6 +424,8 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
                 };
             }
             Action::Save => self.follow_up = FollowUp::Save,
+            Action::SavePreset { n, point } => self.follow_up = FollowUp::SavePreset(n, point),
+            Action::LoadPreset(n) => self.follow_up = FollowUp::LoadPreset(n),
             Action::Yield => self.follow_up = FollowUp::Yield,
         }
     }

@@ -22,6 +22,7 @@ mod geometry;
 mod legacy;
 mod params;
 mod pelco;
+mod presets;
 mod record;
 mod spec;
 mod stepper;
@@ -32,6 +33,7 @@ mod tests;
 pub use error::SettingsError;
 pub use params::{MAX_CODES_PER_RAD, MIN_CODES_PER_RAD, PARAMS, find_param};
 pub use pelco::{PELCO_BAUDS, PelcoSettings};
+pub use presets::{MAX_PRESET, is_preset, savable};
 pub use record::{
     LoadedRecord, MAX_RECORD_LEN, RECORD_LEN, RECORD_VERSION, RecordError, RecordLayout,
     claimed_record_len, crc32, intact_record_len,

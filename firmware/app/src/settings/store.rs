@@ -16,6 +16,14 @@
 //! then on the map is read). Clearing programs a written word again, hence
 //! [`MultiwriteNorFlash`]: on the STM32F4 bits of a programmed word can be
 //! cleared once more (no ECC).
+//!
+//! Presets are items of the same map, one per preset (`presets.rs`): a
+//! preset is written or cleared at once ([`SettingsStore::save_preset`]),
+//! with the same guarantee (a cut leaves the old or the new preset), and
+//! read when it is called ([`SettingsStore::load_preset`]). When a sector
+//! fills, the map moves the live presets with the newest record. While a
+//! record of the earlier layout is there, presets are refused until the
+//! first `save` has migrated it.
 
 use core::ops::Range;
 
@@ -23,7 +31,11 @@ use embedded_storage_async::nor_flash::{MultiwriteNorFlash, NorFlash};
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapStorage};
 
+use super::presets::{
+    PRESET_VALUE_LEN, StoreKey, decode_preset, encode_preset, is_preset, savable,
+};
 use super::record::{MAX_RECORD_LEN, intact_record_len};
+use crate::domain::PointCm;
 use crate::log;
 
 /// Where settings are saved: [`FlashSettingsStore`] over the target's flash
@@ -35,10 +47,15 @@ pub trait SettingsStore {
     async fn load(&mut self, buf: &mut [u8]) -> usize;
     /// Replaces the saved record; `Err` carries a message for the user.
     async fn save(&mut self, record: &[u8]) -> Result<(), &'static str>;
+    /// The board point of preset `n` (1–255), cm, when one is saved.
+    async fn load_preset(&mut self, n: u8) -> Option<PointCm>;
+    /// Saves board point `point` (cm) as preset `n` (1–255), or clears
+    /// preset `n` (`None`), at once; `Err` carries a message for the user.
+    async fn save_preset(&mut self, n: u8, point: Option<PointCm>) -> Result<(), &'static str>;
 }
 
-/// Map key of the settings record (the only item).
-const RECORD_KEY: u8 = 1;
+/// Map key of the settings record.
+const RECORD_KEY: StoreKey = StoreKey::Record;
 
 /// Scratch buffer for one map item (key byte + the longest record this
 /// build loads, of either layout), padded to the largest flash word
@@ -48,12 +65,12 @@ const ITEM_BUFFER_LEN: usize = (1 + MAX_RECORD_LEN).next_multiple_of(32);
 /// Bytes read at a time when checking that a sector is erased.
 const ERASED_CHECK_CHUNK: usize = 64;
 
-type NoCache = Cache<Uncached, Uncached, Uncached, u8>;
+type NoCache = Cache<Uncached, Uncached, Uncached, StoreKey>;
 
 /// The settings store: a [`MapStorage`] over the flash range given by the
 /// board, plus the migration of a record in the earlier raw layout.
 pub struct FlashSettingsStore<F: NorFlash> {
-    map: MapStorage<u8, F, NoCache>,
+    map: MapStorage<StoreKey, F, NoCache>,
 }
 
 impl<F: MultiwriteNorFlash> FlashSettingsStore<F> {
@@ -205,6 +222,53 @@ impl<F: MultiwriteNorFlash> SettingsStore for FlashSettingsStore<F> {
             self.retire_legacy().await?;
         }
         log::info!("settings saved ({} bytes)", record.len());
+        Ok(())
+    }
+
+    async fn load_preset(&mut self, n: u8) -> Option<PointCm> {
+        if !is_preset(n) {
+            return None;
+        }
+        let mut item = [0u8; ITEM_BUFFER_LEN];
+        if self.read_legacy(&mut item).await.is_some() {
+            // The earlier layout had no presets.
+            return None;
+        }
+        let key = StoreKey::Preset(n);
+        match self.map.fetch_item::<&[u8]>(&mut item, &key).await {
+            Ok(value) => value.and_then(decode_preset),
+            Err(e) => {
+                log::warning!("preset {}: flash unreadable ({})", n, describe(&e));
+                None
+            }
+        }
+    }
+
+    async fn save_preset(&mut self, n: u8, point: Option<PointCm>) -> Result<(), &'static str> {
+        if !is_preset(n) {
+            return Err("no such preset (1-255)");
+        }
+        if point.is_some_and(|p| !savable(p)) {
+            return Err("preset point beyond the board limit");
+        }
+        let mut item = [0u8; ITEM_BUFFER_LEN];
+        if self.read_legacy(&mut item).await.is_some() {
+            // The map does not own the range yet: the first `save`
+            // migrates the record, presets come after it.
+            return Err("settings in an earlier firmware's layout: save them first");
+        }
+        let value = point.map(encode_preset);
+        let bytes: &[u8] = value.as_ref().map_or(&[], |v| &v[..]);
+        debug_assert!(bytes.len() <= PRESET_VALUE_LEN);
+        self.map
+            .store_item(&mut item, &StoreKey::Preset(n), &bytes)
+            .await
+            .map_err(|e| describe(&e))?;
+        log::info!(
+            "preset {} {}",
+            n,
+            if point.is_some() { "saved" } else { "cleared" }
+        );
         Ok(())
     }
 }

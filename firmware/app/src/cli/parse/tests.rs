@@ -192,6 +192,7 @@ fn every_help_line_names_a_command_that_parses_with_its_example() {
         "home",
         "goto 1 1",
         "grid 1 1",
+        "preset goto 1",
         "laser on",
         "model exact",
         "target both",
@@ -220,6 +221,32 @@ fn every_help_line_names_a_command_that_parses_with_its_example() {
             continue;
         }
         assert!(matches!(parse_line(example), Ok(Some(_))), "{example}");
+    }
+}
+
+#[test]
+fn preset_commands_parse_and_bad_numbers_are_refused() {
+    use crate::command::PresetCommand;
+    assert_eq!(ok("preset set 1"), Command::Preset(PresetCommand::Set(1)));
+    assert_eq!(
+        ok("PRESET Clear 255"),
+        Command::Preset(PresetCommand::Clear(255))
+    );
+    assert_eq!(
+        ok("preset goto 17"),
+        Command::Preset(PresetCommand::Goto(17))
+    );
+    for bad in [
+        "preset goto 0",
+        "preset set 256",
+        "preset set -1",
+        "preset set 1.5",
+        "preset call 1",
+        "preset set",
+        "preset set 1 2",
+        "preset",
+    ] {
+        assert!(parse_line(bad).is_err(), "{bad}");
     }
 }
 

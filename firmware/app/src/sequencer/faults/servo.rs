@@ -62,7 +62,10 @@ impl Core {
     ) -> Option<ReplyText> {
         let moves_gimbal = matches!(
             command,
-            Command::Goto(_) | Command::Grid { .. } | Command::Pattern { .. }
+            Command::Goto(_)
+                | Command::Grid { .. }
+                | Command::Pattern { .. }
+                | Command::Preset(crate::command::PresetCommand::Goto(_))
         ) && self.drivers().any(Driver::needs_servos);
         if !moves_gimbal {
             return None;

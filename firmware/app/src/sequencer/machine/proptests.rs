@@ -24,7 +24,7 @@ use embassy_time::{Duration, Instant};
 use proptest::prelude::*;
 
 use super::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
-use crate::command::Command;
+use crate::command::{Command, PresetCommand};
 use crate::domain::{Actuator, AimModel, Figure, GridPattern, Pattern, PointCm, Rotation};
 use crate::galvo::{
     GALVO_REQUEST_DEPTH, GalvoError, GalvoEvent, GalvoRequest, ScanPhase, Underrun,
@@ -131,6 +131,11 @@ fn command() -> impl Strategy<Value = Command> {
         }),
         1 => param.prop_map(|i| Command::Get(&PARAMS[i])),
         1 => Just(Command::Save),
+        1 => (0u8..4, any::<u8>()).prop_map(|(op, n)| Command::Preset(match op {
+            0 => PresetCommand::Set(n),
+            1 => PresetCommand::Clear(n),
+            _ => PresetCommand::Goto(n),
+        })),
         1 => Just(Command::Status),
         1 => Just(Command::GalvoStatus),
         1 => Just(Command::Params),
@@ -429,6 +434,11 @@ impl Harness {
             all.extend(actions);
             next = match follow {
                 Some(Action::Yield) => Some(Event::CheckStep),
+                // A saved preset when the store works, none otherwise.
+                Some(Action::LoadPreset(n)) => Some(Event::PresetLoaded {
+                    n,
+                    point: save_ok.then_some(PointCm::new(1.0, -2.0)),
+                }),
                 Some(_) => Some(Event::Saved(if save_ok {
                     Ok(())
                 } else {
@@ -492,7 +502,9 @@ impl Harness {
             }
             Action::Note(super::super::laser::LaserEvent::Stopped { .. }) => self.running = false,
             Action::Note(super::super::laser::LaserEvent::RunStarted) => self.running = true,
-            Action::Save | Action::Yield => *follow = Some(action.clone()),
+            Action::Save | Action::Yield | Action::SavePreset { .. } | Action::LoadPreset(_) => {
+                *follow = Some(action.clone())
+            }
             Action::Stepper(StepperRequest::MoveTo { seq, point, .. }) => {
                 assert!(self.running, "stepper move while stopped");
                 assert!(self.stepper_attached, "stepper move without a stepper");
