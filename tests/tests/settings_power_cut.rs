@@ -478,3 +478,49 @@ fn a_preset_write_on_a_record_of_the_earlier_layout_is_refused_until_a_save() {
     assert_eq!(record_now, record(9));
     assert_eq!(presets[1], Some(spot(5)));
 }
+
+/// The image `image` leaves after a save of `new` cut at `cut` (`None`:
+/// uncut), and whether the save reported success.
+fn after_save(image: &[u8], new: &[u8], cut: Option<PowerCut>) -> (Vec<u8>, bool) {
+    let flash = Flash::from_image(BASE, image.to_vec()).with_power_cut(cut);
+    let ok = block_on(store(flash.clone()).save(new)).is_ok();
+    (flash.image(), ok)
+}
+
+#[test]
+fn a_cut_first_migration_then_saves_never_boot_defaults_once_a_save_succeeded() {
+    // A board with a record in the earlier layout; its first (migrating)
+    // save is cut anywhere (or not), a later save lands, and then every
+    // step of the next save and of a preset write is cut: the boot loads
+    // the last saved or the new record, never nothing.
+    let old = record(7);
+    let mut raw = old.clone();
+    raw.resize(old.len().next_multiple_of(4), 0xFF);
+    let legacy = legacy_image(&raw, 0xFF);
+    let ops = save_ops(&legacy, &record(8));
+    let mut cuts = 0;
+    let firsts = (0..ops)
+        .flat_map(|at_op| Tear::ALL.map(|tear| Some(PowerCut { at_op, tear })))
+        .chain([None]);
+    for first in firsts {
+        let (cut, ok) = after_save(&legacy, &record(8), first);
+        let loaded = boot(cut.clone());
+        assert!(loaded == old || loaded == record(8), "{first:?}: neither");
+        assert!(ok || first.is_some());
+        // Every step of the save after it (from what the cut left).
+        cuts += check_every_cut(&cut, &loaded, &record(9));
+        let (image, ok) = after_save(&cut, &record(9), None);
+        assert!(ok, "{first:?}: the save after the cut");
+        assert_eq!(boot(image.clone()), record(9), "{first:?}");
+        let (tried, broken) = cut_every_step(store, &image, &record(9), &record(10));
+        assert!(
+            broken.is_empty(),
+            "first save cut at {first:?}; {} of {tried} cut points of the third: {broken:#?}",
+            broken.len()
+        );
+        cuts += tried;
+        let (tried, _) = check_every_preset_cut(&image, 3, Some(spot(3)));
+        cuts += tried;
+    }
+    eprintln!("cut migrations then saves: {cuts} cut points (step x tear)");
+}

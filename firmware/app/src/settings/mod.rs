@@ -20,6 +20,7 @@ mod error;
 mod gcode;
 mod geometry;
 mod legacy;
+mod migrate;
 mod params;
 mod pelco;
 mod presets;

@@ -10,12 +10,11 @@
 //!
 //! Earlier firmware wrote the record raw at the start of the range's last
 //! sector (sector 11 on the target). Such a record is loaded as it is until
-//! the first `save`, which migrates it without a window of loss: erase the
-//! other sector (the old record still loads), append the new record through
-//! the map behind the old one, then clear the old record's magic word (from
-//! then on the map is read). Clearing programs a written word again, hence
-//! [`MultiwriteNorFlash`]: on the STM32F4 bits of a programmed word can be
-//! cleared once more (no ECC).
+//! the first `save`, which migrates it without a window of loss and without
+//! the map ever reading the raw record as one of its pages (`migrate.rs`):
+//! the new record goes into the first sector, which is closed, and only
+//! then is the last sector erased; a cut in that erase is repaired by the
+//! map as a cut hand-over.
 //!
 //! Presets are items of the same map, one per preset (`presets.rs`): a
 //! preset is written or cleared at once ([`SettingsStore::save_preset`]),
@@ -31,6 +30,7 @@ use embedded_storage_async::nor_flash::{MultiwriteNorFlash, NorFlash};
 use sequential_storage::cache::{Cache, Uncached};
 use sequential_storage::map::{MapConfig, MapStorage};
 
+use super::migrate::write_closed_first_page;
 use super::presets::{
     PRESET_VALUE_LEN, StoreKey, decode_preset, encode_preset, is_preset, savable,
 };
@@ -146,17 +146,23 @@ impl<F: MultiwriteNorFlash> FlashSettingsStore<F> {
         Ok(())
     }
 
-    /// Retires the record in the earlier layout by clearing its magic word
-    /// (the map already holds the new record behind it).
-    async fn retire_legacy(&mut self) -> Result<(), &'static str> {
-        let at = self.legacy_offset();
-        let zero = [0u8; 32];
-        let word = zero.get(..F::WRITE_SIZE.max(4)).unwrap_or(&zero);
+    /// The first `save` after an update from the earlier layout: the new
+    /// record in the closed first sector (the old one loads meanwhile),
+    /// then the old record's sector erased (see `migrate.rs`).
+    async fn migrate(
+        &mut self,
+        item: &mut [u8; ITEM_BUFFER_LEN],
+        record: &[u8],
+    ) -> Result<(), &'static str> {
+        self.prepare_migration().await?;
+        let range = self.range();
+        write_closed_first_page(self.map.flash(), range, item, record).await?;
+        let legacy = self.legacy_offset();
         self.map
             .flash()
-            .write(at, word)
+            .erase(legacy, legacy + F::ERASE_SIZE as u32)
             .await
-            .map_err(|_| WRITE_FAILED)
+            .map_err(|_| "flash erase failed")
     }
 }
 
@@ -197,13 +203,14 @@ impl<F: MultiwriteNorFlash> SettingsStore for FlashSettingsStore<F> {
 
     async fn save(&mut self, record: &[u8]) -> Result<(), &'static str> {
         let mut item = [0u8; ITEM_BUFFER_LEN];
-        let legacy = self.read_legacy(&mut item).await.is_some();
-        if legacy {
-            self.prepare_migration().await?;
+        if self.read_legacy(&mut item).await.is_some() {
+            self.migrate(&mut item, record).await?;
+            log::info!("settings migrated and saved ({} bytes)", record.len());
+            return Ok(());
         }
         match self.map.store_item(&mut item, &RECORD_KEY, &record).await {
             Ok(()) => {}
-            Err(sequential_storage::Error::Corrupted { .. }) if !legacy => {
+            Err(sequential_storage::Error::Corrupted { .. }) => {
                 // The map could not repair itself. Start afresh only when
                 // no saved record loads any more (nothing left to lose).
                 if let Ok(Some(_)) = self.map.fetch_item::<&[u8]>(&mut item, &RECORD_KEY).await {
@@ -217,9 +224,6 @@ impl<F: MultiwriteNorFlash> SettingsStore for FlashSettingsStore<F> {
                     .map_err(|e| describe(&e))?;
             }
             Err(e) => return Err(describe(&e)),
-        }
-        if legacy {
-            self.retire_legacy().await?;
         }
         log::info!("settings saved ({} bytes)", record.len());
         Ok(())
