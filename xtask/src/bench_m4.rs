@@ -18,6 +18,7 @@
 //! budgets apply to it (see `docs/bench-m4-sweeps.md`).
 
 mod budgets;
+mod gcode_rows;
 mod pelco_rows;
 pub(crate) mod qemu;
 mod report;

@@ -27,6 +27,7 @@ use cortex_m_rt::entry;
 
 mod checks;
 mod galvo_loop;
+mod gcode;
 mod harness;
 mod kinematics;
 mod path;
@@ -71,6 +72,7 @@ fn main() -> ! {
     sweep::jump_sweep(&mut b);
     sweep_strokes::stroke_sweep(&mut b);
     pelco::pelco(&mut b);
+    gcode::gcode_lines(&mut b);
 
     let _ = writeln!(b.out, "done {}", b.failures);
     b.out.flush();

@@ -5,13 +5,17 @@ use anyhow::{Context, Result, bail};
 use serde::Serialize;
 
 use super::budgets::{Enforcement, ROWS, Row, plan_row};
+use super::gcode_rows::GCODE_ROWS;
 use super::pelco_rows::PELCO_ROWS;
 use super::stepper_rows::STEPPER_ROWS;
 
 /// Every row with a description: the galvo's, the stepper's, the PELCO
-/// port's.
+/// port's, the G-code lines'.
 fn all_rows() -> impl Iterator<Item = &'static Row> {
-    ROWS.iter().chain(STEPPER_ROWS).chain(PELCO_ROWS)
+    ROWS.iter()
+        .chain(STEPPER_ROWS)
+        .chain(PELCO_ROWS)
+        .chain(GCODE_ROWS)
 }
 
 /// STM32F407 core clock, MHz.
@@ -186,6 +190,7 @@ fn measured(id: &str, instructions: f64) -> Measured {
         median_instructions: None,
         status: budget.map(|(_, _, e)| match e {
             Enforcement::Enforced => "enforced".to_owned(),
+            Enforcement::NotMet(why) => format!("not met: {why}"),
         }),
         over_budget: budget.is_some_and(|(b, _, e)| e == Enforcement::Enforced && us > b),
     }

@@ -29,6 +29,10 @@ const OUT: &str = "bench-m4 1\ncalibration 2000000 50000\nempty 0 64\n\
     bench pelco.frame.query_pan 237 1\nbench pelco.frame.goto_preset 236 1\n\
     bench sweep.pelco.frame 1930 1\n\
     worst sweep.pelco.frame 2000 A00000120106AF1A (P move) at (21.64,29.03) cm\n\
+    bench gcode.line.gimbal 21948 1\nmedian gcode.line.gimbal 9971 1\n\
+    bench gcode.line.gimbal.core 12565 1\n\
+    worst gcode.line.gimbal 300 G2 X31.251 Y2.232 I14.892 J15.371 F2303\n\
+    bench gcode.line.galvo 7404 1\nbench gcode.line.stepper 118688 1\n\
     done 0\n";
 
 #[test]
@@ -122,6 +126,25 @@ fn an_enforced_budget_over_fails() {
     let err = check(&parse(&pelco).unwrap()).unwrap_err().to_string();
     assert!(err.contains("sweep.pelco.frame"), "{err}");
     assert!(err.contains("A00000120106AF1A"), "{err}");
+}
+
+#[test]
+fn a_goal_not_met_is_shown_against_its_budget_without_failing() {
+    let r = parse(OUT).unwrap();
+    let m = r.rows.iter().find(|m| m.id == "gcode.line.gimbal").unwrap();
+    // 21 948 ticks: 877 920 instructions against 16 000.
+    assert_eq!(m.instructions, 21_948.0 * 40.0);
+    assert!(m.share.unwrap() > 50.0 && !m.over_budget);
+    assert!(m.status.as_deref().unwrap().starts_with("not met: "));
+    assert_eq!(
+        m.worst_input.as_deref(),
+        Some("G2 X31.251 Y2.232 I14.892 J15.371 F2303")
+    );
+    check(&r).unwrap();
+    // Without its line the run is incomplete.
+    let missing = OUT.replace("bench gcode.line.galvo 7404 1\n", "");
+    let err = parse(&missing).unwrap_err().to_string();
+    assert!(err.contains("gcode.line.galvo"), "{err}");
 }
 
 fn manifest(path: &str) -> toml::Table {
