@@ -70,6 +70,11 @@ const fn half_refill_budget(enforcement: Enforcement) -> Option<(f64, &'static s
     ))
 }
 
+/// STM32F407 core clock, MHz.
+pub const CLOCK_MHZ: f64 = 168.0;
+/// Cycles per instruction assumed for the estimate.
+pub const CPI: f64 = 1.3;
+
 /// Every benchmark and its budget (issue 11, "Done when": 100 kHz, CPI 1.3
 /// at 168 MHz). Budgets are µs per unit; exceeding one fails the run
 /// (and `cargo xtask test`).

@@ -5,8 +5,7 @@
 //! (firmware/bench-m4/src/gcode.rs). Goal: 2 000 lines/s within 25 % of
 //! the CPU, i.e. 125 µs per line, ≤ 16 000 M4 instructions.
 
-use super::budgets::{Enforcement, Row};
-use super::report::{CLOCK_MHZ, CPI};
+use super::budgets::{CLOCK_MHZ, CPI, Enforcement, Row};
 
 /// Instructions per line the goal allows.
 const LINE_INSTRUCTIONS: f64 = 16_000.0;

@@ -18,10 +18,7 @@ fn all_rows() -> impl Iterator<Item = &'static Row> {
         .chain(GCODE_ROWS)
 }
 
-/// STM32F407 core clock, MHz.
-pub const CLOCK_MHZ: f64 = 168.0;
-/// Cycles per instruction assumed for the estimate.
-pub const CPI: f64 = 1.3;
+pub use super::budgets::{CLOCK_MHZ, CPI};
 /// Instructions per timer tick the board model implies (1 ns per
 /// instruction, 25 MHz timer); the calibration must agree within 0.5 %.
 const NOMINAL_INSTRUCTIONS_PER_TICK: f64 = 40.0;
