@@ -133,6 +133,24 @@ pub fn assert_safe_allowing(report: &SimReport, open: &[ViolationKind]) {
 /// at every sample period).
 pub const UNTIL_STEP_FIXES: &[ViolationKind] = &[ViolationKind::LongStep];
 
+/// The safety verdict on a run of the calibration build (board rolled,
+/// servo off zero): uncalibrated (`calibrated == false`) the spot is
+/// several mm off its grid and the figure rule must say so (and only it,
+/// beside [`UNTIL_STEP_FIXES`]); calibrated, every invariant holds.
+pub fn assert_calibration_build_safety(report: &SimReport, calibrated: bool) {
+    if calibrated {
+        assert_safe_allowing(report, UNTIL_STEP_FIXES);
+        return;
+    }
+    assert!(
+        check(report)
+            .iter()
+            .any(|v| v.kind == ViolationKind::OffFigure),
+        "the uncalibrated build is off its figure"
+    );
+    assert_safe_allowing(report, &[ViolationKind::LongStep, ViolationKind::OffFigure]);
+}
+
 /// Every line of the terminal transcript (`> command` for what was sent).
 pub fn terminal_lines(report: &SimReport) -> Vec<&str> {
     report

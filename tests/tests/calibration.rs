@@ -6,9 +6,8 @@
 
 use kinematics_core::{MeasuredPoint, fit};
 use laser_sim::bench::BenchBuild;
-use laser_sim::safety::{ViolationKind, check};
 use laser_sim::world::{SimOptions, SimReport};
-use system_tests::{UNTIL_STEP_FIXES, assert_safe_allowing, run_with};
+use system_tests::{assert_calibration_build_safety, run_with};
 
 /// The build error of the README's calibration figures, as
 /// `cargo xtask sim --board-roll-deg 1 --yaw-zero-deg 0.8` sets it.
@@ -30,20 +29,7 @@ fn run_grid(setup: &str) -> SimReport {
     // Uncalibrated (no `set err.*`), the build puts the spot several mm
     // off its grid and the safety checker's figure rule says so;
     // calibrated, it holds with the rest.
-    if setup.is_empty() {
-        assert!(
-            check(&report)
-                .iter()
-                .any(|v| v.kind == ViolationKind::OffFigure),
-            "the uncalibrated build is off its figure"
-        );
-        assert_safe_allowing(
-            &report,
-            &[ViolationKind::LongStep, ViolationKind::OffFigure],
-        );
-    } else {
-        assert_safe_allowing(&report, UNTIL_STEP_FIXES);
-    }
+    assert_calibration_build_safety(&report, !setup.is_empty());
     assert!(report.succeeded(false), "{:?}", report.transcript);
     assert_eq!(report.recording.dwells.len(), 13 * 9);
     report
