@@ -125,26 +125,12 @@ pub fn run_on_qemu() -> Result<()> {
             failures.push(format!("{}: {e:#}", scenario.name));
         }
     }
-    let started = std::time::Instant::now();
-    let verdict = qemu::check_pty_console(&plain);
-    println!(
-        "the --pty console on QEMU: {} ({:.1} s)",
-        if verdict.is_ok() { "ok" } else { "FAILED" },
-        started.elapsed().as_secs_f64()
-    );
-    if let Err(e) = verdict {
-        failures.push(format!("--pty console: {e:#}"));
-    }
-    let started = std::time::Instant::now();
-    let verdict = qemu::check_pelco_port(&plain);
-    println!(
-        "the PELCO port on QEMU: {} ({:.1} s)",
-        if verdict.is_ok() { "ok" } else { "FAILED" },
-        started.elapsed().as_secs_f64()
-    );
-    if let Err(e) = verdict {
-        failures.push(format!("PELCO port: {e:#}"));
-    }
+    timed_check(&mut failures, "the --pty console", || {
+        qemu::check_pty_console(&plain)
+    });
+    timed_check(&mut failures, "the PELCO port", || {
+        qemu::check_pelco_port(&plain)
+    });
     let started = std::time::Instant::now();
     let verdict = hil::check_on_qemu(&plain);
     match &verdict {
@@ -158,19 +144,27 @@ pub fn run_on_qemu() -> Result<()> {
     if let Err(e) = verdict {
         failures.push(format!("hil on QEMU: {e:#}"));
     }
-    let started = std::time::Instant::now();
-    let verdict = qemu::build_image_with(&["defmt-log"], true)
-        .and_then(|elf| qemu::check_defmt_channel(&elf));
-    println!(
-        "the defmt log channel on QEMU: {} ({:.1} s)",
-        if verdict.is_ok() { "ok" } else { "FAILED" },
-        started.elapsed().as_secs_f64()
-    );
-    if let Err(e) = verdict {
-        failures.push(format!("defmt log channel: {e:#}"));
-    }
+    timed_check(&mut failures, "the defmt log channel", || {
+        qemu::build_image_with(&["defmt-log"], true).and_then(|elf| qemu::check_defmt_channel(&elf))
+    });
     if !failures.is_empty() {
         bail!("scenarios failed:\n{}", failures.join("\n"));
     }
     Ok(())
+}
+
+/// Runs one end-to-end check on QEMU, prints `<what> on QEMU: ok|FAILED
+/// (<s>)` and adds a failure (named without a leading "the ") to
+/// `failures`.
+fn timed_check(failures: &mut Vec<String>, what: &str, check: impl FnOnce() -> Result<()>) {
+    let started = std::time::Instant::now();
+    let verdict = check();
+    println!(
+        "{what} on QEMU: {} ({:.1} s)",
+        if verdict.is_ok() { "ok" } else { "FAILED" },
+        started.elapsed().as_secs_f64()
+    );
+    if let Err(e) = verdict {
+        failures.push(format!("{}: {e:#}", what.trim_start_matches("the ")));
+    }
 }
