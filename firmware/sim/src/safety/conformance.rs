@@ -107,7 +107,7 @@ fn off_path(session: &Session, spot: Spot, samples: &[(u64, [f64; 2], bool)]) ->
     let lit: Vec<&Motion> = session.motions.iter().filter(|m| m.lit).collect();
     let mut found = Vec::new();
     // (first µs, last µs, samples, worst mm, where).
-    let mut episode: Option<(u64, u64, u32, f64, [f64; 2])> = None;
+    let mut episode: Option<OffEpisode> = None;
     let mut cursor = 0usize;
     for &(t, p, _) in samples.iter().filter(|s| s.2) {
         let known = lit.partition_point(|m| m.sent_us <= t);
@@ -128,31 +128,41 @@ fn off_path(session: &Session, spot: Spot, samples: &[(u64, [f64; 2], bool)]) ->
             _ => {}
         }
         let d = nearest.map_or(f64::INFINITY, |n| n.1);
-        match episode.as_mut() {
-            Some(e) if t <= e.1 + 100_000 => {
-                e.1 = t;
-                e.2 += 1;
-                if d > e.3 {
-                    e.3 = d;
-                    e.4 = p;
-                }
-            }
-            _ => {
-                flush_path(&mut found, episode.take(), tol, spot);
-                episode = Some((t, t, 1, d, p));
-            }
+        if let Some(done) = extend_episode(&mut episode, (t, d, p), 100_000) {
+            flush_path(&mut found, Some(done), tol, spot);
         }
     }
     flush_path(&mut found, episode, tol, spot);
     found
 }
 
-fn flush_path(
-    found: &mut Vec<Violation>,
-    episode: Option<(u64, u64, u32, f64, [f64; 2])>,
-    tol: f64,
-    spot: Spot,
-) {
+/// Lit samples off their path close together in time: first and last
+/// sample (µs), how many, the worst distance (mm) and where it was (mm).
+pub(super) type OffEpisode = (u64, u64, u32, f64, [f64; 2]);
+
+/// Adds the off-path sample `(t_us, distance_mm, point_mm)` to `episode`
+/// when it comes within `gap_us` of its last sample; otherwise starts a
+/// new episode with it and returns the one it ends.
+pub(super) fn extend_episode(
+    episode: &mut Option<OffEpisode>,
+    (t, d, p): (u64, f64, [f64; 2]),
+    gap_us: u64,
+) -> Option<OffEpisode> {
+    match episode.as_mut() {
+        Some(e) if t <= e.1 + gap_us => {
+            e.1 = t;
+            e.2 += 1;
+            if d > e.3 {
+                e.3 = d;
+                e.4 = p;
+            }
+            None
+        }
+        _ => episode.replace((t, t, 1, d, p)),
+    }
+}
+
+fn flush_path(found: &mut Vec<Violation>, episode: Option<OffEpisode>, tol: f64, spot: Spot) {
     if let Some((first, last, n, worst, p)) = episode {
         found.push(Violation {
             kind: ViolationKind::OffPath,

@@ -7,7 +7,7 @@
 //! is dark in `laser dwell`), half the gimbal's interpolation step added
 //! on a path.
 
-use super::conformance::{Samples, samples, window};
+use super::conformance::{OffEpisode, Samples, extend_episode, samples, window};
 use super::gcode_model::Spot;
 use super::gcode_piece::Piece;
 use super::pattern_model::{JudgedRun, judged_runs};
@@ -52,7 +52,7 @@ fn off_figure(run: &JudgedRun, samples: &[(u64, [f64; 2], bool)]) -> Vec<Violati
     let tol = run.spot.tolerance_mm() + run.extra_mm;
     let mut found = Vec::new();
     // (first µs, last µs, samples, worst mm, where).
-    let mut episode: Option<(u64, u64, u32, f64, [f64; 2])> = None;
+    let mut episode: Option<OffEpisode> = None;
     let mut hint = 0usize;
     for &(t, p, _) in samples.iter().filter(|s| s.2) {
         let d = match nearest(&run.pieces, p, hint, tol) {
@@ -63,30 +63,15 @@ fn off_figure(run: &JudgedRun, samples: &[(u64, [f64; 2], bool)]) -> Vec<Violati
             Some((_, d)) => d,
             None => f64::INFINITY,
         };
-        match episode.as_mut() {
-            Some(e) if t <= e.1 + EPISODE_GAP_US => {
-                e.1 = t;
-                e.2 += 1;
-                if d > e.3 {
-                    e.3 = d;
-                    e.4 = p;
-                }
-            }
-            _ => {
-                found.extend(report(run, episode.take(), tol));
-                episode = Some((t, t, 1, d, p));
-            }
+        if let Some(done) = extend_episode(&mut episode, (t, d, p), EPISODE_GAP_US) {
+            found.extend(report(run, Some(done), tol));
         }
     }
     found.extend(report(run, episode, tol));
     found
 }
 
-fn report(
-    run: &JudgedRun,
-    episode: Option<(u64, u64, u32, f64, [f64; 2])>,
-    tol: f64,
-) -> Option<Violation> {
+fn report(run: &JudgedRun, episode: Option<OffEpisode>, tol: f64) -> Option<Violation> {
     let (first, last, n, worst, p) = episode?;
     let what = if run.pieces.is_empty() {
         "lit where its laser mode draws nothing".to_owned()
