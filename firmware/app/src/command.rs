@@ -17,7 +17,7 @@ use embassy_sync::signal::Signal;
 
 use crate::domain::{Actuator, AimModel, Pattern, PointCm};
 use crate::grbl::realtime::Realtime;
-use crate::outbound::{LineKind, Outbound};
+use crate::outbound::{LineKind, Origin, Outbound};
 
 mod pelco_status;
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
@@ -408,38 +408,94 @@ impl CommandLink {
         self.outbound.push_fmt(LineKind::Notice, args);
     }
 
-    /// Queues one data line of the current reply (never waits; dropped and
-    /// counted when the host is not reading and the queue is full).
+    /// The replies to the command in flight (the sequencer's, whichever
+    /// task sent the command).
+    pub fn reply(&self) -> Reply<'_> {
+        Reply {
+            outbound: &self.outbound,
+            origin: Origin::Command,
+        }
+    }
+
+    /// Lines that are not the command in flight's: the console's own
+    /// answers to lines it does not dispatch, realtime reports (see
+    /// [`Origin::Direct`]).
+    pub fn direct_reply(&self) -> Reply<'_> {
+        Reply {
+            outbound: &self.outbound,
+            origin: Origin::Direct,
+        }
+    }
+
+    /// Queues one data line of the current reply (see [`Reply::data`]).
     pub fn data(&self, args: fmt::Arguments<'_>) {
-        self.outbound.push_fmt(LineKind::Data, args);
+        self.reply().data(args);
+    }
+
+    /// Queues one data line already formatted (see [`Reply::data_line`]).
+    pub fn data_line(&self, line: ReplyText) {
+        self.reply().data_line(line);
+    }
+
+    /// Closes the current reply with `ok` (see [`Reply::ok`]).
+    pub fn ok(&self) {
+        self.reply().ok();
+    }
+
+    /// Closes the current reply with grbl's `error:N` (see
+    /// [`Reply::grbl_error`]).
+    pub fn grbl_error(&self, error: crate::grbl::GrblError) {
+        self.reply().grbl_error(error);
+    }
+
+    /// Closes the current reply with `error: <reason>` (see
+    /// [`Reply::error`]).
+    pub fn error(&self, reason: impl fmt::Display) {
+        self.reply().error(reason);
+    }
+}
+
+/// One answerer's lines into the outbound queue (see [`Origin`]).
+#[derive(Clone, Copy)]
+pub struct Reply<'a> {
+    outbound: &'a Outbound,
+    origin: Origin,
+}
+
+impl Reply<'_> {
+    /// Queues one data line (never waits; dropped and counted when the
+    /// host is not reading and the queue is full).
+    pub fn data(self, args: fmt::Arguments<'_>) {
+        self.outbound
+            .push_fmt_from(self.origin, LineKind::Data, args);
     }
 
     /// Queues one data line already formatted (never waits, like
-    /// [`CommandLink::data`]).
-    pub fn data_line(&self, line: ReplyText) {
-        self.outbound.push(LineKind::Data, &line);
+    /// [`Reply::data`]).
+    pub fn data_line(self, line: ReplyText) {
+        self.outbound.push_from(self.origin, LineKind::Data, &line);
     }
 
-    /// Closes the current reply with `ok` (never waits; a closer always
-    /// has room).
-    pub fn ok(&self) {
-        self.outbound.push(LineKind::Ok, "");
+    /// Closes the reply with `ok` (never waits; a closer always has room).
+    pub fn ok(self) {
+        self.outbound.push_from(self.origin, LineKind::Ok, "");
     }
 
-    /// Closes the current reply with grbl's `error:N` (never waits; a
-    /// closer always has room).
-    pub fn grbl_error(&self, error: crate::grbl::GrblError) {
-        self.outbound.push_fmt(
+    /// Closes the reply with grbl's `error:N` (never waits; a closer
+    /// always has room).
+    pub fn grbl_error(self, error: crate::grbl::GrblError) {
+        self.outbound.push_fmt_from(
+            self.origin,
             LineKind::GrblError,
             format_args!("{}", u32::from(error.code())),
         );
     }
 
-    /// Closes the current reply with `error: <reason>` (never waits; a
-    /// closer always has room).
-    pub fn error(&self, reason: impl fmt::Display) {
+    /// Closes the reply with `error: <reason>` (never waits; a closer
+    /// always has room).
+    pub fn error(self, reason: impl fmt::Display) {
         self.outbound
-            .push_fmt(LineKind::Error, format_args!("{reason}"));
+            .push_fmt_from(self.origin, LineKind::Error, format_args!("{reason}"));
     }
 }
 

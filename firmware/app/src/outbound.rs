@@ -235,6 +235,24 @@ impl Queue {
     }
 }
 
+/// Who queues a line, which decides whether it belongs to the command in
+/// flight.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Origin {
+    /// The reply of the command in flight (or a notice), from whichever
+    /// task runs it: a closer ends the command, and the lines of a quiet
+    /// command (the PELCO port's) are kept from the host.
+    Command,
+    /// Not the command in flight's, straight to the host: the console
+    /// answering a line itself without dispatching it (a parse error, a
+    /// refused line, `pelco status`), a realtime report (`?`, the lines
+    /// of a soft reset). It never closes the command in flight nor counts
+    /// as a quiet command's reply (a PELCO `get` in flight at boot once
+    /// took the console's error for a bad line as its own, and the
+    /// `get`'s reply went to the host instead).
+    Direct,
+}
+
 /// The outbound line queue (usable in a `static`).
 pub struct Outbound {
     queue: Mutex<CriticalSectionRawMutex, RefCell<Queue>>,
@@ -258,16 +276,24 @@ impl Outbound {
         self.queue.lock(|q| f(&mut q.borrow_mut()))
     }
 
-    /// Queues one line without waiting; `false` when it was dropped (and
-    /// counted) because its share of the queue is full. A closer also ends
-    /// the command in flight.
+    /// Queues one line of the command in flight's reply without waiting;
+    /// `false` when it was dropped (and counted) because its share of the
+    /// queue is full. A closer also ends the command in flight.
     pub fn push(&self, kind: LineKind, text: &str) -> bool {
+        self.push_from(Origin::Command, kind, text)
+    }
+
+    /// Queues one line from `origin` without waiting (see [`Origin`]);
+    /// `false` when it was dropped and counted.
+    pub fn push_from(&self, origin: Origin, kind: LineKind, text: &str) -> bool {
         let mut quiet = false;
         let queued = self.with(|q| {
-            if kind.is_closer() {
-                q.awaiting_close = false;
+            if origin == Origin::Command {
+                if kind.is_closer() {
+                    q.awaiting_close = false;
+                }
+                quiet = q.quiet.keep(kind, text);
             }
-            quiet = q.quiet.keep(kind, text);
             quiet || q.push(kind, text)
         });
         if quiet {
@@ -287,9 +313,16 @@ impl Outbound {
         queued
     }
 
-    /// Queues a line formatted from `args` (cut at [`REPLY_LINE_LEN`]).
+    /// Queues a line of the command in flight formatted from `args` (cut
+    /// at [`REPLY_LINE_LEN`]).
     pub fn push_fmt(&self, kind: LineKind, args: fmt::Arguments<'_>) -> bool {
-        self.push(kind, &reply_text(args))
+        self.push_fmt_from(Origin::Command, kind, args)
+    }
+
+    /// Queues a line from `origin` formatted from `args` (cut at
+    /// [`REPLY_LINE_LEN`]).
+    pub fn push_fmt_from(&self, origin: Origin, kind: LineKind, args: fmt::Arguments<'_>) -> bool {
+        self.push_from(origin, kind, &reply_text(args))
     }
 
     /// Takes the next line to write (drop reports included), if any.

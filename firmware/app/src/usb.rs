@@ -170,9 +170,9 @@ async fn read_lines<R: Read>(rx: &mut R, link: &CommandLink) -> ConsoleEnd {
                 if classify(assembler.long_line_head()) != LineKind::Product =>
             {
                 input.greet(link);
-                link.grbl_error(GrblError::LineOverflow);
+                link.direct_reply().grbl_error(GrblError::LineOverflow);
             }
-            Err(e) => link.error(e),
+            Err(e) => link.direct_reply().error(e),
             Ok(line) if classify(line.as_str()) == LineKind::Product => {
                 dispatch(line.as_str(), link, &mut reading).await;
             }
@@ -218,7 +218,7 @@ impl RxBuffer {
     /// Sends grbl's banner once per connection.
     fn greet(&mut self, link: &CommandLink) {
         if !core::mem::replace(&mut self.greeted, true) {
-            link.outbound.push(OutKind::Data, BANNER);
+            link.direct_reply().data(format_args!("{BANNER}"));
         }
     }
 
@@ -283,7 +283,7 @@ async fn dispatch_grbl<R: Read>(
     let out = &link.outbound;
     input.greet(link);
     let Some(line) = GrblLine::new(line) else {
-        link.grbl_error(GrblError::LineOverflow);
+        link.direct_reply().grbl_error(GrblError::LineOverflow);
         return Ok(Filled::Bytes);
     };
     // A quiet command (the PELCO port's) may be in flight.
@@ -356,15 +356,16 @@ async fn dispatch(line: &str, link: &CommandLink, reading: &mut HostReading) {
     let out = &link.outbound;
     if line.split_whitespace().eq(["pelco", "status"]) {
         // Answered here: the port's counters are the console's to read.
-        link.pelco.report(|args| link.data(args));
-        return link.ok();
+        let reply = link.direct_reply();
+        link.pelco.report(|args| reply.data(args));
+        return reply.ok();
     }
     let command = match parse_line(line) {
         Ok(Some(command)) => command,
-        Ok(None) => return link.ok(),
+        Ok(None) => return link.direct_reply().ok(),
         Err(e) => {
             log::debug!("refused line: {}", e);
-            return link.error(e);
+            return link.direct_reply().error(e);
         }
     };
     if command.replies_with_data() && out.queued_bytes() > 0 && !reading.not_reading(out) {

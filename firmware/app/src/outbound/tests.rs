@@ -193,3 +193,28 @@ fn a_quiet_command_reply_is_kept_from_the_host_but_notices_are_not() {
     assert_eq!(drain(&out).len(), 1);
     assert!(out.take_quiet_reply().is_none());
 }
+
+#[test]
+fn a_direct_line_neither_closes_nor_answers_the_quiet_command_in_flight() {
+    let out = Outbound::new();
+    assert!(out.begin_quiet_command());
+    // The console refuses a line it parsed and a `?` is answered meanwhile.
+    assert!(out.push_from(Origin::Direct, LineKind::Error, "unknown command 'xyzzy'"));
+    assert!(out.push_from(
+        Origin::Direct,
+        LineKind::Data,
+        "<Idle|MPos:0.000,0.000,0.000>"
+    ));
+    assert!(out.awaiting_close(), "the quiet command is still in flight");
+    assert!(out.take_quiet_reply().is_none());
+    assert!(out.push(LineKind::Data, "pelco.baud = 9600"));
+    assert!(out.push(LineKind::Ok, ""));
+    let reply = out.take_quiet_reply().expect("closed");
+    assert_eq!(reply.data.as_str(), "pelco.baud = 9600");
+    let host = drain(&out);
+    assert_eq!(host.len(), 2);
+    assert_eq!(
+        (host[0].kind, host[1].kind),
+        (LineKind::Error, LineKind::Data)
+    );
+}

@@ -36,7 +36,7 @@ use crate::galvo::{GalvoLink, GalvoRequest};
 use crate::laser_controls::ControlsLink;
 use crate::laser_gate::LaserGate;
 use crate::log;
-use crate::outbound::LineKind;
+use crate::outbound::{LineKind, Origin};
 use crate::servo::task::ServoLink;
 use crate::settings::Settings;
 use crate::status::StatusBoard;
@@ -112,6 +112,10 @@ struct Io<'a, L: LaserSwitch, S: SettingsStore> {
     /// The gate refused to light the gimbal laser (the core is told once
     /// the event and its follow-ups are done).
     refused: bool,
+    /// Whose data lines the event being handled produces: a realtime
+    /// request's (`?`, a soft reset's banner) are not the reply of the
+    /// command in flight, which may be the PELCO port's quiet one.
+    data_origin: Origin,
 }
 
 /// What the shell does after applying the actions of one event.
@@ -162,6 +166,7 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             store,
             follow_up: FollowUp::Nothing,
             refused: false,
+            data_origin: Origin::Command,
         };
         Self::started(io, record.get(..n).unwrap_or(&[]))
     }
@@ -277,6 +282,10 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             self.core
                 .note_stepper_speed(self.io.stepper.speed_permille());
             self.core.note_laser_controls(self.io.controls.view());
+            self.io.data_origin = match event {
+                Event::Realtime(_) => Origin::Direct,
+                _ => Origin::Command,
+            };
             self.core.on(inputs, event, &mut self.io);
             let follow_up = core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing);
             if follow_up != FollowUp::Nothing {
@@ -413,7 +422,7 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
             Action::Line(line) => {
                 let outbound = &self.link.outbound;
                 let _ = match &line {
-                    Line::Data(text) => outbound.push(LineKind::Data, text),
+                    Line::Data(text) => outbound.push_from(self.data_origin, LineKind::Data, text),
                     Line::Notice(text) => outbound.push(LineKind::Notice, text),
                     Line::Ok => outbound.push(LineKind::Ok, ""),
                     Line::Error(text) => outbound.push(LineKind::Error, text),

@@ -72,10 +72,11 @@ impl OwedClosers {
             let Some((ok, count)) = self.runs.front_mut() else {
                 return;
             };
+            let reply = link.direct_reply();
             if *ok {
-                link.ok();
+                reply.ok();
             } else {
-                link.error(NOT_RUN);
+                reply.error(NOT_RUN);
             }
             *count -= 1;
             if *count == 0 {
