@@ -1,8 +1,8 @@
 //! Import cycles between the files of a module tree (non-test code): a
 //! file's module imports another's when it names it by path (`use`, or
 //! an inline `crate::…` / `super::…` / `self::…` path); `mod` declarations
-//! are not imports, and nor (a known gap) is a child module named without
-//! `self::` (`mod x; use x::Y;`). The tests (`import_cycles/tests.rs`) check that no crate of
+//! are not imports, but naming a child module without `self::`
+//! (`mod x; use x::Y;`) is. The tests (`import_cycles/tests.rs`) check that no crate of
 //! the workspace (the separate `qemu-m4` and `bench-m4` workspaces
 //! included) has an import cycle but those its `KNOWN_CYCLES` lists (a
 //! ratchet: a listed cycle that is gone fails too), that the sequencer's
@@ -28,7 +28,12 @@ pub fn import_graph(
     let mut graph = BTreeMap::new();
     for (module, text) in &sources {
         let mut imports = BTreeSet::new();
-        for path in paths(text) {
+        let children: BTreeSet<&str> = modules
+            .iter()
+            .filter(|m| m.len() == module.len() + 1 && m.starts_with(module))
+            .filter_map(|m| m.last().map(String::as_str))
+            .collect();
+        for path in paths(text, &children) {
             let Some(absolute) = resolve(module, &path, crate_path) else {
                 continue;
             };
@@ -174,9 +179,10 @@ fn without_tests(text: &str) -> String {
 }
 
 /// Every path in `text` that starts with `crate::`, `super::` or
-/// `self::` (not a `pub(in …)` visibility), with `use` groups
+/// `self::` (not a `pub(in …)` visibility), or with one of the module's
+/// `children` (returned as `self::child::…`), with `use` groups
 /// (`a::{b, c::d}`) expanded one level.
-fn paths(text: &str) -> Vec<String> {
+fn paths(text: &str, children: &BTreeSet<&str>) -> Vec<String> {
     let mut out = Vec::new();
     let bytes = text.as_bytes();
     let is_ident = |b: u8| b.is_ascii_alphanumeric() || b == b'_';
@@ -185,20 +191,26 @@ fn paths(text: &str) -> Vec<String> {
         // A visibility (`pub(in crate::a)`) names a module but imports
         // nothing.
         let visibility = bytes[..i].trim_ascii_end().ends_with(b"(in");
+        let at_word = i == 0 || !(is_ident(bytes[i - 1]) || bytes[i - 1] == b':');
+        let child = at_word
+            && children.iter().any(|c| {
+                bytes[i..].starts_with(c.as_bytes()) && bytes[i + c.len()..].starts_with(b"::")
+            });
         let starts = ["crate::", "super::", "self::"]
             .iter()
             .any(|p| bytes[i..].starts_with(p.as_bytes()))
             && (i == 0 || !is_ident(bytes[i - 1]))
             && !visibility;
-        if !starts {
+        if !(starts || child) {
             i += 1;
             continue;
         }
+        let prefix = if starts { "" } else { "self::" };
         let mut j = i;
         while j < bytes.len() && (is_ident(bytes[j]) || bytes[j] == b':') {
             j += 1;
         }
-        let head = text[i..j].trim_end_matches(':').to_string();
+        let head = format!("{prefix}{}", text[i..j].trim_end_matches(':'));
         if text[j..].starts_with('{') {
             let end = text[j..].find('}').map_or(text.len(), |e| j + e);
             for item in text[j + 1..end].split(',') {

@@ -14,7 +14,7 @@
 //! the shell calls these only while [`CommandLink::tracing`]. The galvo's
 //! per-sample laser is not traced (it is not a switch).
 
-use super::{LaserEvent, LaserPower};
+use super::laser::{LaserEvent, LaserPower};
 use crate::command::CommandLink;
 
 /// Reports that the laser output was set to `power` at `t_us`. Out of
