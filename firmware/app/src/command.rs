@@ -19,45 +19,14 @@ use crate::domain::{Actuator, AimModel, Pattern, PointCm};
 use crate::grbl::realtime::Realtime;
 use crate::outbound::{LineKind, Origin, Outbound};
 
+mod help;
 mod pelco_status;
+mod reply;
 use crate::settings::{JumpPlanner, LaserMode, ParamSpec};
 use crate::text::{ReplyText, Shortest};
+pub use help::HELP_LINES;
 pub use pelco_status::PelcoStatus;
-
-/// One line per command for `help` (the command reference; the console
-/// parser in `cli::parse` accepts exactly these).
-pub static HELP_LINES: &[&str] = &[
-    "pattern home|corner|horizontal|vertical|visit-all [once]",
-    "pattern grid-full [raster|serpentine] [once]",
-    "pattern line <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
-    "pattern circle <cx_cm> <cy_cm> <radius_cm> [cw|ccw] [once]",
-    "pattern rect <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
-    "pattern tuning [<cx_cm> <cy_cm> <size_cm>] [once]   (galvo)",
-    "stop                         stop the pattern, laser off",
-    "arm                          laser controls: reset, laser after the delay",
-    "home                         home the stepper on its switches",
-    "goto <x_cm> <y_cm>           aim at a board point",
-    "grid <xi> <yi>               aim at a grid point",
-    "preset set|clear|goto <n>    board point preset n (1-255), saved at once",
-    "laser on|off|auto|dwell      laser mode",
-    "model exact|seed             gimbal kinematic model",
-    "target gimbal|galvo|both     which actuator draws",
-    "planner optimal|seed         galvo jump planner",
-    "galvo status                 galvo loop state, underruns",
-    "pelco status                 PELCO port: frames, errors, last command",
-    "set <param> <value>          change a parameter",
-    "get <param>                  read a parameter",
-    "params                       list parameters",
-    "save                         store parameters in flash",
-    "status                       state, target, faults",
-    "version                      firmware version",
-    "trace on|off                 laser and run events as notices",
-    "servo scan                   ids answering on the servo bus",
-    "servo ping <id>              is servo <id> there",
-    "servo id <id> <new> [confirm]  re-ID the one servo on the bus",
-    "servo zero <id>              its angle now as the axis zero_deg",
-    "help                         this list",
-];
+pub use reply::Reply;
 
 /// A parsed, validated command for the sequencer.
 #[derive(Clone, Copy)]
@@ -411,20 +380,14 @@ impl CommandLink {
     /// The replies to the command in flight (the sequencer's, whichever
     /// task sent the command).
     pub fn reply(&self) -> Reply<'_> {
-        Reply {
-            outbound: &self.outbound,
-            origin: Origin::Command,
-        }
+        Reply::new(&self.outbound, Origin::Command)
     }
 
     /// Lines that are not the command in flight's: the console's own
     /// answers to lines it does not dispatch, realtime reports (see
     /// [`Origin::Direct`]).
     pub fn direct_reply(&self) -> Reply<'_> {
-        Reply {
-            outbound: &self.outbound,
-            origin: Origin::Direct,
-        }
+        Reply::new(&self.outbound, Origin::Direct)
     }
 
     /// Queues one data line of the current reply (see [`Reply::data`]).
@@ -452,50 +415,6 @@ impl CommandLink {
     /// [`Reply::error`]).
     pub fn error(&self, reason: impl fmt::Display) {
         self.reply().error(reason);
-    }
-}
-
-/// One answerer's lines into the outbound queue (see [`Origin`]).
-#[derive(Clone, Copy)]
-pub struct Reply<'a> {
-    outbound: &'a Outbound,
-    origin: Origin,
-}
-
-impl Reply<'_> {
-    /// Queues one data line (never waits; dropped and counted when the
-    /// host is not reading and the queue is full).
-    pub fn data(self, args: fmt::Arguments<'_>) {
-        self.outbound
-            .push_fmt_from(self.origin, LineKind::Data, args);
-    }
-
-    /// Queues one data line already formatted (never waits, like
-    /// [`Reply::data`]).
-    pub fn data_line(self, line: ReplyText) {
-        self.outbound.push_from(self.origin, LineKind::Data, &line);
-    }
-
-    /// Closes the reply with `ok` (never waits; a closer always has room).
-    pub fn ok(self) {
-        self.outbound.push_from(self.origin, LineKind::Ok, "");
-    }
-
-    /// Closes the reply with grbl's `error:N` (never waits; a closer
-    /// always has room).
-    pub fn grbl_error(self, error: crate::grbl::GrblError) {
-        self.outbound.push_fmt_from(
-            self.origin,
-            LineKind::GrblError,
-            format_args!("{}", u32::from(error.code())),
-        );
-    }
-
-    /// Closes the reply with `error: <reason>` (never waits; a closer
-    /// always has room).
-    pub fn error(self, reason: impl fmt::Display) {
-        self.outbound
-            .push_fmt_from(self.origin, LineKind::Error, format_args!("{reason}"));
     }
 }
 

@@ -1,0 +1,36 @@
+//! The command reference `help` prints.
+
+/// One line per command for `help` (the command reference; the console
+/// parser in `cli::parse` accepts exactly these).
+pub static HELP_LINES: &[&str] = &[
+    "pattern home|corner|horizontal|vertical|visit-all [once]",
+    "pattern grid-full [raster|serpentine] [once]",
+    "pattern line <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
+    "pattern circle <cx_cm> <cy_cm> <radius_cm> [cw|ccw] [once]",
+    "pattern rect <x0_cm> <y0_cm> <x1_cm> <y1_cm> [once]",
+    "pattern tuning [<cx_cm> <cy_cm> <size_cm>] [once]   (galvo)",
+    "stop                         stop the pattern, laser off",
+    "arm                          laser controls: reset, laser after the delay",
+    "home                         home the stepper on its switches",
+    "goto <x_cm> <y_cm>           aim at a board point",
+    "grid <xi> <yi>               aim at a grid point",
+    "preset set|clear|goto <n>    board point preset n (1-255), saved at once",
+    "laser on|off|auto|dwell      laser mode",
+    "model exact|seed             gimbal kinematic model",
+    "target gimbal|galvo|both     which actuator draws",
+    "planner optimal|seed         galvo jump planner",
+    "galvo status                 galvo loop state, underruns",
+    "pelco status                 PELCO port: frames, errors, last command",
+    "set <param> <value>          change a parameter",
+    "get <param>                  read a parameter",
+    "params                       list parameters",
+    "save                         store parameters in flash",
+    "status                       state, target, faults",
+    "version                      firmware version",
+    "trace on|off                 laser and run events as notices",
+    "servo scan                   ids answering on the servo bus",
+    "servo ping <id>              is servo <id> there",
+    "servo id <id> <new> [confirm]  re-ID the one servo on the bus",
+    "servo zero <id>              its angle now as the axis zero_deg",
+    "help                         this list",
+];
