@@ -9,7 +9,7 @@
 //! gives the coefficients in the normalised basis, which are then expanded
 //! exactly into the raw basis `1, x, y, x², xy, y²`.
 
-use super::{ErrorModel, MAX_MEASURED_MM, N_COEF, Quadratic};
+use super::model::{ErrorModel, MAX_MEASURED_MM, N_COEF, Quadratic};
 use crate::error::Error;
 use crate::numeric::{back_substitute, finite};
 

@@ -9,7 +9,7 @@
 //! LSB, so the codes stay within ½ LSB of the `f64` reference over the
 //! whole field (`f32_codes_within_half_an_lsb_of_f64_over_the_field`).
 
-use super::{DacAxis, DacCodes, Galvo, round_to_code};
+use super::model::{DacAxis, DacCodes, Galvo, round_to_code};
 use crate::error::Error;
 
 /// tan(π/8): below it the polynomial applies directly.
@@ -62,7 +62,7 @@ pub fn atan_f32(t: f32) -> f32 {
 fn block_code(v: f32) -> u16 {
     let up = (v + 0.5) as u32;
     let code = if v < 0.5 { 0 } else { up };
-    code.min(u32::from(super::DAC_MAX_CODE)) as u16
+    code.min(u32::from(super::model::DAC_MAX_CODE)) as u16
 }
 
 /// The per-sample form of a [`Galvo<f32>`]: checked once when built, then

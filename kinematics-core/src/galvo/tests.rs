@@ -1,4 +1,6 @@
 use super::*;
+use crate::error::Error;
+use crate::frames::PointMm;
 use proptest::prelude::*;
 
 const FIELD_RAD: f64 = 12.5 * core::f64::consts::PI / 180.0;

@@ -8,7 +8,7 @@
 //! `α = atan2(y, x)`, `h = √(x² + y²)`,
 //! `β = π/2 − (atan2(z, h) + acos(OL / √(h² + z²)))`.
 
-use super::JointAngles;
+use super::joints::JointAngles;
 use crate::error::Error;
 use crate::frames::GlobalPoint;
 use crate::numeric::{clamp, finite, trig};

@@ -9,7 +9,10 @@
 //! `L = (0, 0, OL)`.
 
 pub mod exact;
+mod joints;
 pub mod seed;
+
+pub use joints::JointAngles;
 
 use crate::error::{Error, Joint};
 use crate::frames::{BoardFrame, BoardPoint, GlobalPoint};
@@ -18,15 +21,6 @@ use crate::servo::{ServoAxis, WireAngles};
 
 /// SPEC default laser axis offset OL, cm.
 pub const DEFAULT_OL_CM: f64 = 5.4;
-
-/// Gimbal joint angles, degrees.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct JointAngles {
-    /// Yaw α, degrees.
-    pub yaw_deg: f64,
-    /// Pitch β, degrees.
-    pub pitch_deg: f64,
-}
 
 /// Which gimbal model to use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

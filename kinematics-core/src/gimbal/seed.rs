@@ -11,8 +11,8 @@
 //! laser's height (board y = OL, where the beam is level) or on the
 //! vertical axis. `cargo xtask kin grid-error` prints the whole table.
 
-use super::JointAngles;
 use super::exact::{MIN_BEAM_X, check_ol};
+use super::joints::JointAngles;
 use crate::error::Error;
 use crate::frames::GlobalPoint;
 use crate::numeric::{clamp, finite, trig};

@@ -1,7 +1,7 @@
 //! Following a popped block's planned profile at a fixed period (the
 //! gimbal's stream).
 
-use super::LookaheadBlock;
+use super::block::LookaheadBlock;
 
 /// Follows a popped block's planned profile at a fixed period: where the
 /// motion is along the block and how fast it goes.

@@ -4,7 +4,7 @@
 use core::f64::consts::{PI, TAU};
 use core::iter::FusedIterator;
 
-use super::{Criterion, MAX_STEPS, Rotation, check_step};
+use super::method::{Criterion, MAX_STEPS, Rotation, check_step};
 use crate::error::Error;
 use crate::frames::BoardPoint;
 use crate::numeric::finite;

@@ -2,7 +2,7 @@
 
 use core::iter::FusedIterator;
 
-use super::{Criterion, MAX_STEPS, check_step};
+use super::method::{Criterion, MAX_STEPS, check_step};
 use crate::error::Error;
 use crate::frames::BoardPoint;
 

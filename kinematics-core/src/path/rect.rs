@@ -2,7 +2,8 @@
 
 use core::iter::FusedIterator;
 
-use super::{Criterion, LineSteps};
+use super::line::LineSteps;
+use super::method::Criterion;
 use crate::error::Error;
 use crate::frames::BoardPoint;
 

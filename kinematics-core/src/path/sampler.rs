@@ -3,7 +3,7 @@
 use core::f64::consts::TAU;
 use core::iter::FusedIterator;
 
-use super::{MAX_STEPS, Rotation};
+use super::method::{MAX_STEPS, Rotation};
 use crate::error::Error;
 use crate::frames::BoardPoint;
 use crate::numeric::{finite, trig};

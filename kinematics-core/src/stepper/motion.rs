@@ -1,7 +1,17 @@
 //! Limits and errors shared by the stepper planner, segment prep and step
 //! generator.
 
-use super::planner::StepMove;
+/// One requested move: signed microsteps per axis (pan, tilt) and its
+/// limits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepMove {
+    /// Signed microsteps to move, `[pan, tilt]`.
+    pub steps: [i32; 2],
+    /// Cruise rate, step events per second (dominant axis, steps/s).
+    pub nominal_rate_steps_per_s: f64,
+    /// Acceleration limit, step events per second² (steps/s²).
+    pub accel_steps_per_s2: f64,
+}
 
 /// Lowest accepted nominal rate, steps/s: keeps every step interval
 /// (≤ 1 s at cruise, ≤ √2 s from or to rest) inside a `u32` timer period.

@@ -17,20 +17,10 @@
 //! as the plan's data. Planning uses `f64`; it runs in a low-priority
 //! task, never in the step path.
 
+pub use super::motion::StepMove;
+
 use super::motion::{MotionError, validate_move};
 use crate::lookahead::{Lookahead, LookaheadBlock, LookaheadError, Move};
-
-/// One requested move: signed microsteps per axis (pan, tilt) and its
-/// limits.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepMove {
-    /// Signed microsteps to move, `[pan, tilt]`.
-    pub steps: [i32; 2],
-    /// Cruise rate, step events per second (dominant axis, steps/s).
-    pub nominal_rate_steps_per_s: f64,
-    /// Acceleration limit, step events per second² (steps/s²).
-    pub accel_steps_per_s2: f64,
-}
 
 /// A block of the queue: a validated move and its planned speeds.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -263,42 +263,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
     ),
     (
-        "kinematics-core",
-        &["error_model", "error_model/fit"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "kinematics-core",
-        &["galvo", "galvo/sample_map"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "kinematics-core",
-        &["gimbal", "gimbal/exact", "gimbal/seed"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "kinematics-core",
-        &["lookahead", "lookahead/cursor"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "kinematics-core",
-        &[
-            "path",
-            "path/circle",
-            "path/line",
-            "path/rect",
-            "path/sampler",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "kinematics-core",
-        &["stepper/motion", "stepper/planner"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
         "galvo-planner",
         &["model", "model/params"],
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",

@@ -1,6 +1,7 @@
 use super::*;
 use crate::frames::PointMm;
-use crate::galvo::{GalvoGeometry, MirrorAngles, round_to_code};
+use crate::galvo::model::round_to_code;
+use crate::galvo::{GalvoGeometry, MirrorAngles};
 extern crate std;
 
 /// The polynomial arc tangent against the `f64` one: over a dense
