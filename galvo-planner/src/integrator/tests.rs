@@ -1,7 +1,9 @@
 extern crate std;
 
 use super::*;
+use crate::error::Error;
 use crate::jump::{JumpSync, Method, plan_jump, plan_xy_jump};
+use crate::plan::JumpPlan;
 use crate::test_support::{DEG, flex, rigid, simulate};
 use proptest::prelude::*;
 use std::vec::Vec;

@@ -1,6 +1,6 @@
 //! Both mirror axes stepped together.
 
-use super::Integrator;
+use super::axis::Integrator;
 use crate::error::Error;
 use crate::model::Discrete;
 use crate::plan::XyJump;

@@ -2,7 +2,7 @@
 //! models built from them.
 
 use super::linear::{Drive, LinearModel, ModelKind, check_u_max};
-use super::{FLEX_STATES, RIGID_STATES};
+use super::states::{FLEX_STATES, RIGID_STATES};
 use crate::error::{Error, positive};
 
 /// Parameters of the rigid galvo model (SI units).

@@ -1,7 +1,7 @@
 //! What the planner's blocks carry (one segment each: its geometry) and
 //! the running block's frozen `f32` profile.
 
-use super::ArcRotor;
+use super::rotor::ArcRotor;
 use kinematics_core::numeric::clamp;
 
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -263,21 +263,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
     ),
     (
-        "galvo-planner",
-        &["model", "model/params"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "galvo-planner",
-        &["integrator", "integrator/xy"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "galvo-planner",
-        &["path", "path/block"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
         "laser-sim",
         &["stepper", "stepper/drive", "stepper/pan_tilt"],
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
