@@ -196,7 +196,7 @@ async fn host_to_device(
             Ok(bytes) if bytes.is_empty() && host.port_is_open() => {
                 host.close_port();
                 typed = (Vec::new(), false);
-                hangup::acknowledge_close(to_host);
+                acknowledge_close(to_host);
             }
             Ok(bytes) if bytes.is_empty() => host.open_port(),
             Ok(bytes) if host.port_is_open() => {
@@ -209,6 +209,13 @@ async fn host_to_device(
             }
         }
     }
+}
+
+/// Tells the writer thread of a bridge started with hangups that the
+/// closed session's output has ended.
+fn acknowledge_close(to_host: &SyncSender<Vec<u8>>) {
+    // The writer thread only ends with the process.
+    let _ = to_host.send(Vec::new());
 }
 
 /// Device → host, one chunk in hand at a time (dropped when the port

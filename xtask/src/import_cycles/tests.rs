@@ -263,35 +263,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
     ),
     (
-        "laser-sim",
-        &["stepper", "stepper/drive", "stepper/pan_tilt"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "laser-sim",
-        &["servo_model", "servo_model/bus"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "laser-sim",
-        &["pty", "pty/hangup"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "laser-sim",
-        &[
-            "safety",
-            "safety/conformance",
-            "safety/controls",
-            "safety/dark",
-            "safety/moving",
-            "safety/pattern_check",
-            "safety/replies",
-            "safety/steps",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
         "firmware",
         &[
             "board",

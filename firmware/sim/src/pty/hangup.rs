@@ -18,7 +18,7 @@ use std::os::unix::fs::OpenOptionsExt;
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::sync::mpsc::{Receiver, sync_channel};
 use std::time::Duration;
 
 use anyhow::Result;
@@ -127,11 +127,4 @@ fn wait_for_open(master: &File) {
         }
         std::thread::sleep(OPEN_POLL);
     }
-}
-
-/// Tells the writer thread of a bridge started with hangups that the
-/// closed session's output has ended.
-pub(super) fn acknowledge_close(to_host: &SyncSender<Vec<u8>>) {
-    // The writer thread only ends with the process.
-    let _ = to_host.send(Vec::new());
 }

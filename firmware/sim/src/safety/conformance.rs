@@ -14,7 +14,8 @@
 //!   timed.
 
 use super::gcode_model::{Motion, Session, Spot, dist, sessions};
-use super::{SafetyInputs, Violation, ViolationKind};
+use super::inputs::SafetyInputs;
+use super::violation::{Violation, ViolationKind};
 
 /// Slack of a motion's duration bound for acceleration, a servo's
 /// arrival and the laser's switching, s.

@@ -12,8 +12,9 @@
 //! Read from the inputs as the script set them and the indicator as the
 //! board drove it, not from the firmware's own state.
 
+use super::inputs::SafetyInputs;
 use super::timeline::SettingsTimeline;
-use super::{DARK_WITHIN_US, SafetyInputs, Violation, ViolationKind};
+use super::violation::{DARK_WITHIN_US, Violation, ViolationKind};
 use crate::controls::{ControlsRecord, level_at};
 
 /// Lit stretches `(from µs, to µs)` of both lasers.

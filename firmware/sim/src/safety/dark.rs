@@ -1,7 +1,8 @@
 //! (a) Dark after a stop: every laser dark from 1 ms after a shutdown until
 //! the next start.
 
-use super::{DARK_WITHIN_US, STOPS_THAT_ARE_NOT_SHUTDOWNS, SafetyInputs, Violation, ViolationKind};
+use super::inputs::SafetyInputs;
+use super::violation::{DARK_WITHIN_US, STOPS_THAT_ARE_NOT_SHUTDOWNS, Violation, ViolationKind};
 use crate::recorder::SequencerEvent;
 /// Something after which every laser must go dark.
 #[derive(Debug, Clone)]

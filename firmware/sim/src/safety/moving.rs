@@ -3,8 +3,9 @@
 //! arrivals.
 
 use super::dark::gimbal_laser_at;
+use super::inputs::SafetyInputs;
 use super::timeline::SettingsTimeline;
-use super::{DARK_WITHIN_US, SafetyInputs, Violation, ViolationKind};
+use super::violation::{DARK_WITHIN_US, Violation, ViolationKind};
 use crate::recorder::SequencerEvent;
 /// (b) The galvo laser is dark whenever the DAC codes step by more than
 /// marking allows (marking speed in force × sample period × 1.5 + 0.2 mm

@@ -10,8 +10,9 @@
 use super::conformance::{OffEpisode, Samples, extend_episode, samples, window};
 use super::gcode_model::Spot;
 use super::gcode_piece::Piece;
+use super::inputs::SafetyInputs;
 use super::pattern_model::{JudgedRun, judged_runs};
-use super::{SafetyInputs, Violation, ViolationKind};
+use super::violation::{Violation, ViolationKind};
 
 /// Lit samples closer together than this belong to one reported
 /// episode, µs.

@@ -2,7 +2,7 @@
 
 use std::collections::VecDeque;
 
-use super::{Violation, ViolationKind};
+use super::violation::{Violation, ViolationKind};
 use crate::usb_host::Transcript;
 /// (c) Exactly one closing reply per line, in order; notices are whole
 /// `[…]` lines. grbl's realtime bytes (`>> 0xNN`, typed by `@realtime`)

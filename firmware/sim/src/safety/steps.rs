@@ -1,6 +1,6 @@
 //! (d) Short task steps.
 
-use super::{MAX_STEP_NS, Violation, ViolationKind};
+use super::violation::{MAX_STEP_NS, Violation, ViolationKind};
 use crate::executor::{TaskKind, TaskSteps, recurring_steps};
 use crate::world::SimReport;
 

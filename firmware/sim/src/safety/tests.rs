@@ -1,6 +1,9 @@
 use super::*;
-use crate::executor::TaskKind;
+use crate::executor::{TaskKind, TaskSteps};
+use crate::physics::PhysicalGalvo;
 use crate::recorder::SequencerEvent;
+use crate::recorder::{EventRecord, ServoSample};
+use crate::usb_host::Transcript;
 
 fn transcript(lines: &[(u64, &str)]) -> Transcript {
     Transcript {

@@ -3,7 +3,7 @@
 
 use fashionstar::{Message, Request, RequestDecoder};
 
-use super::{PROCESSING_DELAY_US, SimServo, wire_time_us};
+use super::sim_servo::{PROCESSING_DELAY_US, SimServo, wire_time_us};
 
 /// Direction of a frame on the servo bus.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

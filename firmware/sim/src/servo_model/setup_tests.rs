@@ -6,7 +6,7 @@ use std::cell::{Cell, RefCell};
 use std::rc::Rc;
 
 use fashionstar::testing::frame;
-use fashionstar::{DecodeError, ResponseDecoder, WriteResult};
+use fashionstar::{DecodeError, Request, Response, ResponseDecoder, SetAngle, WriteResult};
 use laser_app::servo::task::{
     BusEnd, BusJob, BusReport, ServoBus, ServoBusConfig, ServoLink, ServoOutcome, ServoRequest,
 };

@@ -2,7 +2,10 @@
 //! checked through real response frames decoded by the firmware decoder.
 
 use fashionstar::testing::frame;
-use fashionstar::{DecodeError, ResponseDecoder, SyncEntries};
+use fashionstar::{
+    DecodeError, ReadData, Request, Response, ResponseDecoder, SetAngle, SetAngleByInterval,
+    SetAngleByVelocity, SyncEntries,
+};
 use proptest::prelude::*;
 
 use super::*;

@@ -9,7 +9,8 @@ use std::rc::Rc;
 
 use laser_app::stepper::{DriverSignals, OnePulseTiming, STEP_TIMER_HZ, StepPace, StepperDrive};
 
-use super::{LimitSwitch, PanTiltDrivers, StepEdge, StepPin, StepperGeometry};
+use super::pan_tilt::{PanTiltDrivers, StepEdge, StepPin, StepperGeometry};
+use super::switch::LimitSwitch;
 
 // The step timer's ticks are embassy-time's.
 const _: () = assert!(STEP_TIMER_HZ as u64 == embassy_time::TICK_HZ);

@@ -5,7 +5,7 @@ use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::{Gimbal, GimbalGeometry, GimbalModel, JointAngles};
 use kinematics_core::stepper::StepperAxis;
 
-use super::{AxisDriver, DriverTiming, MotorLimits};
+use super::axis::{AxisDriver, DriverTiming, MotorLimits};
 
 /// Pan and tilt geometry for the spot: the exact gimbal model with its OL
 /// and the two axes' microstep mappings.
