@@ -14,20 +14,16 @@
 //! precision. Paste it into the USB command line (or run it with
 //! `cargo xtask sim --script FILE`), then `save`.
 
-use std::fmt::Write as _;
 use std::fs::File;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use kinematics_core::error_model::COEF_LIMITS;
-use kinematics_core::{AxisFit, FitReport, fit};
+use kinematics_core::{FitReport, fit};
 use serde::Serialize;
 
 use crate::json_out::emit;
+use output::{AxisOut, firmware_commands};
 use xtask::calib_csv::read_points;
-
-/// Longest line the firmware's command line accepts, bytes.
-const FIRMWARE_MAX_LINE: usize = 128;
 
 /// `cargo xtask calib …`
 #[derive(clap::Args, Debug)]
@@ -57,27 +53,6 @@ struct FitArgs {
     /// Also write the model as firmware `set err.*` command lines here.
     #[arg(long)]
     output: Option<PathBuf>,
-}
-
-#[derive(Serialize)]
-struct AxisOut {
-    coef: [f64; 6],
-    sse: f64,
-    r2: f64,
-    rmse: Option<f64>,
-    n: usize,
-}
-
-impl From<&AxisFit> for AxisOut {
-    fn from(f: &AxisFit) -> Self {
-        Self {
-            coef: f.coef,
-            sse: f.sse,
-            r2: f.r2,
-            rmse: f.rmse,
-            n: f.n,
-        }
-    }
 }
 
 #[derive(Serialize)]
@@ -116,83 +91,13 @@ fn fit_json(report: &FitReport) -> Result<String, String> {
     .map_err(|e| e.to_string())
 }
 
-/// A value in the shortest form that parses back to exactly `v`, short
-/// enough for a firmware command line.
-fn exact_number(v: f64) -> String {
-    let plain = format!("{v}");
-    if plain.len() <= 24 {
-        plain
-    } else {
-        format!("{v:e}")
-    }
-}
-
-/// Printable ASCII only (the firmware rejects other bytes), at most
-/// `FIRMWARE_MAX_LINE` bytes.
-fn comment_line(text: &str) -> String {
-    let mut line: String = format!("# {text}")
-        .chars()
-        .map(|c| {
-            if c == ' ' || c.is_ascii_graphic() {
-                c
-            } else {
-                '?'
-            }
-        })
-        .collect();
-    line.truncate(FIRMWARE_MAX_LINE);
-    line
-}
-
-/// The model as firmware command lines (see the module docs).
-pub(crate) fn firmware_commands(report: &FitReport, source: &Path) -> Result<String, String> {
-    let mut out = String::new();
-    let comments = [
-        "Error model for the laser pointing controller (SPEC 5), written by".to_owned(),
-        format!(
-            "`cargo xtask calib fit` from {} ({} points).",
-            source.display(),
-            report.dx.n
-        ),
-        "err.<axis>.c0..c5: d = c0 + c1*x + c2*y + c3*x^2 + c4*x*y + c5*y^2 (x, y, d in mm)."
-            .into(),
-        axis_summary("dx", &report.dx),
-        axis_summary("dy", &report.dy),
-        "Paste into the USB command line (or `cargo xtask sim --script FILE`), then `save`.".into(),
-    ];
-    for c in comments {
-        let _ = writeln!(out, "{}", comment_line(&c));
-    }
-    for (axis, f) in [("dx", &report.dx), ("dy", &report.dy)] {
-        for ((i, c), limit) in f.coef.iter().enumerate().zip(COEF_LIMITS) {
-            if c.abs() > limit {
-                return Err(format!(
-                    "err.{axis}.c{i} = {c} is outside the firmware's range +-{limit}; \
-                     check the units (mm) of the CSV"
-                ));
-            }
-            let _ = writeln!(out, "set err.{axis}.c{i} {}", exact_number(*c));
-        }
-    }
-    Ok(out)
-}
-
-fn axis_summary(axis: &str, f: &AxisFit) -> String {
-    let rmse = f
-        .rmse
-        .map_or_else(|| "n/a (6 points)".into(), |r| format!("{r:.6} mm"));
-    format!(
-        "{axis}: SSE {:.6} mm^2, R^2 {:.6}, RMSE {rmse}",
-        f.sse, f.r2
-    )
-}
-
 pub(crate) mod camera;
 mod capture;
 mod frame_source;
 pub(super) mod frames;
 mod intrinsics;
 mod online;
+mod output;
 mod picture;
 #[cfg(feature = "webcam")]
 mod webcam;

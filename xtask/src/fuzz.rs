@@ -18,16 +18,11 @@ use anyhow::{Context, Result, bail};
 use crate::toolchain::{run, target_dir, workspace_root};
 
 use corpus::{list_files, minimise_corpus};
-use libfuzzer::{RunStats, parse_run_stats, run_fuzzer};
+use libfuzzer::{FUZZ_TRIPLE, MAX_INPUT_LEN, RunStats, parse_run_stats, run_fuzzer};
 
-/// Longest input generated, bytes: longer than a console line burst, a
-/// settings record or a measurement file needs.
-const MAX_INPUT_LEN: usize = 4096;
 /// Corpus size above which `cargo xtask fuzz` warns (the corpus is
 /// committed: keep it to a few hundred small files).
 const CORPUS_FILE_LIMIT: usize = 400;
-/// Host triple the fuzz targets are built for (cargo-fuzz's default).
-const FUZZ_TRIPLE: &str = "x86_64-unknown-linux-gnu";
 
 /// `cargo xtask fuzz …`
 #[derive(clap::Args, Debug)]
@@ -181,11 +176,6 @@ fn list_targets() -> Result<Vec<String>> {
         bail!("no fuzz targets in {dir}");
     }
     Ok(targets)
-}
-
-/// The fuzz binary of `target` built by `cargo fuzz build`.
-pub(super) fn fuzz_binary(target: &str) -> PathBuf {
-    target_dir().join(FUZZ_TRIPLE).join("release").join(target)
 }
 
 /// Builds the fuzz targets (all, or `only`) once: the runs below start

@@ -22,7 +22,7 @@ use crate::scenario::{self, Scenario};
 use crate::serial::Console;
 use crate::toolchain::CHIP;
 
-pub use run::run_scenario;
+pub use run::{Reset, run_scenario};
 
 /// Options of `cargo xtask hil`.
 #[derive(clap::Args, Debug)]
@@ -64,10 +64,6 @@ pub struct Row {
     /// Wall time it took, s.
     pub seconds: f64,
 }
-
-/// How the runner resets the board for `@reset` (none: such scenarios are
-/// skipped).
-pub type Reset<'a> = Option<&'a dyn Fn() -> Result<()>>;
 
 /// Why `scenario` cannot run over a bare console, if it cannot.
 fn unrunnable(scenario: &Scenario, can_reset: bool) -> Option<String> {

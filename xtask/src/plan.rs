@@ -13,20 +13,23 @@
 //! `--resonance-hz` for the flexible model).
 
 mod compare;
+mod method;
 mod model;
 mod plot;
+mod row;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
-use galvo_planner::BisectionConfig;
-use galvo_planner::jump::{Method, plan_jump};
+use galvo_planner::jump::plan_jump;
 use galvo_planner::model::Discrete;
 use serde::Serialize;
 
 use crate::json_out::{fail, print_json};
-pub(crate) use model::{Built, ModelArg, ModelArgs};
+pub(crate) use method::MethodArg;
+pub(crate) use model::{Built, ModelArgs};
+pub(crate) use row::Row;
 
 /// `cargo xtask plan …`
 #[derive(clap::Args, Debug)]
@@ -41,43 +44,6 @@ enum PlanCommand {
     Jump(JumpArgs),
     /// Compare the planners over step sizes 0.05°…20° (markdown table).
     Compare(CompareArgs),
-}
-
-/// Planner choice on the command line.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum MethodArg {
-    /// The patent's bisection on the move time with the minimum-energy input.
-    Seed,
-    /// Time-optimal bang-bang (rigid model only), solved in f32 as on the
-    /// target.
-    Optimal,
-    /// The same, solved in f64 (reference).
-    OptimalF64,
-    /// Trapezoidal velocity profile (baseline).
-    Tcurve,
-    /// Jerk-limited S-curve profile (baseline).
-    Scurve,
-}
-
-impl MethodArg {
-    pub(crate) fn method(self, p: u32) -> Method {
-        match self {
-            MethodArg::Seed => Method::Bisection(BisectionConfig { p, bracket_s: None }),
-            MethodArg::Optimal => Method::TimeOptimal,
-            MethodArg::OptimalF64 => Method::TimeOptimalF64,
-            MethodArg::Tcurve => Method::TCurve,
-            MethodArg::Scurve => Method::SCurve,
-        }
-    }
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            MethodArg::Seed => "seed",
-            MethodArg::Optimal => "optimal",
-            MethodArg::OptimalF64 => "optimal-f64",
-            MethodArg::Tcurve => "tcurve",
-            MethodArg::Scurve => "scurve",
-        }
-    }
 }
 
 #[derive(clap::Args, Debug)]
@@ -120,20 +86,6 @@ struct CompareArgs {
     /// Print JSON rows instead of the markdown table.
     #[arg(long)]
     json: bool,
-}
-
-/// One row of the trajectory: the state at `t = k·Ts` and the voltage held
-/// over `[k·Ts, (k+1)·Ts)` (0 on the last row).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Row {
-    pub k: usize,
-    pub t_s: f64,
-    pub theta_rad: f64,
-    pub omega_rad_s: f64,
-    pub current_a: f64,
-    pub u_v: f64,
-    /// Flexible model: (φ, ω_φ).
-    pub load: Option<(f64, f64)>,
 }
 
 #[derive(Serialize)]

@@ -9,7 +9,10 @@
 //! script's waits stay together in real time.
 
 mod board_log;
+mod board_run;
+mod defmt_check;
 mod defmt_log;
+mod image;
 mod machine;
 mod measure;
 mod pelco;
@@ -19,31 +22,22 @@ mod servo_bus;
 mod terminal;
 
 use std::io::{IsTerminal, Read};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::Receiver;
-use std::thread::JoinHandle;
-use std::time::{Duration, Instant};
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
-use laser_sim::recorder::{Recording, SpotSample};
 
-pub use board_log::{BoardEvent, BoardLog, LogLine, parse_line};
-pub use defmt_log::check_channel as check_defmt_channel;
-pub use machine::{Machine, MachineOptions};
+pub use board_log::{BoardEvent, LogLine, parse_line};
+pub use board_run::{BoardRun, Drive, run_board};
+pub use defmt_check::check_channel as check_defmt_channel;
+pub use image::{MANIFEST, build_image, build_image_with};
+pub use machine::MachineOptions;
 pub use pelco::check_port as check_pelco_port;
 pub use pty::{check_console as check_pty_console, with_board_on_pty};
 pub use script::{BoardStep, parse_board_script, split_at_resets};
-use script::{run_steps, wait_until_idle};
-pub use terminal::Terminal;
-
-use crate::toolchain::{TARGET, ensure_flip_link, target_dir};
-
-/// The board's manifest, relative to the workspace root (a workspace of its
-/// own, like the bench's).
-pub const MANIFEST: &str = "firmware/qemu-m4/Cargo.toml";
 
 /// Options of `cargo xtask qemu` (those of `cargo xtask sim` that apply).
 #[derive(clap::Args, Debug)]
@@ -113,41 +107,6 @@ pub struct QemuArgs {
     measure: bool,
 }
 
-/// Builds the board's release image with the default features; its path.
-pub fn build_image() -> Result<PathBuf> {
-    build_image_with(&[], false)
-}
-
-/// Builds the board's release image with `features` (after
-/// `--no-default-features` when `no_default`); its path (a copy named
-/// after the features).
-pub fn build_image_with(features: &[&str], no_default: bool) -> Result<PathBuf> {
-    crate::bench_m4::qemu::ensure_qemu()?;
-    ensure_flip_link()?;
-    let mut args = vec!["build", "--release", "--target", TARGET];
-    if no_default {
-        args.push("--no-default-features");
-    }
-    let joined = features.join(",");
-    if !features.is_empty() {
-        args.extend(["--features", joined.as_str()]);
-    }
-    crate::bench_m4::cargo_in(MANIFEST, &args)?;
-    let built = target_dir().join(TARGET).join("release").join("qemu-m4");
-    // Cargo writes every feature set to the same file: keep a copy per
-    // set, so images built one after the other (`--scenarios`) stay apart.
-    let mut name = String::from("qemu-m4-");
-    name.push_str(if no_default { "no-default" } else { "default" });
-    for feature in features {
-        name.push('-');
-        name.push_str(feature);
-    }
-    let copy = built.with_file_name(name);
-    std::fs::copy(&built, &copy)
-        .with_context(|| format!("cannot copy {} to {}", built.display(), copy.display()))?;
-    Ok(copy)
-}
-
 /// The script text: the file, stdin (`-` or piped), or nothing when
 /// interactive.
 fn script_text(args: &QemuArgs) -> Result<String> {
@@ -168,136 +127,6 @@ fn script_text(args: &QemuArgs) -> Result<String> {
         }
         None => read_stdin(),
     }
-}
-
-/// How a run on the board ended.
-#[derive(Debug, Clone)]
-pub struct BoardRun {
-    /// The console transcript.
-    pub terminal: Terminal,
-    /// The log channel.
-    pub log: BoardLog,
-    /// Servo-bus frames and spot samples (host time).
-    pub recording: Recording,
-    /// The script was sent completely and every reply read.
-    pub script_done: bool,
-    /// The sequencer was idle at the end (only probed with `until_idle`).
-    pub idle_at_end: bool,
-    /// Host time at the end, µs.
-    pub end_us: u64,
-}
-
-impl BoardRun {
-    /// Whether `--until-idle` exits 0 (as the simulator's rule).
-    pub fn succeeded(&self, allow_errors: bool) -> bool {
-        self.script_done && self.idle_at_end && (allow_errors || self.terminal.error_replies == 0)
-    }
-}
-
-/// Samples the spot (servo model, host time) and the reported laser every
-/// `period` until `stop` is set.
-fn spot_sampler(machine: &Machine, stop: Arc<AtomicBool>) -> JoinHandle<Vec<SpotSample>> {
-    const PERIOD: Duration = Duration::from_millis(2);
-    let (servos, log, t0) = (machine.servos.clone(), machine.log.clone(), machine.t0);
-    std::thread::spawn(move || {
-        let gimbal = laser_sim::physics::PhysicalGimbal::default();
-        let mut samples = Vec::new();
-        while !stop.load(Ordering::Relaxed) {
-            let t_us = t0.elapsed().as_micros() as u64;
-            let power = log.0.lock().map_or(0, |l| l.laser_level());
-            let laser = power > 0;
-            if let Ok(side) = servos.lock() {
-                let yaw = side.bus.angle_deg(gimbal.yaw_id, t_us).unwrap_or(0.0);
-                let pitch = side.bus.angle_deg(gimbal.pitch_id, t_us).unwrap_or(0.0);
-                if let Some((x_cm, y_cm)) = gimbal.spot_cm(yaw, pitch) {
-                    samples.push(SpotSample {
-                        t_us,
-                        x_cm,
-                        y_cm,
-                        laser,
-                        power,
-                    });
-                }
-            }
-            std::thread::sleep(PERIOD);
-        }
-        samples
-    })
-}
-
-/// What to do on a started board.
-pub enum Drive {
-    /// These steps.
-    Steps(Vec<BoardStep>),
-    /// Lines typed on stdin until it ends.
-    Interactive,
-    /// Bytes from the PTY bridge until `stop` is set.
-    Pty {
-        /// The host's bytes.
-        from_host: Receiver<Vec<u8>>,
-        /// Ends the run.
-        stop: Arc<AtomicBool>,
-    },
-}
-
-/// Runs `drive` on a fresh board from `elf`; `until_idle` then waits for
-/// the sequencer to be idle; `trace` samples the spot.
-pub fn run_board(
-    elf: &Path,
-    options: &MachineOptions,
-    drive: Drive,
-    until_idle: bool,
-    max_time: Duration,
-    trace: bool,
-) -> Result<BoardRun> {
-    let mut machine = Machine::start(elf, options)?;
-    let deadline = Instant::now() + max_time;
-    let stop = Arc::new(AtomicBool::new(false));
-    let sampler = trace.then(|| spot_sampler(&machine, stop.clone()));
-    let script_done = match drive {
-        Drive::Steps(steps) => run_steps(&mut machine, &steps, deadline)?,
-        Drive::Interactive => {
-            for line in std::io::stdin().lines().map_while(Result::ok) {
-                let steps = parse_board_script(&line).unwrap_or_default();
-                run_steps(&mut machine, &steps, deadline)?;
-            }
-            true
-        }
-        Drive::Pty { from_host, stop } => {
-            pty::forward_typed(&machine, from_host)?;
-            pty::wait_for_stop(&stop, deadline);
-            true
-        }
-    };
-    let idle_at_end = script_done && until_idle && wait_until_idle(&mut machine, deadline)?;
-    stop.store(true, Ordering::Relaxed);
-    let spot = sampler.and_then(|s| s.join().ok()).unwrap_or_default();
-    let end_us = machine.now_us();
-    machine.stop();
-    let terminal = machine
-        .terminal
-        .0
-        .lock()
-        .map(|t| t.clone())
-        .unwrap_or_default();
-    let log = machine.log.0.lock().map(|l| l.clone()).unwrap_or_default();
-    let frames = machine
-        .servos
-        .lock()
-        .map(|s| s.frames.clone())
-        .unwrap_or_default();
-    Ok(BoardRun {
-        terminal,
-        log,
-        recording: Recording {
-            frames,
-            spot,
-            ..Recording::default()
-        },
-        script_done,
-        idle_at_end,
-        end_us,
-    })
 }
 
 /// Runs `cargo xtask qemu`.

@@ -11,7 +11,7 @@ use camera_calib::target::{GridSpec, TargetLayout};
 use kinematics_core::{FitReport, MeasuredPoint, PointMm, fit};
 use serde::Serialize;
 
-use super::{AxisOut, firmware_commands};
+use super::output::{AxisOut, firmware_commands};
 
 /// `calib target`
 #[derive(clap::Args, Debug)]

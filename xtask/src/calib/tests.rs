@@ -1,5 +1,7 @@
+use super::output::{FIRMWARE_MAX_LINE, comment_line, exact_number};
 use super::*;
 use kinematics_core::MeasuredPoint;
+use std::path::Path;
 
 /// Known quadratic behind `kinematics-core/tests/data/quadratic_noise.csv`
 /// (11 × 11 grid over ±100 mm, Gaussian noise σ = 0.02 mm; see

@@ -4,8 +4,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 
-use super::MAX_INPUT_LEN;
-use super::libfuzzer::run_fuzzer;
+use super::libfuzzer::{MAX_INPUT_LEN, run_fuzzer};
 
 /// Replaces the committed corpus with its seeds (`seed-*`, kept always),
 /// the other corpus files that reach edges the seeds do not, and the new

@@ -1,13 +1,23 @@
 //! Running a libFuzzer binary and reading its statistics.
 
 use std::io::{BufRead, BufReader, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use anyhow::{Context, Result};
 
-use super::fuzz_binary;
-use crate::toolchain::workspace_root;
+use crate::toolchain::{target_dir, workspace_root};
+
+/// Longest input generated, bytes: longer than a console line burst, a
+/// settings record or a measurement file needs.
+pub(super) const MAX_INPUT_LEN: usize = 4096;
+/// Host triple the fuzz targets are built for (cargo-fuzz's default).
+pub(super) const FUZZ_TRIPLE: &str = "x86_64-unknown-linux-gnu";
+
+/// The fuzz binary of `target` built by `cargo fuzz build`.
+fn fuzz_binary(target: &str) -> PathBuf {
+    target_dir().join(FUZZ_TRIPLE).join("release").join(target)
+}
 
 /// Executions and wall time of one libFuzzer run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -8,10 +8,13 @@ use std::time::{Duration, Instant};
 use anyhow::{Result, bail};
 use laser_sim::script::Step;
 
-use super::Reset;
 use crate::qemu::{BoardStep, LogLine, parse_board_script, parse_line};
 use crate::scenario::{Outcome, Scenario};
 use crate::serial::Console;
+
+/// How the runner resets the board for `@reset` (none: such scenarios are
+/// skipped).
+pub type Reset<'a> = Option<&'a dyn Fn() -> Result<()>>;
 
 /// How long one reply may take, s (a `save` may erase a flash sector).
 const REPLY_LIMIT: Duration = Duration::from_secs(30);

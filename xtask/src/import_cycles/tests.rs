@@ -289,50 +289,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
         ],
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
     ),
-    (
-        "xtask",
-        &[
-            "calib",
-            "calib/camera",
-            "calib/capture",
-            "calib/frames",
-            "calib/online",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "xtask",
-        &["fuzz", "fuzz/corpus", "fuzz/libfuzzer"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "xtask",
-        &[
-            "qemu",
-            "qemu/defmt_log",
-            "qemu/machine",
-            "qemu/measure",
-            "qemu/pelco",
-            "qemu/pty",
-            "qemu/script",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "xtask",
-        &["scenario", "scenario/checks"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "xtask",
-        &["hil", "hil/run"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "xtask",
-        &["plan", "plan/compare", "plan/plot"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
 ];
 
 /// A module as written in [`KNOWN_CYCLES`] (`a/b`).

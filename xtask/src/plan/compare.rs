@@ -6,7 +6,8 @@ use galvo_planner::model::Discrete;
 use galvo_planner::{JumpPlan, Method, plan_jump};
 use serde::Serialize;
 
-use super::{Built, MethodArg, ModelArg, ModelArgs};
+use super::method::MethodArg;
+use super::model::{Built, ModelArg, ModelArgs};
 use crate::json_out::{fail, print_json};
 
 /// 0.05° … 20° mechanical.

@@ -6,7 +6,7 @@ use anyhow::anyhow;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::Row;
+use super::row::Row;
 
 type Series = Vec<(f64, f64)>;
 

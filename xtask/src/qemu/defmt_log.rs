@@ -7,14 +7,10 @@
 
 use std::io::Read;
 use std::os::unix::net::UnixStream;
-use std::path::Path;
-use std::time::Duration;
 
-use anyhow::{Result, bail};
 use defmt_decoder::{DecodeError, Table};
 
 use super::board_log::SharedLog;
-use super::{Drive, MachineOptions, parse_board_script, run_board};
 
 /// Reads UART3 until QEMU closes it, decoding every frame into
 /// `log.defmt_lines` (and on stderr when `echo`).
@@ -53,30 +49,4 @@ pub fn read_defmt(mut stream: UnixStream, elf: Vec<u8>, log: SharedLog, echo: bo
             }
         }
     }
-}
-
-/// The defmt channel checked end to end on a `defmt-log` image: the
-/// board's boot record (`no saved settings, using defaults`) and a
-/// pattern's start arrive decoded, stamped and with their level.
-pub fn check_channel(elf: &Path) -> Result<()> {
-    let steps = parse_board_script("pattern home once\nwait 300\nstop\n")?;
-    let run = run_board(
-        elf,
-        &MachineOptions::default(),
-        Drive::Steps(steps),
-        true,
-        Duration::from_secs(30),
-        false,
-    )?;
-    let lines = &run.log.defmt_lines;
-    let boot = lines
-        .iter()
-        .any(|l| l.contains("INFO") && l.ends_with("no saved settings, using defaults"));
-    let start = lines
-        .iter()
-        .any(|l| l.contains("INFO") && l.contains("start home (once=true)"));
-    if !boot || !start || lines.iter().any(|l| l.contains("malformed")) {
-        bail!("defmt lines decoded from the board: {lines:?}");
-    }
-    Ok(())
 }

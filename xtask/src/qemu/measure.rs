@@ -197,20 +197,20 @@ pub fn measure() -> Result<()> {
         ("with laser-app's logs (default)", &[][..], false),
         ("without laser-app's logs", &[][..], true),
     ] {
-        let elf = super::build_image_with(features, no_default)?;
+        let elf = super::image::build_image_with(features, no_default)?;
         println!("qemu-m4 {title}: {}", image_size(&elf)?);
         instructions(&elf)?;
     }
-    let elf = super::build_image_with(&["galvo-dac"], false)?;
+    let elf = super::image::build_image_with(&["galvo-dac"], false)?;
     println!("qemu-m4 with the galvo DAC stream: {}", image_size(&elf)?);
     galvo(&elf)?;
-    let elf = super::build_image_with(&["galvo-dac", "stack-paint"], false)?;
+    let elf = super::image::build_image_with(&["galvo-dac", "stack-paint"], false)?;
     println!(
         "qemu-m4 with the galvo DAC stream and stack painting (instructions include the painting):"
     );
     galvo(&elf)?;
     for (title, no_default) in [("with logs", false), ("without logs", true)] {
-        let elf = super::build_image_with(&["stack-paint"], no_default)?;
+        let elf = super::image::build_image_with(&["stack-paint"], no_default)?;
         println!("qemu-m4 with stack painting, {title}:");
         stack(&elf)?;
     }

@@ -22,9 +22,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use laser_sim::pty::{Pty, PtyBridge};
 
-use super::machine::{Machine, MachineOptions};
-use super::terminal::SharedTerminal;
-use super::{BoardRun, Drive, run_board};
+use super::board_run::{BoardRun, Drive, run_board};
+use super::machine::MachineOptions;
 
 /// Opens the PTY (making `link` a symlink to it) and starts its bridge.
 pub fn open(link: Option<&Path>) -> Result<(Pty, PtyBridge)> {
@@ -34,47 +33,6 @@ pub fn open(link: Option<&Path>) -> Result<(Pty, PtyBridge)> {
     }
     let bridge = PtyBridge::start(&pty)?;
     Ok((pty, bridge))
-}
-
-/// Types the host's bytes on the board's console until the bridge or the
-/// socket closes, recording each typed line in the transcript.
-pub fn forward_typed(machine: &Machine, from_host: Receiver<Vec<u8>>) -> Result<()> {
-    let mut console = machine.console_writer()?;
-    let (terminal, t0) = (machine.terminal.clone(), machine.t0);
-    std::thread::spawn(move || {
-        let mut line = Vec::new();
-        for bytes in from_host {
-            record_typed(&terminal, t0, &mut line, &bytes);
-            if console.write_all(&bytes).is_err() {
-                return;
-            }
-        }
-    });
-    Ok(())
-}
-
-/// Adds `bytes` to the line being typed; a line end records it.
-fn record_typed(terminal: &SharedTerminal, t0: Instant, line: &mut Vec<u8>, bytes: &[u8]) {
-    for &b in bytes {
-        if b != b'\r' && b != b'\n' {
-            line.push(b);
-            continue;
-        }
-        if !line.is_empty()
-            && let Ok(mut term) = terminal.0.lock()
-        {
-            let t_us = t0.elapsed().as_micros() as u64;
-            term.typed_line(t_us, &String::from_utf8_lossy(line));
-        }
-        line.clear();
-    }
-}
-
-/// Waits until `stop` is set or `deadline` passes.
-pub fn wait_for_stop(stop: &AtomicBool, deadline: Instant) {
-    while !stop.load(Ordering::Relaxed) && Instant::now() < deadline {
-        std::thread::sleep(Duration::from_millis(20));
-    }
 }
 
 /// Appends the PTY's `chunks` to `text` until an `ok` line has appeared
@@ -179,24 +137,4 @@ pub fn check_console(elf: &Path) -> Result<()> {
         bail!("error replies on the PTY: {text:?}");
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use std::sync::{Condvar, Mutex};
-
-    #[test]
-    fn typed_bytes_in_chunks_are_recorded_as_lines_at_their_ends() {
-        let terminal: SharedTerminal = Arc::new((Mutex::default(), Condvar::new()));
-        let mut line = Vec::new();
-        let t0 = Instant::now();
-        record_typed(&terminal, t0, &mut line, b"vers");
-        record_typed(&terminal, t0, &mut line, b"ion\r\n$I\r");
-        record_typed(&terminal, t0, &mut line, b"\nG0 X1");
-        let term = terminal.0.lock().unwrap();
-        let typed: Vec<&str> = term.lines.iter().map(|(_, l)| l.as_str()).collect();
-        assert_eq!(typed, ["> version", "> $I"]);
-        assert_eq!(line, b"G0 X1");
-    }
 }

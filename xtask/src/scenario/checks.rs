@@ -4,7 +4,7 @@
 
 use anyhow::{Result, bail, ensure};
 
-use super::Outcome;
+use super::outcome::Outcome;
 use crate::qemu::BoardEvent;
 
 /// The laser is dark this soon after a stop, fault or move, µs (SPEC).
