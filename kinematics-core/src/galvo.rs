@@ -7,7 +7,7 @@
 //! first: `θy = atan(y / d) / 2`, `θx = atan(x / (√(d² + y²) + e)) / 2`.
 //! Board x/y are the board frame's (mm), with the galvo axis through Q.
 //!
-//! Generic over [`Real`]: `f64` is the reference, `f32` the per-sample path
+//! Generic over [`Real`](crate::real::Real): `f64` is the reference, `f32` the per-sample path
 //! for the Cortex-M4F (held to the `f64` one within 0.001 mm over the ±12.5°
 //! field by the tests). DAC code ↔ mechanical angle is linear per axis,
 //! `code = round(offset_code + codes_per_rad · θ)`, clamped to 0..=4095
