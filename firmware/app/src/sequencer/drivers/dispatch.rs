@@ -2,7 +2,7 @@
 
 use crate::domain::{PointCm, Target};
 use crate::grbl::Block;
-use crate::sequencer::drivers::{Arrival, Driver, DriverStep, Drivers};
+use crate::sequencer::drivers::{Arrival, Driver, DriverStep, Drivers, gimbal};
 use crate::sequencer::gcode::queue::planned_length;
 use crate::sequencer::machine::{ActionSink, Core};
 
@@ -71,7 +71,7 @@ impl Core {
         block: &Block,
         out: &mut dyn ActionSink,
     ) -> bool {
-        if !(self.gcode_streams() && planned_length(block).is_some()) {
+        if !(self.drivers().gimbal_streams() && planned_length(block).is_some()) {
             return false;
         }
         self.gcode.motion.current = Some(self.new_current(*block, 1));
@@ -106,10 +106,12 @@ impl Core {
         out: &mut dyn ActionSink,
     ) -> Option<u32> {
         match driver {
-            Driver::Gimbal => {
-                self.gcode_servo_move(step.from, step.to, step.feed, step.corner, out)
-            }
-            Driver::Galvo => self.gcode_galvo_send(step.from, step.to, step.feed, step.lit, out),
+            Driver::Gimbal => self.with_stage(out, |st, _, out| {
+                gimbal::step::send_step(st, step.from, step.to, step.feed, step.corner, out)
+            }),
+            Driver::Galvo => self.with_stage(out, |st, jobs, out| {
+                (jobs.galvo).send_step(st, step.from, step.to, step.feed, step.lit, out)
+            }),
             // Blocks are handed over whole (`gcode_stepper_send`).
             Driver::Stepper => None,
         }

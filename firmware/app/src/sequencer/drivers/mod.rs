@@ -236,4 +236,5 @@ pub(in crate::sequencer) struct DriverStep {
 mod dispatch;
 pub(in crate::sequencer) mod galvo;
 pub(in crate::sequencer) mod gimbal;
+pub(in crate::sequencer) mod stage;
 pub(in crate::sequencer) mod stepper;

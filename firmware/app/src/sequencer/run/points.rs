@@ -2,12 +2,12 @@
 
 use crate::domain::{Aim, AimModel, PathCursor, Pattern, Target};
 use crate::log;
+use crate::sequencer::drivers::gimbal::step::{interval_ms, servo_move};
 use crate::sequencer::drivers::{Arrival, PathRun};
-use crate::sequencer::faults;
 use crate::sequencer::laser::LaserEvent;
 use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::sequencer::run::{Run, RunKind, Start};
-use crate::servo::task::{ServoOutcome, ServoRequest};
+use crate::servo::task::ServoOutcome;
 use crate::status::Phase;
 use crate::text::{Fixed, reply_text};
 use embassy_time::Duration;
@@ -190,9 +190,7 @@ impl Core {
         true
     }
 
-    /// Sends the gimbal to `aim` over `interval_ms`, arrival within
-    /// `deadband_tenths` (0.1°), under a new sequence number (returned), and
-    /// notes the move for the laser logic.
+    /// Sends the gimbal to `aim` ([`servo_move`]); its request number.
     pub(in crate::sequencer) fn send_gimbal_move(
         &mut self,
         aim: &Aim,
@@ -200,34 +198,22 @@ impl Core {
         deadband_tenths: u16,
         out: &mut dyn ActionSink,
     ) -> u32 {
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
-        out.act(Action::Servo(ServoRequest::Move {
-            seq,
-            yaw_tenths: aim.yaw_wire,
-            pitch_tenths: aim.pitch_wire,
+        let next_seq = &mut self.next_seq;
+        servo_move(
+            &self.settings,
+            next_seq,
+            aim,
             interval_ms,
-            ids: (self.settings.yaw.id, self.settings.pitch.id),
             deadband_tenths,
-            ranges_tenths: faults::servo_ranges_tenths(&self.settings),
-        }));
-        out.act(Action::Note(LaserEvent::GimbalMoveSent));
-        seq
+            out,
+        )
     }
 
-    /// Travel time for a move at the configured speed, from the largest
-    /// joint change (at least 20 ms, the SDK's minimum ramp).
+    /// Travel time for a move to `aim` from the last measured (or aimed)
+    /// servo angles at the configured speed ([`interval_ms`]), ms.
     pub(in crate::sequencer) fn move_interval_ms(&self, aim: &Aim) -> u16 {
-        let (from_yaw, from_pitch) = self
-            .measured
-            .or(self.last_aim.map(|(_, a)| (a.yaw_wire, a.pitch_wire)))
-            .unwrap_or((0, 0));
-        let travel_tenths = (i32::from(aim.yaw_wire) - i32::from(from_yaw))
-            .abs()
-            .max((i32::from(aim.pitch_wire) - i32::from(from_pitch)).abs());
-        let travel_deg = f64::from(travel_tenths) / 10.0;
-        let ms = 1000.0 * travel_deg / self.settings.servo_speed_deg_s;
-        (ms as u32).clamp(20, u32::from(u16::MAX)) as u16
+        let at = (self.measured).or(self.last_aim.map(|(_, a)| (a.yaw_wire, a.pitch_wire)));
+        interval_ms(&self.settings, at, aim)
     }
 
     /// The servo task's report.

@@ -1,9 +1,10 @@
 //! The galvo driver's points: a pattern's points, goto and marked paths, its configuration.
 
 use crate::domain::{Pattern, Target};
-use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoEvent, GalvoRequest};
+use crate::galvo::{GalvoEvent, GalvoRequest};
 use crate::log;
 use crate::sequencer::drivers::galvo::{HOLD_US, config_from};
+use crate::sequencer::drivers::stage::{stop_galvo, try_send_galvo};
 use crate::sequencer::machine::{Action, ActionSink, Core, GalvoReadout};
 use crate::sequencer::run::RunKind;
 use crate::settings::LaserMode;
@@ -11,14 +12,9 @@ use crate::status::Phase;
 use crate::text::Shortest;
 
 impl Core {
-    /// Tells the galvo loop to stop (drop its jobs, laser off, clear an
-    /// underrun latch). Never lost: the requests it has not taken yet are
-    /// dropped first, so there is room.
+    /// Tells the galvo loop to stop ([`stop_galvo`]).
     pub(in crate::sequencer) fn stop_galvo(&mut self, out: &mut dyn ActionSink) {
-        out.act(Action::Galvo(GalvoRequest::Stop));
-        if self.inputs.galvo_room.is_some() {
-            self.inputs.galvo_room = Some(GALVO_REQUEST_DEPTH - 1);
-        }
+        stop_galvo(&mut self.inputs, out);
     }
 
     /// Queues a job for the galvo loop; `false` (with an error notice,
@@ -28,15 +24,18 @@ impl Core {
         request: GalvoRequest,
         out: &mut dyn ActionSink,
     ) -> bool {
-        let Some(room) = self.inputs.galvo_room.filter(|room| *room > 0) else {
-            log::warning!("galvo: request queue full");
-            self.notify(out, format_args!("error: galvo not responding; stopped"));
-            self.stop("galvo not responding", out);
-            return false;
-        };
-        self.inputs.galvo_room = Some(room - 1);
-        out.act(Action::Galvo(request));
-        true
+        let sent = try_send_galvo(&mut self.inputs, request, out);
+        if !sent {
+            self.galvo_stalled(out);
+        }
+        sent
+    }
+
+    /// The galvo loop does not keep up (a job found no room): an error
+    /// notice, everything stopped.
+    pub(in crate::sequencer) fn galvo_stalled(&mut self, out: &mut dyn ActionSink) {
+        self.notify(out, format_args!("error: galvo not responding; stopped"));
+        self.stop("galvo not responding", out);
     }
 
     /// Sends the galvo job built for the next request number and makes

@@ -67,5 +67,5 @@ impl Stream {
 }
 
 mod plan;
-mod step;
+pub(in crate::sequencer) mod step;
 mod stream;

@@ -1,0 +1,266 @@
+//! The session's side of the drivers' G-code stages: each stage is a
+//! method of the driver's own state ([`DriverJobs`]) given a [`Stage`]
+//! of the core's state; what follows it here is the session's (a line
+//! waiting for room answered, the step finished, a hold held or resumed)
+//! or the core's (everything stopped when the galvo does not keep up).
+
+use crate::galvo::MarkStop;
+use crate::grbl::Block;
+use crate::sequencer::drivers::DriverJobs;
+use crate::sequencer::drivers::stage::Stage;
+use crate::sequencer::gcode::queue::{CORNER_SETTLE_MS, Hold, planned_length, point_at};
+use crate::sequencer::laser::LaserEvent;
+use crate::sequencer::machine::{Action, ActionSink, Core};
+use crate::servo::task::ServoOutcome;
+use embassy_time::Duration;
+
+impl Core {
+    /// Runs `stage` on the drivers' state with a [`Stage`] of the core's;
+    /// when a galvo job found no room, everything stops after it, and an
+    /// alarm it raised is raised.
+    pub(in crate::sequencer) fn with_stage<R>(
+        &mut self,
+        out: &mut dyn ActionSink,
+        stage: impl FnOnce(&mut Stage, &mut DriverJobs, &mut dyn ActionSink) -> R,
+    ) -> R {
+        let drivers = self.drivers();
+        let mut st = Stage {
+            gcode: &mut self.gcode,
+            settings: &self.settings,
+            aimer: &self.aimer,
+            inputs: &mut self.inputs,
+            next_seq: &mut self.next_seq,
+            last_aim: &mut self.last_aim,
+            measured: self.measured,
+            drivers,
+            alarm: None,
+            galvo_stalled: false,
+        };
+        let result = stage(&mut st, &mut self.jobs, out);
+        let (alarm, stalled) = (st.alarm, st.galvo_stalled);
+        if stalled {
+            self.galvo_stalled(out);
+        }
+        if let Some(alarm) = alarm {
+            self.grbl_alarm(alarm, out);
+        }
+        result
+    }
+
+    /// Sends the pieces that continue the galvo stroke in flight.
+    pub(in crate::sequencer) fn gcode_galvo_send_ahead(&mut self, out: &mut dyn ActionSink) {
+        self.with_stage(out, |st, jobs, out| jobs.galvo.send_ahead(st, out));
+    }
+
+    /// The galvo loop finished job `seq`; `true` when it was the G-code
+    /// step's.
+    pub(in crate::sequencer) fn gcode_galvo_done(
+        &mut self,
+        seq: u32,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        let Some(c) = self.gcode.motion.current.as_mut() else {
+            return false;
+        };
+        if c.galvo_seq != Some(seq) {
+            return false;
+        }
+        c.galvo_seq = None;
+        if self.with_stage(out, |st, jobs, _| jobs.galvo.done(st, seq)) {
+            self.grbl_take_owed(out);
+        }
+        self.gcode_step_done(out);
+        self.with_stage(out, |st, jobs, out| jobs.galvo.drop_unadopted(st, out));
+        true
+    }
+
+    /// Whether the G-code step waits for galvo job `seq`.
+    pub(in crate::sequencer) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
+        self.gcode
+            .motion
+            .current
+            .is_some_and(|c| c.galvo_seq == Some(seq))
+            || self.jobs.galvo.ahead_is(seq)
+    }
+
+    /// The galvo stopped (`at`: where marking ended, if it marked): when a
+    /// hold waits for it, what was marked is done and the hold is held
+    /// (or, resumed meanwhile, goes on from the stop point).
+    #[inline(never)]
+    pub(in crate::sequencer) fn gcode_galvo_stopped(
+        &mut self,
+        at: Option<MarkStop>,
+        out: &mut dyn ActionSink,
+    ) {
+        let Some(moved) = self.with_stage(out, |st, jobs, _| jobs.galvo.stopped(st, at)) else {
+            return;
+        };
+        if moved {
+            // The blocks left the queue: a line waiting for room is queued.
+            self.grbl_take_owed(out);
+        }
+        // Held; `~` came while stopping: resumed at once.
+        let motion = &mut self.gcode.motion;
+        let resumed = motion.hold == Hold::None;
+        motion.hold = Hold::Held;
+        if resumed {
+            self.grbl_resume(out);
+        }
+    }
+
+    /// Starts the gimbal following `block` (the block in flight);
+    /// `false` when it has nothing to move (it then runs step by step).
+    pub(in crate::sequencer) fn stream_begin(
+        &mut self,
+        block: &Block,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        let begun = self.with_stage(out, |st, jobs, out| jobs.gimbal.begin(st, block, out));
+        if begun == Some(true) {
+            self.stream_rest(out);
+        }
+        begun.is_some()
+    }
+
+    /// One period of the block the gimbal follows.
+    pub(in crate::sequencer) fn stream_tick(&mut self, out: &mut dyn ActionSink) {
+        if self.with_stage(out, |st, jobs, out| jobs.gimbal.tick(st, out)) {
+            self.stream_rest(out);
+        }
+    }
+
+    /// The tick reached the end of a block that joins the next at speed:
+    /// the next block (queued, planned) goes on from here, hold or not.
+    #[inline(never)]
+    pub(in crate::sequencer) fn stream_block_done(&mut self, out: &mut dyn ActionSink) {
+        let motion = &mut self.gcode.motion;
+        let mut cancelled = false;
+        if let Some(c) = motion.current.take() {
+            motion.position = point_at(&c.block, 1, 1);
+            cancelled = c.cancelled;
+        }
+        let next = motion.queue.front().copied();
+        match next.filter(|b| planned_length(b).is_some()) {
+            Some(block) => {
+                motion.queue.pop_front();
+                self.grbl_take_owed(out);
+                self.gcode.motion.current = Some(self.new_current(block, 1));
+                if !self.stream_begin(&block, out) {
+                    self.gcode.motion.current = None;
+                    self.grbl_advance(out);
+                }
+            }
+            None => {
+                self.jobs.gimbal.clear();
+                if cancelled {
+                    // A jog cancel between this block's end and the next:
+                    // the parser had gone on to the dropped jogs' ends.
+                    self.grbl_sync_position();
+                }
+                self.grbl_advance(out);
+            }
+        }
+    }
+
+    /// A hold came to rest (`~` goes on from here), or a jog cancel did
+    /// (the jog ends here).
+    #[inline(never)]
+    fn stream_rest(&mut self, out: &mut dyn ActionSink) {
+        let motion = &mut self.gcode.motion;
+        motion.gimbal_lit = false;
+        let cancelled = motion.current.is_some_and(|c| c.cancelled);
+        if let Some(c) = motion.current.as_mut() {
+            // The sample's arrival is not waited for.
+            c.servo_seq = None;
+            c.until = None;
+        }
+        if cancelled {
+            motion.current = None;
+            self.jobs.gimbal.clear();
+            self.grbl_sync_position();
+            self.grbl_advance(out);
+            return;
+        }
+        motion.hold = Hold::Held;
+    }
+
+    /// The servo task confirmed streamed move `seq`: `true` when it was
+    /// a point on the way (the block goes on at its own pace).
+    #[inline(never)]
+    fn stream_arrived(&mut self, seq: u32) -> bool {
+        let motion = &mut self.gcode.motion;
+        let on_the_way = self.jobs.gimbal.is_following()
+            && motion.current.is_some_and(|c| c.servo_seq == Some(seq));
+        if on_the_way {
+            motion.arrived = true;
+            if let Some(c) = motion.current.as_mut() {
+                c.servo_seq = None;
+            }
+        }
+        on_the_way
+    }
+
+    /// The servo task reports move `seq` arrived; `true` when it was the
+    /// G-code step's.
+    fn gcode_servo_arrived(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
+        if self.stream_arrived(seq) {
+            out.act(Action::Note(LaserEvent::GimbalArrived));
+            return true;
+        }
+        let Some(c) = self.gcode.motion.current.as_mut() else {
+            return false;
+        };
+        if c.servo_seq != Some(seq) {
+            return false;
+        }
+        c.servo_seq = None;
+        if c.index >= c.count && c.count > 0 {
+            c.until = Some(
+                self.inputs
+                    .now
+                    .saturating_add(Duration::from_millis(CORNER_SETTLE_MS)),
+            );
+        }
+        self.gcode.motion.arrived = true;
+        out.act(Action::Note(LaserEvent::GimbalArrived));
+        self.gcode_step_done(out);
+        true
+    }
+
+    /// The G-code side of a servo report: an arrival of the step in flight
+    /// moves on; `true` for a fault of it (the caller stops, after its own
+    /// fault handling).
+    pub(in crate::sequencer) fn gcode_servo_outcome(
+        &mut self,
+        outcome: &ServoOutcome,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        match *outcome {
+            ServoOutcome::Arrived { seq, .. } => {
+                self.gcode_servo_arrived(seq, out);
+                false
+            }
+            ServoOutcome::Fault { seq, .. } => self.gcode_awaits_servo(seq),
+            _ => false,
+        }
+    }
+
+    /// Whether the G-code step waits for servo move `seq`.
+    fn gcode_awaits_servo(&self, seq: u32) -> bool {
+        self.gcode
+            .motion
+            .current
+            .is_some_and(|c| c.servo_seq == Some(seq))
+    }
+
+    /// Whether `block` lights the laser (a lit G1/G2/G3).
+    #[inline(never)]
+    pub(in crate::sequencer) fn lights(&self, block: &Block) -> bool {
+        match *block {
+            Block::Line { laser, .. } | Block::Arc { laser, .. } => {
+                self.gcode_lit(laser.mode, laser.power)
+            }
+            _ => false,
+        }
+    }
+}
