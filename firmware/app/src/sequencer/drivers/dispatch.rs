@@ -2,7 +2,7 @@
 
 use crate::domain::{PointCm, Target};
 use crate::grbl::Block;
-use crate::sequencer::drivers::{Arrival, Driver, DriverStep, Drivers, gimbal};
+use crate::sequencer::drivers::{Arrival, Driver, DriverStep, Drivers, gimbal, stepper};
 use crate::sequencer::gcode::queue::planned_length;
 use crate::sequencer::machine::{ActionSink, Core};
 
@@ -17,7 +17,7 @@ impl Core {
         match driver {
             Driver::Gimbal => self.aimer.aim(p).is_ok(),
             Driver::Galvo => self.aimer.galvo_in_range(p),
-            Driver::Stepper => self.stepper_reaches(p),
+            Driver::Stepper => stepper::gcode::reaches(&self.settings, p),
         }
     }
 

@@ -252,15 +252,4 @@ impl Core {
             .current
             .is_some_and(|c| c.servo_seq == Some(seq))
     }
-
-    /// Whether `block` lights the laser (a lit G1/G2/G3).
-    #[inline(never)]
-    pub(in crate::sequencer) fn lights(&self, block: &Block) -> bool {
-        match *block {
-            Block::Line { laser, .. } | Block::Arc { laser, .. } => {
-                self.gcode_lit(laser.mode, laser.power)
-            }
-            _ => false,
-        }
-    }
 }

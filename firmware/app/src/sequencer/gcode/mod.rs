@@ -136,6 +136,7 @@ pub(in crate::sequencer) mod queue;
 pub(in crate::sequencer) mod report;
 pub(in crate::sequencer) mod settings;
 pub(in crate::sequencer) mod step;
+pub(in crate::sequencer) mod stepper;
 
 #[cfg(test)]
 pub(in crate::sequencer) mod tests;

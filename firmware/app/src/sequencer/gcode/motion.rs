@@ -130,7 +130,10 @@ impl Core {
     /// marking stopped).
     pub(in crate::sequencer) fn grbl_hold(&mut self, out: &mut dyn ActionSink) {
         let motion = &self.gcode.motion;
-        if motion.hold != Hold::None || motion.is_idle() || self.gcode_stepper_hold(out) {
+        if motion.hold != Hold::None
+            || motion.is_idle()
+            || self.with_stage(out, |st, jobs, out| jobs.stepper.hold(st, out))
+        {
             return;
         }
         let motion = &mut self.gcode.motion;

@@ -42,7 +42,7 @@ impl StepperJob {
     }
 }
 
-mod gcode;
+pub(in crate::sequencer) mod gcode;
 mod points;
 
 #[cfg(test)]

@@ -10,28 +10,17 @@
 use crate::domain::{Aim, Pattern, PointCm, Segment, Target, Unit};
 use crate::log;
 use crate::sequencer::drivers::Driver;
+use crate::sequencer::drivers::stepper::gcode::{config, junction};
 use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::sequencer::run::RunKind;
 use crate::stepper::{HomingFailure, MoveShape, StepperConfig, StepperEvent, StepperRequest};
 use crate::text::Fixed;
 use kinematics_core::frames::BoardPoint;
-use kinematics_core::gimbal::{Gimbal, GimbalModel};
 
 impl Core {
-    /// The stepper parameters from the settings (`stepper.*`), on the
-    /// board placed as the settings say (OQ, offsets, pose), exact model,
-    /// OL = 0 (the pan/tilt's axes meet at the beam).
+    /// The stepper parameters from the settings ([`config`]).
     pub(in crate::sequencer) fn stepper_config(&self) -> StepperConfig {
-        let mut geometry = self
-            .settings
-            .gimbal(crate::domain::AimModel::Exact)
-            .geometry;
-        geometry.ol_cm = 0.0;
-        let gimbal = Gimbal {
-            model: GimbalModel::Exact,
-            geometry,
-        };
-        StepperConfig::from_settings(&self.settings.stepper, gimbal)
+        config(&self.settings)
     }
 
     /// Sends the stepper task its parameters (applied at rest; the
@@ -41,17 +30,15 @@ impl Core {
         out.act(Action::ConfigureStepper(self.stepper_config()));
     }
 
-    /// The stepper plans with the junction deviation of `gcode` (grbl's
-    /// `$11`, mm at the board, as joint degrees at its centre) or of the
-    /// product (`stepper.junction_deg`); told when it changes.
+    /// The stepper plans with the junction deviation of `gcode` or of the
+    /// product ([`junction`]).
     pub(in crate::sequencer) fn stepper_junction(&mut self, gcode: bool, out: &mut dyn ActionSink) {
-        let want = gcode
-            .then(|| (self.settings.gcode_junction_mm / (self.settings.oq_cm * 10.0)).to_degrees());
-        if want != self.gcode.stepper_junction_deg {
-            self.gcode.stepper_junction_deg = want;
-            let deviation_deg = want.unwrap_or(self.settings.stepper.junction_deviation_deg);
-            out.act(Action::Stepper(StepperRequest::Junction { deviation_deg }));
-        }
+        junction(
+            &self.settings,
+            &mut self.gcode.stepper_junction_deg,
+            gcode,
+            out,
+        );
     }
 
     /// Decelerates the stepper to rest (when it draws).
