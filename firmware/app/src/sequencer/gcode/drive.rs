@@ -4,20 +4,23 @@
 //! waiting for room answered, the step finished, a hold held or resumed)
 //! or the core's (everything stopped when the galvo does not keep up).
 
-use crate::galvo::MarkStop;
+use crate::domain::PointCm;
+use crate::galvo::{GalvoEvent, MarkStop};
 use crate::grbl::Block;
-use crate::sequencer::drivers::DriverJobs;
 use crate::sequencer::drivers::stage::Stage;
+use crate::sequencer::drivers::{Driver, DriverJobs, DriverStep, Said, galvo, gimbal, stepper};
 use crate::sequencer::gcode::queue::{CORNER_SETTLE_MS, Hold, planned_length, point_at};
 use crate::sequencer::laser::LaserEvent;
 use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::servo::task::ServoOutcome;
+use crate::stepper::{StepperEvent, StepperRequest};
 use embassy_time::Duration;
 
 impl Core {
     /// Runs `stage` on the drivers' state with a [`Stage`] of the core's;
-    /// when a galvo job found no room, everything stops after it, and an
-    /// alarm it raised is raised.
+    /// then the core does what it noted ([`Stage::then`]: everything stops
+    /// when a galvo job found no room, …), and an alarm it raised is
+    /// raised.
     pub(in crate::sequencer) fn with_stage<R>(
         &mut self,
         out: &mut dyn ActionSink,
@@ -30,21 +33,130 @@ impl Core {
             aimer: &self.aimer,
             inputs: &mut self.inputs,
             next_seq: &mut self.next_seq,
+            run: &mut self.run,
             last_aim: &mut self.last_aim,
             measured: self.measured,
             drivers,
             alarm: None,
-            galvo_stalled: false,
+            then: Said::Nothing,
         };
         let result = stage(&mut st, &mut self.jobs, out);
-        let (alarm, stalled) = (st.alarm, st.galvo_stalled);
-        if stalled {
-            self.galvo_stalled(out);
-        }
+        let (alarm, then) = (st.alarm, st.then);
+        self.driver_said(then, out);
         if let Some(alarm) = alarm {
             self.grbl_alarm(alarm, out);
         }
         result
+    }
+
+    /// Whether every driver that draws reaches board point `p` (cm).
+    pub(in crate::sequencer) fn drivers_reach(&self, p: PointCm) -> bool {
+        self.drivers().reach(&self.aimer, &self.settings, p)
+    }
+
+    /// grbl's soft reset: a driver that can drop its motion at once does
+    /// (the stepper's steps are killed; the position is then uncertain);
+    /// the stop that follows brakes the others.
+    pub(in crate::sequencer) fn drivers_reset(&mut self, out: &mut dyn ActionSink) {
+        if self.drivers().hands_over_blocks() {
+            out.act(Action::Stepper(StepperRequest::Halt));
+        }
+    }
+
+    /// Offers `block`, just taken from the motion queue, to a driver that
+    /// plans whole blocks itself (the gimbal alone streams them through
+    /// its look-ahead plan); `true` when it took it (it is then the
+    /// current block).
+    pub(in crate::sequencer) fn drivers_take_block(
+        &mut self,
+        block: &Block,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        if !(self.drivers().gimbal_streams() && planned_length(block).is_some()) {
+            return false;
+        }
+        self.gcode.motion.current = Some(self.new_current(*block, 1));
+        self.stream_begin(block, out)
+    }
+
+    /// Hands the current G-code step to a driver with a stage of its own
+    /// (the gimbal following its planned profile, the stepper taking
+    /// blocks whole); `false` when the drivers take it step by step
+    /// ([`Core::driver_step`]).
+    pub(in crate::sequencer) fn drivers_send_in_own_stage(
+        &mut self,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        if self.jobs.gimbal.is_following() {
+            self.stream_tick(out);
+        } else if self.drivers().hands_over_blocks() {
+            self.gcode_stepper_send(out);
+        } else {
+            return false;
+        }
+        true
+    }
+
+    /// Sends the G-code step from `from` to `to` (`feed` mm/min, `None`:
+    /// rapid; `lit`; `corner`: it ends a block) to `driver`; its request
+    /// number, `None` when it could not be sent (the session stopped).
+    pub(in crate::sequencer) fn driver_step(
+        &mut self,
+        driver: Driver,
+        step: DriverStep,
+        out: &mut dyn ActionSink,
+    ) -> Option<u32> {
+        match driver {
+            Driver::Gimbal => self.with_stage(out, |st, _, out| {
+                gimbal::step::send_step(st, step.from, step.to, step.feed, step.corner, out)
+            }),
+            Driver::Galvo => self.with_stage(out, |st, jobs, out| {
+                (jobs.galvo).send_step(st, step.from, step.to, step.feed, step.lit, out)
+            }),
+            // Blocks are handed over whole (`gcode_stepper_send`).
+            Driver::Stepper => None,
+        }
+    }
+
+    /// A report of the galvo loop: the G-code session's when it is (its
+    /// step done, refused, its hold's stop); else what the galvo says of
+    /// it, done by the core.
+    pub(in crate::sequencer) fn galvo_event(
+        &mut self,
+        event: GalvoEvent,
+        out: &mut dyn ActionSink,
+    ) {
+        match event {
+            GalvoEvent::Done { seq } if self.gcode_galvo_done(seq, out) => {}
+            GalvoEvent::Refused { seq, error } if self.gcode_awaits_galvo(seq) => {
+                self.notify(out, format_args!("MSG:galvo: {error}"));
+                self.grbl_alarm(crate::grbl::Alarm::SoftLimit, out);
+            }
+            GalvoEvent::Stopped(at) => self.gcode_galvo_stopped(at, out),
+            _ => {
+                let idle = self.gcode.motion.is_idle();
+                self.driver_said(galvo::points::said(event, self.run, idle), out);
+            }
+        }
+    }
+
+    /// A report of the stepper task: the G-code session's when it is;
+    /// else what the stepper says of it, done by the core.
+    pub(in crate::sequencer) fn stepper_event(
+        &mut self,
+        event: StepperEvent,
+        out: &mut dyn ActionSink,
+    ) {
+        if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
+            self.stepper_homing = false;
+        }
+        if self.gcode_stepper_event(&event, out) {
+            return;
+        }
+        // The run's current point, for messages.
+        let target = (self.last_aim).map_or((0.0, 0.0), |(t, _)| (t.point.x_cm, t.point.y_cm));
+        let said = stepper::points::said(event, &self.settings, self.run, target);
+        self.driver_said(said, out);
     }
 
     /// Sends the pieces that continue the galvo stroke in flight.

@@ -142,6 +142,6 @@ impl Default for GalvoConfig {
 mod ahead;
 mod gcode;
 mod hold;
-mod points;
+pub(in crate::sequencer) mod points;
 #[cfg(test)]
 mod tests;

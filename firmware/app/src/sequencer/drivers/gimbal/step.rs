@@ -27,10 +27,7 @@ pub(in crate::sequencer) fn send_step(
         st.alarm = Some(Alarm::SoftLimit);
         return None;
     };
-    let at = st
-        .measured
-        .or(st.last_aim.map(|(_, a)| (a.yaw_wire, a.pitch_wire)));
-    let by_servo = interval_ms(st.settings, at, &aim);
+    let by_servo = interval_ms(st.settings, st.servo_at(), &aim);
     let by_feed = feed.map_or(0.0, |f| {
         let f = st.gcode.overrides.feed_mm_min(f);
         60_000.0 * from.distance_to(to) / f.max(1e-3)

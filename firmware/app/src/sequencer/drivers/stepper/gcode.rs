@@ -1,16 +1,14 @@
 //! The stepper driver's G-code stage: blocks handed over whole to its task.
 
-use crate::domain::PointCm;
 use crate::grbl::{Block, Laser, PointMm};
 use crate::sequencer::drivers::stage::Stage;
-use crate::sequencer::drivers::stepper::StepperJob;
+use crate::sequencer::drivers::stepper::{StepperJob, config};
 use crate::sequencer::gcode::queue::{Hold, cm, planned_length};
 use crate::sequencer::io::{Action, ActionSink};
 use crate::settings::Settings;
-use crate::stepper::{MoveShape, StepperConfig, StepperEvent, StepperRequest};
+use crate::stepper::{MoveShape, StepperEvent, StepperRequest};
 use kinematics_core::Rotation;
 use kinematics_core::frames::BoardPoint;
-use kinematics_core::gimbal::{Gimbal, GimbalModel};
 
 /// What a stepper report means to the G-code session
 /// ([`StepperJob::event`]).
@@ -209,19 +207,6 @@ impl StepperJob {
     }
 }
 
-/// The stepper parameters from `settings` (`stepper.*`), on the board
-/// placed as the settings say (OQ, offsets, pose), exact model, OL = 0
-/// (the pan/tilt's axes meet at the beam).
-pub(in crate::sequencer) fn config(settings: &Settings) -> StepperConfig {
-    let mut geometry = settings.gimbal(crate::domain::AimModel::Exact).geometry;
-    geometry.ol_cm = 0.0;
-    let gimbal = Gimbal {
-        model: GimbalModel::Exact,
-        geometry,
-    };
-    StepperConfig::from_settings(&settings.stepper, gimbal)
-}
-
 /// The stepper plans with the junction deviation of `gcode` (grbl's
 /// `$11`, mm at the board, as joint degrees at its centre) or of the
 /// product (`stepper.junction_deg`); told when it changes (`current`:
@@ -238,17 +223,6 @@ pub(in crate::sequencer) fn junction(
         let deviation_deg = want.unwrap_or(settings.stepper.junction_deviation_deg);
         out.act(Action::Stepper(StepperRequest::Junction { deviation_deg }));
     }
-}
-
-/// Whether the stepper of `settings` reaches board point `p` within its
-/// soft limits.
-#[inline(never)]
-pub(in crate::sequencer) fn reaches(settings: &Settings, p: PointCm) -> bool {
-    let config = config(settings);
-    config
-        .gimbal
-        .ik(BoardPoint::new(p.x_cm, p.y_cm))
-        .is_ok_and(|j| config.steps_of(j).is_ok())
 }
 
 /// The programmed spot speed of a feed move, mm/s (`None`: G0, at the
