@@ -1,8 +1,10 @@
-//! The session's side of the drivers' G-code stages: each stage is a
-//! method of the driver's own state ([`DriverJobs`]) given a [`Stage`]
-//! of the core's state; what follows it here is the session's (a line
-//! waiting for room answered, the step finished, a hold held or resumed)
-//! or the core's (everything stopped when the galvo does not keep up).
+//! The session's and the core's side of the drivers: a driver is called
+//! with a [`Stage`] of the core's state ([`Core::with_stage`]; its G-code
+//! stage a method of its own state in [`DriverJobs`]), and what follows
+//! it here is the session's (a line waiting for room answered, the step
+//! finished, a hold held or resumed) or the core's (what it noted: a
+//! stop, an alarm). The drivers' reports come here too: the session's
+//! part first, the rest to the core as a [`Said`].
 
 use crate::domain::PointCm;
 use crate::galvo::{GalvoEvent, MarkStop};
