@@ -249,16 +249,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
     ),
     (
         "laser-app",
-        &[
-            "sequencer/drivers",
-            "sequencer/drivers/galvo",
-            "sequencer/drivers/galvo/ahead",
-            "sequencer/machine",
-        ],
-        "left for: the G-code session out of `impl Core` (issue 21: the drivers extend Core)",
-    ),
-    (
-        "laser-app",
         &["app", "app/controls", "app/tasks"],
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
     ),

@@ -4,7 +4,7 @@
 use crate::command::Command;
 use crate::domain::{AimModel, Pattern, PatternCheck, PatternError, Target, check_target};
 use crate::galvo::GalvoError;
-use crate::sequencer::drivers::{Drivers, NO_GALVO};
+use crate::sequencer::drivers::{Drivers, NO_GALVO, galvo};
 use crate::sequencer::machine::{
     Action, ActionSink, AfterCheck, CHECKS_PER_STEP, Core, Pending, Readings,
 };
@@ -60,7 +60,7 @@ impl Core {
             }
             Command::Laser(mode) => {
                 self.settings.laser_mode = mode;
-                self.allow_galvo_laser(out);
+                galvo::points::allow_laser(self.run, &self.settings, &self.inputs, out);
                 self.ok(out);
             }
             Command::Model(model) => self.set_model(model, out),
@@ -111,7 +111,7 @@ impl Core {
                 self.settings.galvo.planner = planner;
                 self.configure_galvo(out);
             }
-            _ => self.report_galvo_status(&readings.galvo, out),
+            _ => galvo::points::report_status(&self.settings, &readings.galvo, out),
         }
         self.ok(out);
     }

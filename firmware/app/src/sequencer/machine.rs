@@ -20,7 +20,8 @@
 
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::log;
-use crate::sequencer::drivers::Driver;
+use crate::sequencer::drivers::stage::stop_galvo as galvo_stop;
+use crate::sequencer::drivers::{Driver, Drivers, galvo, stepper};
 use crate::sequencer::faults::ServoFaults;
 pub use crate::sequencer::io::{Action, ActionSink, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::sequencer::laser::laser_wanted;
@@ -290,6 +291,27 @@ impl Core {
         out.act(Action::CloseGate);
         self.gate_lost = false;
         self.stop_galvo(out);
+    }
+
+    /// The driver(s) that draw.
+    pub(super) fn drivers(&self) -> Drivers {
+        Drivers::of(self.actuator)
+    }
+
+    /// Tells the galvo loop to stop ([`galvo_stop`]).
+    pub(super) fn stop_galvo(&mut self, out: &mut dyn ActionSink) {
+        galvo_stop(&mut self.inputs, out);
+    }
+
+    /// Sends the galvo loop the parameters of the settings ([`galvo::points::configure`]).
+    pub(super) fn configure_galvo(&mut self, out: &mut dyn ActionSink) {
+        galvo::points::configure(&self.settings, self.run, &self.inputs, out);
+    }
+
+    /// Sends the stepper task the parameters of the settings.
+    pub(super) fn configure_stepper(&mut self, out: &mut dyn ActionSink) {
+        let junction = &mut self.gcode.stepper_junction_deg;
+        stepper::points::configure(&self.settings, junction, out);
     }
 
     /// Queues a notice line.

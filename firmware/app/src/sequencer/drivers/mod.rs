@@ -3,21 +3,25 @@
 //! selection ([`Drivers`]: the driver(s) that draw, `target both`
 //! included).
 //!
-//! Everything the core and the G-code session ask an actuator goes
-//! through here: whether it reaches a board point, what it does with a
-//! point of a pattern ([`Core::driver_aim`]) and with a G-code step
-//! ([`Core::driver_step`]), how it is re-aimed, reset and homed, what
-//! laser it carries and how that follows its speed, and how fast it may
-//! mark. Enum dispatch: a [`Driver`] is one byte, each question one
-//! `match`, nothing allocated. What a driver does itself lives in its
-//! files (gimbal: `run/points.rs` point moves, `gcode/step.rs` steps,
-//! `gimbal/` its stream; galvo: `galvo/`; stepper: `stepper/`). A new
+//! The drivers do not extend the core: each answers the interface's
+//! questions here (whether it reaches a board point, what it waits for,
+//! what laser it carries, how fast it may mark: one `match` each), and
+//! does its work in its own files, given what it needs ([`stage::Stage`]:
+//! the session's motion queue, the run, the settings and geometry, the
+//! request numbers). Its G-code stage is a method of its own state
+//! ([`DriverJobs`]: the galvo's stroke, the gimbal's stream, the
+//! stepper's job); its point runs and what its reports ask of the core
+//! ([`Said`]) are functions of its module. The core and the session call
+//! them and do what only they do after (stop, alarm, answer a line).
+//! Enum dispatch: a [`Driver`] is one byte, nothing allocated. A new
 //! actuator is a new variant here, its answers in these `match`es, its
 //! files, and its link in the shell (ARCHITECTURE.md, "Adding a driver").
 
-use crate::domain::Actuator;
+use crate::domain::{Actuator, Aimer, PointCm};
 use crate::grbl::PointMm;
 use crate::settings::Settings;
+use crate::stepper::HomingFailure;
+use crate::text::ReplyText;
 
 /// The reply to galvo commands when no galvo loop serves the link.
 pub(in crate::sequencer) const NO_GALVO: &str = "this build has no galvo output";
@@ -108,6 +112,21 @@ impl Driver {
         }
     }
 
+    /// Whether it reaches board point `p` (cm) with the geometry
+    /// `aimer` of `settings`.
+    pub(in crate::sequencer) fn reaches(
+        self,
+        aimer: &Aimer,
+        settings: &Settings,
+        p: PointCm,
+    ) -> bool {
+        match self {
+            Driver::Gimbal => aimer.aim(p).is_ok(),
+            Driver::Galvo => aimer.galvo_in_range(p),
+            Driver::Stepper => stepper::reaches(settings, p),
+        }
+    }
+
     /// Its highest marking feed, mm/min (unlimited: infinity).
     pub(in crate::sequencer) fn feed_cap_mm_min(self, settings: &Settings) -> f64 {
         match self {
@@ -161,6 +180,16 @@ impl Drivers {
         self.0 == Actuator::Stepper
     }
 
+    /// Whether every driver that draws reaches board point `p` (cm).
+    pub(in crate::sequencer) fn reach(
+        self,
+        aimer: &Aimer,
+        settings: &Settings,
+        p: PointCm,
+    ) -> bool {
+        self.iter().all(|d| d.reaches(aimer, settings, p))
+    }
+
     /// The lowest marking feed cap of the drivers that draw, mm/min.
     pub(in crate::sequencer) fn feed_cap_mm_min(self, settings: &Settings) -> f64 {
         self.iter()
@@ -193,6 +222,24 @@ impl Drivers {
             Actuator::Galvo | Actuator::Both => Err(NO_GALVO),
         }
     }
+}
+
+/// What a driver's report (beyond what the G-code session takes of it)
+/// asks of the core.
+#[derive(Debug, Clone)]
+pub(in crate::sequencer) enum Said {
+    /// Nothing.
+    Nothing,
+    /// The run's move `seq` arrived: its dwell starts.
+    Arrived(u32),
+    /// A job `seq` is done (the run's, if it is its job in flight).
+    JobDone(u32),
+    /// A notice line, then everything stops for the reason given.
+    Stop(Option<ReplyText>, &'static str),
+    /// A notice line.
+    Notice(ReplyText),
+    /// Homing ended at `steps` (`Some`: why it failed), told in a notice.
+    Homed(ReplyText, [i32; 2], Option<HomingFailure>),
 }
 
 /// What each driver keeps of the G-code job: its own state, which only
@@ -233,7 +280,7 @@ pub(in crate::sequencer) struct DriverStep {
     pub(in crate::sequencer) corner: bool,
 }
 
-mod dispatch;
 pub(in crate::sequencer) mod galvo;
 pub(in crate::sequencer) mod gimbal;
+pub(in crate::sequencer) mod stage;
 pub(in crate::sequencer) mod stepper;

@@ -4,10 +4,11 @@
 //! sender expects (`ok` once a line's motion is queued, `error:N`,
 //! `ALARM:N`, status reports).
 
-use crate::grbl::ParserState;
 use crate::grbl::report::Overrides;
 use crate::grbl::settings_map;
+use crate::grbl::{ParserState, SpindleMode};
 use crate::sequencer::gcode::queue::Motion;
+use crate::settings::{LaserMode, Settings};
 
 /// grbl's RX buffer as `$I` advertises it, bytes.
 pub(in crate::sequencer) const RX_BUFFER_BYTES: u16 = crate::grbl::RX_BUFFER_BYTES as u16;
@@ -69,6 +70,19 @@ impl Gcode {
             stepper_junction_deg: None,
         }
     }
+
+    /// Whether laser setting (`mode`, `power`) lights a feed move: a
+    /// power above `$31`'s and the laser mode (`laser auto`) allowing it.
+    pub(in crate::sequencer) fn lit(
+        &self,
+        mode: SpindleMode,
+        power: f64,
+        settings: &Settings,
+    ) -> bool {
+        let v = &self.values;
+        let fraction = crate::grbl::Laser { mode, power }.fraction(v.s_min, v.s_max);
+        fraction > 0.0 && settings.laser_mode == LaserMode::Auto
+    }
 }
 
 /// grbl-only settings the session keeps (RAM; defaults at boot and after
@@ -114,6 +128,7 @@ fn product_param(number: u16) -> Option<(&'static str, f64)> {
     }
 }
 
+pub(in crate::sequencer) mod drive;
 pub(in crate::sequencer) mod lines;
 pub(in crate::sequencer) mod motion;
 pub(in crate::sequencer) mod power;
@@ -121,6 +136,7 @@ pub(in crate::sequencer) mod queue;
 pub(in crate::sequencer) mod report;
 pub(in crate::sequencer) mod settings;
 pub(in crate::sequencer) mod step;
+pub(in crate::sequencer) mod stepper;
 
 #[cfg(test)]
 pub(in crate::sequencer) mod tests;

@@ -5,7 +5,6 @@ use crate::sequencer::drivers::Driver;
 use crate::sequencer::gcode::queue::{Current, Hold, MAX_STEPS, block_end, cm, point_at};
 use crate::sequencer::laser::LaserEvent;
 use crate::sequencer::machine::{Action, ActionSink, Core};
-use crate::settings::LaserMode;
 use embassy_time::Duration;
 
 impl Core {
@@ -123,9 +122,7 @@ impl Core {
 
     /// Whether laser setting (`mode`, `power`) lights a feed move.
     pub(in crate::sequencer) fn gcode_lit(&self, mode: SpindleMode, power: f64) -> bool {
-        let v = &self.gcode.values;
-        let fraction = crate::grbl::Laser { mode, power }.fraction(v.s_min, v.s_max);
-        fraction > 0.0 && self.settings.laser_mode == LaserMode::Auto
+        self.gcode.lit(mode, power, &self.settings)
     }
 
     /// `!`: laser dark at once; the gimbal stops after the step in
@@ -133,14 +130,18 @@ impl Core {
     /// marking stopped).
     pub(in crate::sequencer) fn grbl_hold(&mut self, out: &mut dyn ActionSink) {
         let motion = &self.gcode.motion;
-        if motion.hold != Hold::None || motion.is_idle() || self.gcode_stepper_hold(out) {
+        if motion.hold != Hold::None
+            || motion.is_idle()
+            || self.with_stage(out, |st, jobs, out| jobs.stepper.hold(st, out))
+        {
             return;
         }
         let motion = &mut self.gcode.motion;
         motion.gimbal_lit = false;
         let galvo_in_flight = motion.current.is_some_and(|c| c.galvo_seq.is_some());
         // A galvo stroke: held where the galvo reports it stopped marking.
-        let stroke = self.gcode_galvo_hold();
+        let (current, lockstep) = (motion.current, self.drivers().lockstep());
+        let stroke = self.jobs.galvo.hold(current, lockstep);
         let motion = &mut self.gcode.motion;
         if let Some(c) = motion.current.as_mut() {
             // Its `done` no longer counts: a galvo step (not a stroke) is
@@ -204,7 +205,7 @@ impl Core {
         if self.gcode.motion.clear() {
             self.ok(out);
         }
-        self.gcode_galvo_hold_dropped();
+        self.jobs.galvo.hold_dropped();
         self.grbl_sync_position();
     }
 }

@@ -1,15 +1,14 @@
 //! Running a pattern or goto point by point on the drivers that draw.
 
-use crate::domain::{Aim, AimModel, PathCursor, Pattern, Target};
+use crate::domain::{AimModel, PathCursor, Pattern, Target};
 use crate::log;
-use crate::sequencer::drivers::{Arrival, PathRun};
-use crate::sequencer::faults;
+use crate::sequencer::drivers::{Arrival, Driver, PathRun, Said, galvo, gimbal, stepper};
 use crate::sequencer::laser::LaserEvent;
-use crate::sequencer::machine::{Action, ActionSink, Core};
+use crate::sequencer::machine::{Action, ActionSink, Core, Line};
 use crate::sequencer::run::{Run, RunKind, Start};
-use crate::servo::task::{ServoOutcome, ServoRequest};
+use crate::servo::task::ServoOutcome;
 use crate::status::Phase;
-use crate::text::{Fixed, reply_text};
+use crate::stepper::StepperRequest;
 use embassy_time::Duration;
 
 impl Core {
@@ -26,7 +25,7 @@ impl Core {
         // the galvo drops its points and an underrun latch; the stepper
         // comes to rest before the new run's first move.
         self.close_gate(out);
-        self.stop_stepper(out);
+        stepper::points::stop(self.drivers(), out);
         self.run = None;
         match self.run_kind(start) {
             Some(kind) => {
@@ -54,7 +53,7 @@ impl Core {
         // The stepper traces paths exactly; with `model seed` it keeps the
         // seed's point-by-point method (for comparison), as the gimbal.
         match self.drivers().path_run(self.model == AimModel::Exact) {
-            PathRun::Traced => Self::traced(pattern, once),
+            PathRun::Traced => stepper::points::traced(pattern, once),
             PathRun::Marked => Some(RunKind::Marked { pattern, once }),
             PathRun::Refused => None,
             PathRun::Points => {
@@ -80,7 +79,7 @@ impl Core {
     pub(in crate::sequencer) fn stop(&mut self, why: &'static str, out: &mut dyn ActionSink) {
         out.act(Action::Note(LaserEvent::Stopped { why }));
         self.close_gate(out);
-        self.stop_stepper(out);
+        stepper::points::stop(self.drivers(), out);
         if let Some(run) = self.run.take() {
             log::info!("stop {} ({})", run.kind.name(), why);
         }
@@ -97,7 +96,7 @@ impl Core {
                 self.aimer.grid_target(&Pattern::Grid(pattern), run.index)
             }
             RunKind::Path { cursor, .. } => Some(cursor.target()),
-            RunKind::Traced { pattern, .. } => Self::traced_target(&pattern, run.index),
+            RunKind::Traced { pattern, .. } => stepper::points::traced_target(&pattern, run.index),
             RunKind::Marked { .. } => None,
         }
     }
@@ -106,7 +105,7 @@ impl Core {
     pub(in crate::sequencer) fn begin_point(&mut self, out: &mut dyn ActionSink) {
         let Some(run) = self.run else { return };
         if let RunKind::Marked { pattern, .. } = run.kind {
-            self.begin_galvo_path(pattern, out);
+            self.with_stage(out, |st, _, out| galvo::points::mark(st, pattern, out));
             return;
         }
         let Some(target) = self.current_target() else {
@@ -144,90 +143,71 @@ impl Core {
         self.point_finished_if_done(out);
     }
 
-    /// Aims the gimbal at `target` and sends the servo move; on an
-    /// unreachable target stops with an error notice.
-    pub(in crate::sequencer) fn begin_gimbal_move(
+    /// Aims `driver` at a pattern's current point `target` (`approach`:
+    /// travel, dark); `false` when it could not (the run stopped).
+    fn driver_aim(
         &mut self,
+        d: Driver,
         target: Target,
+        approach: bool,
         out: &mut dyn ActionSink,
     ) -> bool {
-        let aim = match self.aimer.aim(target.point) {
-            Ok(aim) => aim,
-            Err(e) => {
-                let why = reply_text(format_args!("{e}"));
-                log::warning!("target unreachable: {}", why.as_str());
-                // What happened first: the reason may be cut at the
-                // reply line length.
-                let name = self.run.map_or("goto", |r| r.kind.name());
-                self.notify(
-                    out,
-                    format_args!(
-                        "error: {name} stopped, laser off: point ({}, {}) cm unreachable: {}",
-                        Fixed::<2>(target.point.x_cm),
-                        Fixed::<2>(target.point.y_cm),
-                        why
-                    ),
-                );
-                self.stop("unreachable target", out);
-                return false;
+        match d {
+            Driver::Gimbal => {
+                self.with_stage(out, |st, _, out| gimbal::points::aim(st, target, out))
             }
-        };
-        let interval_ms = self.move_interval_ms(&aim);
-        let deadband_tenths = (self.settings.deadband_deg * 10.0) as u16;
-        let seq = self.send_gimbal_move(&aim, interval_ms, deadband_tenths, out);
-        log::info!(
-            "target ({}, {}) cm -> servo {} {} (0.1 deg) over {} ms",
-            target.point.x_cm,
-            target.point.y_cm,
-            aim.yaw_wire,
-            aim.pitch_wire,
-            interval_ms
-        );
-        if let Some(run) = self.run.as_mut() {
-            run.seq = seq;
+            Driver::Stepper => self.with_stage(out, |st, _, out| {
+                stepper::points::aim(st, target, approach, out)
+            }),
+            Driver::Galvo => self.with_stage(out, |st, _, out| galvo::points::aim(st, target, out)),
         }
-        self.last_aim = Some((target, aim));
-        true
     }
 
-    /// Sends the gimbal to `aim` over `interval_ms`, arrival within
-    /// `deadband_tenths` (0.1°), under a new sequence number (returned), and
-    /// notes the move for the laser logic.
-    pub(in crate::sequencer) fn send_gimbal_move(
+    /// The point of the running pattern is re-aimed (`model`): a driver
+    /// whose jobs queue drops the one running first (a servo move
+    /// supersedes the last by itself).
+    pub(in crate::sequencer) fn drivers_supersede(&mut self, out: &mut dyn ActionSink) {
+        if self.drivers().any(|d| d.arrival() == Arrival::Job) {
+            self.stop_galvo(out);
+        }
+    }
+
+    /// Does what a driver's report asks ([`Said`]).
+    pub(in crate::sequencer) fn driver_said(&mut self, said: Said, out: &mut dyn ActionSink) {
+        let notice = |out: &mut dyn ActionSink, text| out.act(Action::Line(Line::Notice(text)));
+        match said {
+            Said::Nothing => {}
+            Said::Arrived(seq) => self.start_dwell(seq, out),
+            Said::JobDone(seq) => {
+                if let Some(run) = self.run.as_mut().filter(|r| r.galvo_seq == seq) {
+                    run.galvo_busy = false;
+                    self.point_finished_if_done(out);
+                }
+            }
+            Said::Stop(text, why) => {
+                text.into_iter().for_each(|text| notice(out, text));
+                self.stop(why, out);
+            }
+            Said::Notice(text) => notice(out, text),
+            Said::Homed(text, steps, failed) => {
+                notice(out, text);
+                self.gcode_homing_done(steps, failed, out);
+            }
+        }
+    }
+
+    /// `home` / `$H` on the stepper: any run stops (laser dark), then the
+    /// stepper task homes the axes with switches; `homed: …` or `error:
+    /// home failed: …` follows. Errors: [`stepper::points::can_home`].
+    pub(in crate::sequencer) fn start_homing(
         &mut self,
-        aim: &Aim,
-        interval_ms: u16,
-        deadband_tenths: u16,
         out: &mut dyn ActionSink,
-    ) -> u32 {
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
-        out.act(Action::Servo(ServoRequest::Move {
-            seq,
-            yaw_tenths: aim.yaw_wire,
-            pitch_tenths: aim.pitch_wire,
-            interval_ms,
-            ids: (self.settings.yaw.id, self.settings.pitch.id),
-            deadband_tenths,
-            ranges_tenths: faults::servo_ranges_tenths(&self.settings),
-        }));
-        out.act(Action::Note(LaserEvent::GimbalMoveSent));
-        seq
-    }
-
-    /// Travel time for a move at the configured speed, from the largest
-    /// joint change (at least 20 ms, the SDK's minimum ramp).
-    pub(in crate::sequencer) fn move_interval_ms(&self, aim: &Aim) -> u16 {
-        let (from_yaw, from_pitch) = self
-            .measured
-            .or(self.last_aim.map(|(_, a)| (a.yaw_wire, a.pitch_wire)))
-            .unwrap_or((0, 0));
-        let travel_tenths = (i32::from(aim.yaw_wire) - i32::from(from_yaw))
-            .abs()
-            .max((i32::from(aim.pitch_wire) - i32::from(from_pitch)).abs());
-        let travel_deg = f64::from(travel_tenths) / 10.0;
-        let ms = 1000.0 * travel_deg / self.settings.servo_speed_deg_s;
-        (ms as u32).clamp(20, u32::from(u16::MAX)) as u16
+    ) -> Result<(), &'static str> {
+        stepper::points::can_home(self.drivers(), &self.settings)?;
+        self.stop("home", out);
+        out.act(Action::Stepper(StepperRequest::Home));
+        self.stepper_homing = true;
+        Ok(())
     }
 
     /// The servo task's report.
@@ -312,7 +292,9 @@ impl Core {
                 .grid_target(&Pattern::Grid(*pattern), run.index)
                 .is_some(),
             RunKind::Path { cursor, .. } => cursor.advance(),
-            RunKind::Traced { pattern, .. } => Self::traced_target(pattern, run.index).is_some(),
+            RunKind::Traced { pattern, .. } => {
+                stepper::points::traced_target(pattern, run.index).is_some()
+            }
             RunKind::Marked { .. } => false,
         };
         if !more {

@@ -3,37 +3,25 @@
 //! next one taking over when the piece in flight is done.
 
 use crate::grbl::PointMm;
-use crate::sequencer::drivers::galvo::{AHEAD, AHEAD_LINES, Cover, Cursor};
+use crate::sequencer::drivers::galvo::gcode::{after, piece, stroke_request};
+use crate::sequencer::drivers::galvo::{AHEAD, AHEAD_LINES, Ahead, Cursor, GalvoStroke};
+use crate::sequencer::drivers::stage::Stage;
 use crate::sequencer::gcode::queue::Hold;
-use crate::sequencer::machine::{ActionSink, Core};
+use crate::sequencer::io::ActionSink;
 
-/// A piece sent ahead of the one in flight.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(in crate::sequencer) struct Ahead {
-    pub(in crate::sequencer) seq: u32,
-    pub(super) start: Cursor,
-    pub(super) cover: Cover,
-    pub(in crate::sequencer) lines: u8,
-}
-
-impl Core {
+impl GalvoStroke {
     /// The piece `next`, sent ahead, becomes the one in flight: it starts
     /// at the block in flight now. Its number, or `None` when it does not
     /// start here.
-    pub(in crate::sequencer) fn gcode_galvo_adopt(
-        &mut self,
-        from: PointMm,
-        next: Ahead,
-    ) -> Option<u32> {
+    pub(super) fn adopt(&mut self, st: &Stage, from: PointMm, next: Ahead) -> Option<u32> {
         let start = Cursor { pos: 0, index: 0 };
-        let piece = self.gcode_galvo_piece(from, start, usize::from(next.lines), true)?;
+        let piece = piece(st, from, start, usize::from(next.lines), true)?;
         if piece.stroke.segments() != usize::from(next.lines) || piece.cover != next.cover {
             return None;
         }
-        let record = &mut self.jobs.galvo;
-        record.seq = Some(next.seq);
-        record.cover = piece.cover;
-        for a in record.ahead.iter_mut().flatten() {
+        self.seq = Some(next.seq);
+        self.cover = piece.cover;
+        for a in self.ahead.iter_mut().flatten() {
             a.start.pos = a.start.pos.saturating_sub(next.start.pos);
         }
         Some(next.seq)
@@ -42,19 +30,19 @@ impl Core {
     /// Sends the pieces that continue the stroke in flight, as far as
     /// lit blocks are queued, up to [`AHEAD`] pieces ahead (after a step
     /// is sent, and when blocks are queued).
-    pub(in crate::sequencer) fn gcode_galvo_send_ahead(&mut self, out: &mut dyn ActionSink) {
-        let motion = &self.gcode.motion;
+    pub(in crate::sequencer) fn send_ahead(&mut self, st: &mut Stage, out: &mut dyn ActionSink) {
+        let motion = &st.gcode.motion;
         let in_flight = motion
             .current
-            .is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == self.jobs.galvo.seq);
-        if !in_flight || motion.hold != Hold::None || self.drivers().lockstep() {
+            .is_some_and(|c| c.galvo_seq.is_some() && c.galvo_seq == self.seq);
+        if !in_flight || motion.hold != Hold::None || st.drivers.lockstep() {
             return;
         }
         loop {
-            let record = self.jobs.galvo;
+            let record = *self;
             let sent = record.ahead.iter().flatten().count();
             // One request slot stays free (for the stroke after).
-            let room = self.inputs.galvo_room.is_some_and(|room| room > 1);
+            let room = st.inputs.galvo_room.is_some_and(|room| room > 1);
             if !room || sent >= AHEAD {
                 return;
             };
@@ -63,23 +51,22 @@ impl Core {
                 Some(a) => (a.start, a.cover),
                 None => (Cursor { pos: 0, index: 0 }, record.cover),
             };
-            let start = self.gcode_galvo_after(start, cover);
-            let Some(piece) = self.gcode_galvo_piece(cover.end, start, AHEAD_LINES, true) else {
+            let start = after(st, start, cover);
+            let Some(piece) = piece(st, cover.end, start, AHEAD_LINES, true) else {
                 return;
             };
-            self.next_seq = self.next_seq.wrapping_add(1);
-            let seq = self.next_seq;
+            let seq = st.take_seq();
             let ahead = Ahead {
                 seq,
                 start,
                 cover: piece.cover,
                 lines: piece.stroke.segments() as u8,
             };
-            let request = self.gcode_galvo_stroke_request(seq, piece);
-            if !self.send_galvo(request, out) {
+            let request = stroke_request(st, seq, piece);
+            if !st.send_galvo(request, out) {
                 return;
             }
-            if let Some(slot) = self.jobs.galvo.ahead.get_mut(sent) {
+            if let Some(slot) = self.ahead.get_mut(sent) {
                 *slot = Some(ahead);
             }
         }
@@ -89,18 +76,21 @@ impl Core {
     /// not take over (cannot happen) is dropped from the galvo, which
     /// brakes dark, rather than left to be marked behind the sequencer's
     /// back.
-    pub(in crate::sequencer) fn gcode_galvo_drop_unadopted(&mut self, out: &mut dyn ActionSink) {
-        if self.jobs.galvo.adopt.take().is_some() {
-            self.stop_galvo(out);
+    pub(in crate::sequencer) fn drop_unadopted(
+        &mut self,
+        st: &mut Stage,
+        out: &mut dyn ActionSink,
+    ) {
+        if self.adopt.take().is_some() {
+            st.stop_galvo(out);
         }
     }
 
     /// Whether `seq` is a piece sent ahead of the stroke in flight.
-    pub(in crate::sequencer) fn gcode_galvo_ahead_is(&self, seq: u32) -> bool {
-        let g = &self.jobs.galvo;
-        g.ahead
+    pub(in crate::sequencer) fn ahead_is(&self, seq: u32) -> bool {
+        self.ahead
             .iter()
-            .chain([&g.adopt])
+            .chain([&self.adopt])
             .flatten()
             .any(|a| a.seq == seq)
     }

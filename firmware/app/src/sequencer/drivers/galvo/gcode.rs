@@ -6,44 +6,46 @@ use crate::galvo::GalvoEvent;
 use crate::galvo::GalvoRequest;
 use crate::grbl::{Block, PointMm};
 use crate::sequencer::drivers::galvo::{Cover, Cursor, GalvoStroke, MAX_ARC_CHORDS, Piece};
+use crate::sequencer::drivers::stage::Stage;
 use crate::sequencer::gcode::queue::{block_point, cm, point_at};
-use crate::sequencer::machine::{ActionSink, Core};
+use crate::sequencer::io::ActionSink;
 
-impl Core {
+impl GalvoStroke {
     /// The galvo's request for the G-code step from `from` to `to` at
     /// `feed` (mm/min), `lit` or dark, with its number; `None` when it
-    /// could not be sent (the sequencer stopped).
-    pub(in crate::sequencer) fn gcode_galvo_send(
+    /// could not be sent (the loop does not keep up:
+    /// [`Stage::galvo_stalled`]).
+    pub(in crate::sequencer) fn send_step(
         &mut self,
+        st: &mut Stage,
         from: PointMm,
         to: PointMm,
         feed: Option<f64>,
         lit: bool,
         out: &mut dyn ActionSink,
     ) -> Option<u32> {
-        let strokes = lit && !self.drivers().lockstep();
-        if let Some(next) = self.jobs.galvo.adopt.take() {
-            if strokes && let Some(seq) = self.gcode_galvo_adopt(from, next) {
+        let strokes = lit && !st.drivers.lockstep();
+        if let Some(next) = self.adopt.take() {
+            if strokes && let Some(seq) = self.adopt(st, from, next) {
                 return Some(seq);
             }
             // Not the step it was sent for (cannot happen): the loop
             // drops it, braking dark.
-            self.stop_galvo(out);
+            st.stop_galvo(out);
         }
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
+        let seq = st.take_seq();
         let start = Cursor { pos: 0, index: 0 };
         let piece = strokes
-            .then(|| self.gcode_galvo_piece(from, start, StrokeCm::MAX_SEGMENTS, false))
+            .then(|| piece(st, from, start, StrokeCm::MAX_SEGMENTS, false))
             .flatten();
         let request = match (piece, lit) {
             (Some(piece), _) => {
-                self.jobs.galvo = GalvoStroke {
+                *self = GalvoStroke {
                     seq: Some(seq),
                     cover: piece.cover,
                     ..GalvoStroke::default()
                 };
-                self.gcode_galvo_stroke_request(seq, piece)
+                stroke_request(st, seq, piece)
             }
             (None, true) => GalvoRequest::Path {
                 seq,
@@ -51,7 +53,7 @@ impl Core {
                     from: cm(from),
                     to: cm(to),
                 },
-                mark_speed_mm_s: feed.map(|f| (self.gcode_galvo_feed_mm_min(f) / 60.0) as f32),
+                mark_speed_mm_s: feed.map(|f| (feed_mm_min(st, f) / 60.0) as f32),
             },
             (None, false) => {
                 let [x_mm, y_mm] = cm(to).galvo_mm();
@@ -63,139 +65,27 @@ impl Core {
                 }
             }
         };
-        self.send_galvo(request, out).then_some(seq)
-    }
-
-    pub(super) fn gcode_galvo_stroke_request(&self, seq: u32, piece: Piece) -> GalvoRequest {
-        GalvoRequest::Path {
-            seq,
-            path: Figure::Stroke(piece.stroke),
-            mark_speed_mm_s: Some((self.gcode_galvo_feed_mm_min(piece.feed) / 60.0) as f32),
-        }
-    }
-
-    /// The block at `pos` (0: the block in flight), its steps on the galvo.
-    pub(super) fn gcode_galvo_block(&self, pos: usize) -> Option<(Block, u32)> {
-        let motion = &self.gcode.motion;
-        let c = motion.current?;
-        if pos == 0 {
-            return Some((c.block, c.count));
-        }
-        let block = *motion.queue.get(pos - 1)?;
-        let steps = match block {
-            Block::Arc { arc, .. } => {
-                arc.segment_count(self.gcode.values.arc_tolerance_mm, MAX_ARC_CHORDS)
-            }
-            _ => 1,
-        };
-        Some((block, steps))
-    }
-
-    /// Where the piece after one starting at `start` with `cover` starts.
-    pub(super) fn gcode_galvo_after(&self, start: Cursor, cover: Cover) -> Cursor {
-        let count = self.gcode_galvo_block(start.pos).map_or(0, |(_, n)| n);
-        if cover.joined == 0 && cover.last_index < count {
-            Cursor {
-                pos: start.pos,
-                index: cover.last_index + 1,
-            }
-        } else {
-            Cursor {
-                pos: start.pos + usize::from(cover.joined) + 1,
-                index: 1,
-            }
-        }
-    }
-
-    /// The piece from `from` (where the piece before it ends) at `start`
-    /// (index 0: the block in flight's current step) through whole lit
-    /// blocks queued after it, up to `max_lines`: `None` when its first
-    /// block is not a lit feed move (the block in flight: not a feed move).
-    pub(super) fn gcode_galvo_piece(
-        &self,
-        from: PointMm,
-        start: Cursor,
-        max_lines: usize,
-        continues: bool,
-    ) -> Option<Piece> {
-        let (block, count) = self.gcode_galvo_block(start.pos)?;
-        let index = match start.index {
-            0 => self.gcode.motion.current?.index,
-            index => index,
-        };
-        let mut feed = feed_of(&block)?;
-        if start.pos > 0 && !self.lights(&block) {
-            return None;
-        }
-        let from_cm = cm(from);
-        let mut stroke = if continues {
-            StrokeCm::continuing(from_cm)?
-        } else {
-            StrokeCm::new(from_cm)?
-        };
-        let mut cover = Cover {
-            last_index: count,
-            joined: 0,
-            end: block_point(&block, 1.0),
-        };
-        let tolerance = self.gcode.values.arc_tolerance_mm;
-        if index > 1 || !push_block(&mut stroke, &block, tolerance, max_lines) {
-            // Part of the block was drawn already (or it does not fit):
-            // its steps (an arc's chords) from here, up to the room.
-            cover.last_index = index.saturating_sub(1);
-            for k in index..=count {
-                let p = point_at(&block, k, count);
-                if stroke.segments() >= max_lines || !stroke.line_to(cm(p)) {
-                    break;
-                }
-                (cover.last_index, cover.end) = (k, p);
-            }
-            if cover.last_index < count {
-                return (stroke.segments() > 0).then_some(Piece {
-                    stroke,
-                    feed,
-                    cover,
-                });
-            }
-        }
-        for block in self.gcode.motion.queue.iter().skip(start.pos) {
-            let Some(block_feed) = feed_of(block).filter(|_| self.lights(block)) else {
-                break;
-            };
-            if !push_block(&mut stroke, block, tolerance, max_lines) {
-                break;
-            }
-            feed = feed.min(block_feed);
-            cover.joined += 1;
-            cover.end = block_point(block, 1.0);
-        }
-        Some(Piece {
-            stroke,
-            feed,
-            cover,
-        })
+        st.send_galvo(request, out).then_some(seq)
     }
 
     /// The galvo finished request `seq`: when it was the stroke in
     /// flight, the block in flight moves to the stroke's last step, and
     /// the blocks joined to it leave the queue (the last one becomes the
     /// block in flight, at its end); the next piece sent ahead is in
-    /// flight from the next step. The caller then finishes the step.
-    pub(in crate::sequencer) fn gcode_galvo_stroke_done(
-        &mut self,
-        seq: u32,
-        out: &mut dyn ActionSink,
-    ) {
-        let record = core::mem::take(&mut self.jobs.galvo);
+    /// flight from the next step. `true` when blocks left the queue (a
+    /// line waiting for room is then queued). The caller then finishes
+    /// the step.
+    pub(in crate::sequencer) fn done(&mut self, st: &mut Stage, seq: u32) -> bool {
+        let record = core::mem::take(self);
         if record.seq != Some(seq) {
-            return;
+            return false;
         }
         let [first, second] = record.ahead;
-        self.jobs.galvo.adopt = first;
-        self.jobs.galvo.ahead = [second, None];
-        let motion = &mut self.gcode.motion;
+        self.adopt = first;
+        self.ahead = [second, None];
+        let motion = &mut st.gcode.motion;
         let Some(c) = motion.current.as_mut() else {
-            return;
+            return false;
         };
         c.index = record.cover.last_index;
         for _ in 0..record.cover.joined {
@@ -203,10 +93,119 @@ impl Core {
                 (c.block, c.index, c.count) = (block, 1, 1);
             }
         }
-        if record.cover.joined > 0 {
-            self.grbl_take_owed(out);
+        record.cover.joined > 0
+    }
+}
+
+/// The galvo request marking `piece` as stroke `seq`.
+pub(super) fn stroke_request(st: &Stage, seq: u32, piece: Piece) -> GalvoRequest {
+    GalvoRequest::Path {
+        seq,
+        path: Figure::Stroke(piece.stroke),
+        mark_speed_mm_s: Some((feed_mm_min(st, piece.feed) / 60.0) as f32),
+    }
+}
+
+/// The block at `pos` (0: the block in flight), its steps on the galvo.
+pub(super) fn block_at(st: &Stage, pos: usize) -> Option<(Block, u32)> {
+    let motion = &st.gcode.motion;
+    let c = motion.current?;
+    if pos == 0 {
+        return Some((c.block, c.count));
+    }
+    let block = *motion.queue.get(pos - 1)?;
+    let steps = match block {
+        Block::Arc { arc, .. } => {
+            arc.segment_count(st.gcode.values.arc_tolerance_mm, MAX_ARC_CHORDS)
+        }
+        _ => 1,
+    };
+    Some((block, steps))
+}
+
+/// Where the piece after one starting at `start` with `cover` starts.
+pub(super) fn after(st: &Stage, start: Cursor, cover: Cover) -> Cursor {
+    let count = block_at(st, start.pos).map_or(0, |(_, n)| n);
+    if cover.joined == 0 && cover.last_index < count {
+        Cursor {
+            pos: start.pos,
+            index: cover.last_index + 1,
+        }
+    } else {
+        Cursor {
+            pos: start.pos + usize::from(cover.joined) + 1,
+            index: 1,
         }
     }
+}
+
+/// The piece from `from` (where the piece before it ends) at `start`
+/// (index 0: the block in flight's current step) through whole lit
+/// blocks queued after it, up to `max_lines`: `None` when its first
+/// block is not a lit feed move (the block in flight: not a feed move).
+pub(super) fn piece(
+    st: &Stage,
+    from: PointMm,
+    start: Cursor,
+    max_lines: usize,
+    continues: bool,
+) -> Option<Piece> {
+    let (block, count) = block_at(st, start.pos)?;
+    let index = match start.index {
+        0 => st.gcode.motion.current?.index,
+        index => index,
+    };
+    let mut feed = feed_of(&block)?;
+    if start.pos > 0 && !st.lights(&block) {
+        return None;
+    }
+    let from_cm = cm(from);
+    let mut stroke = if continues {
+        StrokeCm::continuing(from_cm)?
+    } else {
+        StrokeCm::new(from_cm)?
+    };
+    let mut cover = Cover {
+        last_index: count,
+        joined: 0,
+        end: block_point(&block, 1.0),
+    };
+    let tolerance = st.gcode.values.arc_tolerance_mm;
+    if index > 1 || !push_block(&mut stroke, &block, tolerance, max_lines) {
+        // Part of the block was drawn already (or it does not fit):
+        // its steps (an arc's chords) from here, up to the room.
+        cover.last_index = index.saturating_sub(1);
+        for k in index..=count {
+            let p = point_at(&block, k, count);
+            if stroke.segments() >= max_lines || !stroke.line_to(cm(p)) {
+                break;
+            }
+            (cover.last_index, cover.end) = (k, p);
+        }
+        if cover.last_index < count {
+            return (stroke.segments() > 0).then_some(Piece {
+                stroke,
+                feed,
+                cover,
+            });
+        }
+    }
+    for block in st.gcode.motion.queue.iter().skip(start.pos) {
+        let Some(block_feed) = feed_of(block).filter(|_| st.lights(block)) else {
+            break;
+        };
+        if !push_block(&mut stroke, block, tolerance, max_lines) {
+            break;
+        }
+        feed = feed.min(block_feed);
+        cover.joined += 1;
+        cover.end = block_point(block, 1.0);
+    }
+    Some(Piece {
+        stroke,
+        feed,
+        cover,
+    })
 }
 
 /// Adds feed move `block` (from where the stroke ends) to `stroke`: a
@@ -240,41 +239,10 @@ fn feed_of(block: &Block) -> Option<f64> {
     }
 }
 
-impl Core {
-    /// The galvo's marking feed for programmed feed `feed_mm_min`: the feed
-    /// override applied, capped by the galvo's marking speed
-    /// (`galvo.mark_speed_mm_s`), mm/min.
-    pub(in crate::sequencer) fn gcode_galvo_feed_mm_min(&self, feed_mm_min: f64) -> f64 {
-        let feed = self.gcode.overrides.feed_mm_min(feed_mm_min);
-        feed.min(self.settings.galvo.mark_speed_mm_s * 60.0)
-    }
-
-    /// The galvo loop finished job `seq`; `true` when it was the G-code
-    /// step's.
-    pub(in crate::sequencer) fn gcode_galvo_done(
-        &mut self,
-        seq: u32,
-        out: &mut dyn ActionSink,
-    ) -> bool {
-        let Some(c) = self.gcode.motion.current.as_mut() else {
-            return false;
-        };
-        if c.galvo_seq != Some(seq) {
-            return false;
-        }
-        c.galvo_seq = None;
-        self.gcode_galvo_stroke_done(seq, out);
-        self.gcode_step_done(out);
-        self.gcode_galvo_drop_unadopted(out);
-        true
-    }
-
-    /// Whether the G-code step waits for galvo job `seq`.
-    pub(in crate::sequencer) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
-        self.gcode
-            .motion
-            .current
-            .is_some_and(|c| c.galvo_seq == Some(seq))
-            || self.gcode_galvo_ahead_is(seq)
-    }
+/// The galvo's marking feed for programmed feed `feed_mm_min`: the feed
+/// override applied, capped by the galvo's marking speed
+/// (`galvo.mark_speed_mm_s`), mm/min.
+fn feed_mm_min(st: &Stage, feed_mm_min: f64) -> f64 {
+    let feed = st.gcode.overrides.feed_mm_min(feed_mm_min);
+    feed.min(st.settings.galvo.mark_speed_mm_s * 60.0)
 }

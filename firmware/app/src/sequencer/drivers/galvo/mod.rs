@@ -78,11 +78,20 @@ pub(in crate::sequencer) struct GalvoStroke {
     /// What it covers from the block in flight.
     cover: Cover,
     /// Pieces sent ahead, continuing it, oldest first.
-    ahead: [Option<ahead::Ahead>; AHEAD],
+    ahead: [Option<Ahead>; AHEAD],
     /// The piece after a finished one, in flight from the next step.
-    adopt: Option<ahead::Ahead>,
+    adopt: Option<Ahead>,
     /// A feed hold waits for the galvo to report where it stopped.
     stopping: bool,
+}
+
+/// A piece sent ahead of the one in flight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Ahead {
+    seq: u32,
+    start: Cursor,
+    cover: Cover,
+    lines: u8,
 }
 
 /// A piece built: the stroke, its feed (the slowest, mm/min), its cover.
@@ -133,6 +142,6 @@ impl Default for GalvoConfig {
 mod ahead;
 mod gcode;
 mod hold;
-mod points;
+pub(in crate::sequencer) mod points;
 #[cfg(test)]
 mod tests;

@@ -67,5 +67,6 @@ impl Stream {
 }
 
 mod plan;
-mod step;
+pub(in crate::sequencer) mod points;
+pub(in crate::sequencer) mod step;
 mod stream;

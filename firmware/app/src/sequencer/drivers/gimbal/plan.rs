@@ -4,8 +4,8 @@
 
 use crate::grbl::{Block, PointMm};
 use crate::sequencer::drivers::gimbal::{GIMBAL_ACCEL_DEG_S2, PLAN_BLOCKS};
+use crate::sequencer::drivers::stage::Stage;
 use crate::sequencer::gcode::queue::{MIN_LENGTH_MM, block_point, cm, planned_length, point_at};
-use crate::sequencer::machine::Core;
 use kinematics_core::lookahead::{Lookahead, SpeedCursor};
 
 /// Unit directions at the start and at the end of a motion block of
@@ -24,94 +24,92 @@ fn unit(a: PointMm, b: PointMm) -> [f64; 2] {
     [(b.x_mm - a.x_mm) / d, (b.y_mm - a.y_mm) / d]
 }
 
-impl Core {
-    /// Cruise (mm/s) and acceleration (mm/s²) of `block` on the gimbal:
-    /// F (G0: the rate limit) within `$110` and the servo speed, `$120`
-    /// within [`GIMBAL_ACCEL_DEG_S2`], through the joint degrees per mm
-    /// along the block.
-    #[inline(never)]
-    pub(in crate::sequencer) fn stream_limits(&self, block: &Block, length: f64) -> (f64, f64) {
-        let s = &self.settings;
-        let deg_per_mm = self.joint_deg_per_mm(block, length).max(1e-6);
-        let cap = (s.servo_speed_deg_s / deg_per_mm).min(s.galvo.mark_speed_mm_s);
-        let feed = match *block {
-            Block::Line { feed_mm_min, .. }
-            | Block::Arc { feed_mm_min, .. }
-            | Block::Jog { feed_mm_min, .. } => feed_mm_min / 60.0,
-            _ => cap,
-        };
-        let accel = (GIMBAL_ACCEL_DEG_S2 / deg_per_mm).min(s.galvo.mark_accel_mm_s2);
-        (feed.min(cap).max(1e-3), accel.max(1e-3))
-    }
+/// Cruise (mm/s) and acceleration (mm/s²) of `block` on the gimbal:
+/// F (G0: the rate limit) within `$110` and the servo speed, `$120`
+/// within [`GIMBAL_ACCEL_DEG_S2`], through the joint degrees per mm
+/// along the block.
+#[inline(never)]
+pub(in crate::sequencer) fn stream_limits(st: &Stage, block: &Block, length: f64) -> (f64, f64) {
+    let s = st.settings;
+    let deg_per_mm = joint_deg_per_mm(st, block, length).max(1e-6);
+    let cap = (s.servo_speed_deg_s / deg_per_mm).min(s.galvo.mark_speed_mm_s);
+    let feed = match *block {
+        Block::Line { feed_mm_min, .. }
+        | Block::Arc { feed_mm_min, .. }
+        | Block::Jog { feed_mm_min, .. } => feed_mm_min / 60.0,
+        _ => cap,
+    };
+    let accel = (GIMBAL_ACCEL_DEG_S2 / deg_per_mm).min(s.galvo.mark_accel_mm_s2);
+    (feed.min(cap).max(1e-3), accel.max(1e-3))
+}
 
-    /// The larger joint's travel per mm along `block` (two pieces), °/mm.
-    #[inline(never)]
-    fn joint_deg_per_mm(&self, block: &Block, length: f64) -> f64 {
-        let aim = |k: u32| self.aimer.aim(cm(point_at(block, k, 2))).ok();
-        let (mut yaw, mut pitch) = (0.0, 0.0);
-        let mut prev = aim(0);
-        for k in 1..=2 {
-            let next = aim(k);
-            if let (Some(a), Some(b)) = (prev, next) {
-                yaw += libm::fabs(b.yaw_deg - a.yaw_deg);
-                pitch += libm::fabs(b.pitch_deg - a.pitch_deg);
-            }
-            prev = next;
+/// The larger joint's travel per mm along `block` (two pieces), °/mm.
+#[inline(never)]
+fn joint_deg_per_mm(st: &Stage, block: &Block, length: f64) -> f64 {
+    let aim = |k: u32| st.aimer.aim(cm(point_at(block, k, 2))).ok();
+    let (mut yaw, mut pitch) = (0.0, 0.0);
+    let mut prev = aim(0);
+    for k in 1..=2 {
+        let next = aim(k);
+        if let (Some(a), Some(b)) = (prev, next) {
+            yaw += libm::fabs(b.yaw_deg - a.yaw_deg);
+            pitch += libm::fabs(b.pitch_deg - a.pitch_deg);
         }
-        libm::fmax(yaw, pitch) / length
+        prev = next;
     }
+    libm::fmax(yaw, pitch) / length
+}
 
-    /// The exit speed the plan allows the running block (what is left of
-    /// it from `cursor`): its junction with the next queued motion block
-    /// and what lies behind that, or 0 when the next must start from rest
-    /// (none queued, a dwell, pause or end, a dark → lit change, or the
-    /// gimbal has not arrived anywhere yet: dark until it has).
-    #[inline(never)]
-    pub(in crate::sequencer) fn stream_exit_speed(
-        &self,
-        current: &Block,
-        cursor: &SpeedCursor,
-    ) -> f64 {
-        let motion = &self.gcode.motion;
-        let Ok(mut plan) = Lookahead::<PLAN_BLOCKS>::new(self.settings.gcode_junction_mm) else {
-            return 0.0;
+/// The exit speed the plan allows the running block (what is left of
+/// it from `cursor`): its junction with the next queued motion block
+/// and what lies behind that, or 0 when the next must start from rest
+/// (none queued, a dwell, pause or end, a dark → lit change, or the
+/// gimbal has not arrived anywhere yet: dark until it has).
+#[inline(never)]
+pub(in crate::sequencer) fn stream_exit_speed(
+    st: &Stage,
+    current: &Block,
+    cursor: &SpeedCursor,
+) -> f64 {
+    let motion = &st.gcode.motion;
+    let Ok(mut plan) = Lookahead::<PLAN_BLOCKS>::new(st.settings.gcode_junction_mm) else {
+        return 0.0;
+    };
+    let left = cursor.block.length - cursor.done;
+    let b = &cursor.block;
+    let end_tangent = tangents(current, b.length)[1];
+    if !motion.arrived
+        || plan
+            .push(
+                left.max(MIN_LENGTH_MM),
+                [end_tangent; 2],
+                b.nominal_speed,
+                b.accel,
+            )
+            .is_err()
+    {
+        return 0.0;
+    }
+    plan.limit_head_entry(cursor.speed);
+    let mut lit = st.lights(current);
+    for next in motion.queue.iter() {
+        let Some(length) = planned_length(next) else {
+            break;
         };
-        let left = cursor.block.length - cursor.done;
-        let b = &cursor.block;
-        let end_tangent = tangents(current, b.length)[1];
-        if !motion.arrived
-            || plan
-                .push(
-                    left.max(MIN_LENGTH_MM),
-                    [end_tangent; 2],
-                    b.nominal_speed,
-                    b.accel,
-                )
-                .is_err()
+        let next_lit = st.lights(next);
+        if next_lit && !lit {
+            break;
+        }
+        lit = next_lit;
+        let (cruise, accel) = stream_limits(st, next, length);
+        if plan
+            .push(length, tangents(next, length), cruise, accel)
+            .is_err()
         {
-            return 0.0;
+            break;
         }
-        plan.limit_head_entry(cursor.speed);
-        let mut lit = self.lights(current);
-        for next in motion.queue.iter() {
-            let Some(length) = planned_length(next) else {
-                break;
-            };
-            let next_lit = self.lights(next);
-            if next_lit && !lit {
-                break;
-            }
-            lit = next_lit;
-            let (cruise, accel) = self.stream_limits(next, length);
-            if plan
-                .push(length, tangents(next, length), cruise, accel)
-                .is_err()
-            {
-                break;
-            }
-        }
-        plan.block(1)
-            .filter(|n| n.max_entry_speed > 0.0)
-            .map_or(0.0, |n| n.entry_speed)
     }
+    plan.block(1)
+        .filter(|n| n.max_entry_speed > 0.0)
+        .map_or(0.0, |n| n.entry_speed)
 }

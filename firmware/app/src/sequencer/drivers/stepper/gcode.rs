@@ -1,100 +1,105 @@
 //! The stepper driver's G-code stage: blocks handed over whole to its task.
 
-use crate::domain::PointCm;
-use crate::grbl::{Alarm, Block, GrblError, Laser, PointMm};
-use crate::sequencer::drivers::stepper::StepperJob;
-use crate::sequencer::gcode::GrblMode;
+use crate::grbl::{Block, Laser, PointMm};
+use crate::sequencer::drivers::stage::Stage;
+use crate::sequencer::drivers::stepper::{StepperJob, config};
 use crate::sequencer::gcode::queue::{Hold, cm, planned_length};
-use crate::sequencer::machine::{Action, ActionSink, Core};
-use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
-use crate::text::reply_text;
+use crate::sequencer::io::{Action, ActionSink};
+use crate::settings::Settings;
+use crate::stepper::{MoveShape, StepperEvent, StepperRequest};
 use kinematics_core::Rotation;
 use kinematics_core::frames::BoardPoint;
 
-impl Core {
+/// What a stepper report means to the G-code session
+/// ([`StepperJob::event`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(in crate::sequencer) enum StepperReport {
+    /// Not the job's.
+    Other,
+    /// The job's, nothing more to do.
+    Handled,
+    /// The current block is done on the stepper's side.
+    BlockDone,
+    /// The stepper refused the move handed over (beyond its soft limits).
+    Refused,
+    /// The stepper came to rest (the session syncs its position).
+    AtRest,
+}
+
+impl StepperJob {
     /// Hands the current block to the stepper (or waits for rest first).
     #[inline(never)]
-    pub(in crate::sequencer) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
-        let Some(current) = self.gcode.motion.current else {
+    pub(in crate::sequencer) fn send(&mut self, st: &mut Stage, out: &mut dyn ActionSink) {
+        let Some(current) = st.gcode.motion.current else {
             return;
         };
-        let lit = self.lights(&current.block) && self.gcode.motion.hold == Hold::None;
+        let lit = st.lights(&current.block) && st.gcode.motion.hold == Hold::None;
         let laser = block_laser(&current.block);
-        let job = &mut self.jobs.stepper;
-        if job.inflight.is_some() && (lit != job.lit || (lit && laser != job.laser)) {
-            job.waiting = true;
+        if self.inflight.is_some() && (lit != self.lit || (lit && laser != self.laser)) {
+            self.waiting = true;
             return;
         }
-        job.waiting = false;
-        if core::mem::take(&mut job.held) {
+        self.waiting = false;
+        if core::mem::take(&mut self.held) {
             // A resume: the stepper goes on with the moves it had, from
             // where the hold stopped.
-            job.inflight = current.stepper_seq;
+            self.inflight = current.stepper_seq;
             out.act(Action::Stepper(StepperRequest::Resume));
-            self.gcode.motion.gimbal_lit = lit;
+            st.gcode.motion.gimbal_lit = lit;
             return;
         }
         let Some((point, shape)) = stepper_move(&current.block) else {
             return;
         };
-        self.gcode_stepper_override(out);
-        self.stepper_junction(true, out);
-        let feed_mm_s = self.stepper_feed(&current.block);
-        let seq = self.stepper_request(point, shape, feed_mm_s, out);
-        let motion = &mut self.gcode.motion;
+        self.send_override(st.gcode.overrides.feed, st.drivers.hands_over_blocks(), out);
+        junction(st.settings, &mut st.gcode.stepper_junction_deg, true, out);
+        let feed_mm_s = stepper_feed(&current.block);
+        let seq = self.request(st, point, shape, feed_mm_s, out);
+        let motion = &mut st.gcode.motion;
         if let Some(c) = motion.current.as_mut() {
             c.stepper_seq = Some(seq);
         }
-        self.jobs.stepper.lit = lit;
-        self.jobs.stepper.laser = laser;
+        self.lit = lit;
+        self.laser = laser;
         // Unlike a servo's, the stepper's position is known from the
         // start (its counted steps): the first move is cut from there.
         motion.gimbal_lit = lit;
     }
 
-    /// The programmed spot speed of a feed move, mm/s (`None`: G0, at
-    /// the axes' limit); the stepper task applies the feed override.
+    /// Tells the stepper task the feed override `percent` when it changed
+    /// (`stepping`: the stepper draws; it applies it on the fly, to the
+    /// move being cut too).
     #[inline(never)]
-    fn stepper_feed(&self, block: &Block) -> Option<f64> {
-        match *block {
-            Block::Line { feed_mm_min, .. }
-            | Block::Arc { feed_mm_min, .. }
-            | Block::Jog { feed_mm_min, .. } => Some(feed_mm_min / 60.0),
-            _ => None,
-        }
-    }
-
-    /// Tells the stepper task the feed override when it changed (it
-    /// applies it on the fly, to the move being cut too).
-    #[inline(never)]
-    pub(in crate::sequencer) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
-        let percent = self.gcode.overrides.feed;
-        let stepping = self.drivers().hands_over_blocks();
-        let job = &mut self.jobs.stepper;
-        if stepping && job.feed_percent != Some(percent) {
-            job.feed_percent = Some(percent);
+    pub(in crate::sequencer) fn send_override(
+        &mut self,
+        percent: u8,
+        stepping: bool,
+        out: &mut dyn ActionSink,
+    ) {
+        if stepping && self.feed_percent != Some(percent) {
+            self.feed_percent = Some(percent);
             out.act(Action::Stepper(StepperRequest::FeedOverride { percent }));
         }
     }
 
     /// One move request to the stepper; returns its number.
     #[inline(never)]
-    fn stepper_request(
+    fn request(
         &mut self,
+        st: &mut Stage,
         point: BoardPoint,
         shape: MoveShape,
         feed_mm_s: Option<f64>,
         out: &mut dyn ActionSink,
     ) -> u32 {
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
+        let seq = st.take_seq();
         out.act(Action::Stepper(StepperRequest::MoveTo {
             seq,
             point,
             shape,
             feed_mm_s,
         }));
-        self.jobs.stepper.inflight = Some(seq);
+        self.inflight = Some(seq);
         seq
     }
 
@@ -102,11 +107,10 @@ impl Core {
     /// motion with the same laser (dark, or lit with the same M3/M4 and
     /// S), no hold.
     #[inline(never)]
-    fn stepper_joins_next(&self) -> bool {
-        let motion = &self.gcode.motion;
-        let job = &self.jobs.stepper;
+    fn joins_next(&self, st: &Stage) -> bool {
+        let motion = &st.gcode.motion;
         let same_laser =
-            |b: &Block| self.lights(b) == job.lit && (!job.lit || block_laser(b) == job.laser);
+            |b: &Block| st.lights(b) == self.lit && (!self.lit || block_laser(b) == self.laser);
         motion.hold == Hold::None
             && motion
                 .queue
@@ -114,73 +118,65 @@ impl Core {
                 .is_some_and(|b| planned_length(b).is_some() && same_laser(b))
     }
 
-    /// The G-code side of a stepper report: `true` when it was the job's.
+    /// The G-code side of a stepper report: what it means to the session.
     #[inline(never)]
-    pub(in crate::sequencer) fn gcode_stepper_event(
+    pub(in crate::sequencer) fn event(
         &mut self,
+        st: &mut Stage,
         event: &StepperEvent,
         out: &mut dyn ActionSink,
-    ) -> bool {
-        let current = self.gcode.motion.current;
+    ) -> StepperReport {
+        let current = st.gcode.motion.current;
         let ours = |seq: u32| current.is_some_and(|c| c.stepper_seq == Some(seq));
-        let joins = self.stepper_joins_next();
-        let motion = &mut self.gcode.motion;
+        let joins = self.joins_next(st);
         match *event {
-            StepperEvent::Taken { seq } if ours(seq) && joins => {
-                self.gcode_stepper_done(out);
-                true
-            }
-            StepperEvent::Arrived { seq, .. } if self.jobs.stepper.inflight == Some(seq) => {
-                self.jobs.stepper.inflight = None;
-                motion.arrived = true;
+            StepperEvent::Taken { seq } if ours(seq) && joins => StepperReport::BlockDone,
+            StepperEvent::Arrived { seq, .. } if self.inflight == Some(seq) => {
+                self.inflight = None;
+                st.gcode.motion.arrived = true;
                 if ours(seq) {
-                    self.gcode_stepper_done(out);
-                } else if self.jobs.stepper.waiting {
-                    self.gcode_stepper_send(out);
+                    return StepperReport::BlockDone;
+                } else if self.waiting {
+                    self.send(st, out);
                 }
-                true
+                StepperReport::Handled
             }
-            StepperEvent::Refused { seq, why } if self.jobs.stepper.inflight == Some(seq) => {
-                // The checks before it passed, the stepper refused it
-                // (its axes beyond their soft limits): as on the galvo.
-                self.notify(out, format_args!("MSG:stepper: move refused: {why:?}"));
-                self.grbl_alarm(Alarm::SoftLimit, out);
-                true
+            StepperEvent::Refused { seq, .. } if self.inflight == Some(seq) => {
+                StepperReport::Refused
             }
             StepperEvent::Stopped { steps } => {
-                let braked = core::mem::take(&mut self.jobs.stepper.braking);
-                if !braked && !motion.is_idle() {
+                let braked = core::mem::take(&mut self.braking);
+                if !braked && !st.gcode.motion.is_idle() {
                     // The rest of a stop from before the job (`target
                     // stepper` typed ahead of it): its moves run on.
-                    return false;
+                    return StepperReport::Other;
                 }
-                self.gcode_stepper_at(steps);
-                let motion = &mut self.gcode.motion;
-                self.jobs.stepper.held |= braked;
+                self.at(st, steps);
+                let motion = &mut st.gcode.motion;
+                self.held |= braked;
                 match motion.hold {
                     Hold::Stopping if braked => motion.hold = Hold::Held,
                     // `~` came while it braked: it goes on now it is at
                     // rest (grbl resumes a hold once it is complete).
-                    Hold::None if braked => self.gcode_stepper_send(out),
+                    Hold::None if braked => self.send(st, out),
                     _ => {}
                 }
-                self.grbl_sync_position();
-                false
+                StepperReport::AtRest
             }
 
-            _ => false,
+            _ => StepperReport::Other,
         }
     }
 
     /// The stepper is at rest at `steps`: MPos from the counted steps.
     #[inline(never)]
-    fn gcode_stepper_at(&mut self, steps: [i32; 2]) {
-        let config = self.stepper_config();
+    pub(in crate::sequencer) fn at(&mut self, st: &mut Stage, steps: [i32; 2]) {
+        let config = config(st.settings);
         let at = config
             .joints_of(steps)
             .and_then(|j| config.gimbal.fk(j).ok());
-        let motion = &mut self.gcode.motion;
-        self.jobs.stepper.inflight = None;
+        let motion = &mut st.gcode.motion;
+        self.inflight = None;
         if let Some(p) = at {
             motion.position = PointMm {
                 x_mm: p.x_cm * 10.0,
@@ -189,82 +185,54 @@ impl Core {
         }
     }
 
-    /// The end of homing (`failed`: why it failed), the axes at rest at
-    /// `steps`: MPos where homing left the spot (a failed seek moved the
-    /// axes too); when a `$H` waits, its reply — `ok` (unlocked) or, as
-    /// grbl, `ALARM:N` (locked) and then `ok`; parameters that allow no
-    /// homing: `error:5`.
-    #[inline(never)]
-    pub(in crate::sequencer) fn gcode_homing_done(
-        &mut self,
-        steps: [i32; 2],
-        failed: Option<HomingFailure>,
-        out: &mut dyn ActionSink,
-    ) {
-        if self.gcode.motion.is_idle() {
-            self.gcode_stepper_at(steps);
-            self.grbl_sync_position();
-        }
-        if !core::mem::take(&mut self.gcode.homing) {
-            return;
-        }
-        let alarm = match failed {
-            None => {
-                self.gcode.mode = GrblMode::Normal;
-                return self.ok(out);
-            }
-            Some(HomingFailure::NoSwitches | HomingFailure::BadConfig) => {
-                return self.grbl_error(out, GrblError::HomingDisabled);
-            }
-            Some(HomingFailure::NotFound(_)) => Alarm::HomingNotFound,
-            Some(HomingFailure::StillPressed(_)) => Alarm::HomingPullOff,
-            Some(HomingFailure::Interrupted) => Alarm::HomingReset,
-        };
-        self.gcode.mode = GrblMode::Alarm;
-        self.grbl_data(out, reply_text(format_args!("ALARM:{}", alarm.code())));
-        self.ok(out);
-    }
-
-    /// The current block is done on the stepper's side.
-    #[inline(never)]
-    fn gcode_stepper_done(&mut self, out: &mut dyn ActionSink) {
-        if let Some(c) = self.gcode.motion.current.as_mut() {
-            c.stepper_seq = None;
-        }
-        self.gcode_step_done(out);
-    }
-
     /// `!` on the stepper: decelerate along the path, dark at once.
     /// `false` when nothing moves there.
     #[inline(never)]
-    pub(in crate::sequencer) fn gcode_stepper_hold(&mut self, out: &mut dyn ActionSink) -> bool {
-        let stepping = self.drivers().hands_over_blocks();
-        let motion = &mut self.gcode.motion;
-        if !stepping || self.jobs.stepper.inflight.is_none() {
+    pub(in crate::sequencer) fn hold(&mut self, st: &mut Stage, out: &mut dyn ActionSink) -> bool {
+        let stepping = st.drivers.hands_over_blocks();
+        let motion = &mut st.gcode.motion;
+        if !stepping || self.inflight.is_none() {
             return false;
         }
         motion.gimbal_lit = false;
         motion.hold = Hold::Stopping;
-        self.jobs.stepper.braking = true;
+        self.braking = true;
         out.act(Action::Stepper(StepperRequest::Hold));
         true
     }
 
-    /// Whether the stepper reaches board point `p` within its soft limits.
-    #[inline(never)]
-    pub(in crate::sequencer) fn stepper_reaches(&self, p: PointCm) -> bool {
-        let config = self.stepper_config();
-        config
-            .gimbal
-            .ik(BoardPoint::new(p.x_cm, p.y_cm))
-            .is_ok_and(|j| config.steps_of(j).is_ok())
-    }
-}
-
-impl StepperJob {
     /// Whether the stepper runs a move of the job.
     pub(in crate::sequencer) fn is_moving(&self) -> bool {
         self.inflight.is_some()
+    }
+}
+
+/// The stepper plans with the junction deviation of `gcode` (grbl's
+/// `$11`, mm at the board, as joint degrees at its centre) or of the
+/// product (`stepper.junction_deg`); told when it changes (`current`:
+/// what it was told last, joint degrees; `None`: the product's).
+pub(in crate::sequencer) fn junction(
+    settings: &Settings,
+    current: &mut Option<f64>,
+    gcode: bool,
+    out: &mut dyn ActionSink,
+) {
+    let want = gcode.then(|| (settings.gcode_junction_mm / (settings.oq_cm * 10.0)).to_degrees());
+    if want != *current {
+        *current = want;
+        let deviation_deg = want.unwrap_or(settings.stepper.junction_deviation_deg);
+        out.act(Action::Stepper(StepperRequest::Junction { deviation_deg }));
+    }
+}
+
+/// The programmed spot speed of a feed move, mm/s (`None`: G0, at the
+/// axes' limit); the stepper task applies the feed override.
+fn stepper_feed(block: &Block) -> Option<f64> {
+    match *block {
+        Block::Line { feed_mm_min, .. }
+        | Block::Arc { feed_mm_min, .. }
+        | Block::Jog { feed_mm_min, .. } => Some(feed_mm_min / 60.0),
+        _ => None,
     }
 }
 

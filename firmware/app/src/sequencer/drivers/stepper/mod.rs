@@ -10,7 +10,12 @@
 //! limit (laser dark at once); `~` goes on from the point it stopped at:
 //! the rest of the block it stopped in, then the queue.
 
+use crate::domain::PointCm;
 use crate::grbl::Laser;
+use crate::settings::Settings;
+use crate::stepper::StepperConfig;
+use kinematics_core::frames::BoardPoint;
+use kinematics_core::gimbal::{Gimbal, GimbalModel};
 
 /// What the stepper has of the G-code job.
 #[derive(Debug, Clone, Copy, Default)]
@@ -42,8 +47,32 @@ impl StepperJob {
     }
 }
 
-mod gcode;
-mod points;
+/// The stepper parameters from `settings` (`stepper.*`), on the board
+/// placed as the settings say (OQ, offsets, pose), exact model, OL = 0
+/// (the pan/tilt's axes meet at the beam).
+pub(in crate::sequencer) fn config(settings: &Settings) -> StepperConfig {
+    let mut geometry = settings.gimbal(crate::domain::AimModel::Exact).geometry;
+    geometry.ol_cm = 0.0;
+    let gimbal = Gimbal {
+        model: GimbalModel::Exact,
+        geometry,
+    };
+    StepperConfig::from_settings(&settings.stepper, gimbal)
+}
+
+/// Whether the stepper of `settings` reaches board point `p` within its
+/// soft limits.
+#[inline(never)]
+pub(in crate::sequencer) fn reaches(settings: &Settings, p: PointCm) -> bool {
+    let config = config(settings);
+    config
+        .gimbal
+        .ik(BoardPoint::new(p.x_cm, p.y_cm))
+        .is_ok_and(|j| config.steps_of(j).is_ok())
+}
+
+pub(in crate::sequencer) mod gcode;
+pub(in crate::sequencer) mod points;
 
 #[cfg(test)]
 mod arc_tests;

@@ -9,267 +9,218 @@
 
 use crate::domain::{Aim, Pattern, PointCm, Segment, Target, Unit};
 use crate::log;
-use crate::sequencer::drivers::Driver;
-use crate::sequencer::machine::{Action, ActionSink, Core};
-use crate::sequencer::run::RunKind;
-use crate::stepper::{HomingFailure, MoveShape, StepperConfig, StepperEvent, StepperRequest};
-use crate::text::Fixed;
+use crate::sequencer::drivers::stage::Stage;
+use crate::sequencer::drivers::stepper::config;
+use crate::sequencer::drivers::stepper::gcode::junction;
+use crate::sequencer::drivers::{Driver, Drivers, Said};
+use crate::sequencer::io::{Action, ActionSink};
+use crate::sequencer::run::{Run, RunKind};
+use crate::settings::Settings;
+use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
+use crate::text::{Fixed, reply_text};
 use kinematics_core::frames::BoardPoint;
-use kinematics_core::gimbal::{Gimbal, GimbalModel};
 
-impl Core {
-    /// The stepper parameters from the settings (`stepper.*`), on the
-    /// board placed as the settings say (OQ, offsets, pose), exact model,
-    /// OL = 0 (the pan/tilt's axes meet at the beam).
-    pub(in crate::sequencer) fn stepper_config(&self) -> StepperConfig {
-        let mut geometry = self
-            .settings
-            .gimbal(crate::domain::AimModel::Exact)
-            .geometry;
-        geometry.ol_cm = 0.0;
-        let gimbal = Gimbal {
-            model: GimbalModel::Exact,
-            geometry,
-        };
-        StepperConfig::from_settings(&self.settings.stepper, gimbal)
+/// Sends the stepper task the parameters of `settings` (applied at rest;
+/// the junction deviation the product's, `stepper.junction_deg`:
+/// `junction_deg`, what it was told last, is reset).
+pub(in crate::sequencer) fn configure(
+    settings: &Settings,
+    junction_deg: &mut Option<f64>,
+    out: &mut dyn ActionSink,
+) {
+    *junction_deg = None;
+    out.act(Action::ConfigureStepper(config(settings)));
+}
+
+/// Decelerates the stepper to rest (when it draws: `drivers`).
+pub(in crate::sequencer) fn stop(drivers: Drivers, out: &mut dyn ActionSink) {
+    if drivers.hands_over_blocks() {
+        out.act(Action::Stepper(StepperRequest::Stop));
     }
+}
 
-    /// Sends the stepper task its parameters (applied at rest; the
-    /// junction deviation the product's, `stepper.junction_deg`).
-    pub(in crate::sequencer) fn configure_stepper(&mut self, out: &mut dyn ActionSink) {
-        self.gcode.stepper_junction_deg = None;
-        out.act(Action::ConfigureStepper(self.stepper_config()));
+/// Sends the current point `target` of the run to the stepper task:
+/// travel (`approach`, grid and goto points) straight in joint space, a
+/// path's next point along the board line; `false` when no run.
+pub(in crate::sequencer) fn aim(
+    st: &mut Stage,
+    target: Target,
+    approach: bool,
+    out: &mut dyn ActionSink,
+) -> bool {
+    let Some(run) = *st.run else { return false };
+    let shape = match (run.kind, approach) {
+        (RunKind::Traced { pattern, .. }, false) => traced_shape(&pattern, run.index),
+        // The seed's point-by-point method: straight board lines between
+        // the interpolated points.
+        (RunKind::Path { .. }, false) => MoveShape::Line,
+        _ => MoveShape::Travel,
+    };
+    junction(st.settings, &mut st.gcode.stepper_junction_deg, false, out);
+    let seq = st.take_seq();
+    let point = BoardPoint::new(target.point.x_cm, target.point.y_cm);
+    out.act(Action::Stepper(StepperRequest::MoveTo {
+        seq,
+        point,
+        shape,
+        feed_mm_s: None,
+    }));
+    out.act(Action::Note(
+        crate::sequencer::laser::LaserEvent::GimbalMoveSent,
+    ));
+    log::info!(
+        "stepper target ({}, {}) cm ({})",
+        target.point.x_cm,
+        target.point.y_cm,
+        shape.name()
+    );
+    if let Some(run) = st.run.as_mut() {
+        run.seq = seq;
     }
+    // What `status` and the recorders show: the target and its joint
+    // angles on the stepper (no servo: wire 0).
+    let joints = config(st.settings).gimbal.ik(point).unwrap_or_default();
+    let aim = Aim {
+        yaw_deg: joints.yaw_deg,
+        pitch_deg: joints.pitch_deg,
+        yaw_wire: 0,
+        pitch_wire: 0,
+    };
+    *st.last_aim = Some((target, aim));
+    true
+}
 
-    /// The stepper plans with the junction deviation of `gcode` (grbl's
-    /// `$11`, mm at the board, as joint degrees at its centre) or of the
-    /// product (`stepper.junction_deg`); told when it changes.
-    pub(in crate::sequencer) fn stepper_junction(&mut self, gcode: bool, out: &mut dyn ActionSink) {
-        let want = gcode
-            .then(|| (self.settings.gcode_junction_mm / (self.settings.oq_cm * 10.0)).to_degrees());
-        if want != self.gcode.stepper_junction_deg {
-            self.gcode.stepper_junction_deg = want;
-            let deviation_deg = want.unwrap_or(self.settings.stepper.junction_deviation_deg);
-            out.act(Action::Stepper(StepperRequest::Junction { deviation_deg }));
+/// How a traced run of `pattern` runs (`None`: a figure of more than
+/// one stroke, which the stepper does not trace).
+pub(in crate::sequencer) fn traced(pattern: Pattern, once: bool) -> Option<RunKind> {
+    let Pattern::Path(figure) = pattern else {
+        return None;
+    };
+    let single = figure.stroke(1, Unit::BoardCm).is_none();
+    (single && figure.stroke(0, Unit::BoardCm).is_some())
+        .then_some(RunKind::Traced { pattern, once })
+}
+
+/// Point `index` of a traced pass: the stroke's start, then each
+/// segment's end (`None` past the last).
+pub(in crate::sequencer) fn traced_target(pattern: &Pattern, index: usize) -> Option<Target> {
+    let Pattern::Path(figure) = pattern else {
+        return None;
+    };
+    let stroke = figure.stroke(0, Unit::BoardCm)?;
+    let [x, y] = match index.checked_sub(1) {
+        None => stroke.start,
+        Some(k) => match *stroke.segments.get(k)? {
+            Segment::Line { to } => to,
+            Segment::Arc { end, .. } => end,
+        },
+    };
+    Some(Target {
+        point: PointCm::new(x, y),
+        grid: None,
+    })
+}
+
+/// How the stepper gets to point `index` of a traced pass.
+fn traced_shape(pattern: &Pattern, index: usize) -> MoveShape {
+    let Pattern::Path(figure) = pattern else {
+        return MoveShape::Travel;
+    };
+    let segment = index
+        .checked_sub(1)
+        .and_then(|k| figure.stroke(0, Unit::BoardCm)?.segments.get(k).copied());
+    match segment {
+        Some(Segment::Line { .. }) => MoveShape::Line,
+        Some(Segment::Arc {
+            centre: [x, y],
+            rotation,
+            ..
+        }) => MoveShape::Arc {
+            centre: BoardPoint::new(x, y),
+            rotation,
+        },
+        None => MoveShape::Travel,
+    }
+}
+
+/// What a report of the stepper task the G-code session did not take
+/// asks of the core (`run`: the active run; `target`: the board point,
+/// cm, of its current point, for messages).
+pub(in crate::sequencer) fn said(
+    event: StepperEvent,
+    settings: &Settings,
+    run: Option<Run>,
+    target: (f64, f64),
+) -> Said {
+    match event {
+        StepperEvent::Arrived { seq, steps } => {
+            log::info!("stepper arrived at {} {} steps", steps[0], steps[1]);
+            Said::Arrived(seq)
+        }
+        StepperEvent::Refused { seq, why } => {
+            if run.is_none_or(|r| r.seq != seq) {
+                return Said::Nothing;
+            }
+            let name = run.map_or("goto", |r| r.kind.name());
+            let notice = reply_text(format_args!(
+                "error: {name} stopped, laser off: point ({}, {}) cm refused by the stepper: {why:?}",
+                Fixed::<2>(target.0),
+                Fixed::<2>(target.1),
+            ));
+            Said::Stop(Some(notice), "stepper refused the point")
+        }
+        StepperEvent::Taken { .. } => Said::Nothing,
+        StepperEvent::Stopped { steps } => {
+            log::info!("stepper at rest at {} {} steps", steps[0], steps[1]);
+            Said::Nothing
+        }
+        StepperEvent::LimitHit { axes, steps } => {
+            log::warning!("stepper limit switch at {} {} steps", steps[0], steps[1]);
+            let which = ["", "pan", "tilt", "pan and tilt"][usize::from(axes & 3)];
+            let notice = reply_text(format_args!(
+                "error: stepper limit switch {which} hit: steps halted, laser off"
+            ));
+            Said::Stop(Some(notice), "limit switch")
+        }
+        StepperEvent::Homed { steps } => {
+            let j = config(settings).joints_of(steps).unwrap_or_default();
+            let notice = reply_text(format_args!(
+                "homed: stepper at pan {} tilt {} deg",
+                Fixed::<3>(j.yaw_deg),
+                Fixed::<3>(j.pitch_deg)
+            ));
+            Said::Homed(notice, steps, None)
+        }
+        StepperEvent::HomingFailed { why, steps } => {
+            let text = match why {
+                HomingFailure::NoSwitches => "no homing switches configured",
+                HomingFailure::NotFound(0) => "pan switch not found within the travel",
+                HomingFailure::NotFound(_) => "tilt switch not found within the travel",
+                HomingFailure::StillPressed(_) => "switch still closed after backing off",
+                HomingFailure::Interrupted => "stopped",
+                HomingFailure::BadConfig => "parameters refused for the homing moves",
+            };
+            let notice = reply_text(format_args!("error: home failed: {text}; not homed"));
+            Said::Homed(notice, steps, Some(why))
         }
     }
+}
 
-    /// Decelerates the stepper to rest (when it draws).
-    pub(in crate::sequencer) fn stop_stepper(&self, out: &mut dyn ActionSink) {
-        if self.drivers().hands_over_blocks() {
-            out.act(Action::Stepper(StepperRequest::Stop));
-        }
+/// Whether `home` / `$H` can home with `drivers` and `settings`: `Err`
+/// with the reason when not the stepper, or no switches (nothing
+/// changes; the power-up position stays step 0).
+pub(in crate::sequencer) fn can_home(
+    drivers: Drivers,
+    settings: &Settings,
+) -> Result<(), &'static str> {
+    if !drivers.any(Driver::homes_with_switches) {
+        return Err("home: only with target stepper");
     }
-
-    /// Sends the current point to the stepper task: travel (`approach`,
-    /// grid and goto points) straight in joint space, a path's next point
-    /// along the board line.
-    pub(in crate::sequencer) fn begin_stepper_move(
-        &mut self,
-        target: Target,
-        approach: bool,
-        out: &mut dyn ActionSink,
-    ) -> bool {
-        let Some(run) = self.run else { return false };
-        let shape = match (run.kind, approach) {
-            (RunKind::Traced { pattern, .. }, false) => Self::traced_shape(&pattern, run.index),
-            // The seed's point-by-point method: straight board lines between
-            // the interpolated points.
-            (RunKind::Path { .. }, false) => MoveShape::Line,
-            _ => MoveShape::Travel,
-        };
-        self.stepper_junction(false, out);
-        self.next_seq = self.next_seq.wrapping_add(1);
-        let seq = self.next_seq;
-        let point = BoardPoint::new(target.point.x_cm, target.point.y_cm);
-        out.act(Action::Stepper(StepperRequest::MoveTo {
-            seq,
-            point,
-            shape,
-            feed_mm_s: None,
-        }));
-        out.act(Action::Note(
-            crate::sequencer::laser::LaserEvent::GimbalMoveSent,
-        ));
-        log::info!(
-            "stepper target ({}, {}) cm ({})",
-            target.point.x_cm,
-            target.point.y_cm,
-            shape.name()
+    let s = &settings.stepper;
+    if s.pan.home_dir == 0.0 && s.tilt.home_dir == 0.0 {
+        return Err(
+            "home: no homing switches configured (stepper.pan.home_dir and stepper.tilt.home_dir are 0); the position stays as at power-up",
         );
-        if let Some(run) = self.run.as_mut() {
-            run.seq = seq;
-        }
-        // What `status` and the recorders show: the target and its joint
-        // angles on the stepper (no servo: wire 0).
-        let joints = self.stepper_config().gimbal.ik(point).unwrap_or_default();
-        let aim = Aim {
-            yaw_deg: joints.yaw_deg,
-            pitch_deg: joints.pitch_deg,
-            yaw_wire: 0,
-            pitch_wire: 0,
-        };
-        self.last_aim = Some((target, aim));
-        true
     }
-
-    /// How a traced run of `pattern` runs (`None`: a figure of more than
-    /// one stroke, which the stepper does not trace).
-    pub(in crate::sequencer) fn traced(pattern: Pattern, once: bool) -> Option<RunKind> {
-        let Pattern::Path(figure) = pattern else {
-            return None;
-        };
-        let single = figure.stroke(1, Unit::BoardCm).is_none();
-        (single && figure.stroke(0, Unit::BoardCm).is_some())
-            .then_some(RunKind::Traced { pattern, once })
-    }
-
-    /// Point `index` of a traced pass: the stroke's start, then each
-    /// segment's end (`None` past the last).
-    pub(in crate::sequencer) fn traced_target(pattern: &Pattern, index: usize) -> Option<Target> {
-        let Pattern::Path(figure) = pattern else {
-            return None;
-        };
-        let stroke = figure.stroke(0, Unit::BoardCm)?;
-        let [x, y] = match index.checked_sub(1) {
-            None => stroke.start,
-            Some(k) => match *stroke.segments.get(k)? {
-                Segment::Line { to } => to,
-                Segment::Arc { end, .. } => end,
-            },
-        };
-        Some(Target {
-            point: PointCm::new(x, y),
-            grid: None,
-        })
-    }
-
-    /// How the stepper gets to point `index` of a traced pass.
-    fn traced_shape(pattern: &Pattern, index: usize) -> MoveShape {
-        let Pattern::Path(figure) = pattern else {
-            return MoveShape::Travel;
-        };
-        let segment = index
-            .checked_sub(1)
-            .and_then(|k| figure.stroke(0, Unit::BoardCm)?.segments.get(k).copied());
-        match segment {
-            Some(Segment::Line { .. }) => MoveShape::Line,
-            Some(Segment::Arc {
-                centre: [x, y],
-                rotation,
-                ..
-            }) => MoveShape::Arc {
-                centre: BoardPoint::new(x, y),
-                rotation,
-            },
-            None => MoveShape::Travel,
-        }
-    }
-
-    /// The stepper task's report.
-    pub(in crate::sequencer) fn stepper_event(
-        &mut self,
-        event: StepperEvent,
-        out: &mut dyn ActionSink,
-    ) {
-        if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
-            self.stepper_homing = false;
-        }
-        if self.gcode_stepper_event(&event, out) {
-            return;
-        }
-        match event {
-            StepperEvent::Arrived { seq, steps } => {
-                log::info!("stepper arrived at {} {} steps", steps[0], steps[1]);
-                self.start_dwell(seq, out);
-            }
-            StepperEvent::Refused { seq, why } => {
-                if self.run.is_none_or(|r| r.seq != seq) {
-                    return;
-                }
-                let name = self.run.map_or("goto", |r| r.kind.name());
-                let target = self.last_stepper_target();
-                self.notify(
-                    out,
-                    format_args!(
-                        "error: {name} stopped, laser off: point ({}, {}) cm refused by the stepper: {why:?}",
-                        Fixed::<2>(target.0),
-                        Fixed::<2>(target.1),
-                    ),
-                );
-                self.stop("stepper refused the point", out);
-            }
-            StepperEvent::Taken { .. } => {}
-            StepperEvent::Stopped { steps } => {
-                log::info!("stepper at rest at {} {} steps", steps[0], steps[1]);
-            }
-            StepperEvent::LimitHit { axes, steps } => {
-                log::warning!("stepper limit switch at {} {} steps", steps[0], steps[1]);
-                let which = ["", "pan", "tilt", "pan and tilt"][usize::from(axes & 3)];
-                self.notify(
-                    out,
-                    format_args!(
-                        "error: stepper limit switch {which} hit: steps halted, laser off"
-                    ),
-                );
-                self.stop("limit switch", out);
-            }
-            StepperEvent::Homed { steps } => {
-                let j = self.stepper_config().joints_of(steps).unwrap_or_default();
-                self.notify(
-                    out,
-                    format_args!(
-                        "homed: stepper at pan {} tilt {} deg",
-                        Fixed::<3>(j.yaw_deg),
-                        Fixed::<3>(j.pitch_deg)
-                    ),
-                );
-                self.gcode_homing_done(steps, None, out);
-            }
-            StepperEvent::HomingFailed { why, steps } => {
-                let text = match why {
-                    HomingFailure::NoSwitches => "no homing switches configured",
-                    HomingFailure::NotFound(0) => "pan switch not found within the travel",
-                    HomingFailure::NotFound(_) => "tilt switch not found within the travel",
-                    HomingFailure::StillPressed(_) => "switch still closed after backing off",
-                    HomingFailure::Interrupted => "stopped",
-                    HomingFailure::BadConfig => "parameters refused for the homing moves",
-                };
-                self.notify(out, format_args!("error: home failed: {text}; not homed"));
-                self.gcode_homing_done(steps, Some(why), out);
-            }
-        }
-    }
-
-    /// `home` / `$H` on the stepper: any run stops (laser dark), then the
-    /// stepper task homes the axes with switches; `homed: …` or
-    /// `error: home failed: …` follows.
-    ///
-    /// Errors: not the stepper, or no switches (nothing changes; the
-    /// power-up position stays step 0).
-    pub(in crate::sequencer) fn start_homing(
-        &mut self,
-        out: &mut dyn ActionSink,
-    ) -> Result<(), &'static str> {
-        if !self.drivers().any(Driver::homes_with_switches) {
-            return Err("home: only with target stepper");
-        }
-        let s = &self.settings.stepper;
-        if s.pan.home_dir == 0.0 && s.tilt.home_dir == 0.0 {
-            return Err(
-                "home: no homing switches configured (stepper.pan.home_dir and stepper.tilt.home_dir are 0); the position stays as at power-up",
-            );
-        }
-        self.stop("home", out);
-        out.act(Action::Stepper(StepperRequest::Home));
-        self.stepper_homing = true;
-        Ok(())
-    }
-
-    /// The board point (cm) of the run's current point, for messages.
-    fn last_stepper_target(&self) -> (f64, f64) {
-        self.status()
-            .target
-            .map_or((0.0, 0.0), |(t, _)| (t.point.x_cm, t.point.y_cm))
-    }
+    Ok(())
 }

@@ -121,7 +121,7 @@ fn a_failed_home_leaves_the_counted_position_in_mpos_and_status_says_homing() {
         texts(&out)
     );
     assert_eq!(core.status().activity, Activity::Idle);
-    let config = core.stepper_config();
+    let config = crate::sequencer::drivers::stepper::config(core.settings());
     let spot = config.gimbal.fk(config.joints_of(steps).unwrap()).unwrap();
     let report = status(&mut core, 7001);
     let mpos = std::format!("MPos:{:.3},{:.3},", spot.x_cm * 10.0, spot.y_cm * 10.0);

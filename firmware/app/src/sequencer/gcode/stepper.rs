@@ -1,0 +1,100 @@
+//! The session's side of the stepper's G-code stage
+//! ([`StepperJob`](crate::sequencer::drivers::stepper::StepperJob)):
+//! blocks done, refusals into an alarm, the position synced at rest, and
+//! the reply to `$H`.
+
+use crate::grbl::{Alarm, GrblError};
+use crate::sequencer::drivers::stepper::gcode::StepperReport;
+use crate::sequencer::gcode::GrblMode;
+use crate::sequencer::machine::{ActionSink, Core};
+use crate::stepper::{HomingFailure, StepperEvent};
+use crate::text::reply_text;
+
+impl Core {
+    /// Hands the current block to the stepper (or waits for rest first).
+    pub(in crate::sequencer) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
+        self.with_stage(out, |st, jobs, out| jobs.stepper.send(st, out));
+    }
+
+    /// Tells the stepper task the feed override when it changed.
+    pub(in crate::sequencer) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
+        let percent = self.gcode.overrides.feed;
+        let stepping = self.drivers().hands_over_blocks();
+        self.jobs.stepper.send_override(percent, stepping, out);
+    }
+
+    /// The G-code side of a stepper report: `true` when it was the job's.
+    #[inline(never)]
+    pub(in crate::sequencer) fn gcode_stepper_event(
+        &mut self,
+        event: &StepperEvent,
+        out: &mut dyn ActionSink,
+    ) -> bool {
+        match self.with_stage(out, |st, jobs, out| jobs.stepper.event(st, event, out)) {
+            StepperReport::Other => false,
+            StepperReport::Handled => true,
+            StepperReport::BlockDone => {
+                self.gcode_stepper_done(out);
+                true
+            }
+            StepperReport::Refused => {
+                if let StepperEvent::Refused { why, .. } = event {
+                    // The checks before it passed, the stepper refused it
+                    // (its axes beyond their soft limits): as on the galvo.
+                    self.notify(out, format_args!("MSG:stepper: move refused: {why:?}"));
+                }
+                self.grbl_alarm(Alarm::SoftLimit, out);
+                true
+            }
+            StepperReport::AtRest => {
+                self.grbl_sync_position();
+                false
+            }
+        }
+    }
+
+    /// The end of homing (`failed`: why it failed), the axes at rest at
+    /// `steps`: MPos where homing left the spot (a failed seek moved the
+    /// axes too); when a `$H` waits, its reply — `ok` (unlocked) or, as
+    /// grbl, `ALARM:N` (locked) and then `ok`; parameters that allow no
+    /// homing: `error:5`.
+    #[inline(never)]
+    pub(in crate::sequencer) fn gcode_homing_done(
+        &mut self,
+        steps: [i32; 2],
+        failed: Option<HomingFailure>,
+        out: &mut dyn ActionSink,
+    ) {
+        if self.gcode.motion.is_idle() {
+            self.with_stage(out, |st, jobs, _| jobs.stepper.at(st, steps));
+            self.grbl_sync_position();
+        }
+        if !core::mem::take(&mut self.gcode.homing) {
+            return;
+        }
+        let alarm = match failed {
+            None => {
+                self.gcode.mode = GrblMode::Normal;
+                return self.ok(out);
+            }
+            Some(HomingFailure::NoSwitches | HomingFailure::BadConfig) => {
+                return self.grbl_error(out, GrblError::HomingDisabled);
+            }
+            Some(HomingFailure::NotFound(_)) => Alarm::HomingNotFound,
+            Some(HomingFailure::StillPressed(_)) => Alarm::HomingPullOff,
+            Some(HomingFailure::Interrupted) => Alarm::HomingReset,
+        };
+        self.gcode.mode = GrblMode::Alarm;
+        self.grbl_data(out, reply_text(format_args!("ALARM:{}", alarm.code())));
+        self.ok(out);
+    }
+
+    /// The current block is done on the stepper's side.
+    #[inline(never)]
+    fn gcode_stepper_done(&mut self, out: &mut dyn ActionSink) {
+        if let Some(c) = self.gcode.motion.current.as_mut() {
+            c.stepper_seq = None;
+        }
+        self.gcode_step_done(out);
+    }
+}
