@@ -32,8 +32,15 @@ impl SimOnPty {
         let stop = Arc::new(AtomicBool::new(false));
         let _ = std::fs::remove_file(&link);
         let pelco_link = options.pelco_pty.as_ref().and_then(|p| p.link.clone());
-        if let Some(pelco) = &pelco_link {
-            let _ = std::fs::remove_file(pelco);
+        // Every file the run publishes is there before `start` returns (a
+        // caller reading the spot feed at once found none under load).
+        let published: Vec<PathBuf> = pelco_link
+            .iter()
+            .chain(&options.spot_feed)
+            .cloned()
+            .collect();
+        for path in &published {
+            let _ = std::fs::remove_file(path);
         }
         let options = SimOptions {
             pty: Some(PtyOptions {
@@ -45,11 +52,11 @@ impl SimOnPty {
         };
         let thread = std::thread::spawn(move || run(options));
         let started = Instant::now();
-        for link in std::iter::once(&link).chain(&pelco_link) {
-            while !link.exists() {
+        for path in std::iter::once(&link).chain(&published) {
+            while !path.exists() {
                 if started.elapsed() > START_LIMIT || thread.is_finished() {
                     stop.store(true, Ordering::Relaxed);
-                    bail!("the simulator's PTY did not appear at {}", link.display());
+                    bail!("the simulator's {} did not appear", path.display());
                 }
                 std::thread::sleep(Duration::from_millis(10));
             }
@@ -64,5 +71,33 @@ impl SimOnPty {
             Ok(report) => report,
             Err(panic) => std::panic::resume_unwind(panic),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_spot_feed_is_there_when_start_returns() {
+        let dir = std::env::temp_dir().join(format!("laser-sim-on-pty-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let link = dir.join("console");
+        let feed = crate::spot_feed::beside(&link);
+        // A stale feed of an earlier run must not count.
+        std::fs::write(&feed, "stale\n").unwrap();
+        let sim = SimOnPty::start(
+            link,
+            SimOptions {
+                spot_feed: Some(feed.clone()),
+                max_time_ms: 60_000,
+                ..SimOptions::default()
+            },
+        )
+        .unwrap();
+        let sample = crate::spot_feed::FeedSample::read(&feed);
+        sim.finish();
+        assert!(sample.is_ok(), "{sample:?}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
