@@ -210,18 +210,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
     (
         "laser-app",
         &[
-            "galvo",
-            "galvo/scan",
-            "galvo/scan/memory",
-            "galvo/scan/planning",
-            "galvo/scan/ring",
-            "galvo/scan/state",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "laser-app",
-        &[
             "settings",
             "settings/controls",
             "settings/gcode",
