@@ -246,11 +246,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
         "left for: the G-code session out of `impl Core` (issue 21: the drivers extend Core)",
     ),
     (
-        "laser-app",
-        &["app", "app/controls", "app/tasks"],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
         "kinematics-core",
         &["error_model", "error_model/fit"],
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
