@@ -225,19 +225,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
     (
         "laser-app",
         &[
-            "stepper",
-            "stepper/link",
-            "stepper/motion",
-            "stepper/motion/cut",
-            "stepper/motion/resume",
-            "stepper/one_pulse",
-            "stepper/task",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "laser-app",
-        &[
             "sequencer/drivers",
             "sequencer/drivers/galvo",
             "sequencer/drivers/galvo/ahead",
