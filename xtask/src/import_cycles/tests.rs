@@ -210,21 +210,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
     (
         "laser-app",
         &[
-            "settings",
-            "settings/controls",
-            "settings/gcode",
-            "settings/legacy",
-            "settings/params",
-            "settings/pelco",
-            "settings/record",
-            "settings/spec",
-            "settings/stepper",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
-        "laser-app",
-        &[
             "sequencer/drivers",
             "sequencer/drivers/galvo",
             "sequencer/drivers/galvo/ahead",
