@@ -298,19 +298,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
     ),
     (
-        "firmware",
-        &[
-            "board",
-            "galvo_dac",
-            "galvo_dac/buffers",
-            "galvo_dac/irq",
-            "laser_pwm",
-            "panic",
-            "tasks",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
         "qemu-m4",
         &[
             "controls",
