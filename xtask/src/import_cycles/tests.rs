@@ -298,20 +298,6 @@ const KNOWN_CYCLES: &[(&str, &[&str], &str)] = &[
         "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
     ),
     (
-        "qemu-m4",
-        &[
-            "controls",
-            "galvo_dac",
-            "interrupts",
-            "log_channel",
-            "parts",
-            "stats",
-            "time_driver",
-            "uart",
-        ],
-        "left for: a parent and the children it names without `self::` (seen since the checker reads those paths; issue 21)",
-    ),
-    (
         "xtask",
         &[
             "calib",
