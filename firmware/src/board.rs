@@ -43,11 +43,11 @@ use embassy_time::Instant;
 use embassy_usb::UsbDevice;
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use laser_app::app::{Board, Parts};
-use laser_app::laser_gate::{GateState, LaserGate};
 use static_cell::StaticCell;
 
-use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac, darken_laser_stream};
-use crate::laser_pwm::{LaserPin, laser_dark};
+use crate::galvo_dac::{GalvoDacPeripherals, HalfInterrupt, Stm32GalvoDac};
+use crate::laser_gate::LASER_GATE;
+use crate::laser_pwm::{LASER_PIN_BIT, LaserPin};
 use crate::parts::{
     IndependentDog, LaserControlPins, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UsbDtr,
     UserButton,
@@ -107,27 +107,6 @@ pub fn clock_config() -> embassy_stm32::Config {
     config.rcc.sys = Sysclk::PLL1_P;
     config.rcc.mux.clk48sel = mux::Clk48sel::PLL1_Q;
     config
-}
-
-/// Bit of the laser-enable pin in GPIOB (PB0).
-pub const LASER_PIN_BIT: usize = 0;
-
-/// The master laser gate (see `laser_app::laser_gate`): the sequencer
-/// closes it on every stop, fault and button press, the galvo loop on an
-/// underrun; closing darkens the galvo's laser stream and pulls PB0 low
-/// at once.
-pub static LASER_GATE: LaserGate = LaserGate::with_hook(laser_gate_changed);
-
-/// The gate's hook: when it closes, every word of the galvo's laser
-/// stream is zeroed (none can set the pin again), then PB0 goes low at
-/// once, PWM or not ([`laser_dark`]: TIM3_CH3 forced inactive, the pin's
-/// ODR bit cleared through BSRR, PB0 a GPIO output again), whoever holds
-/// the pin.
-pub fn laser_gate_changed(state: GateState) {
-    if !state.open {
-        darken_laser_stream();
-        laser_dark();
-    }
 }
 
 /// The board's parts, configured (laser off).
@@ -213,7 +192,7 @@ pub fn init(spawner: Spawner) -> Stm32Board {
         SYSCLK_HZ / 1_000_000
     );
     let (usb_device, console) = usb_console(p.USB_OTG_FS, p.PA12, p.PA11);
-    spawner.spawn(defmt::unwrap!(crate::tasks::usb_device(usb_device)));
+    spawner.spawn(defmt::unwrap!(usb_device_task(usb_device)));
     let (servo_tx, servo_rx) = servo_uart(p.USART2, p.PA3, p.PA2);
     let (pelco_tx, pelco_rx) = pelco_uart(p.USART3, p.PB11, p.PB10, p.PB12);
     enable_cycle_counter();
@@ -274,6 +253,12 @@ pub fn init(spawner: Spawner) -> Stm32Board {
         pelco_rx,
         pelco_tx,
     }
+}
+
+/// Runs the USB device stack (enumeration, control requests).
+#[embassy_executor::task]
+async fn usb_device_task(mut device: UsbDevice<'static, UsbDriver>) -> ! {
+    device.run().await
 }
 
 /// USB CDC-ACM on OTG FS (PA12 DP, PA11 DM): the device stack and the

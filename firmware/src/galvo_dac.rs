@@ -26,7 +26,7 @@
 //! are the pure `galvo-dma` crate (host-tested); `regs.rs` is the register
 //! layer. Verified by building only: no board or emulator runs it here.
 
-mod buffers;
+pub(crate) mod buffers;
 mod irq;
 mod regs;
 
@@ -39,21 +39,17 @@ use embassy_stm32::gpio::Flex;
 use embassy_stm32::interrupt::typelevel::{Binding, DMA1_STREAM5};
 use embassy_stm32::peripherals::{DAC1, DMA1_CH5, DMA2_CH1, PA4, PA5, TIM8};
 use embassy_stm32::{Peri, dac, rcc, timer};
-use galvo_dma::ring::{Claim, Cursor, Ring};
+use galvo_dma::ring::{Claim, Cursor};
 use galvo_dma::timing::{RefillMeter, TimerSetting, timer_setting};
 use galvo_dma::words::{LaserTrack, dhr12rd, replays_identically};
 use laser_app::galvo::{DacSample, DacStream, Half, RefillTime, Underrun};
 use laser_app::laser_gate::LaserGate;
 
-pub use buffers::darken_laser_stream;
-use buffers::{DAC_WORDS, LASER_WORDS};
+pub use buffers::HALF_LEN;
+use buffers::{DAC_WORDS, LASER_WORDS, RING, RING_LEN};
 pub use irq::HalfInterrupt;
 use irq::{SHARED, pack_timer, unpack_timer};
 
-/// Samples per half buffer (1.28 ms at the default 10 µs period).
-pub const HALF_LEN: usize = 128;
-const RING: Ring = Ring::new(HALF_LEN);
-const RING_LEN: usize = 2 * HALF_LEN;
 /// Default sample period, s (until the loop sets its own).
 const DEFAULT_PERIOD_S: f64 = 10e-6;
 /// DAC code of mid-scale (the output before the first stream).

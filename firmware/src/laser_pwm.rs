@@ -39,7 +39,8 @@ use embassy_stm32::timer::low_level::{RoundTo, Timer};
 use laser_app::laser_gate::LaserGate;
 use laser_app::sequencer::{LaserPower, LaserSwitch};
 
-use crate::board::LASER_PIN_BIT;
+/// Bit of the laser-enable pin in GPIOB (PB0).
+pub const LASER_PIN_BIT: usize = 0;
 
 /// Laser PWM frequency, Hz (grbl's ≈ 1 kHz).
 pub const LASER_PWM_HZ: u32 = 1_000;

@@ -12,6 +12,7 @@
 
 mod board;
 mod galvo_dac;
+mod laser_gate;
 mod laser_pwm;
 mod panic;
 mod parts;
@@ -59,7 +60,7 @@ async fn main(spawner: Spawner) {
         servo: &SERVO_LINK,
         galvo: &GALVO_LINK,
         status: &STATUS,
-        gate: &board::LASER_GATE,
+        gate: &laser_gate::LASER_GATE,
         stepper: &STEPPER_LINK,
         controls: &CONTROLS_LINK,
     };

@@ -43,8 +43,7 @@ fn laser_off_now() {
     unsafe { core::ptr::write_volatile(TIM3_CCMR2 as *mut u32, CCMR2_FORCE_INACTIVE) };
     pac::GPIOB.bsrr().write(|w| w.set_br(LASER_PIN_BIT, true));
 }
-use crate::board::LASER_PIN_BIT;
-use crate::laser_pwm::{CCMR2_FORCE_INACTIVE, TIM3_CCMR2};
+use crate::laser_pwm::{CCMR2_FORCE_INACTIVE, LASER_PIN_BIT, TIM3_CCMR2};
 
 #[panic_handler]
 fn panic(info: &core::panic::PanicInfo<'_>) -> ! {

@@ -11,7 +11,6 @@ use embassy_executor::{InterruptExecutor, SendSpawner, Spawner};
 use embassy_stm32::interrupt;
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::usart::{BufferedUartRx, BufferedUartTx};
-use embassy_usb::UsbDevice;
 use laser_app::app::{
     ConsoleTask, GalvoTask, IndicatorTask, LaserControlsTask, PelcoTask, SequencerTask,
     ServoBusTask, Spawn, StopButtonTask, WatchdogTask,
@@ -24,17 +23,11 @@ use crate::board::Stm32Board;
 use crate::galvo_dac::{self, Stm32GalvoDac};
 use crate::laser_pwm::LaserPin;
 use crate::parts::{
-    IndependentDog, LaserControlPins, StatusLeds, TimerStepper, UsbConsole, UsbDriver, UserButton,
+    IndependentDog, LaserControlPins, StatusLeds, TimerStepper, UsbConsole, UserButton,
 };
 use crate::rs485::Rs485Tx;
 use crate::settings_flash::FlashSettings;
 use laser_app::stepper::{StepPulseTask, StepperTask};
-
-/// Runs the USB device stack (enumeration, control requests).
-#[embassy_executor::task]
-pub async fn usb_device(mut device: UsbDevice<'static, UsbDriver>) -> ! {
-    device.run().await
-}
 
 /// Serves the command line on the CDC-ACM port; restarts on reconnect.
 #[embassy_executor::task]

@@ -23,6 +23,7 @@ mod stats;
 mod tasks;
 mod time_driver;
 mod uart;
+mod vectors;
 
 use laser_app::app::{Links, wire};
 use laser_app::command::CommandLink;

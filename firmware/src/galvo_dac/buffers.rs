@@ -4,7 +4,14 @@
 
 use core::cell::UnsafeCell;
 
-use super::RING_LEN;
+use galvo_dma::ring::Ring;
+
+/// Samples per half buffer (1.28 ms at the default 10 µs period).
+pub const HALF_LEN: usize = 128;
+/// The ring of two halves both DMA streams run through.
+pub(super) const RING: Ring = Ring::new(HALF_LEN);
+/// Words in each ring.
+pub(super) const RING_LEN: usize = 2 * HALF_LEN;
 
 /// Main SRAM (SRAM1 + SRAM2), the DMA-reachable RAM.
 const SRAM: core::ops::Range<u32> = 0x2000_0000..0x2002_0000;

@@ -12,8 +12,9 @@ use embassy_sync::waitqueue::AtomicWaker;
 use galvo_dma::ring::{Ring, underrun_at_start};
 use galvo_dma::timing::TimerSetting;
 
-use super::{RING, regs};
-use crate::board::LASER_GATE;
+use super::buffers::RING;
+use super::regs;
+use crate::laser_gate::LASER_GATE;
 
 /// State shared by the refill (the galvo task) and the interrupt.
 pub(super) struct Shared {

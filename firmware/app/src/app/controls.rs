@@ -95,7 +95,7 @@ impl<C: LaserControls> LaserControlsTask<C> {
     }
 }
 
-impl LaserControlsTask<super::NoLaserControls> {
+impl LaserControlsTask<super::board::NoLaserControls> {
     /// A board without the controls never gets this task: its spawner's
     /// `laser_controls` hook is this.
     pub fn unreachable(self) -> ! {

@@ -10,8 +10,8 @@ use embassy_futures::select::{Either, select};
 use embassy_time::{Duration, Timer};
 use embedded_io_async::{Read, Write};
 
-use super::Links;
 use super::board::{Console, HostPresence, Indicators, Leds, StopButton, Watchdog};
+use super::links::Links;
 use crate::command::CommandLink;
 use crate::galvo::{DacStream, GalvoConfig, GalvoLink, GalvoLoop, GalvoMemory};
 use crate::laser_gate::LaserGate;
@@ -150,7 +150,7 @@ impl<D: DacStream> GalvoTask<D> {
     }
 }
 
-impl GalvoTask<super::NoGalvoDac> {
+impl GalvoTask<super::board::NoGalvoDac> {
     /// A board without a DAC never gets a galvo task (there is no DAC to
     /// put in one): its spawner's `galvo` hook is this.
     pub fn unreachable(self) -> ! {

@@ -4,8 +4,12 @@ use core::convert::Infallible;
 use std::vec::Vec;
 
 use super::*;
-use crate::galvo::{DacSample, DacStream, Half, Underrun};
+use crate::command::CommandLink;
+use crate::galvo::{DacSample, DacStream, GalvoLink, Half, Underrun};
+use crate::laser_gate::LaserGate;
 use crate::sequencer::{LaserSwitch, SettingsStore};
+use crate::servo::task::ServoLink;
+use crate::status::StatusBoard;
 
 /// A part that says which board it came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,7 +12,8 @@ use self::ring::StepRing;
 use self::state::{Joining, JumpCodes, Motion, Trace};
 use self::types::{Active, JOB_QUEUE, Job, PREP_PER_HALF};
 pub use self::types::{GalvoConfig, GalvoError, MAX_HALF_LEN, ScanPhase};
-use super::{DacSample, DacStream, GalvoEvent, GalvoLink, Half};
+use super::dac::{DacSample, DacStream, Half};
+use super::link::{GalvoEvent, GalvoLink};
 use crate::laser_gate::LaserGate;
 use crate::log;
 
@@ -38,7 +39,7 @@ pub struct GalvoLoop {
     /// Where the running step leaves the mirrors, rad.
     active_end_rad: [f64; 2],
     /// Work since the last half buffer (the cost model's input).
-    work: super::LoopWork,
+    work: super::cost::LoopWork,
     /// Samples held dark for want of a prepared step.
     unprepared_samples: u32,
     motion: Motion,
@@ -131,7 +132,7 @@ impl GalvoLoop {
         let mut drawing: heapless::Deque<(GalvoEvent, u8), DONE_QUEUE> = heapless::Deque::new();
         dac.set_sample_period(period_s);
         loop {
-            self.work = super::LoopWork::default();
+            self.work = super::cost::LoopWork::default();
             let now = gate.generation();
             if now != generation {
                 self.stop();
@@ -264,4 +265,4 @@ mod state;
 #[cfg(test)]
 mod tests;
 mod trace;
-mod types;
+pub(super) mod types;

@@ -14,6 +14,3 @@ pub(super) const CONTROLS_PARAMS: [ParamSpec; 1] = [real!(
     "emission indicator lead after arm, s",
     |s| s.emission_delay_s
 )];
-
-/// The default lead time, s.
-pub const DEFAULT_EMISSION_DELAY_S: f64 = 3.0;

@@ -5,7 +5,7 @@
 use kinematics_core as kc;
 use kinematics_core::{DacAxis, ErrorModel, Galvo, GalvoGeometry, Gimbal, Grid};
 
-use super::{AxisSettings, GalvoSettings, Settings};
+use super::values::{AxisSettings, GalvoSettings, Settings};
 use crate::domain::{AimModel, Aimer};
 
 fn servo_axis(axis: &AxisSettings) -> kc::ServoAxis {

@@ -3,7 +3,7 @@
 //! firmware's parameter table, CRC-32 of all that. They load (the next
 //! `save` writes the id-keyed layout).
 
-use super::record::{
+use super::loading::{
     CRC_LEN, HEADER_LEN, LoadedRecord, Loading, RecordError, RecordLayout, VALUE_LEN, checked_body,
     le_f64,
 };

@@ -34,10 +34,10 @@
 
 use super::controls::CONTROLS_PARAMS;
 use super::gcode::GCODE_PARAMS;
-use super::pelco::PELCO_PARAMS;
+use super::pelco_params::PELCO_PARAMS;
 use super::spec::COEF_HELP;
 use super::spec::{ParamSpec, Precision, Slot, choice, count, err_coef, real};
-use super::stepper::STEPPER_PARAMS;
+use super::stepper_params::STEPPER_PARAMS;
 use kinematics_core::error_model::COEF_LIMITS;
 
 /// Smallest |galvo DAC scale|, codes/rad: 4096 codes over ±45° of mirror.

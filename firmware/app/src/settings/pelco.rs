@@ -6,9 +6,6 @@
 //! 35 million saves over the sectors' 100 000 erase cycles); a record
 //! saved before them loads with the 3 at their defaults.
 
-use super::Settings;
-use super::spec::{ParamSpec, Precision, Slot, choice, count, real};
-
 /// The baud rates the PELCO port runs at (8N1).
 pub const PELCO_BAUDS: [u32; 4] = [2400, 4800, 9600, 19200];
 
@@ -32,40 +29,6 @@ impl Default for PelcoSettings {
             motion_timeout_s: 0.0,
         }
     }
-}
-
-/// Parameters 200–209.
-pub(super) const PELCO_PARAMS: [ParamSpec; 3] = [
-    count!(
-        200,
-        "pelco.address",
-        1.0,
-        255.0,
-        "PELCO device address",
-        |s| s.pelco.address
-    ),
-    ParamSpec {
-        id: 201,
-        name: "pelco.baud",
-        min: 2400.0,
-        max: 19200.0,
-        min_magnitude: 0.0,
-        precision: Precision::F64,
-        help: "PELCO port baud rate: 2400, 4800, 9600 or 19200",
-        slot: Slot::Baud(baud),
-    },
-    real!(
-        202,
-        "pelco.timeout_s",
-        0.0,
-        3600.0,
-        "PELCO motion timeout without frames, s (0: off)",
-        |s| s.pelco.motion_timeout_s
-    ),
-];
-
-fn baud(s: &mut Settings) -> &mut f64 {
-    &mut s.pelco.baud
 }
 
 /// Whether `value` is a baud rate the port runs at.

@@ -30,25 +30,23 @@
 //! ids) still load, through `legacy.rs`.
 
 use super::legacy;
-use super::params::param_by_id;
-use super::spec::{ParamSpec, check_value};
-use super::{PARAMS, Settings};
+use super::loading::{
+    CRC_LEN, HEADER_LEN, LoadedRecord, Loading, RecordError, RecordLayout, VALUE_LEN, checked_body,
+    crc32, le_f64,
+};
+use super::params::PARAMS;
+use super::spec::ParamSpec;
+use super::values::Settings;
 
 /// Version of the record framing. Parameters come and go without a new
 /// version (they are keyed by id); bump it only when the framing changes.
 pub const RECORD_VERSION: u16 = 3;
 /// Record magic (the same for every version).
 pub(super) const RECORD_MAGIC: [u8; 4] = *b"LPS1";
-/// Bytes before the first run: magic, version, length.
-pub(super) const HEADER_LEN: usize = 8;
 /// Bytes of a run head: first id, value count.
 const RUN_HEAD_LEN: usize = 3;
 /// Most values in one run.
 const MAX_RUN: usize = u8::MAX as usize;
-/// Bytes of one value.
-pub(super) const VALUE_LEN: usize = 8;
-/// Bytes of the checksum at the end.
-pub(super) const CRC_LEN: usize = 4;
 /// The checksum starts at a multiple of this (a 32-bit word).
 const WORD: usize = 4;
 
@@ -85,51 +83,6 @@ pub const RECORD_LEN: usize = record_len(PARAMS);
 pub const MAX_RECORD_LEN: usize = 1024;
 
 const _: () = assert!(RECORD_LEN <= MAX_RECORD_LEN && legacy::MAX_LEN <= MAX_RECORD_LEN);
-
-/// Why a saved record was not loaded.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum RecordError {
-    /// Too short or wrong magic: nothing saved yet.
-    Missing,
-    /// A version this firmware cannot read.
-    WrongVersion(u16),
-    /// Checksum or length mismatch.
-    Corrupt,
-    /// A value is out of range, or the entries are not in the written form.
-    Invalid,
-}
-
-/// How a loaded record was laid out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum RecordLayout {
-    /// Version 3: (id, value) entries.
-    IdKeyed,
-    /// Version 2: values by position in the parameter table of that time.
-    Positional,
-}
-
-/// A record that loaded, and what loading it had to make up for.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LoadedRecord {
-    /// The settings it holds.
-    pub settings: Settings,
-    /// Its layout (a positional one is migrated by the next `save`).
-    pub layout: RecordLayout,
-    /// Entries skipped because this build has no parameter with their id.
-    pub unknown: usize,
-    /// Parameters it has no entry for, left at their defaults.
-    pub defaulted: usize,
-}
-
-impl LoadedRecord {
-    /// Whether saving the loaded settings writes the same record again
-    /// (an id-keyed record with exactly this build's parameters).
-    pub fn is_exact(&self) -> bool {
-        self.layout == RecordLayout::IdKeyed && self.unknown == 0 && self.defaulted == 0
-    }
-}
 
 impl Settings {
     /// Serialises into the versioned, checksummed record.
@@ -237,71 +190,6 @@ fn decode_runs(table: &[ParamSpec], bytes: &[u8], len: usize) -> Result<LoadedRe
     loading.finish(RecordLayout::IdKeyed)
 }
 
-/// Everything before the checksum, when `bytes` is exactly `len` bytes
-/// long and its checksum matches.
-pub(super) fn checked_body(bytes: &[u8], len: usize) -> Result<&[u8], RecordError> {
-    if bytes.len() != len {
-        return Err(RecordError::Corrupt);
-    }
-    let (body, crc) = bytes
-        .split_at_checked(len.saturating_sub(CRC_LEN))
-        .ok_or(RecordError::Corrupt)?;
-    if crc32(body).to_le_bytes()[..] != *crc {
-        return Err(RecordError::Corrupt);
-    }
-    Ok(body)
-}
-
-/// Settings being loaded from a record, value by value.
-pub(super) struct Loading<'t> {
-    table: &'t [ParamSpec],
-    settings: Settings,
-    known: usize,
-    unknown: usize,
-}
-
-impl<'t> Loading<'t> {
-    /// Starts from the defaults.
-    pub(super) fn new(table: &'t [ParamSpec]) -> Self {
-        Self {
-            table,
-            settings: Settings::default(),
-            known: 0,
-            unknown: 0,
-        }
-    }
-
-    /// Loads the value of parameter `id` (each id at most once), or counts
-    /// it as unknown when `table` has no such parameter.
-    pub(super) fn entry(&mut self, id: u16, value: f64) -> Result<(), RecordError> {
-        let Some(param) = param_by_id(self.table, id) else {
-            self.unknown += 1;
-            return Ok(());
-        };
-        check_value(param, value).map_err(|_| RecordError::Invalid)?;
-        self.settings.apply(param, value);
-        // Only the encoding `to_record` writes loads (e.g. not −0 for an
-        // id), so a loaded record re-saves byte for byte.
-        if self.settings.get(param).to_bits() != value.to_bits() {
-            return Err(RecordError::Invalid);
-        }
-        self.known += 1;
-        Ok(())
-    }
-
-    /// The loaded settings, once the rules between parameters hold for
-    /// them as a whole.
-    pub(super) fn finish(self, layout: RecordLayout) -> Result<LoadedRecord, RecordError> {
-        self.settings.validate().map_err(|_| RecordError::Invalid)?;
-        Ok(LoadedRecord {
-            settings: self.settings,
-            layout,
-            unknown: self.unknown,
-            defaulted: self.table.len().saturating_sub(self.known),
-        })
-    }
-}
-
 /// Length of the record at the start of `bytes` when it is complete and its
 /// checksum matches, whatever its version (the length comes from its own
 /// count); `None` for anything else. Tells a record an earlier firmware
@@ -331,11 +219,6 @@ fn le_u16(bytes: &[u8]) -> Option<u16> {
     Some(u16::from_le_bytes(bytes.try_into().ok()?))
 }
 
-/// A little-endian f64 from exactly eight bytes.
-pub(super) fn le_f64(bytes: &[u8]) -> Option<f64> {
-    Some(f64::from_le_bytes(bytes.try_into().ok()?))
-}
-
 struct Cursor<'a> {
     buf: &'a mut [u8],
     at: usize,
@@ -348,17 +231,4 @@ impl Cursor<'_> {
         }
         self.at += bytes.len();
     }
-}
-
-/// CRC-32 (IEEE 802.3, reflected, init and xor-out 0xFFFFFFFF).
-pub fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = 0xFFFF_FFFFu32;
-    for &b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            let mask = (crc & 1).wrapping_neg();
-            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
-        }
-    }
-    !crc
 }

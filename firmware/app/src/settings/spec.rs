@@ -5,7 +5,7 @@
 use core::fmt;
 
 use super::error::SettingsError;
-use super::{LaserMode, Settings};
+use super::values::{LaserMode, Settings};
 use crate::text::{Interval, Shortest};
 
 /// How a parameter's value is stored.

@@ -11,9 +11,11 @@
 use embassy_futures::select::{Either3, select, select3};
 use embassy_time::Timer;
 
-use super::link::{HomingFailure, LimitMode, StepperEvent, StepperLink, StepperRefusal};
+use super::config::StepperConfig;
+use super::link::{
+    HomingFailure, LimitMode, StepperEvent, StepperLink, StepperRefusal, StepperRequest,
+};
 use super::task::{REFILL_PERIOD, Running};
-use super::{StepperConfig, StepperRequest};
 use crate::log;
 
 /// How a homing move ended.

@@ -12,9 +12,9 @@ use embassy_sync::channel::Channel;
 use embassy_sync::signal::Signal;
 use kinematics_core::stepper::{SegmentQueue, StepBlock, StepGenerator, StepTick};
 
-use super::{DriverSignals, StepperConfig};
+use super::config::{DriverSignals, StepperConfig};
 
-mod messages;
+pub(super) mod messages;
 
 pub use messages::{HomingFailure, MoveShape, StepperEvent, StepperRefusal, StepperRequest};
 

@@ -4,16 +4,19 @@
 //! straight in steps, enough pieces (a power of two) that the spot stays
 //! within [`LINE_TOLERANCE_MM`] of the board curve.
 
+mod curve;
 mod cut;
+mod history;
 mod resume;
 
-use cut::{Curve, PieceCut};
+use curve::{Curve, PieceCut};
 
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::JointAngles;
 use kinematics_core::stepper::{Planner, Segment, SegmentPrep, SegmentQueue, StepBlock, StepMove};
 
-use super::{MoveShape, SEGMENT_S, STEP_TIMER_HZ, StepperConfig, StepperRefusal};
+use super::config::{SEGMENT_S, STEP_TIMER_HZ, StepperConfig};
+use super::link::messages::{MoveShape, StepperRefusal};
 use kinematics_core::numeric::clamp;
 
 /// Largest distance of the pieces' joint-space insides from the board
@@ -23,7 +26,7 @@ pub const LINE_TOLERANCE_MM: f64 = 0.05;
 /// Most pieces one line is cut into.
 const MAX_PIECES: u32 = 4096;
 /// The step timer's queue of prepared segments.
-pub type StepQueue = SegmentQueue<{ super::STEP_QUEUE_LEN }>;
+pub type StepQueue = SegmentQueue<{ super::link::STEP_QUEUE_LEN }>;
 /// Look-ahead depth of the planner, blocks.
 const PLANNER_LEN: usize = 16;
 
@@ -48,7 +51,7 @@ pub struct StepperMotion {
     /// A queued move started being cut (reported as taken).
     started: Option<u32>,
     /// The moves since the last rest, for a hold's resume.
-    history: resume::History,
+    history: history::History,
     /// Feed override: moves at a feed run at feed × this.
     feed_scale: f64,
     /// A junction deviation (deg) to plan with once the planner is empty.
@@ -78,7 +81,7 @@ impl StepperMotion {
             pending: None,
             next: None,
             started: None,
-            history: resume::History::default(),
+            history: history::History::default(),
             feed_scale: 1.0,
             junction_pending: None,
         })

@@ -18,7 +18,7 @@
 //! up); [`OnePulseTiming::event`], on the step path, only selects
 //! precomputed values (no division, no float).
 
-use super::DriverSignals;
+use super::config::DriverSignals;
 
 /// Output-compare mode "force inactive" (OCxM = 100).
 const OCM_FORCE_INACTIVE: u32 = 0b100;

@@ -7,9 +7,10 @@ use core::sync::atomic::Ordering;
 use embassy_futures::select::{Either4, select4};
 use embassy_time::{Duration, Instant, Timer};
 
+use super::config::{SEGMENT_S, StepperConfig};
+use super::drive::StepperDrive;
 use super::link::{StepperEvent, StepperLink, StepperRequest};
 use super::motion::StepperMotion;
-use super::{SEGMENT_S, StepperConfig, StepperDrive};
 use crate::log;
 
 /// How often the stepper task refills the segment queue while steps run.

@@ -9,7 +9,8 @@ use super::planning::Planning;
 use super::ring::StepRing;
 use super::state::{JumpCodes, Motion, Trace};
 use super::{GalvoConfig, GalvoError, GalvoLoop};
-use crate::galvo::{DacSample, DacStream, LoopWork};
+use crate::galvo::cost::LoopWork;
+use crate::galvo::dac::{DacSample, DacStream};
 
 pub(super) fn samples_for(us: u32, ts_s: f64) -> u32 {
     // Whole samples, rounded up: a delay is never shorter than asked.

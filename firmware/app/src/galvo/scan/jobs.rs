@@ -9,7 +9,8 @@ use super::build::samples_for;
 use super::state::Motion;
 use super::{Active, GalvoConfig, GalvoError, GalvoLoop, Job, ScanPhase};
 use crate::domain::Unit;
-use crate::galvo::{DacSample, GalvoEvent, GalvoRequest};
+use crate::galvo::dac::DacSample;
+use crate::galvo::link::{GalvoEvent, GalvoRequest};
 use crate::log;
 
 impl GalvoLoop {

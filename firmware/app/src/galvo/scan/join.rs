@@ -15,7 +15,7 @@ use kinematics_core::PointMm;
 use super::state::Joining;
 use super::{GalvoLoop, Job, ScanPhase};
 use crate::domain::{Figure, Segment, StrokeCm, Unit};
-use crate::galvo::GalvoEvent;
+use crate::galvo::link::GalvoEvent;
 
 /// The continuation stroke of `job`, if it is one.
 fn continuation(job: &Job) -> Option<&StrokeCm> {

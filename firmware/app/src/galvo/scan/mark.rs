@@ -8,7 +8,8 @@ use super::runs::{BLOCK, write_codes};
 use super::state::Motion;
 use super::{GalvoError, GalvoLoop, ScanPhase};
 use crate::domain::{Figure, Unit};
-use crate::galvo::{DacSample, GalvoEvent};
+use crate::galvo::dac::DacSample;
+use crate::galvo::link::GalvoEvent;
 
 impl GalvoLoop {
     /// DAC codes of a board position (mm).

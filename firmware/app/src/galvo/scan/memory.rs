@@ -2,7 +2,7 @@
 //! `static` so the loop is counted once and never built on a stack.
 
 use super::{GalvoLoop, MAX_HALF_LEN};
-use crate::galvo::DacSample;
+use crate::galvo::dac::DacSample;
 
 /// The galvo loop's memory: the loop (its prepared steps and jump
 /// integrator, about 22 KB) and the half buffer of `HALF` samples it

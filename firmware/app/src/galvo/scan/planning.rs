@@ -3,7 +3,7 @@
 use galvo_planner::{Discrete, JumpSync, Method, XyJump, plan_xy_jump, plan_xy_jump_f32};
 
 use super::types::{GalvoError, INTEGRATOR_CAPACITY};
-use crate::galvo::DacStream;
+use crate::galvo::dac::DacStream;
 
 /// How the loop plans a two-axis jump from, to (rad) with a method.
 type XyPlanner = fn(&Discrete<3>, [f64; 2], [f64; 2], Method) -> Result<XyJump<3>, GalvoError>;

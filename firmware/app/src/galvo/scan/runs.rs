@@ -9,7 +9,8 @@ use galvo_planner::{Error as PlannerError, XyJump};
 
 use super::state::JumpCodes;
 use super::{GalvoLoop, ScanPhase};
-use crate::galvo::{DacSample, GalvoEvent};
+use crate::galvo::dac::DacSample;
+use crate::galvo::link::GalvoEvent;
 
 /// Samples computed per block (angles or positions, and codes, on the
 /// stack).

@@ -7,7 +7,8 @@ use super::build::samples_for;
 use super::runs::queue_jump;
 use super::{Active, GalvoError, GalvoLoop, Job, ScanPhase};
 use crate::domain::Unit;
-use crate::galvo::{DacSample, GalvoEvent};
+use crate::galvo::dac::DacSample;
+use crate::galvo::link::GalvoEvent;
 
 impl GalvoLoop {
     /// The sample every fill produces while nothing runs (no job, none

@@ -5,7 +5,7 @@ use galvo_planner::blocks::PRECOMPUTED_JUMP;
 use galvo_planner::{PathPlanner, XyJump};
 
 use super::types::{GalvoError, Job, MARK_BLOCKS};
-use crate::galvo::MarkStop;
+use crate::galvo::link::MarkStop;
 
 /// Steps prepared ahead of the refill (a step takes at least the laser
 /// delays and its jump; four cover a half buffer of the shortest jobs).

@@ -9,7 +9,7 @@
 use super::state::HALVES;
 use super::{GalvoLoop, Job, ScanPhase};
 use crate::domain::Figure;
-use crate::galvo::{GalvoEvent, GalvoLink, MarkStop};
+use crate::galvo::link::{GalvoEvent, GalvoLink, MarkStop};
 
 /// The note of the half the DAC output when the gate closed, as the loop
 /// sees the close (at the start of its next half): two halves before the

@@ -4,7 +4,7 @@
 mod record;
 mod stepper;
 
-use super::spec::survives_f32;
+use super::spec::{check_value, survives_f32};
 use super::*;
 
 #[test]

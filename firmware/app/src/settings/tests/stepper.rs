@@ -3,7 +3,7 @@
 
 extern crate std;
 
-use super::super::stepper::STEPPER_PARAMS;
+use super::super::stepper_params::STEPPER_PARAMS;
 use crate::settings::*;
 
 /// A version-3 record of the 54 parameters before the stepper's, written

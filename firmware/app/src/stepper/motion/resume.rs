@@ -4,66 +4,11 @@
 //! in, then the ones after it, one at a time as the cutting takes them —
 //! under their own request numbers.
 
-use heapless::Deque;
 use kinematics_core::frames::BoardPoint;
 
-use super::super::{MoveShape, StepperRefusal};
+use super::super::link::messages::{MoveShape, StepperRefusal};
 use super::StepperMotion;
-
-/// Moves the stepper can hold at once: its planner's pieces (each move at
-/// least one), the piece being cut and the move waiting behind it.
-const REMEMBERED: usize = 18;
-
-/// A move queued since the last rest: request number, end, shape, feed.
-#[derive(Debug, Clone, Copy)]
-struct Remembered {
-    seq: u32,
-    point: BoardPoint,
-    shape: MoveShape,
-    feed_mm_s: Option<f64>,
-}
-
-/// The moves queued since the last rest and where the oldest starts.
-#[derive(Debug, Clone, Default)]
-pub(super) struct History {
-    moves: Deque<Remembered, REMEMBERED>,
-    start: Option<BoardPoint>,
-    /// Moves still to queue again (the tail of `moves`).
-    again: usize,
-}
-
-impl History {
-    /// Remembers a move queued (the oldest goes beyond [`REMEMBERED`]).
-    pub(super) fn push(
-        &mut self,
-        seq: u32,
-        point: BoardPoint,
-        shape: MoveShape,
-        feed_mm_s: Option<f64>,
-    ) {
-        if self.moves.is_full() {
-            self.start = self.moves.pop_front().map(|m| m.point);
-        }
-        let _ = self.moves.push_back(Remembered {
-            seq,
-            point,
-            shape,
-            feed_mm_s,
-        });
-    }
-
-    /// Whether nothing waits to be queued again.
-    pub(super) fn is_done(&self) -> bool {
-        self.again == 0
-    }
-
-    /// At rest at `at`: nothing to remember.
-    pub(super) fn rest(&mut self, at: Option<BoardPoint>) {
-        self.moves.clear();
-        self.start = at;
-        self.again = 0;
-    }
-}
+use super::history::Remembered;
 
 /// Whether `p` lies on the move from `from` to `to` short of its end:
 /// within 0.05 mm of a line or an arc (a joint-space travel within 2 mm
