@@ -58,13 +58,7 @@ fn console_errors_typed_while_the_port_reads_its_settings_stay_the_consoles() {
             }
         }
         script += "version\nwait 100\n";
-        let report = run_with(
-            &script,
-            SimOptions {
-                pelco_pty: Some(PelcoPtyOptions::default()),
-                ..SimOptions::default()
-            },
-        );
+        let report = run_with(&script, with_port());
         let lines = terminal_lines(&report);
         let errors = lines.iter().filter(|l| l.starts_with("error:")).count();
         let oks = lines.iter().filter(|l| **l == "ok").count();
@@ -91,13 +85,7 @@ fn status_reports_asked_while_the_port_reads_its_settings_reach_the_host() {
     // G-code sender).
     for delay_ms in 0..12 {
         let script = format!("wait {delay_ms}\n@realtime ?\nwait 100\n");
-        let report = run_with(
-            &script,
-            SimOptions {
-                pelco_pty: Some(PelcoPtyOptions::default()),
-                ..SimOptions::default()
-            },
-        );
+        let report = run_with(&script, with_port());
         let lines = terminal_lines(&report);
         assert_eq!(
             lines.iter().filter(|l| l.starts_with("<Idle|")).count(),
@@ -105,5 +93,13 @@ fn status_reports_asked_while_the_port_reads_its_settings_reach_the_host() {
             "asked after {delay_ms} ms: {lines:#?}"
         );
         assert_eq!(report.pelco.baud, Some(9600), "after {delay_ms} ms");
+    }
+}
+
+/// The simulator's options with a PELCO port (its settings read at boot).
+fn with_port() -> SimOptions {
+    SimOptions {
+        pelco_pty: Some(PelcoPtyOptions::default()),
+        ..SimOptions::default()
     }
 }
