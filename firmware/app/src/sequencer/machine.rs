@@ -82,6 +82,9 @@ pub struct Core {
     /// The geometry of `settings` and `model`, rebuilt when either changes
     /// ([`Core::geometry_changed`]).
     pub(super) aimer: Aimer,
+    /// Per driver, the board rectangle proven reachable with `settings`
+    /// (the soft-limit check's fast path), rebuilt with `aimer`.
+    pub(super) reach: crate::sequencer::gcode::reach::ReachBoxes,
     /// Which actuator(s) draw.
     pub(super) actuator: Actuator,
     pub(super) booted_at: Instant,
@@ -121,10 +124,11 @@ impl Core {
     /// Idle, default settings, gimbal, laser off; booted at `now`.
     #[inline(never)]
     pub fn new(now: Instant) -> Self {
-        Self {
+        let mut core = Self {
             settings: Settings::default(),
             model: AimModel::Exact,
             aimer: Settings::default().aimer(AimModel::Exact),
+            reach: crate::sequencer::gcode::reach::ReachBoxes::NONE,
             actuator: Actuator::Gimbal,
             booted_at: now,
             run: None,
@@ -147,7 +151,9 @@ impl Core {
             jobs: crate::sequencer::drivers::DriverJobs::new(),
             stepper_homing: false,
             controls: None,
-        }
+        };
+        core.reach = core.prove_reach_boxes();
+        core
     }
 
     /// Handles `event`, writing what is to be done into `out`.
@@ -252,6 +258,8 @@ impl Core {
     /// model changed.
     pub(super) fn geometry_changed(&mut self) {
         self.aimer = self.settings.aimer(self.model);
+        self.reach = self.prove_reach_boxes();
+        self.jobs.gimbal.geometry_changed();
     }
 
     /// Switches the gimbal laser to what the state calls for.

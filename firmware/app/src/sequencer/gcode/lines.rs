@@ -71,6 +71,7 @@ impl Core {
         self.grbl_take_owed(out);
         self.grbl_advance(out);
         self.gcode_galvo_send_ahead(out);
+        self.stream_remember();
     }
 
     /// Moves the blocks of the line waiting for room into the queue when

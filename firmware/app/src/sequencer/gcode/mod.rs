@@ -118,6 +118,7 @@ pub(in crate::sequencer) mod lines;
 pub(in crate::sequencer) mod motion;
 pub(in crate::sequencer) mod power;
 pub(in crate::sequencer) mod queue;
+pub(in crate::sequencer) mod reach;
 pub(in crate::sequencer) mod report;
 pub(in crate::sequencer) mod settings;
 pub(in crate::sequencer) mod step;

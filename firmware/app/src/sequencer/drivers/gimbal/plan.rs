@@ -44,9 +44,19 @@ impl Core {
         (feed.min(cap).max(1e-3), accel.max(1e-3))
     }
 
-    /// The larger joint's travel per mm along `block` (two pieces), °/mm.
-    #[inline(never)]
+    /// The larger joint's travel per mm along `block` (two pieces), °/mm:
+    /// kept since the block was queued, or worked out.
     fn joint_deg_per_mm(&self, block: &Block, length: f64) -> f64 {
+        match self.jobs.gimbal.deg_per_mm.get(block) {
+            Some(v) => v,
+            None => self.joint_deg_per_mm_aimed(block, length),
+        }
+    }
+
+    /// [`Self::joint_deg_per_mm`] through the aims of the block's ends and
+    /// middle.
+    #[inline(never)]
+    pub(super) fn joint_deg_per_mm_aimed(&self, block: &Block, length: f64) -> f64 {
         let aim = |k: u32| self.aimer.aim(cm(point_at(block, k, 2))).ok();
         let (mut yaw, mut pitch) = (0.0, 0.0);
         let mut prev = aim(0);

@@ -31,6 +31,7 @@ impl Core {
         let Some(length) = planned_length(block) else {
             return false;
         };
+        self.stream_remember();
         let (cruise, accel) = self.stream_limits(block, length);
         let planned = LookaheadBlock {
             length,
@@ -64,6 +65,7 @@ impl Core {
             return;
         };
         let braking = motion.hold != Hold::None || current.cancelled;
+        self.stream_remember();
         // The exit: the next block's entry while it joins at speed.
         cursor.block.exit_speed = self.stream_exit_speed(&current.block, &cursor);
         let joins = cursor.block.exit_speed > 0.0;
