@@ -5,6 +5,7 @@
 //! within [`LINE_TOLERANCE_MM`] of the board curve.
 
 mod cut;
+mod fast;
 mod resume;
 
 use cut::{Curve, PieceCut};
@@ -53,6 +54,8 @@ pub struct StepperMotion {
     feed_scale: f64,
     /// A junction deviation (deg) to plan with once the planner is empty.
     junction_pending: Option<f64>,
+    /// The joint geometry in single precision, for counting pieces.
+    joints32: Option<fast::Joints32>,
 }
 
 /// A move waiting behind the line being cut.
@@ -81,6 +84,7 @@ impl StepperMotion {
             history: resume::History::default(),
             feed_scale: 1.0,
             junction_pending: None,
+            joints32: fast::Joints32::of(&config),
         })
     }
 
@@ -117,6 +121,7 @@ impl StepperMotion {
     /// Errors: [`StepperRefusal::BadConfig`] (nothing changes).
     pub fn configure(&mut self, config: StepperConfig) -> Result<(), StepperRefusal> {
         let (planner, prep) = Self::pipeline(&config)?;
+        self.joints32 = fast::Joints32::of(&config);
         self.config = config;
         self.planner = planner;
         self.prep = prep;

@@ -31,6 +31,11 @@ impl Curve {
         Some(Curve(Shape::of(segment)))
     }
 
+    /// The curve's shape.
+    pub(super) fn shape(&self) -> Shape {
+        self.0
+    }
+
     /// The point a fraction `t` (0..=1) along the curve.
     fn at(&self, t: f64) -> BoardPoint {
         self.0.point_at(t)
@@ -39,7 +44,7 @@ impl Curve {
     /// Pieces to start from: arcs in pieces of at most 22.5° (so a
     /// piece's midpoint tells its deviation; a full circle is not one
     /// piece from its start to itself).
-    fn fewest_pieces(&self) -> u32 {
+    pub(super) fn fewest_pieces(&self) -> u32 {
         match self.0 {
             Shape::Line { .. } => 1,
             Shape::Arc { sweep_rad, .. } => {
@@ -83,8 +88,17 @@ impl PieceCut {
 impl StepperMotion {
     /// The fewest pieces (a power of two) whose joint-space midpoints lie
     /// within [`LINE_TOLERANCE_MM`] of the curve; every piece end within
-    /// the soft limits.
+    /// the soft limits. Counted in single precision when that is sure
+    /// (`fast.rs`), else through the f64 IK and FK of every piece.
     pub(super) fn pieces_for(&self, curve: Curve) -> Result<u32, StepperRefusal> {
+        if let Some(pieces) = self.joints32.and_then(|j| j.pieces(&curve)) {
+            return Ok(pieces);
+        }
+        self.pieces_exactly(curve)
+    }
+
+    /// [`Self::pieces_for`] through the f64 IK and FK of every piece.
+    pub(super) fn pieces_exactly(&self, curve: Curve) -> Result<u32, StepperRefusal> {
         let mut pieces = curve.fewest_pieces();
         loop {
             let cut = PieceCut {
