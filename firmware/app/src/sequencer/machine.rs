@@ -82,9 +82,9 @@ pub struct Core {
     /// The geometry of `settings` and `model`, rebuilt when either changes
     /// ([`Core::geometry_changed`]).
     pub(super) aimer: Aimer,
-    /// Per driver, the board rectangle proven reachable with `settings`
-    /// (the soft-limit check's fast path), rebuilt with `aimer`.
-    pub(super) reach: crate::sequencer::gcode::reach::ReachBoxes,
+    /// Per driver, the part of the board proven reachable with `settings`
+    /// (the soft-limit check's fast path), proven again with `aimer`.
+    pub(super) reach: crate::sequencer::gcode::proven::ProvenReach,
     /// Which actuator(s) draw.
     pub(super) actuator: Actuator,
     pub(super) booted_at: Instant,
@@ -124,11 +124,11 @@ impl Core {
     /// Idle, default settings, gimbal, laser off; booted at `now`.
     #[inline(never)]
     pub fn new(now: Instant) -> Self {
-        let mut core = Self {
+        Self {
             settings: Settings::default(),
             model: AimModel::Exact,
             aimer: Settings::default().aimer(AimModel::Exact),
-            reach: crate::sequencer::gcode::reach::ReachBoxes::NONE,
+            reach: crate::sequencer::gcode::proven::ProvenReach::UNPROVEN,
             actuator: Actuator::Gimbal,
             booted_at: now,
             run: None,
@@ -151,14 +151,15 @@ impl Core {
             jobs: crate::sequencer::drivers::DriverJobs::new(),
             stepper_homing: false,
             controls: None,
-        };
-        core.reach = core.prove_reach_boxes();
-        core
+        }
     }
 
     /// Handles `event`, writing what is to be done into `out`.
     pub fn on(&mut self, inputs: Inputs, event: Event, out: &mut dyn ActionSink) {
         self.inputs = inputs;
+        if !self.reach.is_proven() {
+            self.reach = self.prove_reach();
+        }
         if !matches!(event, Event::CheckStep) {
             // Not what the shell does; should it happen, the command in
             // check still gets its reply first.
@@ -258,7 +259,7 @@ impl Core {
     /// model changed.
     pub(super) fn geometry_changed(&mut self) {
         self.aimer = self.settings.aimer(self.model);
-        self.reach = self.prove_reach_boxes();
+        self.reach = self.prove_reach();
         self.jobs.gimbal.geometry_changed();
     }
 

@@ -117,6 +117,7 @@ fn product_param(number: u16) -> Option<(&'static str, f64)> {
 pub(in crate::sequencer) mod lines;
 pub(in crate::sequencer) mod motion;
 pub(in crate::sequencer) mod power;
+pub(in crate::sequencer) mod proven;
 pub(in crate::sequencer) mod queue;
 pub(in crate::sequencer) mod reach;
 pub(in crate::sequencer) mod report;

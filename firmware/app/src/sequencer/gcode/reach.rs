@@ -28,17 +28,16 @@
 
 use crate::grbl::{Block, PointMm};
 use crate::sequencer::drivers::Driver;
+use crate::sequencer::gcode::proven::{ProvenReach, SCALES};
 use crate::sequencer::gcode::queue::{block_end, cm};
 use crate::sequencer::machine::Core;
 
 /// How much larger than it is used a rectangle is proven, mm.
 const MARGIN_MM: f64 = 1e-3;
-/// Fractions of the board tried, largest first.
-const SCALES: [f64; 2] = [1.0, 0.5];
 
 /// A rectangle of the board, mm.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(in crate::sequencer) struct BoxMm {
+struct BoxMm {
     lo: [f64; 2],
     hi: [f64; 2],
 }
@@ -57,21 +56,8 @@ impl BoxMm {
     }
 }
 
-/// Per driver (gimbal, stepper, galvo), the rectangle proven reachable
-/// (`None`: none, every point takes the exact check).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub(in crate::sequencer) struct ReachBoxes([Option<BoxMm>; 3]);
-
-impl ReachBoxes {
-    /// No rectangle: every point takes the exact check.
-    pub(in crate::sequencer) const NONE: Self = Self([None; 3]);
-
-    fn of(&self, driver: Driver) -> Option<BoxMm> {
-        self.0[index(driver)]
-    }
-}
-
-fn index(driver: Driver) -> usize {
+/// The driver's slot in [`ProvenReach`].
+fn slot(driver: Driver) -> usize {
     match driver {
         Driver::Gimbal => 0,
         Driver::Stepper => 1,
@@ -80,32 +66,44 @@ fn index(driver: Driver) -> usize {
 }
 
 impl Core {
-    /// The drivers' rectangles proven reachable with the current settings
-    /// (board extent `$130` × `$131`, geometry, limits), each the largest
-    /// of [`SCALES`] of the board that passes.
-    pub(in crate::sequencer) fn prove_reach_boxes(&self) -> ReachBoxes {
+    /// Half the board's extent (`$130` × `$131`), mm.
+    fn half_board_mm(&self) -> [f64; 2] {
         let s = &self.settings;
-        let half = [
+        [
             s.grid_pitch_cm * f64::from(s.grid_cols) * 5.0,
             s.grid_pitch_cm * f64::from(s.grid_rows) * 5.0,
-        ];
-        let mut boxes = ReachBoxes::NONE;
+        ]
+    }
+
+    /// The part of the board (about its centre) that `scale` of it is.
+    fn board_box(&self, scale: f64) -> BoxMm {
+        let [w, h] = self.half_board_mm();
+        BoxMm {
+            lo: [-w * scale, -h * scale],
+            hi: [w * scale, h * scale],
+        }
+    }
+
+    /// The drivers' fractions of the board proven reachable with the
+    /// current settings (board extent, geometry, limits), each the
+    /// largest of [`SCALES`] that passes.
+    #[inline(never)]
+    pub(in crate::sequencer) fn prove_reach(&self) -> ProvenReach {
+        let half = self.half_board_mm();
+        let mut proven = ProvenReach::NONE;
+        if !half.iter().all(|h| h.is_finite() && *h > 0.0) {
+            return proven;
+        }
         for driver in [Driver::Gimbal, Driver::Stepper, Driver::Galvo] {
             let Some(axis) = self.monotone_axis(driver) else {
                 continue;
             };
-            boxes.0[index(driver)] = SCALES.iter().find_map(|k| {
-                let b = BoxMm {
-                    lo: [-half[0] * k, -half[1] * k],
-                    hi: [half[0] * k, half[1] * k],
-                };
-                (half.iter().all(|h| h.is_finite() && *h > 0.0) && self.proves(driver, b, axis))
-                    .then_some(b)
-            });
+            let scale =
+                (0..SCALES.len()).find(|&k| self.proves(driver, self.board_box(SCALES[k]), axis));
+            proven = proven.with(slot(driver), scale);
         }
-        boxes
+        proven
     }
-
     /// The board point (mm) where `driver`'s limits may turn along a
     /// rectangle's edges (module docs), or `None` when the geometry is
     /// not one the proof covers.
@@ -167,7 +165,8 @@ impl Core {
             _ => None,
         };
         self.drivers().iter().all(|d| {
-            self.reach.of(d).is_some_and(|b| {
+            self.reach.scale(slot(d)).is_some_and(|k| {
+                let b = self.board_box(k);
                 b.contains(end) && circle.is_none_or(|(c, r)| b.contains_square(c, r))
             })
         })

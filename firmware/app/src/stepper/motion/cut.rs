@@ -91,13 +91,22 @@ impl StepperMotion {
     /// the soft limits. Counted in single precision when that is sure
     /// (`fast.rs`), else through the f64 IK and FK of every piece.
     pub(super) fn pieces_for(&self, curve: Curve) -> Result<u32, StepperRefusal> {
-        if let Some(pieces) = self.joints32.and_then(|j| j.pieces(&curve)) {
+        let fast = self.joints32.and_then(|j| {
+            j.pieces(
+                curve.shape(),
+                curve.fewest_pieces(),
+                LINE_TOLERANCE_MM,
+                MAX_PIECES,
+            )
+        });
+        if let Some(pieces) = fast {
             return Ok(pieces);
         }
         self.pieces_exactly(curve)
     }
 
     /// [`Self::pieces_for`] through the f64 IK and FK of every piece.
+    #[inline(never)]
     pub(super) fn pieces_exactly(&self, curve: Curve) -> Result<u32, StepperRefusal> {
         let mut pieces = curve.fewest_pieces();
         loop {

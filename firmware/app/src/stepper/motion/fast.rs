@@ -1,7 +1,8 @@
 //! Counting a curve's pieces without the f64 IK and FK per piece (~30 000
 //! M4 instructions each, doubled with every doubling of the count): the
 //! stepper's exact model with OL = 0 in single precision and without
-//! trigonometry, for the pan/tilt's joint geometry is a ray from O.
+//! trigonometry, for the pan/tilt's joint geometry is a ray from O. A leaf:
+//! it takes the geometry, the limits and the curve's shape as arguments.
 //!
 //! With OL = 0, the beam to the global point `(X, y, z)` has yaw `atan2(y,
 //! X)` and pitch `−atan2(z, h)` (`h = √(X² + y²)`), so the sines and
@@ -12,11 +13,12 @@
 //! (their tangents), shrunk by [`LIMIT_MARGIN_DEG`].
 //!
 //! Single precision errs by ~1e-4 mm on the deviation (points within
-//! ~±50 cm); a count is taken when the deviation is below
-//! [`TOLERANCE_SHARE`] of the tolerance, so a count taken here also passes
-//! the exact check: at most one doubling more than it, never fewer. A
-//! piece end near a limit, or a geometry outside these assumptions,
-//! leaves the count to the exact check.
+//! ~±50 cm), so each round's pass or fail is taken here only when the
+//! deviation lies more than [`UNSURE_SHARE`] of the tolerance (the
+//! stepper's 0.05 mm) from it: the count is then the exact check's, the
+//! same rounds deciding the same way. A deviation that close, a piece end
+//! near a limit, or a geometry outside these assumptions leaves the count
+//! to the exact check.
 
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::{Gimbal, GimbalModel};
@@ -25,14 +27,11 @@ use kinematics_core::path::Shape;
 use kinematics_core::servo::ServoAxis;
 use kinematics_core::sqrt_f32;
 
-use super::super::StepperConfig;
-use super::cut::Curve;
-use super::{LINE_TOLERANCE_MM, MAX_PIECES};
-
 /// How far inside the joint limits a piece end must lie here, deg.
 const LIMIT_MARGIN_DEG: f64 = 0.01;
-/// The share of [`LINE_TOLERANCE_MM`] the deviation must stay below here.
-const TOLERANCE_SHARE: f32 = 0.98;
+/// How far (a share of the tolerance) the deviation must lie from the
+/// tolerance for single precision to decide (it errs by < 0.2 % of it).
+const UNSURE_SHARE: f32 = 0.02;
 /// Highest joint limit handled, deg (tangents stay finite).
 const MAX_LIMIT_DEG: f64 = 85.0;
 
@@ -61,10 +60,12 @@ struct End {
 }
 
 impl Joints32 {
-    /// The geometry of `config`, or `None` when it is not the exact model
-    /// with OL = 0 (or its limits lie beyond ±[`MAX_LIMIT_DEG`]).
-    pub(super) fn of(config: &StepperConfig) -> Option<Self> {
-        let gimbal: &Gimbal = &config.gimbal;
+    /// The geometry of `gimbal` within the stepper's soft limits
+    /// `min_deg`..`max_deg` (`[pan, tilt]`, joint degrees), or `None` when
+    /// it is not the exact model with OL = 0 (or its limits lie beyond
+    /// ±[`MAX_LIMIT_DEG`]).
+    #[inline(never)]
+    pub(super) fn of(gimbal: &Gimbal, min_deg: [f64; 2], max_deg: [f64; 2]) -> Option<Self> {
         let g = &gimbal.geometry;
         if gimbal.model != GimbalModel::Exact || g.ol_cm != 0.0 {
             return None;
@@ -78,15 +79,14 @@ impl Joints32 {
                 (servo.min_deg - servo.zero_deg) / sign,
                 (servo.max_deg - servo.zero_deg) / sign,
             );
-            let lo = a.min(b).max(config.min_deg[i]) + LIMIT_MARGIN_DEG;
-            let hi = a.max(b).min(config.max_deg[i]) - LIMIT_MARGIN_DEG;
+            let lo = a.min(b).max(min_deg[i]) + LIMIT_MARGIN_DEG;
+            let hi = a.max(b).min(max_deg[i]) - LIMIT_MARGIN_DEG;
             let range = -MAX_LIMIT_DEG..=MAX_LIMIT_DEG;
-            (lo < hi && range.contains(&lo) && range.contains(&hi)).then(|| {
-                [
-                    libm::tan(lo.to_radians()) as f32,
-                    libm::tan(hi.to_radians()) as f32,
-                ]
-            })
+            let tan = |deg: f64| {
+                let (s, c) = trig::sin_cos(deg.to_radians());
+                (s / c) as f32
+            };
+            (lo < hi && range.contains(&lo) && range.contains(&hi)).then(|| [tan(lo), tan(hi)])
         };
         Some(Self {
             plane_x: plane_x as f32,
@@ -135,15 +135,27 @@ impl Joints32 {
         Some([u - self.offset[0], v - self.offset[1]])
     }
 
-    /// The fewest pieces (a power of two from the curve's fewest) whose
-    /// joint-space midpoints lie within [`TOLERANCE_SHARE`] of
-    /// [`LINE_TOLERANCE_MM`] of `curve`, every piece end well within the
-    /// limits; `None`: left to the exact check.
-    pub(super) fn pieces(&self, curve: &Curve) -> Option<u32> {
-        let mut pieces = curve.fewest_pieces();
-        let tolerance_cm = TOLERANCE_SHARE * (LINE_TOLERANCE_MM as f32) / 10.0;
+    /// The fewest pieces (a power of two from `fewest`, at most
+    /// `max_pieces`) of `shape` whose joint-space midpoints lie within
+    /// `tolerance_mm` of it, as the exact check counts them; `None`: left
+    /// to the exact check (a round too close to call, an end near a limit).
+    #[inline(never)]
+    pub(super) fn pieces(
+        &self,
+        shape: Shape,
+        fewest: u32,
+        tolerance_mm: f64,
+        max_pieces: u32,
+    ) -> Option<u32> {
+        let mut pieces = fewest;
+        let tolerance_cm = (tolerance_mm as f32) / 10.0;
+        let unsure_cm = UNSURE_SHARE * tolerance_cm;
         loop {
-            if self.deviation_cm(curve.shape(), pieces)? <= tolerance_cm || pieces >= MAX_PIECES {
+            let deviation_cm = self.deviation_cm(shape, pieces)?;
+            if (deviation_cm - tolerance_cm).abs() <= unsure_cm {
+                return None;
+            }
+            if deviation_cm <= tolerance_cm || pieces >= max_pieces {
                 return Some(pieces);
             }
             pieces *= 2;

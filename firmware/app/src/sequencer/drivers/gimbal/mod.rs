@@ -38,7 +38,7 @@ pub(in crate::sequencer) struct Stream {
     /// Highest cruise of the running block (servo speed, `$110`), mm/s.
     cap_mm_s: f64,
     /// The joint degrees per mm of the blocks planned.
-    deg_per_mm: cache::DegPerMm,
+    deg_per_mm: deg_per_mm::DegPerMm<PLAN_BLOCKS>,
 }
 
 impl Stream {
@@ -46,7 +46,7 @@ impl Stream {
         Self {
             cursor: None,
             cap_mm_s: 0.0,
-            deg_per_mm: cache::DegPerMm::new(),
+            deg_per_mm: deg_per_mm::DegPerMm::new(),
         }
     }
 
@@ -75,6 +75,7 @@ impl Stream {
 }
 
 mod cache;
+mod deg_per_mm;
 mod plan;
 mod step;
 mod stream;
