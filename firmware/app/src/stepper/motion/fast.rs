@@ -13,12 +13,12 @@
 //! (their tangents), shrunk by [`LIMIT_MARGIN_DEG`].
 //!
 //! Single precision errs by ~1e-4 mm on the deviation (points within
-//! ~±50 cm), so each round's pass or fail is taken here only when the
+//! ~±50 cm), so a piece's pass or fail is taken here only when its
 //! deviation lies more than [`UNSURE_SHARE`] of the tolerance (the
-//! stepper's 0.05 mm) from it: the count is then the exact check's, the
-//! same rounds deciding the same way. A deviation that close, a piece end
-//! near a limit, or a geometry outside these assumptions leaves the count
-//! to the exact check.
+//! stepper's 0.05 mm) from it; the few closer are decided through the f64
+//! IK and FK, piece by piece: the count is the exact check's, every round
+//! deciding the same way. A piece end near a limit, or a geometry outside
+//! these assumptions, leaves the count to the exact check.
 
 use kinematics_core::frames::BoardPoint;
 use kinematics_core::gimbal::{Gimbal, GimbalModel};
@@ -32,6 +32,9 @@ const LIMIT_MARGIN_DEG: f64 = 0.01;
 /// How far (a share of the tolerance) the deviation must lie from the
 /// tolerance for single precision to decide (it errs by < 0.2 % of it).
 const UNSURE_SHARE: f32 = 0.02;
+/// Unsure pieces of a round kept by index (beyond them, every piece from
+/// the next unsure one is decided through f64).
+const UNSURE_KEPT: usize = 8;
 /// Highest joint limit handled, deg (tangents stay finite).
 const MAX_LIMIT_DEG: f64 = 85.0;
 
@@ -137,8 +140,11 @@ impl Joints32 {
 
     /// The fewest pieces (a power of two from `fewest`, at most
     /// `max_pieces`) of `shape` whose joint-space midpoints lie within
-    /// `tolerance_mm` of it, as the exact check counts them; `None`: left
-    /// to the exact check (a round too close to call, an end near a limit).
+    /// `tolerance_mm` of it, as the exact check counts them: a piece
+    /// whose deviation lies within [`UNSURE_SHARE`] of the tolerance is
+    /// decided by `exact_mm(k, pieces)` (piece `k` of `pieces`, its
+    /// deviation in mm through the f64 IK and FK). `None`: left to the
+    /// exact check (an end near a limit, `exact_mm` failing).
     #[inline(never)]
     pub(super) fn pieces(
         &self,
@@ -146,34 +152,63 @@ impl Joints32 {
         fewest: u32,
         tolerance_mm: f64,
         max_pieces: u32,
+        exact_mm: &dyn Fn(u32, u32) -> Option<f64>,
     ) -> Option<u32> {
         let mut pieces = fewest;
         let tolerance_cm = (tolerance_mm as f32) / 10.0;
         let unsure_cm = UNSURE_SHARE * tolerance_cm;
         loop {
-            let deviation_cm = self.deviation_cm(shape, pieces)?;
-            if (deviation_cm - tolerance_cm).abs() <= unsure_cm {
-                return None;
+            let mut passes = true;
+            // The unsure pieces: the first few, and the first of the rest.
+            let mut unsure = [0u32; UNSURE_KEPT];
+            let mut count = 0;
+            let mut more = None;
+            self.deviations_cm(shape, pieces, &mut |k, deviation_cm| {
+                if (deviation_cm - tolerance_cm).abs() <= unsure_cm {
+                    match unsure.get_mut(count) {
+                        Some(slot) => {
+                            *slot = k;
+                            count += 1;
+                        }
+                        None => more = more.or(Some(k)),
+                    }
+                } else if deviation_cm > tolerance_cm {
+                    passes = false;
+                }
+            })?;
+            if passes {
+                let rest = more.map_or(1..=0, |first| first..=pieces);
+                for k in unsure.into_iter().take(count).chain(rest) {
+                    if exact_mm(k, pieces)? > tolerance_mm {
+                        passes = false;
+                        break;
+                    }
+                }
             }
-            if deviation_cm <= tolerance_cm || pieces >= max_pieces {
+            if passes || pieces >= max_pieces {
                 return Some(pieces);
             }
             pieces *= 2;
         }
     }
 
-    /// Largest distance of the joint-space midpoints of `pieces` equal
-    /// pieces of `shape` from it, cm.
-    fn deviation_cm(&self, shape: Shape, pieces: u32) -> Option<f32> {
+    /// The distance of each joint-space midpoint of `pieces` equal pieces
+    /// of `shape` from it, cm, to `each(k, deviation)` (`k` from 1);
+    /// `None` for an end near or beyond a limit.
+    fn deviations_cm(
+        &self,
+        shape: Shape,
+        pieces: u32,
+        each: &mut dyn FnMut(u32, f32),
+    ) -> Option<()> {
         let n = f64::from(pieces);
-        let mut worst = 0.0_f32;
         let mut a = self.end(point32(shape.point_at(0.0)))?;
         match shape {
             Shape::Line { from, to } => {
                 let (f, t) = (point32(from), point32(to));
                 for k in 1..=pieces {
                     let b = self.end(point32(shape.point_at(f64::from(k) / n)))?;
-                    worst = worst.max(to_segment_cm(self.mid_spot(a, b)?, f, t));
+                    each(k, to_segment_cm(self.mid_spot(a, b)?, f, t));
                     a = b;
                 }
             }
@@ -188,18 +223,18 @@ impl Joints32 {
                 let (start_sin, start_cos) = trig::sin_cos(start_rad);
                 let (mut ex, mut ey) = (radius_cm * start_cos, radius_cm * start_sin);
                 let (cx, cy, r) = (centre.x_cm as f32, centre.y_cm as f32, radius_cm as f32);
-                for _ in 1..=pieces {
+                for k in 1..=pieces {
                     (ex, ey) = (ex * c - ey * s, ex * s + ey * c);
                     let b =
                         self.end(point32(BoardPoint::new(centre.x_cm + ex, centre.y_cm + ey)))?;
                     let m = self.mid_spot(a, b)?;
                     let (dx, dy) = (m[0] - cx, m[1] - cy);
-                    worst = worst.max((sqrt_f32(dx * dx + dy * dy) - r).abs());
+                    each(k, (sqrt_f32(dx * dx + dy * dy) - r).abs());
                     a = b;
                 }
             }
         }
-        Some(worst)
+        Some(())
     }
 }
 
