@@ -19,23 +19,25 @@ const LINE_INSTRUCTIONS: f64 = 16_000.0;
 /// block's joint speed once, the stepper counts pieces in f32.
 const NOT_MET_GIMBAL: &str = "a block's joint degrees per mm take three f64 aims \
     (error-model compensation, IK, servo mapping: ~28 000 instructions each) once, when \
-    it is queued (the core's ~115 000 of the worst arc, ~29 000 of it parse and queue); \
-    the next 20 ms stream tick ~120 000: one f64 aim for the servo point and the f64 \
+    it is queued (the core's ~113 000 of the worst arc, ~30 000 of it parse and queue); \
+    the next 20 ms stream tick ~115 000: one f64 aim for the servo point and the f64 \
     look-ahead replan over the queue (each block's end tangents, arcs through f64 \
     sin/cos; not profiled call by call). Proposed goal: 250 000 per line, i.e. 100 \
     lines/s (twice the stream's 50 Hz) within 20 % of the CPU";
 /// See [`NOT_MET_GIMBAL`].
 const NOT_MET_GALVO: &str = "the f64 path planner's add alone is 16 000 (line) to \
     23 000 (arc) instructions (rows path.add.*), the core's f64 parse, arc set-up and \
-    queue ~29 000 for an arc: ~60 000 for an arc, ~26 000 the median line. Proposed \
+    queue ~30 000 for an arc: ~61 000 for an arc, ~27 000 the median line. Proposed \
     goal: 64 000 per line, i.e. 500 lines/s within 25 % of the CPU";
 /// See [`NOT_MET_GIMBAL`].
-const NOT_MET_STEPPER: &str = "every piece of a line (an arc of 21 mm: 64 pieces) goes \
-    through the f64 IK and a planner push with an f64 replan, ~45 000 instructions, and \
-    one next_segment fills the 16-block planner: the worst arc ~690 000 for 15 pieces, \
-    ~160 000 for its piece count (f32), ~29 000 the core; the median line ~57 000. \
-    Proposed goal: 64 000 per line plus 48 000 per piece cut (an f32 IK for the piece \
-    ends and an f32 stepper planner would be needed for less)";
+const NOT_MET_STEPPER: &str = "every piece of a line goes through the f64 IK and a \
+    planner push with an f64 replan, ~45 000 instructions, and one next_segment fills \
+    the 16-block planner (15 pieces: ~690 000); the piece count runs in f32 (~160 000 \
+    for a 64-piece arc) but a round whose deviation lies within 2 % of the tolerance is \
+    decided piece by piece through the f64 IK and FK (~45 000 a piece: the worst line, \
+    a 16-piece arc of r 5 mm, ~1 540 000); the median line ~58 000. Proposed goal: \
+    64 000 per line plus 48 000 per piece cut (less needs an f32 IK for the piece ends \
+    and an f32 stepper planner)";
 
 /// Budget of one line: 16 000 instructions at the table's CPI and clock.
 const fn line_budget(why: &'static str) -> Option<(f64, &'static str, Enforcement)> {
