@@ -177,7 +177,7 @@ impl Joints32 {
                 }
             })?;
             if passes {
-                let rest = more.map_or(1..=0, |first| first..=pieces);
+                let rest = more.map(|first| first..=pieces).into_iter().flatten();
                 for k in unsure.into_iter().take(count).chain(rest) {
                     if exact_mm(k, pieces)? > tolerance_mm {
                         passes = false;
