@@ -10,21 +10,41 @@ use super::budgets::{CLOCK_MHZ, CPI, Enforcement, Row};
 /// Instructions per line the goal allows.
 const LINE_INSTRUCTIONS: f64 = 16_000.0;
 
-/// Why the goal is not met (measured: `gcode.line.*.core` is the core's
-/// part of the dearest line; the rest is the actuator's stage; the causes
-/// read from the code on that path).
-const NOT_MET: &str = "f64 soft-float IK on every line: the core's reach check \
-    (block_reachable: the end, an arc 17 points) is ~23 000-40 000 instructions for a \
-    line, ~270 000-500 000 for an arc; the gimbal's stream tick aims 3 points per queued \
-    block (joint_deg_per_mm); the stepper's piece count doubles with an IK + FK per piece \
-    (pieces_for)";
+/// Why the goal is not met, per actuator, with the goal proposed instead
+/// (measured: `gcode.line.*.core` is the core's part of the dearest line,
+/// the rest the actuator's stage; the causes read from the code on that
+/// path and from the per-call rows `gimbal.ik_wire`, `path.add.*`). The
+/// reach check no longer runs the IK for blocks inside the board rectangle
+/// proven reachable (`sequencer/gcode/reach.rs`), the gimbal works out a
+/// block's joint speed once, the stepper counts pieces in f32.
+const NOT_MET_GIMBAL: &str = "a block's joint degrees per mm take three f64 aims \
+    (error-model compensation, IK, servo mapping: ~28 000 instructions each) once, when \
+    it is queued (the core's ~113 000 of the worst arc, ~30 000 of it parse and queue); \
+    the next 20 ms stream tick ~115 000: one f64 aim for the servo point and the f64 \
+    look-ahead replan over the queue (each block's end tangents, arcs through f64 \
+    sin/cos; not profiled call by call). Proposed goal: 250 000 per line, i.e. 100 \
+    lines/s (twice the stream's 50 Hz) within 20 % of the CPU";
+/// See [`NOT_MET_GIMBAL`].
+const NOT_MET_GALVO: &str = "the f64 path planner's add alone is 16 000 (line) to \
+    23 000 (arc) instructions (rows path.add.*), the core's f64 parse, arc set-up and \
+    queue ~30 000 for an arc: ~61 000 for an arc, ~27 000 the median line. Proposed \
+    goal: 64 000 per line, i.e. 500 lines/s within 25 % of the CPU";
+/// See [`NOT_MET_GIMBAL`].
+const NOT_MET_STEPPER: &str = "every piece of a line goes through the f64 IK and a \
+    planner push with an f64 replan, ~45 000 instructions, and one next_segment fills \
+    the 16-block planner (15 pieces: ~690 000); the piece count runs in f32 (~160 000 \
+    for a 64-piece arc) but a round whose deviation lies within 2 % of the tolerance is \
+    decided piece by piece through the f64 IK and FK (~45 000 a piece: the worst line, \
+    a 16-piece arc of r 5 mm, ~1 540 000); the median line ~58 000. Proposed goal: \
+    64 000 per line plus 48 000 per piece cut (less needs an f32 IK for the piece ends \
+    and an f32 stepper planner)";
 
 /// Budget of one line: 16 000 instructions at the table's CPI and clock.
-const fn line_budget() -> Option<(f64, &'static str, Enforcement)> {
+const fn line_budget(why: &'static str) -> Option<(f64, &'static str, Enforcement)> {
     Some((
         LINE_INSTRUCTIONS * CPI / CLOCK_MHZ,
         "16 000 instructions: 2 000 lines/s within 25 % of the CPU",
-        Enforcement::NotMet(NOT_MET),
+        Enforcement::NotMet(why),
     ))
 }
 
@@ -34,7 +54,7 @@ pub const GCODE_ROWS: &[Row] = &[
         id: "gcode.line.gimbal",
         what: "G-code line -> gimbal: core (parse, queue) + the next stream tick (look-ahead replan, servo aim); worst of a seeded sweep",
         unit: "line",
-        budget: line_budget(),
+        budget: line_budget(NOT_MET_GIMBAL),
     },
     Row {
         id: "gcode.line.gimbal.core",
@@ -46,7 +66,7 @@ pub const GCODE_ROWS: &[Row] = &[
         id: "gcode.line.galvo",
         what: "G-code line -> galvo: core (parse, queue, stroke hand-over) + PathPlanner add onto three segments (replan); worst of a seeded sweep",
         unit: "line",
-        budget: line_budget(),
+        budget: line_budget(NOT_MET_GALVO),
     },
     Row {
         id: "gcode.line.galvo.core",
@@ -58,7 +78,7 @@ pub const GCODE_ROWS: &[Row] = &[
         id: "gcode.line.stepper",
         what: "G-code line -> stepper: core (parse, queue) + StepperMotion move_to and next_segment (mm -> steps, pieces into the planner, replan, one segment); worst of a seeded sweep",
         unit: "line",
-        budget: line_budget(),
+        budget: line_budget(NOT_MET_STEPPER),
     },
     Row {
         id: "gcode.line.stepper.core",

@@ -133,4 +133,9 @@ impl Aimer {
     pub fn gimbal(&self) -> &Gimbal {
         &self.gimbal
     }
+
+    /// The error model the points are compensated with.
+    pub fn error_model(&self) -> &ErrorModel {
+        &self.error_model
+    }
 }

@@ -83,6 +83,9 @@ pub struct Core {
     /// The geometry of `settings` and `model`, rebuilt when either changes
     /// ([`Core::geometry_changed`]).
     pub(super) aimer: Aimer,
+    /// Per driver, the part of the board proven reachable with `settings`
+    /// (the soft-limit check's fast path), proven again with `aimer`.
+    pub(super) reach: crate::sequencer::gcode::proven::ProvenReach,
     /// Which actuator(s) draw.
     pub(super) actuator: Actuator,
     pub(super) booted_at: Instant,
@@ -126,6 +129,7 @@ impl Core {
             settings: Settings::default(),
             model: AimModel::Exact,
             aimer: Settings::default().aimer(AimModel::Exact),
+            reach: crate::sequencer::gcode::proven::ProvenReach::UNPROVEN,
             actuator: Actuator::Gimbal,
             booted_at: now,
             run: None,
@@ -154,6 +158,9 @@ impl Core {
     /// Handles `event`, writing what is to be done into `out`.
     pub fn on(&mut self, inputs: Inputs, event: Event, out: &mut dyn ActionSink) {
         self.inputs = inputs;
+        if !self.reach.is_proven() {
+            self.reach = self.prove_reach();
+        }
         if !matches!(event, Event::CheckStep) {
             // Not what the shell does; should it happen, the command in
             // check still gets its reply first.
@@ -253,6 +260,8 @@ impl Core {
     /// model changed.
     pub(super) fn geometry_changed(&mut self) {
         self.aimer = self.settings.aimer(self.model);
+        self.reach = self.prove_reach();
+        self.jobs.gimbal.geometry_changed();
     }
 
     /// Switches the gimbal laser to what the state calls for.

@@ -71,6 +71,9 @@ impl Core {
         self.grbl_take_owed(out);
         self.grbl_advance(out);
         self.gcode_galvo_send_ahead(out);
+        if self.drivers().gimbal_streams() {
+            self.with_stage(out, |st, jobs, _| jobs.gimbal.remember(st));
+        }
     }
 
     /// Moves the blocks of the line waiting for room into the queue when

@@ -12,6 +12,12 @@ impl Core {
     /// the board (`$130` × `$131` about its centre) and within the reach
     /// of the actuator(s) (end points, and arcs along their sweep).
     pub(in crate::sequencer) fn block_reachable(&self, block: &Block) -> bool {
+        self.surely_reachable(block) || self.block_reachable_exactly(block)
+    }
+
+    /// [`Self::block_reachable`] point by point through the drivers' exact
+    /// checks.
+    pub(in crate::sequencer) fn block_reachable_exactly(&self, block: &Block) -> bool {
         let Some(end) = block_end(block) else {
             return true;
         };

@@ -28,6 +28,11 @@ impl Curve {
         Some(Curve(Shape::of(segment)))
     }
 
+    /// The curve's shape.
+    pub(super) fn shape(&self) -> Shape {
+        self.0
+    }
+
     /// The point a fraction `t` (0..=1) along the curve.
     pub(super) fn at(&self, t: f64) -> BoardPoint {
         self.0.point_at(t)

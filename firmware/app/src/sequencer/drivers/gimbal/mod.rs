@@ -37,6 +37,8 @@ pub(in crate::sequencer) struct Stream {
     cursor: Option<SpeedCursor>,
     /// Highest cruise of the running block (servo speed, `$110`), mm/s.
     cap_mm_s: f64,
+    /// The joint degrees per mm of the blocks planned.
+    deg_per_mm: deg_per_mm::DegPerMm<PLAN_BLOCKS>,
 }
 
 impl Stream {
@@ -44,6 +46,7 @@ impl Stream {
         Self {
             cursor: None,
             cap_mm_s: 0.0,
+            deg_per_mm: deg_per_mm::DegPerMm::new(),
         }
     }
 
@@ -59,6 +62,11 @@ impl Stream {
         self.cursor.is_some()
     }
 
+    /// Forgets the joint degrees per mm worked out (the geometry changed).
+    pub(in crate::sequencer) fn geometry_changed(&mut self) {
+        self.deg_per_mm.clear();
+    }
+
     /// Speed now, mm/s (0 at rest).
     #[inline(never)]
     pub(in crate::sequencer) fn speed_mm_s(&self) -> f64 {
@@ -66,6 +74,8 @@ impl Stream {
     }
 }
 
+mod cache;
+mod deg_per_mm;
 mod plan;
 pub(in crate::sequencer) mod points;
 pub(in crate::sequencer) mod step;

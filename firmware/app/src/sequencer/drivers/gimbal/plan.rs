@@ -3,6 +3,7 @@
 //! allows the block running.
 
 use crate::grbl::{Block, PointMm};
+use crate::sequencer::drivers::gimbal::deg_per_mm::DegPerMm;
 use crate::sequencer::drivers::gimbal::{GIMBAL_ACCEL_DEG_S2, PLAN_BLOCKS};
 use crate::sequencer::drivers::stage::Stage;
 use crate::sequencer::gcode::queue::{MIN_LENGTH_MM, block_point, cm, planned_length, point_at};
@@ -29,9 +30,14 @@ fn unit(a: PointMm, b: PointMm) -> [f64; 2] {
 /// within [`GIMBAL_ACCEL_DEG_S2`], through the joint degrees per mm
 /// along the block.
 #[inline(never)]
-pub(in crate::sequencer) fn stream_limits(st: &Stage, block: &Block, length: f64) -> (f64, f64) {
+pub(in crate::sequencer) fn stream_limits(
+    st: &Stage,
+    kept: &DegPerMm<PLAN_BLOCKS>,
+    block: &Block,
+    length: f64,
+) -> (f64, f64) {
     let s = st.settings;
-    let deg_per_mm = joint_deg_per_mm(st, block, length).max(1e-6);
+    let deg_per_mm = joint_deg_per_mm(st, kept, block, length).max(1e-6);
     let cap = (s.servo_speed_deg_s / deg_per_mm).min(s.galvo.mark_speed_mm_s);
     let feed = match *block {
         Block::Line { feed_mm_min, .. }
@@ -43,9 +49,18 @@ pub(in crate::sequencer) fn stream_limits(st: &Stage, block: &Block, length: f64
     (feed.min(cap).max(1e-3), accel.max(1e-3))
 }
 
-/// The larger joint's travel per mm along `block` (two pieces), °/mm.
+/// The larger joint's travel per mm along `block` (two pieces), °/mm:
+/// kept since the block was queued (`kept`), or worked out.
+fn joint_deg_per_mm(st: &Stage, kept: &DegPerMm<PLAN_BLOCKS>, block: &Block, length: f64) -> f64 {
+    match kept.get(block) {
+        Some(v) => v,
+        None => joint_deg_per_mm_aimed(st, block, length),
+    }
+}
+
+/// [`joint_deg_per_mm`] through the aims of the block's ends and middle.
 #[inline(never)]
-fn joint_deg_per_mm(st: &Stage, block: &Block, length: f64) -> f64 {
+pub(super) fn joint_deg_per_mm_aimed(st: &Stage, block: &Block, length: f64) -> f64 {
     let aim = |k: u32| st.aimer.aim(cm(point_at(block, k, 2))).ok();
     let (mut yaw, mut pitch) = (0.0, 0.0);
     let mut prev = aim(0);
@@ -68,6 +83,7 @@ fn joint_deg_per_mm(st: &Stage, block: &Block, length: f64) -> f64 {
 #[inline(never)]
 pub(in crate::sequencer) fn stream_exit_speed(
     st: &Stage,
+    kept: &DegPerMm<PLAN_BLOCKS>,
     current: &Block,
     cursor: &SpeedCursor,
 ) -> f64 {
@@ -101,7 +117,7 @@ pub(in crate::sequencer) fn stream_exit_speed(
             break;
         }
         lit = next_lit;
-        let (cruise, accel) = stream_limits(st, next, length);
+        let (cruise, accel) = stream_limits(st, kept, next, length);
         if plan
             .push(length, tangents(next, length), cruise, accel)
             .is_err()

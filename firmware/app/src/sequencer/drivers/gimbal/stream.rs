@@ -28,7 +28,8 @@ impl Stream {
         out: &mut dyn ActionSink,
     ) -> Option<bool> {
         let length = planned_length(block)?;
-        let (cruise, accel) = stream_limits(st, block, length);
+        self.remember(st);
+        let (cruise, accel) = stream_limits(st, &self.deg_per_mm, block, length);
         let planned = LookaheadBlock {
             length,
             nominal_speed: cruise,
@@ -56,13 +57,14 @@ impl Stream {
     /// (or ends the jog) there.
     #[inline(never)]
     pub(in crate::sequencer) fn tick(&mut self, st: &mut Stage, out: &mut dyn ActionSink) -> bool {
+        self.remember(st);
         let motion = &mut st.gcode.motion;
         let (Some(current), Some(mut cursor)) = (motion.current, self.cursor) else {
             return false;
         };
         let braking = motion.hold != Hold::None || current.cancelled;
         // The exit: the next block's entry while it joins at speed.
-        cursor.block.exit_speed = stream_exit_speed(st, &current.block, &cursor);
+        cursor.block.exit_speed = stream_exit_speed(st, &self.deg_per_mm, &current.block, &cursor);
         let joins = cursor.block.exit_speed > 0.0;
         // The feed override, never slower than grbl's minimum feed.
         let nominal_mm_s = cursor.block.nominal_speed.max(1e-9);

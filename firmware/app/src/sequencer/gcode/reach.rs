@@ -1,0 +1,184 @@
+//! The soft-limit check's fast path: per driver, a rectangle of the board
+//! proven reachable when the geometry changes, so that a block lying in it
+//! needs none of the f64 IK calls of the exact check (~37 000 M4
+//! instructions a point on the gimbal, 17 points an arc).
+//!
+//! Why a rectangle is proven by a few points: on each driver the reachable
+//! set is, in board coordinates, convex along one axis and its limits are
+//! monotone along the rectangle's edges except where a coordinate crosses
+//! the driver's axis:
+//!
+//! * gimbal and stepper (exact or seed model, no board roll, no error
+//!   model, board farther than OL): yaw depends on the board x alone,
+//!   monotone; for a fixed x the pitch falls strictly with the board y
+//!   (`dβ/dz = −(h + OL·z/√(r² − OL²))/r² < 0` as `h > OL`); along a
+//!   horizontal edge the pitch is monotone in the horizontal distance `h`
+//!   (`dβ/dh` has no zero off `z = OL`, where β is constant), which is
+//!   monotone on each side of the x where the beam is level (`gy = 0`);
+//! * galvo: the y mirror depends on y alone, monotone; the x mirror on
+//!   `x / (√(d² + y²) + e)`, monotone in x and in |y|.
+//!
+//! The servo, soft-limit and DAC-code mappings are monotone in the joint
+//! angles, so each limit holds on an interval. A rectangle whose corners
+//! and whose edge points on those axes all pass the exact check is then
+//! reachable everywhere. It is proven a [`MARGIN_MM`] larger than it is
+//! used, so the exact check's rounding cannot refuse a point inside it.
+//! The property test in `reach_tests.rs` checks this against the exact
+//! check over random points, lines and arcs.
+
+use crate::grbl::{Block, PointMm};
+use crate::sequencer::drivers::Driver;
+use crate::sequencer::gcode::proven::{ProvenReach, SCALES};
+use crate::sequencer::gcode::queue::{block_end, cm};
+use crate::sequencer::machine::Core;
+
+/// How much larger than it is used a rectangle is proven, mm.
+const MARGIN_MM: f64 = 1e-3;
+
+/// A rectangle of the board, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct BoxMm {
+    lo: [f64; 2],
+    hi: [f64; 2],
+}
+
+impl BoxMm {
+    fn contains(&self, p: PointMm) -> bool {
+        p.x_mm >= self.lo[0] && p.x_mm <= self.hi[0] && p.y_mm >= self.lo[1] && p.y_mm <= self.hi[1]
+    }
+
+    /// Whether the square of half side `r` about `c` lies inside.
+    fn contains_square(&self, c: PointMm, r: f64) -> bool {
+        c.x_mm - r >= self.lo[0]
+            && c.x_mm + r <= self.hi[0]
+            && c.y_mm - r >= self.lo[1]
+            && c.y_mm + r <= self.hi[1]
+    }
+}
+
+/// The driver's slot in [`ProvenReach`].
+fn slot(driver: Driver) -> usize {
+    match driver {
+        Driver::Gimbal => 0,
+        Driver::Stepper => 1,
+        Driver::Galvo => 2,
+    }
+}
+
+impl Core {
+    /// Half the board's extent (`$130` × `$131`), mm.
+    fn half_board_mm(&self) -> [f64; 2] {
+        let s = &self.settings;
+        [
+            s.grid_pitch_cm * f64::from(s.grid_cols) * 5.0,
+            s.grid_pitch_cm * f64::from(s.grid_rows) * 5.0,
+        ]
+    }
+
+    /// The part of the board (about its centre) that `scale` of it is.
+    fn board_box(&self, scale: f64) -> BoxMm {
+        let [w, h] = self.half_board_mm();
+        BoxMm {
+            lo: [-w * scale, -h * scale],
+            hi: [w * scale, h * scale],
+        }
+    }
+
+    /// The drivers' fractions of the board proven reachable with the
+    /// current settings (board extent, geometry, limits), each the
+    /// largest of [`SCALES`] that passes.
+    #[inline(never)]
+    pub(in crate::sequencer) fn prove_reach(&self) -> ProvenReach {
+        let half = self.half_board_mm();
+        let mut proven = ProvenReach::NONE;
+        if !half.iter().all(|h| h.is_finite() && *h > 0.0) {
+            return proven;
+        }
+        for driver in [Driver::Gimbal, Driver::Stepper, Driver::Galvo] {
+            let Some(axis) = self.monotone_axis(driver) else {
+                continue;
+            };
+            let scale =
+                (0..SCALES.len()).find(|&k| self.proves(driver, self.board_box(SCALES[k]), axis));
+            proven = proven.with(slot(driver), scale);
+        }
+        proven
+    }
+    /// The board point (mm) where `driver`'s limits may turn along a
+    /// rectangle's edges (module docs), or `None` when the geometry is
+    /// not one the proof covers.
+    fn monotone_axis(&self, driver: Driver) -> Option<PointMm> {
+        let frame = match driver {
+            Driver::Galvo => return Some(PointMm::ZERO),
+            Driver::Gimbal => {
+                let gimbal = self.aimer.gimbal();
+                let g = &gimbal.geometry;
+                let zero_model =
+                    *self.aimer.error_model() == kinematics_core::ErrorModel::default();
+                (zero_model && g.frame.oq_cm + g.frame.pose.dx_cm > g.ol_cm).then_some(g.frame)?
+            }
+            Driver::Stepper => {
+                crate::sequencer::drivers::stepper::config(&self.settings)
+                    .gimbal
+                    .geometry
+                    .frame
+            }
+        };
+        (frame.pose.roll_deg == 0.0).then_some(PointMm {
+            x_mm: 10.0 * (frame.pose.dy_cm - frame.x_offset_cm),
+            y_mm: 10.0 * (-frame.pose.dz_cm - frame.y_offset_cm),
+        })
+    }
+
+    /// Whether `driver` reaches every point of `b` grown by
+    /// [`MARGIN_MM`]: its corners and its edges' points on `axis` pass the
+    /// exact check.
+    fn proves(&self, driver: Driver, b: BoxMm, axis: PointMm) -> bool {
+        let lo = [b.lo[0] - MARGIN_MM, b.lo[1] - MARGIN_MM];
+        let hi = [b.hi[0] + MARGIN_MM, b.hi[1] + MARGIN_MM];
+        let reaches = |x_mm: f64, y_mm: f64| {
+            driver.reaches(&self.aimer, &self.settings, cm(PointMm { x_mm, y_mm }))
+        };
+        let inside = |v: f64, i: usize| v > lo[i] && v < hi[i];
+        let corners = [lo[0], hi[0]]
+            .iter()
+            .all(|&x| reaches(x, lo[1]) && reaches(x, hi[1]));
+        let across_x = [axis.x_mm, 0.0]
+            .iter()
+            .all(|&x| !inside(x, 0) || (reaches(x, lo[1]) && reaches(x, hi[1])));
+        let across_y = [axis.y_mm, 0.0]
+            .iter()
+            .all(|&y| !inside(y, 1) || (reaches(lo[0], y) && reaches(hi[0], y)));
+        corners && across_x && across_y
+    }
+
+    /// Whether every point the soft-limit check looks at of `block` lies
+    /// in the proven rectangle of every driver that draws (then the board
+    /// and reach checks pass: the rectangles lie on the board). An arc:
+    /// its end, and the circle about its centre through its start.
+    pub(in crate::sequencer) fn surely_reachable(&self, block: &Block) -> bool {
+        let Some(end) = block_end(block) else {
+            return false;
+        };
+        let circle = match *block {
+            Block::Arc { arc, .. } => {
+                let (sx, sy) = (
+                    arc.from.x_mm - arc.centre.x_mm,
+                    arc.from.y_mm - arc.centre.y_mm,
+                );
+                Some((arc.centre, libm::sqrt(sx * sx + sy * sy)))
+            }
+            _ => None,
+        };
+        self.drivers().iter().all(|d| {
+            self.reach.scale(slot(d)).is_some_and(|k| {
+                let b = self.board_box(k);
+                b.contains(end) && circle.is_none_or(|(c, r)| b.contains_square(c, r))
+            })
+        })
+    }
+}
+
+#[cfg(test)]
+#[path = "reach_tests.rs"]
+mod tests;
