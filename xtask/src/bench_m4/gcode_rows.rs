@@ -37,14 +37,23 @@ const NOT_MET_STEPPER: &str = "every piece of a line goes through the f64 IK and
     decided piece by piece through the f64 IK and FK (~45 000 a piece: the worst line, \
     a 16-piece arc of r 5 mm, ~1 540 000); the median line ~58 000. Proposed goal: \
     64 000 per line plus 48 000 per piece cut (less needs an f32 IK for the piece ends \
-    and an f32 stepper planner)";
+    and an f32 stepper planner); enforced at 1 700 000, the worst line's 1 541 000 \
+    with 10 % of room";
 
-/// Budget of one line: 16 000 instructions at the table's CPI and clock.
-const fn line_budget(why: &'static str) -> Option<(f64, &'static str, Enforcement)> {
+/// Budget of one line: 16 000 instructions at the table's CPI and clock,
+/// not met for `why`; enforced at the goal restated for the actuator
+/// (`ceiling_instructions`, the proposal in `why`).
+const fn line_budget(
+    why: &'static str,
+    ceiling_instructions: f64,
+) -> Option<(f64, &'static str, Enforcement)> {
     Some((
         LINE_INSTRUCTIONS * CPI / CLOCK_MHZ,
         "16 000 instructions: 2 000 lines/s within 25 % of the CPU",
-        Enforcement::NotMet(why),
+        Enforcement::NotMet {
+            why,
+            ceiling_instructions,
+        },
     ))
 }
 
@@ -54,7 +63,7 @@ pub const GCODE_ROWS: &[Row] = &[
         id: "gcode.line.gimbal",
         what: "G-code line -> gimbal: core (parse, queue) + the next stream tick (look-ahead replan, servo aim); worst of a seeded sweep",
         unit: "line",
-        budget: line_budget(NOT_MET_GIMBAL),
+        budget: line_budget(NOT_MET_GIMBAL, 250_000.0),
     },
     Row {
         id: "gcode.line.gimbal.core",
@@ -66,7 +75,7 @@ pub const GCODE_ROWS: &[Row] = &[
         id: "gcode.line.galvo",
         what: "G-code line -> galvo: core (parse, queue, stroke hand-over) + PathPlanner add onto three segments (replan); worst of a seeded sweep",
         unit: "line",
-        budget: line_budget(NOT_MET_GALVO),
+        budget: line_budget(NOT_MET_GALVO, 64_000.0),
     },
     Row {
         id: "gcode.line.galvo.core",
@@ -78,7 +87,7 @@ pub const GCODE_ROWS: &[Row] = &[
         id: "gcode.line.stepper",
         what: "G-code line -> stepper: core (parse, queue) + StepperMotion move_to and next_segment (mm -> steps, pieces into the planner, replan, one segment); worst of a seeded sweep",
         unit: "line",
-        budget: line_budget(NOT_MET_STEPPER),
+        budget: line_budget(NOT_MET_STEPPER, 1_700_000.0),
     },
     Row {
         id: "gcode.line.stepper.core",

@@ -187,9 +187,18 @@ fn measured(id: &str, instructions: f64) -> Measured {
         median_instructions: None,
         status: budget.map(|(_, _, e)| match e {
             Enforcement::Enforced => "enforced".to_owned(),
-            Enforcement::NotMet(why) => format!("not met: {why}"),
+            Enforcement::NotMet {
+                why,
+                ceiling_instructions,
+            } => format!("not met: {why}; enforced: {ceiling_instructions:.0} instructions"),
         }),
-        over_budget: budget.is_some_and(|(b, _, e)| e == Enforcement::Enforced && us > b),
+        over_budget: budget.is_some_and(|(b, _, e)| match e {
+            Enforcement::Enforced => us > b,
+            Enforcement::NotMet {
+                ceiling_instructions,
+                ..
+            } => instructions > ceiling_instructions,
+        }),
     }
 }
 

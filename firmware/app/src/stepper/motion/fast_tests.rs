@@ -6,7 +6,7 @@ use proptest::prelude::*;
 
 use super::super::super::{LINE_TOLERANCE_MM, MoveShape, StepperConfig};
 use super::super::StepperMotion;
-use super::super::cut::Curve;
+use super::super::curve::Curve;
 use super::Joints32;
 
 /// Configurations: the default, a board off-centre and rolled, reversed
