@@ -109,7 +109,7 @@ pub struct Core {
     /// jobs are sent).
     pub(super) inputs: Inputs,
     /// The grbl session: G-code parser, motion queue, grbl settings.
-    pub(super) gcode: crate::sequencer::gcode::Gcode,
+    pub(super) gcode: crate::sequencer::gcode::GcodeSession,
     /// What each actuator driver keeps of the G-code job.
     pub(super) jobs: crate::sequencer::drivers::DriverJobs,
     /// The stepper task homes (`home` or `$H` sent, its end not reported).
@@ -144,7 +144,7 @@ impl Core {
                 galvo_bisection: false,
                 stepper_attached: false,
             },
-            gcode: crate::sequencer::gcode::Gcode::new(),
+            gcode: crate::sequencer::gcode::GcodeSession::new(),
             jobs: crate::sequencer::drivers::DriverJobs::new(),
             stepper_homing: false,
             controls: None,

@@ -49,7 +49,7 @@ pub use crate::settings::store::SettingsStore;
 /// RAM the G-code path adds, bytes (host layout): the sequencer's grbl
 /// session with its motion queue, the drivers' G-code state, the
 /// realtime command queue and the console's RX buffer.
-pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::Gcode>()
+pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::GcodeSession>()
     + core::mem::size_of::<drivers::DriverJobs>()
     + core::mem::size_of::<
         embassy_sync::channel::Channel<

@@ -8,6 +8,7 @@ use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError};
 use crate::sequencer::drivers::Driver;
 use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
+use crate::sequencer::gcode::settings::Written;
 use crate::sequencer::gcode::{GrblMode, GrblValues, NO_OVERRIDES};
 use crate::sequencer::machine::{Action, ActionSink, Core, Line};
 use crate::settings::Settings;
@@ -134,8 +135,10 @@ impl Core {
                 if !idle {
                     return self.grbl_error(out, GrblError::NotIdle);
                 }
-                if let Err(e) = self.grbl_set_setting(number, value, out) {
-                    return self.grbl_error(out, e);
+                match self.gcode.set_setting(number, value, &mut self.settings) {
+                    Ok(Written::Session) => {}
+                    Ok(Written::Product) => self.configure_galvo(out),
+                    Err(e) => return self.grbl_error(out, e),
                 }
             }
         }

@@ -33,7 +33,7 @@ pub(in crate::sequencer) enum GrblMode {
 
 /// The grbl session's state.
 #[derive(Debug, Clone)]
-pub(in crate::sequencer) struct Gcode {
+pub(in crate::sequencer) struct GcodeSession {
     /// Modal state of the lines accepted so far.
     pub(in crate::sequencer) parser: ParserState,
     pub(in crate::sequencer) mode: GrblMode,
@@ -55,7 +55,7 @@ pub(in crate::sequencer) struct Gcode {
     pub(in crate::sequencer) stepper_junction_deg: Option<f64>,
 }
 
-impl Gcode {
+impl GcodeSession {
     /// Power-up state.
     pub(in crate::sequencer) fn new() -> Self {
         Self {

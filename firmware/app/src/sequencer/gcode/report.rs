@@ -108,7 +108,7 @@ impl Core {
     /// `$$`.
     fn grbl_report_settings(&mut self, out: &mut dyn ActionSink) {
         for setting in crate::grbl::settings_map::SETTINGS {
-            let value = self.grbl_setting_value(setting);
+            let value = self.gcode.setting_value(setting, &self.settings);
             let text = reply_text(format_args!("{}", SettingLine(setting, value)));
             self.grbl_data(out, text);
         }
