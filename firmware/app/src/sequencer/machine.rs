@@ -269,11 +269,11 @@ impl Core {
             && self.faults.gimbal_laser_blocked(yaw, pitch, phase);
         let wanted = drivers.any(Driver::carries_laser_pin)
             && (laser_wanted(self.settings.laser_mode, phase, servo_blocked)
-                || self.gcode_gimbal_lit())
+                || self.gcode.gimbal_lit(&self.settings))
             && !self.gate_lost;
         // Full power for the product's patterns; G-code's S, overrides
         // and M4 speed scaling otherwise (dark at 0: M4 at rest).
-        let power = self.gcode_gimbal_power();
+        let power = self.gcode.gimbal_power(&self.settings, &self.jobs, drivers);
         let wanted = wanted && power.is_on();
         if wanted && power != self.laser_power {
             self.laser_power = power;

@@ -3,11 +3,12 @@
 use crate::command::RealtimeRequest;
 use crate::grbl::classify::{LineKind, classify};
 use crate::grbl::realtime::Realtime;
-use crate::grbl::report;
 use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError};
 use crate::sequencer::drivers::Driver;
+use crate::sequencer::gcode::power::Seen;
 use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
+use crate::sequencer::gcode::report;
 use crate::sequencer::gcode::settings::Written;
 use crate::sequencer::gcode::{GrblMode, GrblValues, NO_OVERRIDES};
 use crate::sequencer::machine::{Action, ActionSink, Core, Line};
@@ -31,7 +32,7 @@ impl Core {
 
     /// A data line in grbl's form (no decoration).
     pub(in crate::sequencer) fn grbl_data(&self, out: &mut dyn ActionSink, text: ReplyText) {
-        out.act(Action::Line(Line::Data(text)));
+        report::data(out, text);
     }
 
     /// `ALARM:N`, the machine locked; motion stopped, laser dark.
@@ -103,7 +104,7 @@ impl Core {
             | SystemCommand::Parameters
             | SystemCommand::ParserState
             | SystemCommand::BuildInfo
-            | SystemCommand::StartupLines => self.grbl_info(command, out),
+            | SystemCommand::StartupLines => self.gcode.info(command, &self.settings, out),
             SystemCommand::CheckMode => return self.grbl_check_mode(idle, out),
             SystemCommand::Unlock => {
                 if self.gcode.mode == GrblMode::Alarm {
@@ -233,7 +234,11 @@ impl Core {
         let before = self.gcode.overrides;
         let ov = &mut self.gcode.overrides;
         match request.command {
-            Realtime::StatusReport => self.grbl_status(request.rx_free_bytes, out),
+            Realtime::StatusReport => {
+                let text = self.gcode.status(request.rx_free_bytes, &Seen::of(self));
+                self.gcode.count_report();
+                self.grbl_data(out, text);
+            }
             Realtime::FeedHold => self.grbl_hold(out),
             Realtime::CycleStart => self.grbl_resume(out),
             Realtime::SoftReset => self.grbl_reset(out),
@@ -246,7 +251,7 @@ impl Core {
             Realtime::SpindleOverride(step) => ov.spindle = step.apply(ov.spindle, 10, 200),
             Realtime::SpindleStop | Realtime::Ignored(_) => {}
         }
-        self.grbl_report_changed_overrides(before);
+        self.gcode.note_overrides(before);
     }
 
     /// 0x18: everything stops at once, laser dark; the parser's modes
@@ -274,7 +279,10 @@ impl Core {
                 )),
             );
         }
-        self.grbl_data(out, reply_text(format_args!("{}", report::BANNER)));
+        self.grbl_data(
+            out,
+            reply_text(format_args!("{}", crate::grbl::report::BANNER)),
+        );
         if self.gcode.mode == GrblMode::Alarm {
             self.notify(out, format_args!("MSG:'$H'|'$X' to unlock"));
         }

@@ -6,6 +6,7 @@
 
 use crate::grbl::Block;
 use crate::sequencer::drivers::{Arrival, DriverStep};
+use crate::sequencer::gcode::power::Seen;
 use crate::sequencer::gcode::queue::{Hold, point_at};
 use crate::sequencer::machine::{ActionSink, Core};
 use embassy_time::Instant;
@@ -98,14 +99,10 @@ impl Core {
     ) -> Option<Instant> {
         run_deadline
             .or(self.gcode.motion.current.and_then(|c| c.until))
-            .or_else(|| self.gcode_stepper_power_tick())
-    }
-
-    /// Whether G-code lights the gimbal laser now: a lit step or dwell
-    /// runs, and the laser mode (`laser auto`) still allows it (`laser off`
-    /// mid-step darkens at once).
-    pub(in crate::sequencer) fn gcode_gimbal_lit(&self) -> bool {
-        self.gcode.motion.gimbal_lit && self.settings.laser_mode == crate::settings::LaserMode::Auto
+            .or_else(|| {
+                self.gcode
+                    .stepper_power_tick(&Seen::of(self), self.inputs.now)
+            })
     }
 
     /// The dwell deadline passed: a run's dwell, or the G-code step's.
