@@ -77,7 +77,7 @@ impl Core {
         if !(self.drivers().gimbal_streams() && planned_length(block).is_some()) {
             return false;
         }
-        self.gcode.motion.current = Some(self.new_current(*block, 1));
+        self.gcode.motion.current = Some(self.gcode.new_current(*block, 1));
         self.stream_begin(block, out)
     }
 
@@ -258,7 +258,7 @@ impl Core {
             Some(block) => {
                 motion.queue.pop_front();
                 self.grbl_take_owed(out);
-                self.gcode.motion.current = Some(self.new_current(block, 1));
+                self.gcode.motion.current = Some(self.gcode.new_current(block, 1));
                 if !self.stream_begin(&block, out) {
                     self.gcode.motion.current = None;
                     self.grbl_advance(out);

@@ -28,7 +28,10 @@ impl Core {
             }
             | Block::Arc {
                 feed_mm_min, laser, ..
-            } => (Some(feed_mm_min), self.gcode_lit(laser.mode, laser.power)),
+            } => (
+                Some(feed_mm_min),
+                self.gcode.lit(laser.mode, laser.power, &self.settings),
+            ),
             Block::Jog { feed_mm_min, .. } => (Some(feed_mm_min), false),
             _ => (None, false),
         };
