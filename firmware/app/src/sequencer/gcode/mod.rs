@@ -46,7 +46,7 @@ pub(in crate::sequencer) struct GcodeSession {
     /// Status reports sent (grbl adds `WCO:` / `Ov:` every few).
     pub(in crate::sequencer) reports: u32,
     /// Actual over programmed speed of the gimbal step in flight, 0..=1
-    /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
+    /// (M4 scales the power by it; [`GcodeSession::gimbal_power`]).
     pub(in crate::sequencer) step_speed_ratio: f32,
     /// A `$H` on the stepper waits for homing to end for its reply.
     pub(in crate::sequencer) homing: bool,
