@@ -134,6 +134,7 @@ pub(in crate::sequencer) mod motion;
 pub(in crate::sequencer) mod power;
 pub(in crate::sequencer) mod queue;
 pub(in crate::sequencer) mod report;
+pub(in crate::sequencer) mod session;
 pub(in crate::sequencer) mod settings;
 pub(in crate::sequencer) mod step;
 pub(in crate::sequencer) mod stepper;

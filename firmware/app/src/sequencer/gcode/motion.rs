@@ -37,7 +37,7 @@ impl Core {
             let Some(block) = self.gcode.motion.queue.pop_front() else {
                 return;
             };
-            self.grbl_take_owed(out);
+            self.gcode.take_owed(out);
             if !self.gcode.motion.started {
                 // A G-code job starts like a run: what ran stops, nothing
                 // of it may shine.
@@ -162,7 +162,7 @@ impl Core {
             self.ok(out);
         }
         self.jobs.galvo.hold_dropped();
-        self.grbl_sync_position();
+        self.gcode.sync_position();
     }
 }
 

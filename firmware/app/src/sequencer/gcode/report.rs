@@ -1,19 +1,34 @@
 //! What the grbl session reports: status reports (`?`), `$$`, `$#`,
 //! `$G`, `$I`, `$N` and `$` help, formatted by [`crate::grbl::report`].
 
-use crate::grbl::ParserState;
 use crate::grbl::report::{self, MachineState, Status};
 use crate::grbl::system::SystemCommand;
+use crate::grbl::{GrblError, ParserState};
 use crate::sequencer::gcode::power::Seen;
 use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
 use crate::sequencer::gcode::{GcodeSession, GrblMode, RX_BUFFER_BYTES};
-use crate::sequencer::machine::{Action, ActionSink, Line};
+use crate::sequencer::io::{Action, ActionSink, Line};
 use crate::settings::Settings;
 use crate::text::{ReplyText, reply_text};
 
 /// A data line in grbl's form (no decoration).
 pub(in crate::sequencer) fn data(out: &mut dyn ActionSink, text: ReplyText) {
     out.act(Action::Line(Line::Data(text)));
+}
+
+/// A notice line (`[MSG:…]` and the like).
+pub(in crate::sequencer) fn notice(out: &mut dyn ActionSink, args: core::fmt::Arguments<'_>) {
+    out.act(Action::Line(Line::Notice(reply_text(args))));
+}
+
+/// Closes the current reply with `ok`.
+pub(in crate::sequencer) fn ok(out: &mut dyn ActionSink) {
+    out.act(Action::Line(Line::Ok));
+}
+
+/// Closes the current reply with `error:N`.
+pub(in crate::sequencer) fn error(out: &mut dyn ActionSink, error: GrblError) {
+    out.act(Action::Line(Line::GrblError(error)));
 }
 
 impl GcodeSession {

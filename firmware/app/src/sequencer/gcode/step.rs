@@ -136,7 +136,7 @@ impl Core {
         }
         if finished {
             if c.cancelled {
-                self.grbl_sync_position();
+                self.gcode.sync_position();
             }
             self.grbl_advance(out);
         } else {

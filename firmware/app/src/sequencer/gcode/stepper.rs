@@ -47,7 +47,7 @@ impl Core {
                 true
             }
             StepperReport::AtRest => {
-                self.grbl_sync_position();
+                self.gcode.sync_position();
                 false
             }
         }
@@ -67,7 +67,7 @@ impl Core {
     ) {
         if self.gcode.motion.is_idle() {
             self.with_stage(out, |st, jobs, _| jobs.stepper.at(st, steps));
-            self.grbl_sync_position();
+            self.gcode.sync_position();
         }
         if !core::mem::take(&mut self.gcode.homing) {
             return;
