@@ -112,7 +112,7 @@ pub struct Core {
     /// jobs are sent).
     pub(super) inputs: Inputs,
     /// The grbl session: G-code parser, motion queue, grbl settings.
-    pub(super) gcode: crate::sequencer::gcode::Gcode,
+    pub(super) gcode: crate::sequencer::gcode::GcodeSession,
     /// What each actuator driver keeps of the G-code job.
     pub(super) jobs: crate::sequencer::drivers::DriverJobs,
     /// The stepper task homes (`home` or `$H` sent, its end not reported).
@@ -148,7 +148,7 @@ impl Core {
                 galvo_bisection: false,
                 stepper_attached: false,
             },
-            gcode: crate::sequencer::gcode::Gcode::new(),
+            gcode: crate::sequencer::gcode::GcodeSession::new(),
             jobs: crate::sequencer::drivers::DriverJobs::new(),
             stepper_homing: false,
             controls: None,
@@ -278,11 +278,11 @@ impl Core {
             && self.faults.gimbal_laser_blocked(yaw, pitch, phase);
         let wanted = drivers.any(Driver::carries_laser_pin)
             && (laser_wanted(self.settings.laser_mode, phase, servo_blocked)
-                || self.gcode_gimbal_lit())
+                || self.gcode.gimbal_lit(&self.settings))
             && !self.gate_lost;
         // Full power for the product's patterns; G-code's S, overrides
         // and M4 speed scaling otherwise (dark at 0: M4 at rest).
-        let power = self.gcode_gimbal_power();
+        let power = self.gcode.gimbal_power(&self.settings, &self.jobs, drivers);
         let wanted = wanted && power.is_on();
         if wanted && power != self.laser_power {
             self.laser_power = power;

@@ -49,7 +49,7 @@ pub use crate::settings::store::SettingsStore;
 /// RAM the G-code path adds, bytes (host layout): the sequencer's grbl
 /// session with its motion queue, the drivers' G-code state, the
 /// realtime command queue and the console's RX buffer.
-pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::Gcode>()
+pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::GcodeSession>()
     + core::mem::size_of::<drivers::DriverJobs>()
     + core::mem::size_of::<
         embassy_sync::channel::Channel<
@@ -279,8 +279,8 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
                 galvo_bisection: galvo.plans_bisection(),
                 stepper_attached: self.io.stepper.is_attached(),
             };
-            self.core
-                .note_stepper_speed(self.io.stepper.speed_permille());
+            // The stepper's speed over its block's cruise speed, ‰.
+            self.core.jobs.stepper.speed_permille = self.io.stepper.speed_permille();
             self.core.note_laser_controls(self.io.controls.view());
             self.io.data_origin = match event {
                 Event::Realtime(_) => Origin::Direct,

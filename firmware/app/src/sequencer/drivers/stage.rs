@@ -14,7 +14,7 @@ use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest};
 use crate::grbl::{Alarm, Block};
 use crate::log;
 use crate::sequencer::drivers::{Drivers, Said};
-use crate::sequencer::gcode::Gcode;
+use crate::sequencer::gcode::GcodeSession;
 use crate::sequencer::io::{Action, ActionSink, Inputs};
 use crate::sequencer::run::Run;
 use crate::settings::Settings;
@@ -23,7 +23,7 @@ use crate::text::reply_text;
 /// A driver's view of the sequencer for one call of its G-code stage.
 pub(in crate::sequencer) struct Stage<'a> {
     /// The G-code session: parser, motion queue, overrides, grbl values.
-    pub(in crate::sequencer) gcode: &'a mut Gcode,
+    pub(in crate::sequencer) gcode: &'a mut GcodeSession,
     /// The product's settings.
     pub(in crate::sequencer) settings: &'a Settings,
     /// Their geometry (aiming the gimbal and the stepper).

@@ -77,7 +77,7 @@ impl Core {
         if !(self.drivers().gimbal_streams() && planned_length(block).is_some()) {
             return false;
         }
-        self.gcode.motion.current = Some(self.new_current(*block, 1));
+        self.gcode.motion.current = Some(self.gcode.new_current(*block, 1));
         self.stream_begin(block, out)
     }
 
@@ -181,7 +181,7 @@ impl Core {
         }
         c.galvo_seq = None;
         if self.with_stage(out, |st, jobs, _| jobs.galvo.done(st, seq)) {
-            self.grbl_take_owed(out);
+            self.gcode.take_owed(out);
         }
         self.gcode_step_done(out);
         self.with_stage(out, |st, jobs, out| jobs.galvo.drop_unadopted(st, out));
@@ -211,7 +211,7 @@ impl Core {
         };
         if moved {
             // The blocks left the queue: a line waiting for room is queued.
-            self.grbl_take_owed(out);
+            self.gcode.take_owed(out);
         }
         // Held; `~` came while stopping: resumed at once.
         let motion = &mut self.gcode.motion;
@@ -257,8 +257,8 @@ impl Core {
         match next.filter(|b| planned_length(b).is_some()) {
             Some(block) => {
                 motion.queue.pop_front();
-                self.grbl_take_owed(out);
-                self.gcode.motion.current = Some(self.new_current(block, 1));
+                self.gcode.take_owed(out);
+                self.gcode.motion.current = Some(self.gcode.new_current(block, 1));
                 if !self.stream_begin(&block, out) {
                     self.gcode.motion.current = None;
                     self.grbl_advance(out);
@@ -269,7 +269,7 @@ impl Core {
                 if cancelled {
                     // A jog cancel between this block's end and the next:
                     // the parser had gone on to the dropped jogs' ends.
-                    self.grbl_sync_position();
+                    self.gcode.sync_position();
                 }
                 self.grbl_advance(out);
             }
@@ -291,7 +291,7 @@ impl Core {
         if cancelled {
             motion.current = None;
             self.jobs.gimbal.clear();
-            self.grbl_sync_position();
+            self.gcode.sync_position();
             self.grbl_advance(out);
             return;
         }

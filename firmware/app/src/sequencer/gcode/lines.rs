@@ -3,13 +3,15 @@
 use crate::command::RealtimeRequest;
 use crate::grbl::classify::{LineKind, classify};
 use crate::grbl::realtime::Realtime;
-use crate::grbl::report;
 use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError};
 use crate::sequencer::drivers::Driver;
-use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
+use crate::sequencer::gcode::power::Seen;
+use crate::sequencer::gcode::queue::Hold;
+use crate::sequencer::gcode::report;
+use crate::sequencer::gcode::settings::Written;
 use crate::sequencer::gcode::{GrblMode, GrblValues, NO_OVERRIDES};
-use crate::sequencer::machine::{Action, ActionSink, Core, Line};
+use crate::sequencer::machine::{ActionSink, Core};
 use crate::settings::Settings;
 use crate::text::{ReplyText, reply_text};
 
@@ -25,12 +27,12 @@ impl Core {
 
     /// Closes the current reply with `error:N`.
     pub(in crate::sequencer) fn grbl_error(&self, out: &mut dyn ActionSink, error: GrblError) {
-        out.act(Action::Line(Line::GrblError(error)));
+        report::error(out, error);
     }
 
     /// A data line in grbl's form (no decoration).
     pub(in crate::sequencer) fn grbl_data(&self, out: &mut dyn ActionSink, text: ReplyText) {
-        out.act(Action::Line(Line::Data(text)));
+        report::data(out, text);
     }
 
     /// `ALARM:N`, the machine locked; motion stopped, laser dark.
@@ -68,29 +70,12 @@ impl Core {
             return self.ok(out);
         }
         self.gcode.motion.owed = Some(blocks);
-        self.grbl_take_owed(out);
+        self.gcode.take_owed(out);
         self.grbl_advance(out);
         self.gcode_galvo_send_ahead(out);
         if self.drivers().gimbal_streams() {
             self.with_stage(out, |st, jobs, _| jobs.gimbal.remember(st));
         }
-    }
-
-    /// Moves the blocks of the line waiting for room into the queue when
-    /// they fit, and answers it.
-    pub(in crate::sequencer) fn grbl_take_owed(&mut self, out: &mut dyn ActionSink) {
-        let motion = &mut self.gcode.motion;
-        let Some(blocks) = motion.owed.as_ref() else {
-            return;
-        };
-        if PLANNER_BLOCKS - motion.queue.len() < blocks.len() {
-            return;
-        }
-        for block in motion.owed.take().into_iter().flatten() {
-            // Room was checked above.
-            let _ = self.gcode.motion.queue.push_back(block);
-        }
-        self.ok(out);
     }
 
     fn grbl_system(&mut self, line: &str, out: &mut dyn ActionSink) {
@@ -105,8 +90,8 @@ impl Core {
             | SystemCommand::Parameters
             | SystemCommand::ParserState
             | SystemCommand::BuildInfo
-            | SystemCommand::StartupLines => self.grbl_info(command, out),
-            SystemCommand::CheckMode => return self.grbl_check_mode(idle, out),
+            | SystemCommand::StartupLines => self.gcode.info(command, &self.settings, out),
+            SystemCommand::CheckMode => return self.gcode.check_mode(idle, out),
             SystemCommand::Unlock => {
                 if self.gcode.mode == GrblMode::Alarm {
                     self.gcode.mode = GrblMode::Normal;
@@ -116,7 +101,7 @@ impl Core {
             SystemCommand::Home => return self.grbl_home(idle, out),
             SystemCommand::Sleep => {
                 self.stop("grbl sleep", out);
-                self.grbl_sync_position();
+                self.gcode.sync_position();
             }
             SystemCommand::Jog(text) => return self.grbl_jog(text, out),
             SystemCommand::Restore(scope) => {
@@ -137,29 +122,12 @@ impl Core {
                 if !idle {
                     return self.grbl_error(out, GrblError::NotIdle);
                 }
-                if let Err(e) = self.grbl_set_setting(number, value, out) {
-                    return self.grbl_error(out, e);
+                match self.gcode.set_setting(number, value, &mut self.settings) {
+                    Ok(Written::Session) => {}
+                    Ok(Written::Product) => self.configure_galvo(out),
+                    Err(e) => return self.grbl_error(out, e),
                 }
             }
-        }
-        self.ok(out);
-    }
-
-    /// `$C`: toggles check mode (only when idle; leaving it resets the
-    /// parser, as grbl does).
-    fn grbl_check_mode(&mut self, idle: bool, out: &mut dyn ActionSink) {
-        match self.gcode.mode {
-            GrblMode::Check => {
-                self.gcode.mode = GrblMode::Normal;
-                self.gcode.parser.soft_reset();
-                self.grbl_sync_position();
-                self.notify(out, format_args!("MSG:Disabled"));
-            }
-            GrblMode::Normal if idle => {
-                self.gcode.mode = GrblMode::Check;
-                self.notify(out, format_args!("MSG:Enabled"));
-            }
-            _ => return self.grbl_error(out, GrblError::NotIdle),
         }
         self.ok(out);
     }
@@ -216,14 +184,6 @@ impl Core {
         self.grbl_queue(blocks, out);
     }
 
-    /// The parser continues from where the spot is (after a stop, a
-    /// reset or a jog cancel).
-    pub(in crate::sequencer) fn grbl_sync_position(&mut self) {
-        if self.gcode.motion.is_idle() {
-            self.gcode.parser.position = self.gcode.motion.position;
-        }
-    }
-
     /// A realtime command from the console.
     pub(in crate::sequencer) fn grbl_realtime(
         &mut self,
@@ -233,7 +193,11 @@ impl Core {
         let before = self.gcode.overrides;
         let ov = &mut self.gcode.overrides;
         match request.command {
-            Realtime::StatusReport => self.grbl_status(request.rx_free_bytes, out),
+            Realtime::StatusReport => {
+                let text = self.gcode.status(request.rx_free_bytes, &Seen::of(self));
+                self.gcode.count_report();
+                self.grbl_data(out, text);
+            }
             Realtime::FeedHold => self.grbl_hold(out),
             Realtime::CycleStart => self.grbl_resume(out),
             Realtime::SoftReset => self.grbl_reset(out),
@@ -246,7 +210,7 @@ impl Core {
             Realtime::SpindleOverride(step) => ov.spindle = step.apply(ov.spindle, 10, 200),
             Realtime::SpindleStop | Realtime::Ignored(_) => {}
         }
-        self.grbl_report_changed_overrides(before);
+        self.gcode.note_overrides(before);
     }
 
     /// 0x18: everything stops at once, laser dark; the parser's modes
@@ -259,7 +223,7 @@ impl Core {
         self.drivers_reset(out);
         self.stop("grbl soft reset", out);
         self.gcode.parser.soft_reset();
-        self.grbl_sync_position();
+        self.gcode.sync_position();
         self.gcode.overrides = NO_OVERRIDES;
         if self.gcode.mode == GrblMode::Check {
             self.gcode.mode = GrblMode::Normal;
@@ -274,7 +238,10 @@ impl Core {
                 )),
             );
         }
-        self.grbl_data(out, reply_text(format_args!("{}", report::BANNER)));
+        self.grbl_data(
+            out,
+            reply_text(format_args!("{}", crate::grbl::report::BANNER)),
+        );
         if self.gcode.mode == GrblMode::Alarm {
             self.notify(out, format_args!("MSG:'$H'|'$X' to unlock"));
         }

@@ -33,7 +33,7 @@ pub(in crate::sequencer) enum GrblMode {
 
 /// The grbl session's state.
 #[derive(Debug, Clone)]
-pub(in crate::sequencer) struct Gcode {
+pub(in crate::sequencer) struct GcodeSession {
     /// Modal state of the lines accepted so far.
     pub(in crate::sequencer) parser: ParserState,
     pub(in crate::sequencer) mode: GrblMode,
@@ -46,7 +46,7 @@ pub(in crate::sequencer) struct Gcode {
     /// Status reports sent (grbl adds `WCO:` / `Ov:` every few).
     pub(in crate::sequencer) reports: u32,
     /// Actual over programmed speed of the gimbal step in flight, 0..=1
-    /// (M4 scales the power by it; [`Core::gcode_gimbal_power`]).
+    /// (M4 scales the power by it; [`GcodeSession::gimbal_power`]).
     pub(in crate::sequencer) step_speed_ratio: f32,
     /// A `$H` on the stepper waits for homing to end for its reply.
     pub(in crate::sequencer) homing: bool,
@@ -55,7 +55,7 @@ pub(in crate::sequencer) struct Gcode {
     pub(in crate::sequencer) stepper_junction_deg: Option<f64>,
 }
 
-impl Gcode {
+impl GcodeSession {
     /// Power-up state.
     pub(in crate::sequencer) fn new() -> Self {
         Self {
@@ -136,6 +136,7 @@ pub(in crate::sequencer) mod proven;
 pub(in crate::sequencer) mod queue;
 pub(in crate::sequencer) mod reach;
 pub(in crate::sequencer) mod report;
+pub(in crate::sequencer) mod session;
 pub(in crate::sequencer) mod settings;
 pub(in crate::sequencer) mod step;
 pub(in crate::sequencer) mod stepper;

@@ -1,7 +1,8 @@
 //! Running the motion queue: blocks started, held, resumed, aborted.
 
 use crate::grbl::{Block, PointMm, SpindleMode};
-use crate::sequencer::drivers::Driver;
+use crate::sequencer::drivers::{Driver, Drivers};
+use crate::sequencer::gcode::GcodeSession;
 use crate::sequencer::gcode::queue::{Current, Hold, MAX_STEPS, block_end, cm, point_at};
 use crate::sequencer::laser::LaserEvent;
 use crate::sequencer::machine::{Action, ActionSink, Core};
@@ -35,35 +36,6 @@ impl Core {
         }
     }
 
-    /// Steps `block` is split into on the current actuator(s).
-    fn step_count(&self, block: &Block) -> u32 {
-        // One arc sent as its chords would be drawn as that many whole
-        // arcs by a driver that takes arcs whole (each from its end: a
-        // full circle each).
-        if matches!(block, Block::Arc { .. }) && self.drivers().any(Driver::takes_arcs_whole) {
-            return 1;
-        }
-        let step_mm = (self.aimer.path_step_cm() * 10.0).max(0.01);
-        let gimbal = self.drivers().any(Driver::steps_lines);
-        let steps =
-            |length_mm: f64| libm::ceil(length_mm / step_mm).clamp(1.0, MAX_STEPS as f64) as u32;
-        match *block {
-            Block::Rapid { .. } => 1,
-            Block::Line { from, to, .. } | Block::Jog { from, to, .. } if gimbal => {
-                steps(from.distance_to(to))
-            }
-            Block::Arc { arc, .. } => {
-                let chords = arc.segment_count(self.gcode.values.arc_tolerance_mm, MAX_STEPS);
-                if gimbal {
-                    chords.max(steps(arc.length_mm()))
-                } else {
-                    chords
-                }
-            }
-            _ => 1,
-        }
-    }
-
     /// Starts the next block when nothing runs (and no hold), skipping
     /// blocks with nothing to move.
     pub(in crate::sequencer) fn grbl_advance(&mut self, out: &mut dyn ActionSink) {
@@ -71,7 +43,7 @@ impl Core {
             let Some(block) = self.gcode.motion.queue.pop_front() else {
                 return;
             };
-            self.grbl_take_owed(out);
+            self.gcode.take_owed(out);
             if !self.gcode.motion.started {
                 // A G-code job starts like a run: what ran stops, nothing
                 // of it may shine.
@@ -93,9 +65,10 @@ impl Core {
                         .inputs
                         .now
                         .saturating_add(Duration::from_micros((seconds.max(0.0) * 1e6) as u64));
-                    self.gcode.motion.gimbal_lit = self.gcode_lit(laser.mode, laser.power)
+                    let g = &mut self.gcode;
+                    g.motion.gimbal_lit = g.lit(laser.mode, laser.power, &self.settings)
                         && laser.mode == SpindleMode::Constant;
-                    self.gcode.motion.current = Some(self.new_current(block, 0));
+                    g.motion.current = Some(g.new_current(block, 0));
                     if let Some(c) = self.gcode.motion.current.as_mut() {
                         c.until = Some(until);
                     }
@@ -104,31 +77,14 @@ impl Core {
                     if self.drivers_take_block(&block, out) {
                         continue;
                     }
-                    let count = self.step_count(&block);
-                    self.gcode.motion.current = Some(self.new_current(block, count));
+                    let (path_step_cm, drivers) = (self.aimer.path_step_cm(), self.drivers());
+                    let g = &mut self.gcode;
+                    let count = g.step_count(&block, path_step_cm, drivers);
+                    g.motion.current = Some(g.new_current(block, count));
                     self.gcode_send_step(out);
                 }
             }
         }
-    }
-
-    pub(in crate::sequencer) fn new_current(&self, block: Block, count: u32) -> Current {
-        Current {
-            block,
-            index: 1,
-            count,
-            from: self.gcode.motion.position,
-            servo_seq: None,
-            galvo_seq: None,
-            stepper_seq: None,
-            until: None,
-            cancelled: false,
-        }
-    }
-
-    /// Whether laser setting (`mode`, `power`) lights a feed move.
-    pub(in crate::sequencer) fn gcode_lit(&self, mode: SpindleMode, power: f64) -> bool {
-        self.gcode.lit(mode, power, &self.settings)
     }
 
     /// `!`: laser dark at once; the gimbal stops after the step in
@@ -212,6 +168,55 @@ impl Core {
             self.ok(out);
         }
         self.jobs.galvo.hold_dropped();
-        self.grbl_sync_position();
+        self.gcode.sync_position();
+    }
+}
+
+impl GcodeSession {
+    /// The block that starts running now, `count` steps, from where the
+    /// spot is.
+    pub(in crate::sequencer) fn new_current(&self, block: Block, count: u32) -> Current {
+        Current {
+            block,
+            index: 1,
+            count,
+            from: self.motion.position,
+            servo_seq: None,
+            galvo_seq: None,
+            stepper_seq: None,
+            until: None,
+            cancelled: false,
+        }
+    }
+
+    /// Steps `block` is split into on the current actuator(s).
+    /// `path_step_cm`: the geometry's path step; `drivers`: the driver(s)
+    /// that draw.
+    fn step_count(&self, block: &Block, path_step_cm: f64, drivers: Drivers) -> u32 {
+        // One arc sent as its chords would be drawn as that many whole
+        // arcs by a driver that takes arcs whole (each from its end: a
+        // full circle each).
+        if matches!(block, Block::Arc { .. }) && drivers.any(Driver::takes_arcs_whole) {
+            return 1;
+        }
+        let step_mm = (path_step_cm * 10.0).max(0.01);
+        let gimbal = drivers.any(Driver::steps_lines);
+        let steps =
+            |length_mm: f64| libm::ceil(length_mm / step_mm).clamp(1.0, MAX_STEPS as f64) as u32;
+        match *block {
+            Block::Rapid { .. } => 1,
+            Block::Line { from, to, .. } | Block::Jog { from, to, .. } if gimbal => {
+                steps(from.distance_to(to))
+            }
+            Block::Arc { arc, .. } => {
+                let chords = arc.segment_count(self.values.arc_tolerance_mm, MAX_STEPS);
+                if gimbal {
+                    chords.max(steps(arc.length_mm()))
+                } else {
+                    chords
+                }
+            }
+            _ => 1,
+        }
     }
 }

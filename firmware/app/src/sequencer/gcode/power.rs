@@ -13,11 +13,14 @@
 
 use crate::grbl::report::Overrides;
 use crate::grbl::{Block, Laser, SpindleMode};
-use crate::sequencer::drivers::Driver;
 use crate::sequencer::drivers::gimbal::STREAM_PERIOD_MS;
+use crate::sequencer::drivers::{Driver, DriverJobs, Drivers};
+use crate::sequencer::gcode::GcodeSession;
 use crate::sequencer::gcode::queue::Hold;
 use crate::sequencer::laser::LaserPower;
 use crate::sequencer::machine::Core;
+use crate::settings::{LaserMode, Settings};
+use embassy_time::Instant;
 
 /// Actual over programmed speed of a gimbal step that takes `interval_ms`
 /// where the programmed feed would take `by_feed_ms`: below 1 when the
@@ -29,18 +32,56 @@ pub(in crate::sequencer) fn speed_ratio(by_feed_ms: f64, interval_ms: u16) -> f3
     (by_feed_ms / f64::from(interval_ms.max(1))).clamp(0.0, 1.0) as f32
 }
 
-impl Core {
+/// What the session reads of the core for its laser power and its
+/// status reports.
+pub(in crate::sequencer) struct Seen<'a> {
+    /// The product's settings (laser mode, marking speeds).
+    pub(in crate::sequencer) settings: &'a Settings,
+    /// What each driver keeps of the G-code job (their speeds).
+    pub(in crate::sequencer) jobs: &'a DriverJobs,
+    /// The driver(s) that draw.
+    pub(in crate::sequencer) drivers: Drivers,
+    /// Whether the gimbal laser is on, and at what power.
+    pub(in crate::sequencer) laser: Option<LaserPower>,
+    /// The stepper task homes.
+    pub(in crate::sequencer) stepper_homing: bool,
+    /// The laser controls' door substate (`None`: not held by them).
+    pub(in crate::sequencer) door: Option<u8>,
+}
+
+impl<'a> Seen<'a> {
+    /// What `core` shows the session now.
+    pub(in crate::sequencer) fn of(core: &'a Core) -> Self {
+        Self {
+            settings: &core.settings,
+            jobs: &core.jobs,
+            drivers: core.drivers(),
+            laser: core.laser_on.then_some(core.laser_power),
+            stepper_homing: core.stepper_homing,
+            door: core.door_substate(),
+        }
+    }
+}
+
+impl GcodeSession {
+    /// Whether G-code lights the gimbal laser now: a lit step or dwell
+    /// runs, and the laser mode (`laser auto`) of `settings` still allows
+    /// it (`laser off` mid-step darkens at once).
+    pub(in crate::sequencer) fn gimbal_lit(&self, settings: &Settings) -> bool {
+        self.motion.gimbal_lit && settings.laser_mode == LaserMode::Auto
+    }
+
     /// The laser setting of the feed move or dwell that runs (none in a
     /// hold), with the power override applied to S.
-    fn gcode_running_laser(&self) -> Option<Laser> {
-        let motion = &self.gcode.motion;
+    fn running_laser(&self) -> Option<Laser> {
+        let motion = &self.motion;
         let laser = match motion.current.filter(|_| motion.hold == Hold::None)?.block {
             Block::Line { laser, .. } | Block::Arc { laser, .. } | Block::Dwell { laser, .. } => {
                 laser
             }
             _ => return None,
         };
-        let percent = f64::from(self.gcode.overrides.spindle);
+        let percent = f64::from(self.overrides.spindle);
         Some(Laser {
             mode: laser.mode,
             power: laser.power * percent / 100.0,
@@ -49,29 +90,35 @@ impl Core {
 
     /// The gimbal laser's power: full for the product's own runs; while
     /// G-code lights it, S with the override, × the step's speed ratio
-    /// under M4 in laser mode (0 at rest: dark).
-    pub(in crate::sequencer) fn gcode_gimbal_power(&self) -> LaserPower {
-        if !self.gcode_gimbal_lit() {
+    /// under M4 in laser mode (0 at rest: dark). `settings`, `jobs` and
+    /// `drivers` as in [`Seen`].
+    pub(in crate::sequencer) fn gimbal_power(
+        &self,
+        settings: &Settings,
+        jobs: &DriverJobs,
+        drivers: Drivers,
+    ) -> LaserPower {
+        if !self.gimbal_lit(settings) {
             return LaserPower::FULL;
         }
-        let Some(laser) = self.gcode_running_laser() else {
+        let Some(laser) = self.running_laser() else {
             return LaserPower::OFF;
         };
-        let v = &self.gcode.values;
+        let v = &self.values;
         let mut fraction = laser.fraction(v.s_min, v.s_max) as f32;
         if laser.mode == SpindleMode::Dynamic && v.laser_mode {
-            let c = self.gcode.motion.current;
+            let c = self.motion.current;
             // A streamed block moves while its cursor has speed.
-            let streaming = self.jobs.gimbal.speed_mm_s() > 0.0;
+            let streaming = jobs.gimbal.speed_mm_s() > 0.0;
             let moving = streaming || c.is_some_and(|c| c.until.is_none() && c.servo_seq.is_some());
             // The stepper: its step generator's speed while its steps run.
-            let stepping = self.drivers().any(Driver::polls_speed)
+            let stepping = drivers.any(Driver::polls_speed)
                 && c.is_some_and(|c| c.until.is_none())
-                && self.jobs.stepper.is_moving();
+                && jobs.stepper.is_moving();
             fraction *= if stepping {
-                f32::from(self.jobs.stepper.speed_permille) / 1000.0
+                f32::from(jobs.stepper.speed_permille) / 1000.0
             } else if moving {
-                self.gcode.step_speed_ratio
+                self.step_speed_ratio
             } else {
                 0.0
             };
@@ -79,40 +126,38 @@ impl Core {
         LaserPower::from_fraction(fraction)
     }
 
-    /// The stepper's speed over its block's cruise speed, ‰ (0..=1000,
-    /// the step generator's; the shell, before each event).
-    pub(in crate::sequencer) fn note_stepper_speed(&mut self, permille: u16) {
-        self.jobs.stepper.speed_permille = permille;
-    }
-
     /// While G-code lights the stepper's moves: the next time M4 power
-    /// follows its speed (the gimbal's stream period after the last event; under M3
-    /// nothing changes then), else `None`.
-    pub(in crate::sequencer) fn gcode_stepper_power_tick(&self) -> Option<embassy_time::Instant> {
-        let lit = self.drivers().any(Driver::polls_speed) && self.gcode_gimbal_lit();
-        (lit && self.jobs.stepper.is_moving())
-            .then(|| self.inputs.now + embassy_time::Duration::from_millis(STREAM_PERIOD_MS))
+    /// follows its speed (the gimbal's stream period after `now`, the
+    /// last event; under M3 nothing changes then), else `None`.
+    pub(in crate::sequencer) fn stepper_power_tick(
+        &self,
+        seen: &Seen<'_>,
+        now: Instant,
+    ) -> Option<Instant> {
+        let lit = seen.drivers.any(Driver::polls_speed) && self.gimbal_lit(seen.settings);
+        (lit && seen.jobs.stepper.is_moving())
+            .then(|| now + embassy_time::Duration::from_millis(STREAM_PERIOD_MS))
     }
 
     /// After a realtime command: when it changed an override (`before`
     /// the old values), the next status report carries `Ov:` (as grbl's
     /// report counter reset).
-    pub(in crate::sequencer) fn grbl_report_changed_overrides(&mut self, before: Overrides) {
-        if self.gcode.overrides != before {
-            self.gcode.reports = 1;
+    pub(in crate::sequencer) fn note_overrides(&mut self, before: Overrides) {
+        if self.overrides != before {
+            self.reports = 1;
         }
     }
 
     /// The power `FS:` reports, in S units: on the galvo the running S
     /// with the override, clamped to `$31`..`$30` (its output is on/off);
     /// elsewhere the level the laser output runs at now (0 when dark).
-    pub(in crate::sequencer) fn gcode_reported_power(&self) -> f64 {
-        let v = &self.gcode.values;
-        let fraction = if self.drivers().any(Driver::reports_programmed_power) {
-            self.gcode_running_laser()
+    pub(in crate::sequencer) fn reported_power(&self, seen: &Seen<'_>) -> f64 {
+        let v = &self.values;
+        let fraction = if seen.drivers.any(Driver::reports_programmed_power) {
+            self.running_laser()
                 .map_or(0.0, |l| l.fraction(v.s_min, v.s_max))
-        } else if self.laser_on && self.gcode_gimbal_lit() {
-            f64::from(self.laser_power.per_mille()) / 1000.0
+        } else if let Some(level) = seen.laser.filter(|_| self.gimbal_lit(seen.settings)) {
+            f64::from(level.per_mille()) / 1000.0
         } else {
             0.0
         };

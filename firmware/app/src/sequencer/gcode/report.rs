@@ -1,37 +1,67 @@
 //! What the grbl session reports: status reports (`?`), `$$`, `$#`,
 //! `$G`, `$I`, `$N` and `$` help, formatted by [`crate::grbl::report`].
 
-use crate::grbl::ParserState;
 use crate::grbl::report::{self, MachineState, Status};
 use crate::grbl::system::SystemCommand;
+use crate::grbl::{GrblError, ParserState};
+use crate::sequencer::gcode::power::Seen;
 use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
-use crate::sequencer::gcode::{GrblMode, RX_BUFFER_BYTES};
-use crate::sequencer::machine::{ActionSink, Core};
-use crate::text::reply_text;
+use crate::sequencer::gcode::{GcodeSession, GrblMode, RX_BUFFER_BYTES};
+use crate::sequencer::io::{Action, ActionSink, Line};
+use crate::settings::Settings;
+use crate::text::{ReplyText, reply_text};
 
-impl Core {
+/// A data line in grbl's form (no decoration).
+pub(in crate::sequencer) fn data(out: &mut dyn ActionSink, text: ReplyText) {
+    out.act(Action::Line(Line::Data(text)));
+}
+
+/// A notice line (`[MSG:…]` and the like).
+pub(in crate::sequencer) fn notice(out: &mut dyn ActionSink, args: core::fmt::Arguments<'_>) {
+    out.act(Action::Line(Line::Notice(reply_text(args))));
+}
+
+/// Closes the current reply with `ok`.
+pub(in crate::sequencer) fn ok(out: &mut dyn ActionSink) {
+    out.act(Action::Line(Line::Ok));
+}
+
+/// Closes the current reply with `error:N`.
+pub(in crate::sequencer) fn error(out: &mut dyn ActionSink, error: GrblError) {
+    out.act(Action::Line(Line::GrblError(error)));
+}
+
+impl GcodeSession {
     /// The `$` commands that only report (`$`, `$$`, `$#`, `$G`, `$I`,
-    /// `$N`): their data lines.
-    pub(in crate::sequencer) fn grbl_info(
-        &mut self,
+    /// `$N`): their data lines (`$$` reads the product's `settings`).
+    pub(in crate::sequencer) fn info(
+        &self,
         command: SystemCommand<'_>,
+        settings: &Settings,
         out: &mut dyn ActionSink,
     ) {
         match command {
-            SystemCommand::Help => {
-                self.grbl_data(out, reply_text(format_args!("{}", report::HELP)))
+            SystemCommand::Help => data(out, reply_text(format_args!("{}", report::HELP))),
+            SystemCommand::Settings => {
+                for setting in crate::grbl::settings_map::SETTINGS {
+                    let value = self.setting_value(setting, settings);
+                    data(
+                        out,
+                        reply_text(format_args!("{}", SettingLine(setting, value))),
+                    );
+                }
             }
-            SystemCommand::Settings => self.grbl_report_settings(out),
             SystemCommand::Parameters => {
                 for index in 0..report::PARAMETER_LINES {
-                    let p = &self.gcode.parser;
-                    let text = reply_text(format_args!("{}", ParameterLine(index, p)));
-                    self.grbl_data(out, text);
+                    let p = &self.parser;
+                    data(out, reply_text(format_args!("{}", ParameterLine(index, p))));
                 }
             }
             SystemCommand::ParserState => {
-                let text = reply_text(format_args!("{}", ParserLine(&self.gcode.parser)));
-                self.grbl_data(out, text);
+                data(
+                    out,
+                    reply_text(format_args!("{}", ParserLine(&self.parser))),
+                );
             }
             SystemCommand::BuildInfo => {
                 let version = reply_text(format_args!(
@@ -39,31 +69,29 @@ impl Core {
                     crate::build_info::VERSION,
                     crate::build_info::PRODUCT
                 ));
-                self.grbl_data(out, version);
+                data(out, version);
                 // As u32: the u16 writer is not linked (text::Int).
                 let rx_bytes = u32::from(RX_BUFFER_BYTES);
                 let options = reply_text(format_args!("[OPT:VN,{PLANNER_BLOCKS},{rx_bytes}]"));
-                self.grbl_data(out, options);
+                data(out, options);
             }
             SystemCommand::StartupLines => {
-                self.grbl_data(out, reply_text(format_args!("$N0=")));
-                self.grbl_data(out, reply_text(format_args!("$N1=")));
+                data(out, reply_text(format_args!("$N0=")));
+                data(out, reply_text(format_args!("$N1=")));
             }
             _ => {}
         }
     }
 
-    /// `?`: one status report, whatever the state.
-    pub(in crate::sequencer) fn grbl_status(
-        &mut self,
-        rx_free_bytes: u16,
-        out: &mut dyn ActionSink,
-    ) {
-        let g = &self.gcode;
+    /// `?`: one status report, whatever the state (`rx_free_bytes`: room
+    /// in the console's RX buffer). The caller counts it
+    /// ([`Self::count_report`]) once it is sent.
+    pub(in crate::sequencer) fn status(&self, rx_free_bytes: u16, seen: &Seen<'_>) -> ReplyText {
+        let g = self;
         let motion = &g.motion;
         let state = match (g.mode, motion.hold) {
             // A `$H` waiting for the stepper's homing (grbl's `Home`).
-            _ if g.homing || self.stepper_homing => MachineState::Home,
+            _ if g.homing || seen.stepper_homing => MachineState::Home,
             (GrblMode::Alarm, _) => MachineState::Alarm,
             (GrblMode::Check, _) => MachineState::Check,
             (_, Hold::Held) => MachineState::Hold {
@@ -71,17 +99,15 @@ impl Core {
             },
             (_, Hold::Stopping) => MachineState::Hold { decelerating: true },
             // The laser controls keep the laser off (grbl's safety door).
-            _ if self.door_substate().is_some() => {
-                MachineState::Door(self.door_substate().unwrap_or(0))
-            }
+            _ if seen.door.is_some() => MachineState::Door(seen.door.unwrap_or(0)),
             _ if motion.jogging() => MachineState::Jog,
             _ if motion.is_idle() => MachineState::Idle,
             _ => MachineState::Run,
         };
-        let (mut feed, _) = motion.feed_and_power(&g.overrides, &self.jobs.gimbal);
-        let power = self.gcode_reported_power();
+        let (mut feed, _) = motion.feed_and_power(&g.overrides, &seen.jobs.gimbal);
+        let power = self.reported_power(seen);
         // A driver may mark at most at its marking speed.
-        feed = feed.min(self.drivers().feed_cap_mm_min(&self.settings));
+        feed = feed.min(seen.drivers.feed_cap_mm_min(seen.settings));
         let mask = g.values.report_mask;
         let free_blocks = (PLANNER_BLOCKS - motion.queue.len()) as u16;
         let status = Status {
@@ -93,25 +119,19 @@ impl Core {
             line_number: None,
             feed_mm_min: feed,
             power,
-            show_work_offset: self.gcode.reports.is_multiple_of(10),
-            overrides: (self.gcode.reports % 10 == 1).then_some((
+            show_work_offset: self.reports.is_multiple_of(10),
+            overrides: (self.reports % 10 == 1).then_some((
                 g.overrides,
                 g.parser.spindle,
                 g.parser.coolant,
             )),
         };
-        let text = reply_text(format_args!("{}", StatusLine(&status)));
-        self.gcode.reports = self.gcode.reports.wrapping_add(1);
-        self.grbl_data(out, text);
+        reply_text(format_args!("{}", StatusLine(&status)))
     }
 
-    /// `$$`.
-    fn grbl_report_settings(&mut self, out: &mut dyn ActionSink) {
-        for setting in crate::grbl::settings_map::SETTINGS {
-            let value = self.grbl_setting_value(setting);
-            let text = reply_text(format_args!("{}", SettingLine(setting, value)));
-            self.grbl_data(out, text);
-        }
+    /// A status report was sent (grbl adds `WCO:` / `Ov:` every few).
+    pub(in crate::sequencer) fn count_report(&mut self) {
+        self.reports = self.reports.wrapping_add(1);
     }
 }
 

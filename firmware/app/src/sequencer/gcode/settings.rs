@@ -2,15 +2,28 @@
 
 use crate::grbl::GrblError;
 use crate::grbl::settings_map::{self, Binding, GrblSetting};
-use crate::sequencer::gcode::product_param;
-use crate::sequencer::machine::{ActionSink, Core};
-use crate::settings::find_param;
+use crate::sequencer::gcode::{GcodeSession, product_param};
+use crate::settings::{Settings, find_param};
 
-impl Core {
-    /// The value `$$` shows for `setting`.
-    pub(in crate::sequencer) fn grbl_setting_value(&self, setting: &GrblSetting) -> f64 {
-        let v = &self.gcode.values;
-        let s = &self.settings;
+/// What a `$N=value` changed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(in crate::sequencer) enum Written {
+    /// Only the session's own values (or nothing: a fixed one).
+    Session,
+    /// A product parameter: the core sends the galvo loop its parameters.
+    Product,
+}
+
+impl GcodeSession {
+    /// The value `$$` shows for `setting`, the product's parameters read
+    /// from `settings`.
+    pub(in crate::sequencer) fn setting_value(
+        &self,
+        setting: &GrblSetting,
+        settings: &Settings,
+    ) -> f64 {
+        let v = &self.values;
+        let s = settings;
         match setting.number {
             10 => f64::from(v.report_mask),
             12 => v.arc_tolerance_mm,
@@ -26,15 +39,16 @@ impl Core {
         }
     }
 
-    /// `$N=value`; on error nothing changed.
-    pub(in crate::sequencer) fn grbl_set_setting(
+    /// `$N=value`, a product parameter written into `settings`; on error
+    /// nothing changed.
+    pub(in crate::sequencer) fn set_setting(
         &mut self,
         number: u16,
         value: f64,
-        out: &mut dyn ActionSink,
-    ) -> Result<(), GrblError> {
+        settings: &mut Settings,
+    ) -> Result<Written, GrblError> {
         let setting = settings_map::find(number).ok_or(GrblError::InvalidStatement)?;
-        let v = &mut self.gcode.values;
+        let v = &mut self.values;
         match number {
             10 if value <= 3.0 => v.report_mask = value as u8,
             12 if value > 0.0 => v.arc_tolerance_mm = value,
@@ -44,19 +58,19 @@ impl Core {
             n if product_param(n).is_some() => {
                 let (name, k) = product_param(n).ok_or(GrblError::InvalidStatement)?;
                 let param = find_param(name).ok_or(GrblError::InvalidStatement)?;
-                self.settings
+                settings
                     .set(param, value / k)
                     .map_err(|_| GrblError::InvalidStatement)?;
-                self.configure_galvo(out);
+                return Ok(Written::Product);
             }
             // Fixed ones (and the board extent) take only their value.
             _ if setting.binding == Binding::Fixed || matches!(number, 130 | 131) => {
-                if value != self.grbl_setting_value(setting) {
+                if value != self.setting_value(setting, settings) {
                     return Err(GrblError::InvalidStatement);
                 }
             }
             _ => return Err(GrblError::InvalidStatement),
         }
-        Ok(())
+        Ok(Written::Session)
     }
 }

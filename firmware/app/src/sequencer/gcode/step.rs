@@ -6,6 +6,7 @@
 
 use crate::grbl::Block;
 use crate::sequencer::drivers::{Arrival, DriverStep};
+use crate::sequencer::gcode::power::Seen;
 use crate::sequencer::gcode::queue::{Hold, point_at};
 use crate::sequencer::machine::{ActionSink, Core};
 use embassy_time::Instant;
@@ -27,7 +28,10 @@ impl Core {
             }
             | Block::Arc {
                 feed_mm_min, laser, ..
-            } => (Some(feed_mm_min), self.gcode_lit(laser.mode, laser.power)),
+            } => (
+                Some(feed_mm_min),
+                self.gcode.lit(laser.mode, laser.power, &self.settings),
+            ),
             Block::Jog { feed_mm_min, .. } => (Some(feed_mm_min), false),
             _ => (None, false),
         };
@@ -98,14 +102,10 @@ impl Core {
     ) -> Option<Instant> {
         run_deadline
             .or(self.gcode.motion.current.and_then(|c| c.until))
-            .or_else(|| self.gcode_stepper_power_tick())
-    }
-
-    /// Whether G-code lights the gimbal laser now: a lit step or dwell
-    /// runs, and the laser mode (`laser auto`) still allows it (`laser off`
-    /// mid-step darkens at once).
-    pub(in crate::sequencer) fn gcode_gimbal_lit(&self) -> bool {
-        self.gcode.motion.gimbal_lit && self.settings.laser_mode == crate::settings::LaserMode::Auto
+            .or_else(|| {
+                self.gcode
+                    .stepper_power_tick(&Seen::of(self), self.inputs.now)
+            })
     }
 
     /// The dwell deadline passed: a run's dwell, or the G-code step's.
@@ -136,7 +136,7 @@ impl Core {
         }
         if finished {
             if c.cancelled {
-                self.grbl_sync_position();
+                self.gcode.sync_position();
             }
             self.grbl_advance(out);
         } else {

@@ -5,7 +5,8 @@
 
 use crate::grbl::{Alarm, GrblError};
 use crate::sequencer::drivers::stepper::gcode::StepperReport;
-use crate::sequencer::gcode::GrblMode;
+use crate::sequencer::gcode::report;
+use crate::sequencer::gcode::{GcodeSession, GrblMode};
 use crate::sequencer::machine::{ActionSink, Core};
 use crate::stepper::{HomingFailure, StepperEvent};
 use crate::text::reply_text;
@@ -47,7 +48,7 @@ impl Core {
                 true
             }
             StepperReport::AtRest => {
-                self.grbl_sync_position();
+                self.gcode.sync_position();
                 false
             }
         }
@@ -67,26 +68,9 @@ impl Core {
     ) {
         if self.gcode.motion.is_idle() {
             self.with_stage(out, |st, jobs, _| jobs.stepper.at(st, steps));
-            self.grbl_sync_position();
+            self.gcode.sync_position();
         }
-        if !core::mem::take(&mut self.gcode.homing) {
-            return;
-        }
-        let alarm = match failed {
-            None => {
-                self.gcode.mode = GrblMode::Normal;
-                return self.ok(out);
-            }
-            Some(HomingFailure::NoSwitches | HomingFailure::BadConfig) => {
-                return self.grbl_error(out, GrblError::HomingDisabled);
-            }
-            Some(HomingFailure::NotFound(_)) => Alarm::HomingNotFound,
-            Some(HomingFailure::StillPressed(_)) => Alarm::HomingPullOff,
-            Some(HomingFailure::Interrupted) => Alarm::HomingReset,
-        };
-        self.gcode.mode = GrblMode::Alarm;
-        self.grbl_data(out, reply_text(format_args!("ALARM:{}", alarm.code())));
-        self.ok(out);
+        self.gcode.homing_done(failed, out);
     }
 
     /// The current block is done on the stepper's side.
@@ -96,5 +80,31 @@ impl Core {
             c.stepper_seq = None;
         }
         self.gcode_step_done(out);
+    }
+}
+
+impl GcodeSession {
+    /// The end of homing (`failed`: why it failed) for the session: when a
+    /// `$H` waits, its reply — `ok` (unlocked) or, as grbl, `ALARM:N`
+    /// (locked) and then `ok`; parameters that allow no homing: `error:5`.
+    fn homing_done(&mut self, failed: Option<HomingFailure>, out: &mut dyn ActionSink) {
+        if !core::mem::take(&mut self.homing) {
+            return;
+        }
+        let alarm = match failed {
+            None => {
+                self.mode = GrblMode::Normal;
+                return report::ok(out);
+            }
+            Some(HomingFailure::NoSwitches | HomingFailure::BadConfig) => {
+                return report::error(out, GrblError::HomingDisabled);
+            }
+            Some(HomingFailure::NotFound(_)) => Alarm::HomingNotFound,
+            Some(HomingFailure::StillPressed(_)) => Alarm::HomingPullOff,
+            Some(HomingFailure::Interrupted) => Alarm::HomingReset,
+        };
+        self.mode = GrblMode::Alarm;
+        report::data(out, reply_text(format_args!("ALARM:{}", alarm.code())));
+        report::ok(out);
     }
 }

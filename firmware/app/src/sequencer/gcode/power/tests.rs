@@ -136,8 +136,9 @@ fn feed_hold_and_reset_darken_the_powered_laser() {
 
 #[test]
 fn product_runs_light_at_full_power() {
-    assert_eq!(
-        Core::new(Instant::from_millis(0)).gcode_gimbal_power(),
-        LaserPower::FULL
-    );
+    let core = Core::new(Instant::from_millis(0));
+    let power = core
+        .gcode
+        .gimbal_power(&core.settings, &core.jobs, core.drivers());
+    assert_eq!(power, LaserPower::FULL);
 }
