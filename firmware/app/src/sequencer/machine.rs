@@ -125,11 +125,11 @@ impl Core {
     /// Idle, default settings, gimbal, laser off; booted at `now`.
     #[inline(never)]
     pub fn new(now: Instant) -> Self {
-        Self {
+        let mut core = Self {
             settings: Settings::default(),
             model: AimModel::Exact,
             aimer: Settings::default().aimer(AimModel::Exact),
-            reach: crate::sequencer::gcode::proven::ProvenReach::UNPROVEN,
+            reach: crate::sequencer::gcode::proven::ProvenReach::NONE,
             actuator: Actuator::Gimbal,
             booted_at: now,
             run: None,
@@ -152,15 +152,14 @@ impl Core {
             jobs: crate::sequencer::drivers::DriverJobs::new(),
             stepper_homing: false,
             controls: None,
-        }
+        };
+        core.reach = core.prove_reach();
+        core
     }
 
     /// Handles `event`, writing what is to be done into `out`.
     pub fn on(&mut self, inputs: Inputs, event: Event, out: &mut dyn ActionSink) {
         self.inputs = inputs;
-        if !self.reach.is_proven() {
-            self.reach = self.prove_reach();
-        }
         if !matches!(event, Event::CheckStep) {
             // Not what the shell does; should it happen, the command in
             // check still gets its reply first.
@@ -299,17 +298,12 @@ impl Core {
     pub(super) fn close_gate(&mut self, out: &mut dyn ActionSink) {
         out.act(Action::CloseGate);
         self.gate_lost = false;
-        self.stop_galvo(out);
+        galvo_stop(&mut self.inputs, out);
     }
 
     /// The driver(s) that draw.
     pub(super) fn drivers(&self) -> Drivers {
         Drivers::of(self.actuator)
-    }
-
-    /// Tells the galvo loop to stop ([`galvo_stop`]).
-    pub(super) fn stop_galvo(&mut self, out: &mut dyn ActionSink) {
-        galvo_stop(&mut self.inputs, out);
     }
 
     /// Sends the galvo loop the parameters of the settings ([`galvo::points::configure`]).

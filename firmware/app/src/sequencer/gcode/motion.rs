@@ -154,7 +154,7 @@ impl Core {
         };
         c.cancelled = true;
         if c.galvo_seq.take().is_some() {
-            self.stop_galvo(out);
+            crate::sequencer::drivers::stage::stop_galvo(&mut self.inputs, out);
             self.gcode_step_done(out);
         }
     }

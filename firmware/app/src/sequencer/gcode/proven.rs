@@ -7,21 +7,13 @@
 pub(in crate::sequencer) const SCALES: [f64; 2] = [1.0, 0.5];
 
 /// Per driver slot, 1 + the index in [`SCALES`] of the fraction of the
-/// board (about its centre) proven reachable, 0 for none; all
-/// [`u8::MAX`] before the first proof.
+/// board (about its centre) proven reachable, 0 for none.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(in crate::sequencer) struct ProvenReach([u8; 3]);
 
 impl ProvenReach {
-    /// Not proven yet (the core proves it before its first event).
-    pub(in crate::sequencer) const UNPROVEN: Self = Self([u8::MAX; 3]);
     /// Nothing proven: every point takes the exact check.
     pub(in crate::sequencer) const NONE: Self = Self([0; 3]);
-
-    /// Whether the proof was made.
-    pub(in crate::sequencer) fn is_proven(&self) -> bool {
-        *self != Self::UNPROVEN
-    }
 
     /// The fraction of the board proven for driver slot `slot`.
     pub(in crate::sequencer) fn scale(&self, slot: usize) -> Option<f64> {

@@ -168,7 +168,7 @@ impl Core {
     /// supersedes the last by itself).
     pub(in crate::sequencer) fn drivers_supersede(&mut self, out: &mut dyn ActionSink) {
         if self.drivers().any(|d| d.arrival() == Arrival::Job) {
-            self.stop_galvo(out);
+            crate::sequencer::drivers::stage::stop_galvo(&mut self.inputs, out);
         }
     }
 
