@@ -167,6 +167,8 @@ pub enum Line {
     Data(ReplyText),
     /// An unsolicited notice.
     Notice(ReplyText),
+    /// A grbl push message (`ALARM:N`): never the command in flight's.
+    Push(ReplyText),
     /// Closes the reply: `ok`.
     Ok,
     /// Closes the reply: `error: <reason>`.

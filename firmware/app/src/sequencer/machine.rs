@@ -334,9 +334,8 @@ impl Core {
 
     /// Closes the current reply with `error: <reason>`.
     pub(super) fn error(&self, out: &mut dyn ActionSink, reason: impl core::fmt::Display) {
-        out.act(Action::Line(Line::Error(reply_text(format_args!(
-            "{reason}"
-        )))));
+        let text = reply_text(format_args!("{reason}"));
+        out.act(Action::Line(Line::Error(text)));
     }
 }
 

@@ -113,8 +113,7 @@ struct Io<'a, L: LaserSwitch, S: SettingsStore> {
     /// the event and its follow-ups are done).
     refused: bool,
     /// Whose data lines the event being handled produces: a realtime
-    /// request's (`?`, a soft reset's banner) are not the reply of the
-    /// command in flight, which may be the PELCO port's quiet one.
+    /// request's (`?`, a reset's banner) are never the command in flight's.
     data_origin: Origin,
 }
 
@@ -424,6 +423,7 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
                 let _ = match &line {
                     Line::Data(text) => outbound.push_from(self.data_origin, LineKind::Data, text),
                     Line::Notice(text) => outbound.push(LineKind::Notice, text),
+                    Line::Push(text) => outbound.push_from(Origin::Direct, LineKind::Data, text),
                     Line::Ok => outbound.push(LineKind::Ok, ""),
                     Line::Error(text) => outbound.push(LineKind::Error, text),
                     Line::GrblError(error) => outbound.push_fmt(

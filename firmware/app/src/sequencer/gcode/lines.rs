@@ -39,10 +39,10 @@ impl Core {
     pub(in crate::sequencer) fn grbl_alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
         self.stop("grbl alarm", out);
         self.gcode.mode = GrblMode::Alarm;
-        self.grbl_data(
-            out,
-            reply_text(format_args!("ALARM:{}", u32::from(alarm.code()))),
-        );
+        let text = reply_text(format_args!("ALARM:{}", u32::from(alarm.code())));
+        out.act(crate::sequencer::io::Action::Line(
+            crate::sequencer::io::Line::Push(text),
+        ));
     }
 
     fn grbl_gcode(&mut self, line: &str, out: &mut dyn ActionSink) {

@@ -59,7 +59,9 @@ pub(crate) fn texts(actions: &[Action]) -> Vec<String> {
     actions
         .iter()
         .filter_map(|a| match a {
-            Action::Line(Line::Data(t) | Line::Notice(t)) => Some(String::from(t.as_str())),
+            Action::Line(Line::Data(t) | Line::Notice(t) | Line::Push(t)) => {
+                Some(String::from(t.as_str()))
+            }
             _ => None,
         })
         .collect()

@@ -10,7 +10,7 @@ use embassy_time::Instant;
 use crate::domain::Actuator;
 use crate::grbl::realtime::Realtime;
 use crate::sequencer::gcode::tests::{line, on, realtime, status, texts};
-use crate::sequencer::machine::{Action, Core, Event};
+use crate::sequencer::machine::{Action, Core, Event, Line};
 use crate::status::Activity;
 use crate::stepper::{HomingFailure, MoveShape, StepperEvent, StepperRequest};
 
@@ -162,6 +162,13 @@ fn a_move_the_stepper_refuses_raises_a_soft_limit_alarm_and_ends_the_job() {
         texts(&out).iter().any(|t| t == "ALARM:2"),
         "{:?}",
         texts(&out)
+    );
+    // A push message: not part of whatever command is in flight (the
+    // PELCO port's quiet one would have kept it from the host).
+    assert!(
+        out.iter()
+            .any(|a| matches!(a, Action::Line(Line::Push(t)) if t.as_str() == "ALARM:2")),
+        "{out:?}"
     );
     assert!(status(&mut core, 3).starts_with("<Alarm|"));
     assert!(!core.laser_on());
