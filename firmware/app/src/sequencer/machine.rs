@@ -125,11 +125,11 @@ impl Core {
     /// Idle, default settings, gimbal, laser off; booted at `now`.
     #[inline(never)]
     pub fn new(now: Instant) -> Self {
-        let mut core = Self {
+        Self {
             settings: Settings::default(),
             model: AimModel::Exact,
             aimer: Settings::default().aimer(AimModel::Exact),
-            reach: crate::sequencer::gcode::proven::ProvenReach::NONE,
+            reach: crate::sequencer::gcode::proven::ProvenReach::UNPROVEN,
             actuator: Actuator::Gimbal,
             booted_at: now,
             run: None,
@@ -152,14 +152,13 @@ impl Core {
             jobs: crate::sequencer::drivers::DriverJobs::new(),
             stepper_homing: false,
             controls: None,
-        };
-        core.reach = core.prove_reach();
-        core
+        }
     }
 
     /// Handles `event`, writing what is to be done into `out`.
     pub fn on(&mut self, inputs: Inputs, event: Event, out: &mut dyn ActionSink) {
         self.inputs = inputs;
+        self.reach = self.reach.or_prove(|| self.prove_reach());
         if !matches!(event, Event::CheckStep) {
             // Not what the shell does; should it happen, the command in
             // check still gets its reply first.

@@ -7,13 +7,26 @@
 pub(in crate::sequencer) const SCALES: [f64; 2] = [1.0, 0.5];
 
 /// Per driver slot, 1 + the index in [`SCALES`] of the fraction of the
-/// board (about its centre) proven reachable, 0 for none.
+/// board (about its centre) proven reachable, 0 for none; all
+/// [`u8::MAX`] before the first proof.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(in crate::sequencer) struct ProvenReach([u8; 3]);
 
 impl ProvenReach {
+    /// Not proven yet (the core proves it at its first event: proving in
+    /// `Core::new` copied the core on its stack frame, 9 284 B).
+    pub(in crate::sequencer) const UNPROVEN: Self = Self([u8::MAX; 3]);
     /// Nothing proven: every point takes the exact check.
     pub(in crate::sequencer) const NONE: Self = Self([0; 3]);
+
+    /// This, or `prove()` when not proven yet.
+    pub(in crate::sequencer) fn or_prove(self, prove: impl FnOnce() -> Self) -> Self {
+        if self == Self::UNPROVEN {
+            prove()
+        } else {
+            self
+        }
+    }
 
     /// The fraction of the board proven for driver slot `slot`.
     pub(in crate::sequencer) fn scale(&self, slot: usize) -> Option<f64> {
