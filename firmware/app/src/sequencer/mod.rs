@@ -112,9 +112,6 @@ struct Io<'a, L: LaserSwitch, S: SettingsStore> {
     /// The gate refused to light the gimbal laser (the core is told once
     /// the event and its follow-ups are done).
     refused: bool,
-    /// Whose data lines the event being handled produces: a realtime
-    /// request's (`?`, a reset's banner) are never the command in flight's.
-    data_origin: Origin,
 }
 
 /// What the shell does after applying the actions of one event.
@@ -165,7 +162,6 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             store,
             follow_up: FollowUp::Nothing,
             refused: false,
-            data_origin: Origin::Command,
         };
         Self::started(io, record.get(..n).unwrap_or(&[]))
     }
@@ -281,10 +277,6 @@ impl<'a, L: LaserSwitch, S: SettingsStore> Sequencer<'a, L, S> {
             // The stepper's speed over its block's cruise speed, ‰.
             self.core.jobs.stepper.speed_permille = self.io.stepper.speed_permille();
             self.core.note_laser_controls(self.io.controls.view());
-            self.io.data_origin = match event {
-                Event::Realtime(_) => Origin::Direct,
-                _ => Origin::Command,
-            };
             self.core.on(inputs, event, &mut self.io);
             let follow_up = core::mem::replace(&mut self.io.follow_up, FollowUp::Nothing);
             if follow_up != FollowUp::Nothing {
@@ -421,7 +413,7 @@ impl<L: LaserSwitch, S: SettingsStore> ActionSink for Io<'_, L, S> {
             Action::Line(line) => {
                 let outbound = &self.link.outbound;
                 let _ = match &line {
-                    Line::Data(text) => outbound.push_from(self.data_origin, LineKind::Data, text),
+                    Line::Data(text) => outbound.push(LineKind::Data, text),
                     Line::Notice(text) => outbound.push(LineKind::Notice, text),
                     Line::Push(text) => outbound.push_from(Origin::Direct, LineKind::Data, text),
                     Line::Ok => outbound.push(LineKind::Ok, ""),

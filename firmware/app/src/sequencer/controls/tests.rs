@@ -38,7 +38,9 @@ fn command(core: &mut Core, controls: Option<ControlsView>, command: Command) ->
 fn texts(out: &[Action]) -> Vec<String> {
     out.iter()
         .filter_map(|a| match a {
-            Action::Line(Line::Data(t) | Line::Error(t)) => Some(String::from(t.as_str())),
+            Action::Line(Line::Data(t) | Line::Push(t) | Line::Error(t)) => {
+                Some(String::from(t.as_str()))
+            }
             _ => None,
         })
         .collect()

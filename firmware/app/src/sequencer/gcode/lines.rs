@@ -13,7 +13,7 @@ use crate::sequencer::gcode::settings::Written;
 use crate::sequencer::gcode::{GrblMode, GrblValues, NO_OVERRIDES};
 use crate::sequencer::machine::{ActionSink, Core};
 use crate::settings::Settings;
-use crate::text::{ReplyText, reply_text};
+use crate::text::reply_text;
 
 impl Core {
     /// A G-code or `$` line from the console: closed with `ok` (for a
@@ -30,19 +30,11 @@ impl Core {
         report::error(out, error);
     }
 
-    /// A data line in grbl's form (no decoration).
-    pub(in crate::sequencer) fn grbl_data(&self, out: &mut dyn ActionSink, text: ReplyText) {
-        report::data(out, text);
-    }
-
     /// `ALARM:N`, the machine locked; motion stopped, laser dark.
     pub(in crate::sequencer) fn grbl_alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
         self.stop("grbl alarm", out);
         self.gcode.mode = GrblMode::Alarm;
-        let text = reply_text(format_args!("ALARM:{}", u32::from(alarm.code())));
-        out.act(crate::sequencer::io::Action::Line(
-            crate::sequencer::io::Line::Push(text),
-        ));
+        report::alarm(out, alarm);
     }
 
     fn grbl_gcode(&mut self, line: &str, out: &mut dyn ActionSink) {
@@ -196,7 +188,7 @@ impl Core {
             Realtime::StatusReport => {
                 let text = self.gcode.status(request.rx_free_bytes, &Seen::of(self));
                 self.gcode.count_report();
-                self.grbl_data(out, text);
+                report::push(out, text);
             }
             Realtime::FeedHold => self.grbl_hold(out),
             Realtime::CycleStart => self.grbl_resume(out),
@@ -230,15 +222,9 @@ impl Core {
         }
         if moving {
             self.gcode.mode = GrblMode::Alarm;
-            self.grbl_data(
-                out,
-                reply_text(format_args!(
-                    "ALARM:{}",
-                    u32::from(Alarm::ResetWhileMoving.code())
-                )),
-            );
+            report::alarm(out, Alarm::ResetWhileMoving);
         }
-        self.grbl_data(
+        report::push(
             out,
             reply_text(format_args!("{}", crate::grbl::report::BANNER)),
         );

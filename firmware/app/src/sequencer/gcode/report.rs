@@ -3,7 +3,7 @@
 
 use crate::grbl::report::{self, MachineState, Status};
 use crate::grbl::system::SystemCommand;
-use crate::grbl::{GrblError, ParserState};
+use crate::grbl::{Alarm, GrblError, ParserState};
 use crate::sequencer::gcode::power::Seen;
 use crate::sequencer::gcode::queue::{Hold, PLANNER_BLOCKS};
 use crate::sequencer::gcode::{GcodeSession, GrblMode, RX_BUFFER_BYTES};
@@ -11,9 +11,24 @@ use crate::sequencer::io::{Action, ActionSink, Line};
 use crate::settings::Settings;
 use crate::text::{ReplyText, reply_text};
 
-/// A data line in grbl's form (no decoration).
+/// A data line of the reply in grbl's form (no decoration).
 pub(in crate::sequencer) fn data(out: &mut dyn ActionSink, text: ReplyText) {
     out.act(Action::Line(Line::Data(text)));
+}
+
+/// A grbl push message (a status report, `ALARM:N`, the banner): printed
+/// bare, never part of the reply of the command in flight (which may be
+/// the PELCO port's quiet one).
+pub(in crate::sequencer) fn push(out: &mut dyn ActionSink, text: ReplyText) {
+    out.act(Action::Line(Line::Push(text)));
+}
+
+/// `ALARM:N` as a push message.
+pub(in crate::sequencer) fn alarm(out: &mut dyn ActionSink, alarm: Alarm) {
+    let mut text = ReplyText::new();
+    // Fits: `ALARM:` and a one- or two-digit code.
+    let _ = report::write_alarm(&mut text, alarm);
+    push(out, text);
 }
 
 /// A notice line (`[MSG:…]` and the like).

@@ -9,7 +9,6 @@ use crate::sequencer::gcode::report;
 use crate::sequencer::gcode::{GcodeSession, GrblMode};
 use crate::sequencer::machine::{ActionSink, Core};
 use crate::stepper::{HomingFailure, StepperEvent};
-use crate::text::reply_text;
 
 impl Core {
     /// Hands the current block to the stepper (or waits for rest first).
@@ -104,7 +103,7 @@ impl GcodeSession {
             Some(HomingFailure::Interrupted) => Alarm::HomingReset,
         };
         self.mode = GrblMode::Alarm;
-        report::data(out, reply_text(format_args!("ALARM:{}", alarm.code())));
+        report::alarm(out, alarm);
         report::ok(out);
     }
 }
