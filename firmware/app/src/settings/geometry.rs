@@ -6,6 +6,7 @@ use kinematics_core as kc;
 use kinematics_core::{DacAxis, ErrorModel, Galvo, GalvoGeometry, Gimbal, Grid};
 
 use super::values::{AxisSettings, GalvoSettings, Settings};
+use crate::domain::units::mm_from_cm;
 use crate::domain::{AimModel, Aimer};
 
 fn servo_axis(axis: &AxisSettings) -> kc::ServoAxis {
@@ -19,6 +20,15 @@ fn servo_axis(axis: &AxisSettings) -> kc::ServoAxis {
 }
 
 impl Settings {
+    /// The board's extent, width and height (grbl's `$130`, `$131`: the
+    /// grid's columns and rows times its pitch), mm.
+    pub fn board_size_mm(&self) -> [f64; 2] {
+        [
+            mm_from_cm(self.grid_pitch_cm * f64::from(self.grid_cols)),
+            mm_from_cm(self.grid_pitch_cm * f64::from(self.grid_rows)),
+        ]
+    }
+
     /// The calibrated gimbal these settings describe, aimed with `model`.
     pub fn gimbal(&self, model: AimModel) -> Gimbal {
         Gimbal {

@@ -22,9 +22,8 @@ impl Core {
         let Some(end) = block_end(block) else {
             return true;
         };
-        let s = &self.settings;
-        let half_width_mm = s.grid_pitch_cm * f64::from(s.grid_cols) * 5.0;
-        let half_height_mm = s.grid_pitch_cm * f64::from(s.grid_rows) * 5.0;
+        let [width_mm, height_mm] = self.settings.board_size_mm();
+        let (half_width_mm, half_height_mm) = (0.5 * width_mm, 0.5 * height_mm);
         let reachable = |p: PointMm| {
             let on_board = libm::fabs(p.x_mm) <= half_width_mm + 1e-9
                 && libm::fabs(p.y_mm) <= half_height_mm + 1e-9;

@@ -68,11 +68,7 @@ fn slot(driver: Driver) -> usize {
 impl Core {
     /// Half the board's extent (`$130` × `$131`), mm.
     fn half_board_mm(&self) -> [f64; 2] {
-        let s = &self.settings;
-        [
-            s.grid_pitch_cm * f64::from(s.grid_cols) * 5.0,
-            s.grid_pitch_cm * f64::from(s.grid_rows) * 5.0,
-        ]
+        self.settings.board_size_mm().map(|mm| 0.5 * mm)
     }
 
     /// The part of the board (about its centre) that `scale` of it is.

@@ -30,8 +30,8 @@ impl GcodeSession {
             30 => v.s_max,
             31 => v.s_min,
             32 => f64::from(u8::from(v.laser_mode)),
-            130 => s.grid_pitch_cm * f64::from(s.grid_cols) * 10.0,
-            131 => s.grid_pitch_cm * f64::from(s.grid_rows) * 10.0,
+            130 => s.board_size_mm()[0],
+            131 => s.board_size_mm()[1],
             n => match product_param(n).and_then(|(name, k)| Some((find_param(name)?, k))) {
                 Some((param, k)) => s.get(param) * k,
                 None => setting.default,
