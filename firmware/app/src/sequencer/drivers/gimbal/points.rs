@@ -32,15 +32,7 @@ pub(in crate::sequencer) fn aim(st: &mut Stage, target: Target, out: &mut dyn Ac
         }
     };
     let interval_ms = interval_ms(st.settings, st.servo_at(), &aim);
-    let deadband_tenths = (st.settings.deadband_deg * 10.0) as u16;
-    let seq = servo_move(
-        st.settings,
-        st.next_seq,
-        &aim,
-        interval_ms,
-        deadband_tenths,
-        out,
-    );
+    let seq = servo_move(st, target, aim, interval_ms, false, out);
     log::info!(
         "target ({}, {}) cm -> servo {} {} (0.1 deg) over {} ms",
         target.point.x_cm,
@@ -52,6 +44,5 @@ pub(in crate::sequencer) fn aim(st: &mut Stage, target: Target, out: &mut dyn Ac
     if let Some(run) = st.run.as_mut() {
         run.seq = seq;
     }
-    *st.last_aim = Some((target, aim));
     true
 }

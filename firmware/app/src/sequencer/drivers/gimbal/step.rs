@@ -34,36 +34,29 @@ pub(in crate::sequencer) fn send_step(
     });
     let interval_ms = libm::fmax(f64::from(by_servo), by_feed).min(f64::from(u16::MAX)) as u16;
     st.gcode.step_speed_ratio = crate::sequencer::gcode::power::speed_ratio(by_feed, interval_ms);
+    let target = Target { point, grid: None };
+    Some(servo_move(st, target, aim, interval_ms, corner, out))
+}
+
+/// Sends the gimbal to `aim` (at `target`) over `interval_ms` under the
+/// next request number (returned), arrival within the deadband (the
+/// corner's, tighter, when `corner`: a block or the stream ends there);
+/// notes the move for the laser logic and as the last aim.
+pub(in crate::sequencer) fn servo_move(
+    st: &mut Stage,
+    target: Target,
+    aim: Aim,
+    interval_ms: u16,
+    corner: bool,
+    out: &mut dyn ActionSink,
+) -> u32 {
+    let settings = st.settings;
     let deadband_tenths = if corner {
         CORNER_DEADBAND_TENTHS
     } else {
-        (st.settings.deadband_deg * 10.0) as u16
+        (settings.deadband_deg * 10.0) as u16
     };
-    let seq = servo_move(
-        st.settings,
-        st.next_seq,
-        &aim,
-        interval_ms,
-        deadband_tenths,
-        out,
-    );
-    *st.last_aim = Some((Target { point, grid: None }, aim));
-    Some(seq)
-}
-
-/// Sends the gimbal to `aim` over `interval_ms`, arrival within
-/// `deadband_tenths` (0.1°), under the next request number (returned),
-/// and notes the move for the laser logic.
-pub(in crate::sequencer) fn servo_move(
-    settings: &Settings,
-    next_seq: &mut u32,
-    aim: &Aim,
-    interval_ms: u16,
-    deadband_tenths: u16,
-    out: &mut dyn ActionSink,
-) -> u32 {
-    *next_seq = next_seq.wrapping_add(1);
-    let seq = *next_seq;
+    let seq = st.take_seq();
     out.act(Action::Servo(ServoRequest::Move {
         seq,
         yaw_tenths: aim.yaw_wire,
@@ -74,6 +67,7 @@ pub(in crate::sequencer) fn servo_move(
         ranges_tenths: faults::servo_ranges_tenths(settings),
     }));
     out.act(Action::Note(LaserEvent::GimbalMoveSent));
+    *st.last_aim = Some((target, aim));
     seq
 }
 

@@ -7,9 +7,7 @@ use crate::sequencer::drivers::gimbal::plan::{stream_exit_speed, stream_limits};
 use crate::sequencer::drivers::gimbal::step::servo_move;
 use crate::sequencer::drivers::gimbal::{MIN_TICK_MS, STREAM_PERIOD_MS, Stream};
 use crate::sequencer::drivers::stage::Stage;
-use crate::sequencer::gcode::queue::{
-    CORNER_DEADBAND_TENTHS, Hold, block_point, cm, planned_length,
-};
+use crate::sequencer::gcode::queue::{Hold, block_point, cm, planned_length};
 use crate::sequencer::io::ActionSink;
 use embassy_time::Duration;
 use kinematics_core::lookahead::{LookaheadBlock, SpeedCursor};
@@ -127,14 +125,9 @@ impl Stream {
             st.alarm = Some(Alarm::SoftLimit);
             return false;
         };
-        let deadband = if last {
-            CORNER_DEADBAND_TENTHS
-        } else {
-            (st.settings.deadband_deg * 10.0) as u16
-        };
         let interval_ms = (libm::ceil(tick_ms) as u16).max(1);
-        let seq = servo_move(st.settings, st.next_seq, &aim, interval_ms, deadband, out);
-        *st.last_aim = Some((Target { point, grid: None }, aim));
+        let target = Target { point, grid: None };
+        let seq = servo_move(st, target, aim, interval_ms, last, out);
         let lit = block_lit(st);
         st.gcode.step_speed_ratio = self.speed_ratio(st);
         let motion = &mut st.gcode.motion;
