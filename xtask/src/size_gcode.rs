@@ -13,10 +13,16 @@ use std::process::Command;
 use anyhow::{Context, Result, bail};
 
 /// Symbol name parts that belong to the G-code path.
-const GCODE_SYMBOLS: [&str; 7] = [
+/// (The gimbal's point runs, `drivers::gimbal::points`, are the
+/// product's patterns, not G-code.)
+const GCODE_SYMBOLS: [&str; 11] = [
     "laser_app::grbl::",
     "laser_app::sequencer::gcode",
-    "laser_app::sequencer::drivers::gimbal::",
+    "laser_app::sequencer::drivers::gimbal::stream",
+    "laser_app::sequencer::drivers::gimbal::plan",
+    "laser_app::sequencer::drivers::gimbal::step",
+    "laser_app::sequencer::drivers::gimbal::cache",
+    "laser_app::sequencer::drivers::gimbal::deg_per_mm",
     "laser_app::sequencer::drivers::galvo::gcode",
     "laser_app::sequencer::drivers::galvo::ahead",
     "laser_app::sequencer::drivers::galvo::hold",
@@ -76,10 +82,12 @@ mod tests {
                   08000200 00000010 t laser_app::sequencer::gcode::queue::point_at\n\
                   08000210 00000008 t laser_app::sequencer::drivers::galvo::hold::<impl laser_app::sequencer::machine::Core>::gcode_galvo_hold\n\
                   08000218 00000004 t laser_app::sequencer::drivers::galvo::points::<impl laser_app::sequencer::machine::Core>::stop_galvo\n\
+                  08000220 00000030 t laser_app::sequencer::drivers::gimbal::stream::Stream::tick\n\
+                  08000250 00000018 t laser_app::sequencer::drivers::gimbal::points::aim\n\
                   08000300 00000020 R laser_app::grbl::settings_map::SETTINGS\n\
                   20000000 00000100 B laser_app::grbl::something_in_ram\n\
                   08000400 00000080 T laser_app::usb::run_console\n\
                   08000500 T no_size_symbol\n";
-        assert_eq!(flash_of(nm), (0x40 + 0x10 + 0x8 + 0x20, 4));
+        assert_eq!(flash_of(nm), (0x40 + 0x10 + 0x8 + 0x30 + 0x20, 5));
     }
 }

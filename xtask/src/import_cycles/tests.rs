@@ -185,6 +185,49 @@ fn laser_app_imports_only_its_own_layer_or_below() {
     );
 }
 
+/// The sequencer's core: `Core` (machine.rs) and the files that extend it.
+const CORE_MODULES: &[&str] = &[
+    "machine",
+    "commands",
+    "controls",
+    "presets",
+    "report",
+    "servo_setup",
+    "run/points",
+    "faults/servo",
+];
+
+#[test]
+fn the_gcode_session_and_the_drivers_stay_below_the_core() {
+    // ARCHITECTURE.md, "The sequencer inside": the session and the drivers
+    // work on what they are handed (a Session, a Stage), never on `Core`.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/app/src/sequencer");
+    let graph = import_graph(&dir, "crate::sequencer").unwrap();
+    let mut texts = BTreeMap::new();
+    collect(&dir, &dir, &mut texts).unwrap();
+    let below = |m: &Module| {
+        let in_layer = m
+            .first()
+            .is_some_and(|top| top == "gcode" || top == "drivers");
+        in_layer && !m.last().is_some_and(|last| last.ends_with("_tests"))
+    };
+    let core: BTreeSet<Module> = CORE_MODULES
+        .iter()
+        .map(|m| m.split('/').map(str::to_owned).collect())
+        .collect();
+    let mut offenders = Vec::new();
+    for (module, targets) in graph.iter().filter(|(m, _)| below(m)) {
+        for target in targets.intersection(&core) {
+            offenders.push(format!("{} imports {}", module.join("/"), target.join("/")));
+        }
+        if texts.get(module).is_some_and(|t| t.contains("impl Core")) {
+            offenders.push(format!("{} extends Core", module.join("/")));
+        }
+    }
+    assert!(graph.keys().filter(|m| below(m)).count() > 20, "{graph:?}");
+    assert!(offenders.is_empty(), "{offenders:#?}");
+}
+
 /// The source trees of the workspace's crates (the separate workspaces
 /// `firmware/qemu-m4` and `firmware/bench-m4` included), as
 /// `(crate, directory below the repository root)`.

@@ -41,7 +41,7 @@ impl Core {
             Command::Arm => self.arm(out),
             // The shell switched the trace as the command arrived.
             Command::Trace(_) => self.ok(out),
-            Command::Home => match self.start_homing(out) {
+            Command::Home => match self.session().start_homing(out) {
                 Ok(()) => self.ok(out),
                 Err(reason) => self.error(out, reason),
             },
@@ -75,7 +75,7 @@ impl Core {
                 self.pending = Some(Pending::Save);
                 out.act(Action::Save);
             }
-            Command::Grbl(line) => self.grbl_line(line.as_str(), out),
+            Command::Grbl(line) => self.session().grbl_line(line.as_str(), out),
             Command::Servo(setup) => self.servo_setup(setup, out),
             Command::Preset(preset) => self.preset(preset, out),
         }

@@ -20,9 +20,11 @@
 
 use crate::domain::{Actuator, Aim, AimModel, Aimer, PatternCheck, Target};
 use crate::log;
-use crate::sequencer::drivers::stage::stop_galvo as galvo_stop;
 use crate::sequencer::drivers::{Driver, Drivers, galvo, stepper};
 use crate::sequencer::faults::ServoFaults;
+use crate::sequencer::gcode::context::Session;
+use crate::sequencer::gcode::proven::ProvenReach;
+use crate::sequencer::gcode::reach::ReachCheck;
 pub use crate::sequencer::io::{Action, ActionSink, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::sequencer::laser::laser_wanted;
 use crate::sequencer::run::Run;
@@ -85,7 +87,7 @@ pub struct Core {
     pub(super) aimer: Aimer,
     /// Per driver, the part of the board proven reachable with `settings`
     /// (the soft-limit check's fast path), proven again with `aimer`.
-    pub(super) reach: crate::sequencer::gcode::proven::ProvenReach,
+    pub(super) reach: ProvenReach,
     /// Which actuator(s) draw.
     pub(super) actuator: Actuator,
     pub(super) booted_at: Instant,
@@ -129,7 +131,7 @@ impl Core {
             settings: Settings::default(),
             model: AimModel::Exact,
             aimer: Settings::default().aimer(AimModel::Exact),
-            reach: crate::sequencer::gcode::proven::ProvenReach::UNPROVEN,
+            reach: ProvenReach::UNPROVEN,
             actuator: Actuator::Gimbal,
             booted_at: now,
             run: None,
@@ -158,7 +160,7 @@ impl Core {
     /// Handles `event`, writing what is to be done into `out`.
     pub fn on(&mut self, inputs: Inputs, event: Event, out: &mut dyn ActionSink) {
         self.inputs = inputs;
-        self.reach = self.reach.or_prove(|| self.prove_reach());
+        self.reach = (self.reach).or_prove(|| ReachCheck::new(&self.settings, &self.aimer).prove());
         if !matches!(event, Event::CheckStep) {
             // Not what the shell does; should it happen, the command in
             // check still gets its reply first.
@@ -170,14 +172,17 @@ impl Core {
             Event::Servo(outcome) => self.servo_outcome(outcome, out),
             Event::Galvo(event) => self.galvo_event(event, out),
             Event::Stepper(event) => self.stepper_event(event, out),
-            Event::DwellEnded => self.dwell_ended(out),
+            Event::DwellEnded => {
+                self.dwell_finished(out);
+                self.session().gcode_dwell_check(out);
+            }
             Event::Tick => self.heartbeat = self.heartbeat.wrapping_add(1),
             Event::CheckStep => self.check_step(CHECKS_PER_STEP, out),
             Event::Saved(result) => self.saved(result, out),
             Event::PresetLoaded { n, point } => self.preset_loaded(n, point, out),
             Event::SettingsLoaded(loaded) => self.settings_loaded(loaded, out),
             Event::GateLost => self.gate_lost = true,
-            Event::Realtime(request) => self.grbl_realtime(request, out),
+            Event::Realtime(request) => self.session().grbl_realtime(request, out),
         }
         // A command in check has not changed anything yet.
         if !matches!(self.pending, Some(Pending::Check { .. })) {
@@ -192,7 +197,9 @@ impl Core {
 
     /// When the current dwell ends (`None`: no dwell running).
     pub fn dwell_deadline(&self) -> Option<Instant> {
-        self.gcode_deadline_or(self.run.and_then(|r| r.dwell_until))
+        let run_deadline = self.run.and_then(|r| r.dwell_until);
+        let drivers = (&self.settings, &self.jobs, self.drivers());
+        (self.gcode).deadline_or(run_deadline, drivers, self.inputs.now)
     }
 
     /// Whether the gimbal laser is on.
@@ -258,7 +265,7 @@ impl Core {
     /// model changed.
     pub(super) fn geometry_changed(&mut self) {
         self.aimer = self.settings.aimer(self.model);
-        self.reach = self.prove_reach();
+        self.reach = ReachCheck::new(&self.settings, &self.aimer).prove();
         self.jobs.gimbal.geometry_changed();
     }
 
@@ -292,12 +299,32 @@ impl Core {
         }
     }
 
+    /// The G-code session at work on this event, with what it moves on.
+    pub(super) fn session(&mut self) -> Session<'_> {
+        let door = self.door_substate();
+        Session {
+            gcode: &mut self.gcode,
+            jobs: &mut self.jobs,
+            settings: &mut self.settings,
+            aimer: &self.aimer,
+            reach: self.reach,
+            inputs: &mut self.inputs,
+            next_seq: &mut self.next_seq,
+            run: &mut self.run,
+            last_aim: &mut self.last_aim,
+            measured: self.measured,
+            drivers: Drivers::of(self.actuator),
+            gate_lost: &mut self.gate_lost,
+            stepper_homing: &mut self.stepper_homing,
+            laser: self.laser_on.then_some(self.laser_power),
+            door,
+        }
+    }
+
     /// Closes the master laser gate (laser dark from now on, also samples
     /// the galvo DAC already holds) and stops the galvo loop.
     pub(super) fn close_gate(&mut self, out: &mut dyn ActionSink) {
-        out.act(Action::CloseGate);
-        self.gate_lost = false;
-        galvo_stop(&mut self.inputs, out);
+        self.session().close_gate(out);
     }
 
     /// The driver(s) that draw.

@@ -29,6 +29,7 @@ use embassy_futures::select::{Either, Either3, Either4, select, select3, select4
 use embassy_time::{Duration, Instant, Timer};
 
 pub use self::drivers::galvo::config_from;
+pub use self::gcode::GCODE_RAM_BYTES;
 pub use self::laser::{LaserEvent, LaserPower, LaserSwitch, laser_wanted};
 pub use self::machine::{Action, ActionSink, Core, Event, GalvoReadout, Inputs, Line, Readings};
 use crate::command::{Command, CommandLink};
@@ -45,20 +46,6 @@ use crate::stepper::{StepperLink, StepperRequest};
 /// Where settings are saved (defined with the settings; named here too,
 /// as the sequencer's store).
 pub use crate::settings::store::SettingsStore;
-
-/// RAM the G-code path adds, bytes (host layout): the sequencer's grbl
-/// session with its motion queue, the drivers' G-code state, the
-/// realtime command queue and the console's RX buffer.
-pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<gcode::GcodeSession>()
-    + core::mem::size_of::<drivers::DriverJobs>()
-    + core::mem::size_of::<
-        embassy_sync::channel::Channel<
-            embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex,
-            crate::command::RealtimeRequest,
-            { crate::command::REALTIME_QUEUE_DEPTH },
-        >,
-    >()
-    + crate::grbl::RX_BUFFER_BYTES;
 
 /// Period of the housekeeping tick (liveness for the watchdog).
 const HOUSEKEEPING: Duration = Duration::from_millis(250);

@@ -280,6 +280,7 @@ pub(in crate::sequencer) struct DriverStep {
     pub(in crate::sequencer) corner: bool,
 }
 
+pub(in crate::sequencer) mod dispatch;
 pub(in crate::sequencer) mod galvo;
 pub(in crate::sequencer) mod gimbal;
 pub(in crate::sequencer) mod stage;

@@ -13,12 +13,12 @@ use crate::domain::{Aim, Aimer, Target};
 use crate::galvo::{GALVO_REQUEST_DEPTH, GalvoRequest};
 use crate::grbl::{Alarm, Block};
 use crate::log;
-use crate::sequencer::drivers::{Drivers, Said};
+use crate::sequencer::drivers::Drivers;
 use crate::sequencer::gcode::GcodeSession;
 use crate::sequencer::io::{Action, ActionSink, Inputs};
 use crate::sequencer::run::Run;
 use crate::settings::Settings;
-use crate::text::reply_text;
+use crate::text::{ReplyText, reply_text};
 
 /// A driver's view of the sequencer for one call of its G-code stage.
 pub(in crate::sequencer) struct Stage<'a> {
@@ -43,9 +43,19 @@ pub(in crate::sequencer) struct Stage<'a> {
     /// An alarm the stage raised (a point out of reach): the core raises
     /// it once the stage returns.
     pub(in crate::sequencer) alarm: Option<Alarm>,
-    /// What the core does once the stage returns (everything stops when
-    /// a galvo job found no room: the loop does not keep up).
-    pub(in crate::sequencer) then: Said,
+    /// A stop the stage asks for, done once it returns (everything stops
+    /// when a galvo job found no room: the loop does not keep up).
+    pub(in crate::sequencer) stop: Option<StopAsked>,
+}
+
+/// A stop a driver's stage asks for: its notice line (if any), then
+/// everything stops for `why`.
+#[derive(Debug, Clone)]
+pub(in crate::sequencer) struct StopAsked {
+    /// The notice line that says why, sent before the stop.
+    pub(in crate::sequencer) notice: Option<ReplyText>,
+    /// The stop's cause (the laser event's and the log's).
+    pub(in crate::sequencer) why: &'static str,
 }
 
 impl Stage<'_> {
@@ -77,7 +87,7 @@ impl Stage<'_> {
     }
 
     /// Queues a job for the galvo loop; `false` when the loop does not
-    /// keep up (then everything stops, with an error notice: [`Self::then`]).
+    /// keep up (then everything stops, with an error notice: [`Self::stop`]).
     pub(in crate::sequencer) fn send_galvo(
         &mut self,
         request: GalvoRequest,
@@ -86,7 +96,10 @@ impl Stage<'_> {
         let sent = try_send_galvo(self.inputs, request, out);
         if !sent {
             let notice = reply_text(format_args!("error: galvo not responding; stopped"));
-            self.then = Said::Stop(Some(notice), "galvo not responding");
+            self.stop = Some(StopAsked {
+                notice: Some(notice),
+                why: "galvo not responding",
+            });
         }
         sent
     }

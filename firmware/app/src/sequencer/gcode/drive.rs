@@ -1,61 +1,23 @@
-//! The session's and the core's side of the drivers: a driver is called
-//! with a [`Stage`] of the core's state ([`Core::with_stage`]; its G-code
-//! stage a method of its own state in [`DriverJobs`]), and what follows
-//! it here is the session's (a line waiting for room answered, the step
-//! finished, a hold held or resumed) or the core's (what it noted: a
-//! stop, an alarm). The drivers' reports come here too: the session's
-//! part first, the rest to the core as a [`Said`].
+//! The session's side of the drivers: a driver's G-code stage (a method
+//! of its own state in [`DriverJobs`](crate::sequencer::drivers::DriverJobs))
+//! is called with a [`Stage`](crate::sequencer::drivers::stage::Stage)
+//! ([`Session::with_stage`]), and what follows it is here: a line waiting
+//! for room answered, the step finished, a hold held or resumed. The
+//! drivers' reports come here first: what is not the session's goes on to
+//! the core (as a [`Said`](crate::sequencer::drivers::Said)).
 
-use crate::domain::PointCm;
 use crate::galvo::{GalvoEvent, MarkStop};
 use crate::grbl::Block;
-use crate::sequencer::drivers::stage::Stage;
-use crate::sequencer::drivers::{Driver, DriverJobs, DriverStep, Said, galvo, gimbal, stepper};
+use crate::sequencer::drivers::{Driver, DriverStep, dispatch};
+use crate::sequencer::gcode::context::Session;
 use crate::sequencer::gcode::queue::{CORNER_SETTLE_MS, Hold, planned_length, point_at};
+use crate::sequencer::io::{Action, ActionSink};
 use crate::sequencer::laser::LaserEvent;
-use crate::sequencer::machine::{Action, ActionSink, Core};
 use crate::servo::task::ServoOutcome;
 use crate::stepper::{StepperEvent, StepperRequest};
 use embassy_time::Duration;
 
-impl Core {
-    /// Runs `stage` on the drivers' state with a [`Stage`] of the core's;
-    /// then the core does what it noted ([`Stage::then`]: everything stops
-    /// when a galvo job found no room, …), and an alarm it raised is
-    /// raised.
-    pub(in crate::sequencer) fn with_stage<R>(
-        &mut self,
-        out: &mut dyn ActionSink,
-        stage: impl FnOnce(&mut Stage, &mut DriverJobs, &mut dyn ActionSink) -> R,
-    ) -> R {
-        let drivers = self.drivers();
-        let mut st = Stage {
-            gcode: &mut self.gcode,
-            settings: &self.settings,
-            aimer: &self.aimer,
-            inputs: &mut self.inputs,
-            next_seq: &mut self.next_seq,
-            run: &mut self.run,
-            last_aim: &mut self.last_aim,
-            measured: self.measured,
-            drivers,
-            alarm: None,
-            then: Said::Nothing,
-        };
-        let result = stage(&mut st, &mut self.jobs, out);
-        let (alarm, then) = (st.alarm, st.then);
-        self.driver_said(then, out);
-        if let Some(alarm) = alarm {
-            self.grbl_alarm(alarm, out);
-        }
-        result
-    }
-
-    /// Whether every driver that draws reaches board point `p` (cm).
-    pub(in crate::sequencer) fn drivers_reach(&self, p: PointCm) -> bool {
-        self.drivers().reach(&self.aimer, &self.settings, p)
-    }
-
+impl Session<'_> {
     /// grbl's soft reset: a driver that can drop its motion at once does
     /// (the stepper's steps are killed; the position is then uncertain);
     /// the stop that follows brakes the others.
@@ -84,7 +46,7 @@ impl Core {
     /// Hands the current G-code step to a driver with a stage of its own
     /// (the gimbal following its planned profile, the stepper taking
     /// blocks whole); `false` when the drivers take it step by step
-    /// ([`Core::driver_step`]).
+    /// ([`Session::driver_step`]).
     pub(in crate::sequencer) fn drivers_send_in_own_stage(
         &mut self,
         out: &mut dyn ActionSink,
@@ -99,66 +61,53 @@ impl Core {
         true
     }
 
-    /// Sends the G-code step from `from` to `to` (`feed` mm/min, `None`:
-    /// rapid; `lit`; `corner`: it ends a block) to `driver`; its request
-    /// number, `None` when it could not be sent (the session stopped).
+    /// Sends the G-code step `step` to `driver` ([`dispatch::step`]);
+    /// its request number, `None` when it could not be sent (the session
+    /// stopped).
     pub(in crate::sequencer) fn driver_step(
         &mut self,
         driver: Driver,
         step: DriverStep,
         out: &mut dyn ActionSink,
     ) -> Option<u32> {
-        match driver {
-            Driver::Gimbal => self.with_stage(out, |st, _, out| {
-                gimbal::step::send_step(st, step.from, step.to, step.feed, step.corner, out)
-            }),
-            Driver::Galvo => self.with_stage(out, |st, jobs, out| {
-                (jobs.galvo).send_step(st, step.from, step.to, step.feed, step.lit, out)
-            }),
-            // Blocks are handed over whole (`gcode_stepper_send`).
-            Driver::Stepper => None,
-        }
+        self.with_stage(out, |st, jobs, out| {
+            dispatch::step(driver, st, jobs, step, out)
+        })
     }
 
-    /// A report of the galvo loop: the G-code session's when it is (its
-    /// step done, refused, its hold's stop); else what the galvo says of
-    /// it, done by the core.
+    /// A report of the galvo loop, when it is the G-code session's (its
+    /// step done, refused, its hold's stop): `true` when it was.
     pub(in crate::sequencer) fn galvo_event(
         &mut self,
-        event: GalvoEvent,
+        event: &GalvoEvent,
         out: &mut dyn ActionSink,
-    ) {
-        match event {
-            GalvoEvent::Done { seq } if self.gcode_galvo_done(seq, out) => {}
+    ) -> bool {
+        match *event {
+            GalvoEvent::Done { seq } => self.gcode_galvo_done(seq, out),
             GalvoEvent::Refused { seq, error } if self.gcode_awaits_galvo(seq) => {
                 self.notify(out, format_args!("MSG:galvo: {error}"));
                 self.grbl_alarm(crate::grbl::Alarm::SoftLimit, out);
+                true
             }
-            GalvoEvent::Stopped(at) => self.gcode_galvo_stopped(at, out),
-            _ => {
-                let idle = self.gcode.motion.is_idle();
-                self.driver_said(galvo::points::said(event, self.run, idle), out);
+            GalvoEvent::Stopped(at) => {
+                self.gcode_galvo_stopped(at, out);
+                true
             }
+            _ => false,
         }
     }
 
-    /// A report of the stepper task: the G-code session's when it is;
-    /// else what the stepper says of it, done by the core.
+    /// A report of the stepper task, when it is the G-code session's:
+    /// `true` when it was. The end of homing is noted either way.
     pub(in crate::sequencer) fn stepper_event(
         &mut self,
-        event: StepperEvent,
+        event: &StepperEvent,
         out: &mut dyn ActionSink,
-    ) {
+    ) -> bool {
         if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
-            self.stepper_homing = false;
+            *self.stepper_homing = false;
         }
-        if self.gcode_stepper_event(&event, out) {
-            return;
-        }
-        // The run's current point, for messages.
-        let target = (self.last_aim).map_or((0.0, 0.0), |(t, _)| (t.point.x_cm, t.point.y_cm));
-        let said = stepper::points::said(event, &self.settings, self.run, target);
-        self.driver_said(said, out);
+        self.gcode_stepper_event(event, out)
     }
 
     /// Sends the pieces that continue the galvo stroke in flight.

@@ -6,16 +6,16 @@ use crate::grbl::realtime::Realtime;
 use crate::grbl::system::{RestoreScope, SystemCommand, parse_system};
 use crate::grbl::{Alarm, Block, Blocks, GrblError};
 use crate::sequencer::drivers::Driver;
-use crate::sequencer::gcode::power::Seen;
+use crate::sequencer::gcode::context::Session;
 use crate::sequencer::gcode::queue::Hold;
 use crate::sequencer::gcode::report;
 use crate::sequencer::gcode::settings::Written;
 use crate::sequencer::gcode::{GrblMode, GrblValues, NO_OVERRIDES};
-use crate::sequencer::machine::{ActionSink, Core};
+use crate::sequencer::io::ActionSink;
 use crate::settings::Settings;
 use crate::text::reply_text;
 
-impl Core {
+impl Session<'_> {
     /// A G-code or `$` line from the console: closed with `ok` (for a
     /// motion, once it is queued) or `error:N`.
     pub(in crate::sequencer) fn grbl_line(&mut self, line: &str, out: &mut dyn ActionSink) {
@@ -49,7 +49,7 @@ impl Core {
         if !blocks.iter().all(|b| self.block_reachable(b)) {
             self.gcode.parser = before;
             self.grbl_alarm(Alarm::SoftLimit, out);
-            self.ok(out);
+            report::ok(out);
             return;
         }
         self.grbl_queue(blocks, out);
@@ -59,7 +59,7 @@ impl Core {
     /// room (the `ok` then waits: back-pressure to the sender).
     fn grbl_queue(&mut self, blocks: Blocks, out: &mut dyn ActionSink) {
         if self.gcode.mode == GrblMode::Check || blocks.is_empty() {
-            return self.ok(out);
+            return report::ok(out);
         }
         self.gcode.motion.owed = Some(blocks);
         self.gcode.take_owed(out);
@@ -82,7 +82,7 @@ impl Core {
             | SystemCommand::Parameters
             | SystemCommand::ParserState
             | SystemCommand::BuildInfo
-            | SystemCommand::StartupLines => self.gcode.info(command, &self.settings, out),
+            | SystemCommand::StartupLines => self.gcode.info(command, self.settings, out),
             SystemCommand::CheckMode => return self.gcode.check_mode(idle, out),
             SystemCommand::Unlock => {
                 if self.gcode.mode == GrblMode::Alarm {
@@ -114,14 +114,14 @@ impl Core {
                 if !idle {
                     return self.grbl_error(out, GrblError::NotIdle);
                 }
-                match self.gcode.set_setting(number, value, &mut self.settings) {
+                match self.gcode.set_setting(number, value, self.settings) {
                     Ok(Written::Session) => {}
                     Ok(Written::Product) => self.configure_galvo(out),
                     Err(e) => return self.grbl_error(out, e),
                 }
             }
         }
-        self.ok(out);
+        report::ok(out);
     }
 
     /// `$H`: no switches to home on; aims at the board origin (dark) and
@@ -186,7 +186,7 @@ impl Core {
         let ov = &mut self.gcode.overrides;
         match request.command {
             Realtime::StatusReport => {
-                let text = self.gcode.status(request.rx_free_bytes, &Seen::of(self));
+                let text = self.gcode.status(request.rx_free_bytes, &self.seen());
                 self.gcode.count_report();
                 report::push(out, text);
             }

@@ -10,6 +10,20 @@ use crate::grbl::{ParserState, SpindleMode};
 use crate::sequencer::gcode::queue::Motion;
 use crate::settings::{LaserMode, Settings};
 
+/// RAM the G-code path adds, bytes (host layout): the sequencer's grbl
+/// session with its motion queue, the drivers' G-code state, the
+/// realtime command queue and the console's RX buffer.
+pub const GCODE_RAM_BYTES: usize = core::mem::size_of::<GcodeSession>()
+    + core::mem::size_of::<crate::sequencer::drivers::DriverJobs>()
+    + core::mem::size_of::<
+        embassy_sync::channel::Channel<
+            embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex,
+            crate::command::RealtimeRequest,
+            { crate::command::REALTIME_QUEUE_DEPTH },
+        >,
+    >()
+    + crate::grbl::RX_BUFFER_BYTES;
+
 /// grbl's RX buffer as `$I` advertises it, bytes.
 pub(in crate::sequencer) const RX_BUFFER_BYTES: u16 = crate::grbl::RX_BUFFER_BYTES as u16;
 
@@ -128,6 +142,7 @@ fn product_param(number: u16) -> Option<(&'static str, f64)> {
     }
 }
 
+pub(in crate::sequencer) mod context;
 pub(in crate::sequencer) mod drive;
 pub(in crate::sequencer) mod lines;
 pub(in crate::sequencer) mod motion;

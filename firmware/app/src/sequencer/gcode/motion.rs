@@ -1,40 +1,16 @@
 //! Running the motion queue: blocks started, held, resumed, aborted.
 
-use crate::grbl::{Block, PointMm, SpindleMode};
+use crate::grbl::{Block, SpindleMode};
 use crate::sequencer::drivers::{Driver, Drivers};
 use crate::sequencer::gcode::GcodeSession;
-use crate::sequencer::gcode::queue::{Current, Hold, MAX_STEPS, block_end, cm, point_at};
+use crate::sequencer::gcode::context::Session;
+use crate::sequencer::gcode::queue::{Current, Hold, MAX_STEPS};
+use crate::sequencer::gcode::report;
+use crate::sequencer::io::{Action, ActionSink};
 use crate::sequencer::laser::LaserEvent;
-use crate::sequencer::machine::{Action, ActionSink, Core};
 use embassy_time::Duration;
 
-impl Core {
-    /// Whether every point of `block` is within grbl's soft limits: on
-    /// the board (`$130` × `$131` about its centre) and within the reach
-    /// of the actuator(s) (end points, and arcs along their sweep).
-    pub(in crate::sequencer) fn block_reachable(&self, block: &Block) -> bool {
-        self.surely_reachable(block) || self.block_reachable_exactly(block)
-    }
-
-    /// [`Self::block_reachable`] point by point through the drivers' exact
-    /// checks.
-    pub(in crate::sequencer) fn block_reachable_exactly(&self, block: &Block) -> bool {
-        let Some(end) = block_end(block) else {
-            return true;
-        };
-        let [width_mm, height_mm] = self.settings.board_size_mm();
-        let (half_width_mm, half_height_mm) = (0.5 * width_mm, 0.5 * height_mm);
-        let reachable = |p: PointMm| {
-            let on_board = libm::fabs(p.x_mm) <= half_width_mm + 1e-9
-                && libm::fabs(p.y_mm) <= half_height_mm + 1e-9;
-            on_board && self.drivers_reach(cm(p))
-        };
-        match block {
-            Block::Arc { .. } => (0..=16).all(|k| reachable(point_at(block, k, 16))),
-            _ => reachable(end),
-        }
-    }
-
+impl Session<'_> {
     /// Starts the next block when nothing runs (and no hold), skipping
     /// blocks with nothing to move.
     pub(in crate::sequencer) fn grbl_advance(&mut self, out: &mut dyn ActionSink) {
@@ -65,7 +41,7 @@ impl Core {
                         .now
                         .saturating_add(Duration::from_micros((seconds.max(0.0) * 1e6) as u64));
                     let g = &mut self.gcode;
-                    g.motion.gimbal_lit = g.lit(laser.mode, laser.power, &self.settings)
+                    g.motion.gimbal_lit = g.lit(laser.mode, laser.power, self.settings)
                         && laser.mode == SpindleMode::Constant;
                     g.motion.current = Some(g.new_current(block, 0));
                     if let Some(c) = self.gcode.motion.current.as_mut() {
@@ -153,7 +129,7 @@ impl Core {
         };
         c.cancelled = true;
         if c.galvo_seq.take().is_some() {
-            crate::sequencer::drivers::stage::stop_galvo(&mut self.inputs, out);
+            crate::sequencer::drivers::stage::stop_galvo(self.inputs, out);
             self.gcode_step_done(out);
         }
     }
@@ -164,7 +140,7 @@ impl Core {
         self.jobs.gimbal.clear();
         self.jobs.stepper.clear();
         if self.gcode.motion.clear() {
-            self.ok(out);
+            report::ok(out);
         }
         self.jobs.galvo.hold_dropped();
         self.gcode.sync_position();

@@ -18,7 +18,6 @@ use crate::sequencer::drivers::{Driver, DriverJobs, Drivers};
 use crate::sequencer::gcode::GcodeSession;
 use crate::sequencer::gcode::queue::Hold;
 use crate::sequencer::laser::LaserPower;
-use crate::sequencer::machine::Core;
 use crate::settings::{LaserMode, Settings};
 use embassy_time::Instant;
 
@@ -47,20 +46,6 @@ pub(in crate::sequencer) struct Seen<'a> {
     pub(in crate::sequencer) stepper_homing: bool,
     /// The laser controls' door substate (`None`: not held by them).
     pub(in crate::sequencer) door: Option<u8>,
-}
-
-impl<'a> Seen<'a> {
-    /// What `core` shows the session now.
-    pub(in crate::sequencer) fn of(core: &'a Core) -> Self {
-        Self {
-            settings: &core.settings,
-            jobs: &core.jobs,
-            drivers: core.drivers(),
-            laser: core.laser_on.then_some(core.laser_power),
-            stepper_homing: core.stepper_homing,
-            door: core.door_substate(),
-        }
-    }
 }
 
 impl GcodeSession {
@@ -131,11 +116,13 @@ impl GcodeSession {
     /// last event; under M3 nothing changes then), else `None`.
     pub(in crate::sequencer) fn stepper_power_tick(
         &self,
-        seen: &Seen<'_>,
+        settings: &Settings,
+        jobs: &DriverJobs,
+        drivers: Drivers,
         now: Instant,
     ) -> Option<Instant> {
-        let lit = seen.drivers.any(Driver::polls_speed) && self.gimbal_lit(seen.settings);
-        (lit && seen.jobs.stepper.is_moving())
+        let lit = drivers.any(Driver::polls_speed) && self.gimbal_lit(settings);
+        (lit && jobs.stepper.is_moving())
             .then(|| now + embassy_time::Duration::from_millis(STREAM_PERIOD_MS))
     }
 

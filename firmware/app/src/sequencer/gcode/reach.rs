@@ -26,11 +26,12 @@
 //! The property test in `reach_tests.rs` checks this against the exact
 //! check over random points, lines and arcs.
 
+use crate::domain::Aimer;
 use crate::grbl::{Block, PointMm};
-use crate::sequencer::drivers::Driver;
+use crate::sequencer::drivers::{Driver, Drivers};
 use crate::sequencer::gcode::proven::{ProvenReach, SCALES};
-use crate::sequencer::gcode::queue::{block_end, cm};
-use crate::sequencer::machine::Core;
+use crate::sequencer::gcode::queue::{block_end, cm, point_at};
+use crate::settings::Settings;
 
 /// How much larger than it is used a rectangle is proven, mm.
 const MARGIN_MM: f64 = 1e-3;
@@ -65,7 +66,51 @@ fn slot(driver: Driver) -> usize {
     }
 }
 
-impl Core {
+/// grbl's soft-limit check with the settings and geometry given.
+#[derive(Clone, Copy)]
+pub(in crate::sequencer) struct ReachCheck<'a> {
+    /// The product's settings (board extent, limits).
+    settings: &'a Settings,
+    /// Their geometry.
+    aimer: &'a Aimer,
+}
+
+impl<'a> ReachCheck<'a> {
+    /// The check with `settings` and their geometry `aimer`.
+    pub(in crate::sequencer) fn new(settings: &'a Settings, aimer: &'a Aimer) -> Self {
+        Self { settings, aimer }
+    }
+
+    /// Whether every point of `block` is within grbl's soft limits for
+    /// `drivers`: on the board (`$130` × `$131` about its centre) and
+    /// within the reach of the actuator(s) (end points, and arcs along
+    /// their sweep). `proven`: the rectangles [`Self::prove`] found.
+    pub(in crate::sequencer) fn block(
+        &self,
+        block: &Block,
+        drivers: Drivers,
+        proven: ProvenReach,
+    ) -> bool {
+        self.surely(block, drivers, proven) || self.exactly(block, drivers)
+    }
+
+    /// [`Self::block`] point by point through the drivers' exact checks.
+    pub(in crate::sequencer) fn exactly(&self, block: &Block, drivers: Drivers) -> bool {
+        let Some(end) = block_end(block) else {
+            return true;
+        };
+        let [half_width_mm, half_height_mm] = self.half_board_mm();
+        let reachable = |p: PointMm| {
+            let on_board = libm::fabs(p.x_mm) <= half_width_mm + 1e-9
+                && libm::fabs(p.y_mm) <= half_height_mm + 1e-9;
+            on_board && drivers.reach(self.aimer, self.settings, cm(p))
+        };
+        match block {
+            Block::Arc { .. } => (0..=16).all(|k| reachable(point_at(block, k, 16))),
+            _ => reachable(end),
+        }
+    }
+
     /// Half the board's extent (`$130` × `$131`), mm.
     fn half_board_mm(&self) -> [f64; 2] {
         self.settings.board_size_mm().map(|mm| 0.5 * mm)
@@ -84,7 +129,7 @@ impl Core {
     /// current settings (board extent, geometry, limits), each the
     /// largest of [`SCALES`] that passes.
     #[inline(never)]
-    pub(in crate::sequencer) fn prove_reach(&self) -> ProvenReach {
+    pub(in crate::sequencer) fn prove(&self) -> ProvenReach {
         let half = self.half_board_mm();
         let mut proven = ProvenReach::NONE;
         if !half.iter().all(|h| h.is_finite() && *h > 0.0) {
@@ -114,7 +159,7 @@ impl Core {
                 (zero_model && g.frame.oq_cm + g.frame.pose.dx_cm > g.ol_cm).then_some(g.frame)?
             }
             Driver::Stepper => {
-                crate::sequencer::drivers::stepper::config(&self.settings)
+                crate::sequencer::drivers::stepper::config(self.settings)
                     .gimbal
                     .geometry
                     .frame
@@ -133,7 +178,7 @@ impl Core {
         let lo = [b.lo[0] - MARGIN_MM, b.lo[1] - MARGIN_MM];
         let hi = [b.hi[0] + MARGIN_MM, b.hi[1] + MARGIN_MM];
         let reaches = |x_mm: f64, y_mm: f64| {
-            driver.reaches(&self.aimer, &self.settings, cm(PointMm { x_mm, y_mm }))
+            driver.reaches(self.aimer, self.settings, cm(PointMm { x_mm, y_mm }))
         };
         let inside = |v: f64, i: usize| v > lo[i] && v < hi[i];
         let corners = [lo[0], hi[0]]
@@ -152,7 +197,12 @@ impl Core {
     /// in the proven rectangle of every driver that draws (then the board
     /// and reach checks pass: the rectangles lie on the board). An arc:
     /// its end, and the circle about its centre through its start.
-    pub(in crate::sequencer) fn surely_reachable(&self, block: &Block) -> bool {
+    pub(in crate::sequencer) fn surely(
+        &self,
+        block: &Block,
+        drivers: Drivers,
+        proven: ProvenReach,
+    ) -> bool {
         let Some(end) = block_end(block) else {
             return false;
         };
@@ -166,8 +216,8 @@ impl Core {
             }
             _ => None,
         };
-        self.drivers().iter().all(|d| {
-            self.reach.scale(slot(d)).is_some_and(|k| {
+        drivers.iter().all(|d| {
+            proven.scale(slot(d)).is_some_and(|k| {
                 let b = self.board_box(k);
                 b.contains(end) && circle.is_none_or(|(c, r)| b.contains_square(c, r))
             })

@@ -4,6 +4,7 @@
 use crate::domain::Actuator;
 use crate::grbl::block::Arc;
 use crate::grbl::{Block, Laser, PointMm};
+use crate::sequencer::gcode::reach::ReachCheck;
 use crate::sequencer::machine::Core;
 use crate::settings::find_param;
 use embassy_time::Instant;
@@ -48,6 +49,29 @@ fn core(variant: usize, actuator: Actuator) -> Core {
     core.geometry_changed();
     core.actuator = actuator;
     core
+}
+
+/// The soft-limit check `core` runs with: (fast path, exact check, the
+/// check) of a block.
+struct Check<'a>(&'a Core);
+
+impl Check<'_> {
+    fn inner(&self) -> ReachCheck<'_> {
+        ReachCheck::new(&self.0.settings, &self.0.aimer)
+    }
+    fn surely(&self, b: &Block) -> bool {
+        self.inner().surely(b, self.0.drivers(), self.0.reach)
+    }
+    fn exactly(&self, b: &Block) -> bool {
+        self.inner().exactly(b, self.0.drivers())
+    }
+    fn block(&self, b: &Block) -> bool {
+        self.inner().block(b, self.0.drivers(), self.0.reach)
+    }
+}
+
+fn check(core: &Core) -> Check<'_> {
+    Check(core)
 }
 
 fn point(x_mm: f64, y_mm: f64) -> PointMm {
@@ -110,10 +134,10 @@ proptest! {
     ) {
         let core = core(variant, ACTUATORS[actuator]);
         let b = make(&core, f, arc);
-        if core.surely_reachable(&b) {
-            prop_assert!(core.block_reachable_exactly(&b), "{b:?}");
+        if check(&core).surely(&b) {
+            prop_assert!(check(&core).exactly(&b), "{b:?}");
         }
-        prop_assert_eq!(core.block_reachable(&b), core.block_reachable_exactly(&b));
+        prop_assert_eq!(check(&core).block(&b), check(&core).exactly(&b));
     }
 }
 
@@ -134,8 +158,8 @@ fn the_fast_path_passes_most_blocks_on_the_board() {
                 let f = [next(), next(), next(), next()];
                 let arc = (next() > 0.0).then(|| (0.1 + 0.2 * next(), 6.0 * next(), next() > 0.0));
                 let b = make(&core, [f[0] * 0.4, f[1] * 0.4, f[2] * 0.4, f[3] * 0.4], arc);
-                fast += u32::from(core.surely_reachable(&b));
-                exact += u32::from(core.block_reachable_exactly(&b));
+                fast += u32::from(check(&core).surely(&b));
+                exact += u32::from(check(&core).exactly(&b));
             }
             std::println!("variant {variant} {actuator:?}: {fast} of {exact}");
             // Blocks within the middle 40 % of the board (arcs may leave
@@ -153,8 +177,8 @@ fn the_fast_path_passes_most_blocks_on_the_board() {
 fn a_rolled_board_takes_the_exact_check() {
     let core = core(VARIANTS.len() - 1, Actuator::Gimbal);
     let b = block(PointMm::ZERO, point(1.0, 1.0), None);
-    assert!(!core.surely_reachable(&b));
-    assert!(core.block_reachable(&b));
+    assert!(!check(&core).surely(&b));
+    assert!(check(&core).block(&b));
 }
 
 #[test]
@@ -163,14 +187,14 @@ fn off_the_board_is_never_sure() {
         let core = core(0, actuator);
         let [w, h] = half_board_mm(&core);
         let inside = block(PointMm::ZERO, point(w * 0.5, h * 0.5), None);
-        assert!(core.surely_reachable(&inside), "{actuator:?}");
+        assert!(check(&core).surely(&inside), "{actuator:?}");
         let off = block(PointMm::ZERO, point(w * 1.01, 0.0), None);
-        assert!(!core.surely_reachable(&off), "{actuator:?}");
-        assert!(!core.block_reachable(&off), "{actuator:?}");
+        assert!(!check(&core).surely(&off), "{actuator:?}");
+        assert!(!check(&core).block(&off), "{actuator:?}");
         // An arc whose circle leaves the board though its ends do not.
         let r = h * 1.2;
         assert!(r < w);
         let bulge = block(point(r, 0.0), point(-r, 0.0), Some((PointMm::ZERO, true)));
-        assert!(!core.surely_reachable(&bulge), "{actuator:?}");
+        assert!(!check(&core).surely(&bulge), "{actuator:?}");
     }
 }

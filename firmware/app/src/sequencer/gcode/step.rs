@@ -1,17 +1,19 @@
 //! The G-code step in flight: the drivers that draw get it through the
-//! driver interface ([`Core::gcode_send_step`]: a driver's own stage, or
-//! [`Core::driver_step`] for each), and report it done (servo arrival,
+//! driver interface ([`Session::gcode_send_step`]: a driver's own stage, or
+//! [`Session::driver_step`] for each), and report it done (servo arrival,
 //! galvo job done, dwell end; each driver's side in `drivers/`); then the
 //! next step, block or hold follows.
 
 use crate::grbl::Block;
-use crate::sequencer::drivers::{Arrival, DriverStep};
-use crate::sequencer::gcode::power::Seen;
+use crate::sequencer::drivers::{Arrival, DriverJobs, DriverStep, Drivers};
+use crate::sequencer::gcode::GcodeSession;
+use crate::sequencer::gcode::context::Session;
 use crate::sequencer::gcode::queue::{Hold, point_at};
-use crate::sequencer::machine::{ActionSink, Core};
+use crate::sequencer::io::ActionSink;
+use crate::settings::Settings;
 use embassy_time::Instant;
 
-impl Core {
+impl Session<'_> {
     /// Sends the current step to every actuator that draws.
     pub(in crate::sequencer) fn gcode_send_step(&mut self, out: &mut dyn ActionSink) {
         if self.drivers_send_in_own_stage(out) {
@@ -30,7 +32,7 @@ impl Core {
                 feed_mm_min, laser, ..
             } => (
                 Some(feed_mm_min),
-                self.gcode.lit(laser.mode, laser.power, &self.settings),
+                self.gcode.lit(laser.mode, laser.power, self.settings),
             ),
             Block::Jog { feed_mm_min, .. } => (Some(feed_mm_min), false),
             _ => (None, false),
@@ -73,7 +75,7 @@ impl Core {
     }
 
     /// When the dwell deadline passed: the dwell block is done.
-    fn gcode_dwell_check(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn gcode_dwell_check(&mut self, out: &mut dyn ActionSink) {
         let now = self.inputs.now;
         let Some(c) = self.gcode.motion.current.as_mut() else {
             return;
@@ -92,26 +94,6 @@ impl Core {
             self.gcode.motion.gimbal_lit = false;
             self.gcode_step_done(out);
         }
-    }
-
-    /// `run_deadline` (a run's dwell), or when the G-code dwell or settle
-    /// ends.
-    pub(in crate::sequencer) fn gcode_deadline_or(
-        &self,
-        run_deadline: Option<Instant>,
-    ) -> Option<Instant> {
-        run_deadline
-            .or(self.gcode.motion.current.and_then(|c| c.until))
-            .or_else(|| {
-                self.gcode
-                    .stepper_power_tick(&Seen::of(self), self.inputs.now)
-            })
-    }
-
-    /// The dwell deadline passed: a run's dwell, or the G-code step's.
-    pub(in crate::sequencer) fn dwell_ended(&mut self, out: &mut dyn ActionSink) {
-        self.dwell_finished(out);
-        self.gcode_dwell_check(out);
     }
 
     /// Every actuator finished the step in flight: the next step, the next
@@ -145,4 +127,18 @@ impl Core {
     }
 }
 
-impl Core {}
+impl GcodeSession {
+    /// `run_deadline` (a run's dwell), or when the G-code dwell or settle
+    /// ends, or the next M4 power tick of a driver polled for its speed
+    /// ([`GcodeSession::stepper_power_tick`]; `now`: the event's time).
+    pub(in crate::sequencer) fn deadline_or(
+        &self,
+        run_deadline: Option<Instant>,
+        (settings, jobs, drivers): (&Settings, &DriverJobs, Drivers),
+        now: Instant,
+    ) -> Option<Instant> {
+        run_deadline
+            .or(self.motion.current.and_then(|c| c.until))
+            .or_else(|| self.stepper_power_tick(settings, jobs, drivers, now))
+    }
+}

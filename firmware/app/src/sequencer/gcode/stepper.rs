@@ -5,12 +5,13 @@
 
 use crate::grbl::{Alarm, GrblError};
 use crate::sequencer::drivers::stepper::gcode::StepperReport;
+use crate::sequencer::gcode::context::Session;
 use crate::sequencer::gcode::report;
 use crate::sequencer::gcode::{GcodeSession, GrblMode};
-use crate::sequencer::machine::{ActionSink, Core};
+use crate::sequencer::io::ActionSink;
 use crate::stepper::{HomingFailure, StepperEvent};
 
-impl Core {
+impl Session<'_> {
     /// Hands the current block to the stepper (or waits for rest first).
     pub(in crate::sequencer) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
         self.with_stage(out, |st, jobs, out| jobs.stepper.send(st, out));

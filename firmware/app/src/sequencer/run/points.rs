@@ -1,14 +1,16 @@
 //! Running a pattern or goto point by point on the drivers that draw.
 
 use crate::domain::{AimModel, PathCursor, Pattern, Target};
+use crate::galvo::GalvoEvent;
 use crate::log;
-use crate::sequencer::drivers::{Arrival, Driver, PathRun, Said, galvo, gimbal, stepper};
+use crate::sequencer::drivers::dispatch::aim;
+use crate::sequencer::drivers::{Arrival, PathRun, Said, galvo, stepper};
 use crate::sequencer::laser::LaserEvent;
 use crate::sequencer::machine::{Action, ActionSink, Core, Line};
 use crate::sequencer::run::{Run, RunKind, Start};
 use crate::servo::task::ServoOutcome;
 use crate::status::Phase;
-use crate::stepper::StepperRequest;
+use crate::stepper::StepperEvent;
 use embassy_time::Duration;
 
 impl Core {
@@ -19,7 +21,7 @@ impl Core {
             Start::Pattern { pattern, once } => (pattern.name(), once),
         };
         log::info!("start {} (once={})", name, once);
-        self.gcode_abort(out);
+        self.session().gcode_abort(out);
         out.act(Action::Note(LaserEvent::RunStarted));
         // Nothing of an earlier run may shine: a new gate generation, and
         // the galvo drops its points and an underrun latch; the stepper
@@ -73,17 +75,9 @@ impl Core {
         PathCursor::start(pattern, &self.aimer)?.ok()
     }
 
-    /// Stops whatever runs — and, whatever the core thinks runs, the laser
-    /// and the galvo loop: the gate closes at once and the loop gets
-    /// `Stop`.
+    /// Stops whatever runs ([`Session::stop`](crate::sequencer::gcode::context::Session::stop)).
     pub(in crate::sequencer) fn stop(&mut self, why: &'static str, out: &mut dyn ActionSink) {
-        out.act(Action::Note(LaserEvent::Stopped { why }));
-        self.close_gate(out);
-        stepper::points::stop(self.drivers(), out);
-        if let Some(run) = self.run.take() {
-            log::info!("stop {} ({})", run.kind.name(), why);
-        }
-        self.gcode_abort(out);
+        self.session().stop(why, out);
     }
 
     /// The target of the current point of the run (`None`: past the last
@@ -105,7 +99,8 @@ impl Core {
     pub(in crate::sequencer) fn begin_point(&mut self, out: &mut dyn ActionSink) {
         let Some(run) = self.run else { return };
         if let RunKind::Marked { pattern, .. } = run.kind {
-            self.with_stage(out, |st, _, out| galvo::points::mark(st, pattern, out));
+            self.session()
+                .with_stage(out, |st, _, out| galvo::points::mark(st, pattern, out));
             return;
         }
         let Some(target) = self.current_target() else {
@@ -120,7 +115,8 @@ impl Core {
         let approach = holds || (run.index == 0 && !closed);
         let (mut moves, mut jobs) = (false, false);
         for driver in self.drivers().iter() {
-            if !self.driver_aim(driver, target, approach, out) {
+            let mut session = self.session();
+            if !session.with_stage(out, |st, _, out| aim(driver, st, target, approach, out)) {
                 return;
             }
             match driver.arrival() {
@@ -141,26 +137,6 @@ impl Core {
             run.galvo_busy = jobs && !holds;
         }
         self.point_finished_if_done(out);
-    }
-
-    /// Aims `driver` at a pattern's current point `target` (`approach`:
-    /// travel, dark); `false` when it could not (the run stopped).
-    fn driver_aim(
-        &mut self,
-        d: Driver,
-        target: Target,
-        approach: bool,
-        out: &mut dyn ActionSink,
-    ) -> bool {
-        match d {
-            Driver::Gimbal => {
-                self.with_stage(out, |st, _, out| gimbal::points::aim(st, target, out))
-            }
-            Driver::Stepper => self.with_stage(out, |st, _, out| {
-                stepper::points::aim(st, target, approach, out)
-            }),
-            Driver::Galvo => self.with_stage(out, |st, _, out| galvo::points::aim(st, target, out)),
-        }
     }
 
     /// The point of the running pattern is re-aimed (`model`): a driver
@@ -191,23 +167,38 @@ impl Core {
             Said::Notice(text) => notice(out, text),
             Said::Homed(text, steps, failed) => {
                 notice(out, text);
-                self.gcode_homing_done(steps, failed, out);
+                self.session().gcode_homing_done(steps, failed, out);
             }
         }
     }
 
-    /// `home` / `$H` on the stepper: any run stops (laser dark), then the
-    /// stepper task homes the axes with switches; `homed: …` or `error:
-    /// home failed: …` follows. Errors: [`stepper::points::can_home`].
-    pub(in crate::sequencer) fn start_homing(
+    /// A report of the galvo loop: the G-code session's first, else what
+    /// it says of the run.
+    pub(in crate::sequencer) fn galvo_event(
         &mut self,
+        event: GalvoEvent,
         out: &mut dyn ActionSink,
-    ) -> Result<(), &'static str> {
-        stepper::points::can_home(self.drivers(), &self.settings)?;
-        self.stop("home", out);
-        out.act(Action::Stepper(StepperRequest::Home));
-        self.stepper_homing = true;
-        Ok(())
+    ) {
+        if !self.session().galvo_event(&event, out) {
+            let idle = self.gcode.motion.is_idle();
+            self.driver_said(galvo::points::said(event, self.run, idle), out);
+        }
+    }
+
+    /// A report of the stepper task: the G-code session's first, else
+    /// what it says of the run.
+    pub(in crate::sequencer) fn stepper_event(
+        &mut self,
+        event: StepperEvent,
+        out: &mut dyn ActionSink,
+    ) {
+        if self.session().stepper_event(&event, out) {
+            return;
+        }
+        // The run's current point, for messages.
+        let target = (self.last_aim).map_or((0.0, 0.0), |(t, _)| (t.point.x_cm, t.point.y_cm));
+        let said = stepper::points::said(event, &self.settings, self.run, target);
+        self.driver_said(said, out);
     }
 
     /// The servo task's report.
@@ -216,7 +207,7 @@ impl Core {
         outcome: ServoOutcome,
         out: &mut dyn ActionSink,
     ) {
-        let gcode_fault = self.gcode_servo_outcome(&outcome, out);
+        let gcode_fault = self.session().gcode_servo_outcome(&outcome, out);
         match outcome {
             ServoOutcome::Recovered { id } => self.servo_recovered(id, out),
             ServoOutcome::Arrived {

@@ -6,7 +6,7 @@ use crate::galvo::{GalvoEvent, GalvoRequest};
 use crate::log;
 use crate::sequencer::drivers::Said;
 use crate::sequencer::drivers::galvo::{HOLD_US, config_from};
-use crate::sequencer::drivers::stage::Stage;
+use crate::sequencer::drivers::stage::{Stage, StopAsked};
 use crate::sequencer::io::{Action, ActionSink, GalvoReadout, Inputs, Line};
 use crate::sequencer::run::{Run, RunKind};
 use crate::settings::{LaserMode, Settings};
@@ -61,7 +61,10 @@ pub(in crate::sequencer) fn aim(st: &mut Stage, target: Target, out: &mut dyn Ac
 pub(in crate::sequencer) fn mark(st: &mut Stage, pattern: Pattern, out: &mut dyn ActionSink) {
     allow_laser(*st.run, st.settings, st.inputs, out);
     let Some(path) = pattern.figure() else {
-        st.then = Said::Stop(None, "not a path");
+        st.stop = Some(StopAsked {
+            notice: None,
+            why: "not a path",
+        });
         return;
     };
     if !send_job(

@@ -3,15 +3,14 @@
 
 use crate::domain::Target;
 use crate::log;
-use crate::sequencer::drivers::Said;
 use crate::sequencer::drivers::gimbal::step::{interval_ms, servo_move};
-use crate::sequencer::drivers::stage::Stage;
+use crate::sequencer::drivers::stage::{Stage, StopAsked};
 use crate::sequencer::io::ActionSink;
 use crate::text::{Fixed, reply_text};
 
 /// Aims the gimbal at the run's current point `target` and sends the
 /// servo move; `false` on an unreachable target (the run stops with an
-/// error notice: [`Stage::then`]).
+/// error notice: [`Stage::stop`]).
 pub(in crate::sequencer) fn aim(st: &mut Stage, target: Target, out: &mut dyn ActionSink) -> bool {
     let aim = match st.aimer.aim(target.point) {
         Ok(aim) => aim,
@@ -27,7 +26,10 @@ pub(in crate::sequencer) fn aim(st: &mut Stage, target: Target, out: &mut dyn Ac
                 Fixed::<2>(target.point.y_cm),
                 why
             ));
-            st.then = Said::Stop(Some(notice), "unreachable target");
+            st.stop = Some(StopAsked {
+                notice: Some(notice),
+                why: "unreachable target",
+            });
             return false;
         }
     };

@@ -4,7 +4,7 @@
 //! seed's point-by-point interpolation joined by board lines), its
 //! arrivals back into the dwell, its refusals into an error and a stop,
 //! a stop into a deceleration at the limit (the laser dark at once:
-//! [`Core::stop`] closes the gate first). The stop button halts the steps
+//! [`Session::stop`](crate::sequencer::gcode::context::Session::stop) closes the gate first). The stop button halts the steps
 //! at once through the link itself.
 
 use crate::domain::{Aim, Pattern, PointCm, Segment, Target, Unit};
