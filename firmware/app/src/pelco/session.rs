@@ -174,8 +174,10 @@ impl Session {
             });
             let from = point(m.planned, view.oq_cm);
             let to = point(next, view.oq_cm);
-            let chord_mm =
-                10.0 * kinematics_core::numeric::hypot(to.x_cm - from.x_cm, to.y_cm - from.y_cm);
+            let chord_mm = crate::domain::units::mm_from_cm(kinematics_core::numeric::hypot(
+                to.x_cm - from.x_cm,
+                to.y_cm - from.y_cm,
+            ));
             if chord_mm < 1e-3 {
                 // At the limit: nothing to queue, held until a stop.
                 m.planned_until_ms = view.now_ms + LEAD_MS;
@@ -245,8 +247,8 @@ fn jog_line(to: PointCm, feed_mm_min: f64) -> Option<GrblLine> {
     write!(
         text,
         "$J=G53G90G21X{}Y{}F{}",
-        Fixed::<3>(to.x_cm * 10.0),
-        Fixed::<3>(to.y_cm * 10.0),
+        Fixed::<3>(crate::domain::units::mm_from_cm(to.x_cm)),
+        Fixed::<3>(crate::domain::units::mm_from_cm(to.y_cm)),
         Fixed::<3>(feed_mm_min)
     )
     .ok()?;

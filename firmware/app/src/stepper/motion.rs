@@ -292,8 +292,10 @@ impl StepperMotion {
                 self.line = None;
                 break;
             };
-            let length_mm =
-                10.0 * kinematics_core::numeric::hypot(b.x_cm - a.x_cm, b.y_cm - a.y_cm);
+            let length_mm = crate::domain::units::mm_from_cm(kinematics_core::numeric::hypot(
+                b.x_cm - a.x_cm,
+                b.y_cm - a.y_cm,
+            ));
             if self
                 .push_to(end, cut.feed_mm_s.map(|f| (f, length_mm)))
                 .is_err()

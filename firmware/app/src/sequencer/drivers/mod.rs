@@ -17,6 +17,7 @@
 //! actuator is a new variant here, its answers in these `match`es, its
 //! files, and its link in the shell (ARCHITECTURE.md, "Adding a driver").
 
+use crate::domain::units::mm_from_cm;
 use crate::domain::{Actuator, Aimer, PointCm};
 use crate::grbl::PointMm;
 use crate::settings::Settings;
@@ -125,6 +126,45 @@ impl Driver {
             Driver::Galvo => aimer.galvo_in_range(p),
             Driver::Stepper => stepper::reaches(settings, p),
         }
+    }
+
+    /// Every driver, in the order of [`Driver::slot`].
+    pub(in crate::sequencer) const ALL: [Driver; 3] =
+        [Driver::Gimbal, Driver::Stepper, Driver::Galvo];
+
+    /// Its slot in a per-driver table (the soft-limit check's proven
+    /// rectangles).
+    pub(in crate::sequencer) const fn slot(self) -> usize {
+        match self {
+            Driver::Gimbal => 0,
+            Driver::Stepper => 1,
+            Driver::Galvo => 2,
+        }
+    }
+
+    /// The board point (mm) where its reach limits may turn along a
+    /// rectangle's edges (the soft-limit check's proof,
+    /// `sequencer/gcode/reach.rs`), or `None` when the geometry is not one
+    /// the proof covers (board roll, an error model, a board nearer than
+    /// OL).
+    pub(in crate::sequencer) fn monotone_axis(
+        self,
+        settings: &Settings,
+        aimer: &Aimer,
+    ) -> Option<PointMm> {
+        let frame = match self {
+            Driver::Galvo => return Some(PointMm::ZERO),
+            Driver::Gimbal => {
+                let g = &aimer.gimbal().geometry;
+                let zero_model = *aimer.error_model() == kinematics_core::ErrorModel::default();
+                (zero_model && g.frame.oq_cm + g.frame.pose.dx_cm > g.ol_cm).then_some(g.frame)?
+            }
+            Driver::Stepper => stepper::config(settings).gimbal.geometry.frame,
+        };
+        (frame.pose.roll_deg == 0.0).then_some(PointMm {
+            x_mm: mm_from_cm(frame.pose.dy_cm - frame.x_offset_cm),
+            y_mm: mm_from_cm(-frame.pose.dz_cm - frame.y_offset_cm),
+        })
     }
 
     /// Its highest marking feed, mm/min (unlimited: infinity).

@@ -174,7 +174,7 @@ impl GcodeSession {
         if matches!(block, Block::Arc { .. }) && drivers.any(Driver::takes_arcs_whole) {
             return 1;
         }
-        let step_mm = (path_step_cm * 10.0).max(0.01);
+        let step_mm = crate::domain::units::mm_from_cm(path_step_cm).max(0.01);
         let gimbal = drivers.any(Driver::steps_lines);
         let steps =
             |length_mm: f64| libm::ceil(length_mm / step_mm).clamp(1.0, MAX_STEPS as f64) as u32;

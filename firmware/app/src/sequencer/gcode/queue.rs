@@ -18,6 +18,7 @@
 //! goes on from that point ([`crate::sequencer::drivers::galvo`]).
 
 use crate::domain::PointCm;
+use crate::domain::units::cm_from_mm;
 use crate::grbl::report::Overrides;
 use crate::grbl::{Block, Blocks, PointMm};
 use crate::sequencer::drivers::gimbal::Stream;
@@ -187,7 +188,7 @@ pub(in crate::sequencer) fn block_point(block: &Block, t: f64) -> PointMm {
 }
 
 pub(in crate::sequencer) fn cm(p: PointMm) -> PointCm {
-    PointCm::new(p.x_mm / 10.0, p.y_mm / 10.0)
+    PointCm::new(cm_from_mm(p.x_mm), cm_from_mm(p.y_mm))
 }
 
 /// Shorter blocks are not planned (nothing to move).

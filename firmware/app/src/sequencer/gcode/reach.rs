@@ -57,15 +57,6 @@ impl BoxMm {
     }
 }
 
-/// The driver's slot in [`ProvenReach`].
-fn slot(driver: Driver) -> usize {
-    match driver {
-        Driver::Gimbal => 0,
-        Driver::Stepper => 1,
-        Driver::Galvo => 2,
-    }
-}
-
 /// grbl's soft-limit check with the settings and geometry given.
 #[derive(Clone, Copy)]
 pub(in crate::sequencer) struct ReachCheck<'a> {
@@ -135,42 +126,16 @@ impl<'a> ReachCheck<'a> {
         if !half.iter().all(|h| h.is_finite() && *h > 0.0) {
             return proven;
         }
-        for driver in [Driver::Gimbal, Driver::Stepper, Driver::Galvo] {
-            let Some(axis) = self.monotone_axis(driver) else {
+        for driver in Driver::ALL {
+            let Some(axis) = driver.monotone_axis(self.settings, self.aimer) else {
                 continue;
             };
             let scale =
                 (0..SCALES.len()).find(|&k| self.proves(driver, self.board_box(SCALES[k]), axis));
-            proven = proven.with(slot(driver), scale);
+            proven = proven.with(driver.slot(), scale);
         }
         proven
     }
-    /// The board point (mm) where `driver`'s limits may turn along a
-    /// rectangle's edges (module docs), or `None` when the geometry is
-    /// not one the proof covers.
-    fn monotone_axis(&self, driver: Driver) -> Option<PointMm> {
-        let frame = match driver {
-            Driver::Galvo => return Some(PointMm::ZERO),
-            Driver::Gimbal => {
-                let gimbal = self.aimer.gimbal();
-                let g = &gimbal.geometry;
-                let zero_model =
-                    *self.aimer.error_model() == kinematics_core::ErrorModel::default();
-                (zero_model && g.frame.oq_cm + g.frame.pose.dx_cm > g.ol_cm).then_some(g.frame)?
-            }
-            Driver::Stepper => {
-                crate::sequencer::drivers::stepper::config(self.settings)
-                    .gimbal
-                    .geometry
-                    .frame
-            }
-        };
-        (frame.pose.roll_deg == 0.0).then_some(PointMm {
-            x_mm: 10.0 * (frame.pose.dy_cm - frame.x_offset_cm),
-            y_mm: 10.0 * (-frame.pose.dz_cm - frame.y_offset_cm),
-        })
-    }
-
     /// Whether `driver` reaches every point of `b` grown by
     /// [`MARGIN_MM`]: its corners and its edges' points on `axis` pass the
     /// exact check.
@@ -217,7 +182,7 @@ impl<'a> ReachCheck<'a> {
             _ => None,
         };
         drivers.iter().all(|d| {
-            proven.scale(slot(d)).is_some_and(|k| {
+            proven.scale(d.slot()).is_some_and(|k| {
                 let b = self.board_box(k);
                 b.contains(end) && circle.is_none_or(|(c, r)| b.contains_square(c, r))
             })

@@ -89,6 +89,6 @@ impl StepperMotion {
             .gimbal
             .fk(mid)
             .map_err(|_| StepperRefusal::Unreachable)?;
-        Ok(10.0 * curve.distance_cm(spot))
+        Ok(crate::domain::units::mm_from_cm(curve.distance_cm(spot)))
     }
 }

@@ -155,7 +155,7 @@ impl Joints32 {
         exact_mm: &dyn Fn(u32, u32) -> Option<f64>,
     ) -> Option<u32> {
         let mut pieces = fewest;
-        let tolerance_cm = (tolerance_mm as f32) / 10.0;
+        let tolerance_cm = crate::domain::units::cm_from_mm(tolerance_mm) as f32;
         let unsure_cm = UNSURE_SHARE * tolerance_cm;
         loop {
             let mut passes = true;

@@ -15,7 +15,10 @@ use super::history::Remembered;
 /// of its chord).
 fn short_of_end_on(from: BoardPoint, to: &Remembered, p: BoardPoint) -> bool {
     let d = |a: BoardPoint, b: BoardPoint| {
-        10.0 * kinematics_core::numeric::hypot(a.x_cm - b.x_cm, a.y_cm - b.y_cm)
+        crate::domain::units::mm_from_cm(kinematics_core::numeric::hypot(
+            a.x_cm - b.x_cm,
+            a.y_cm - b.y_cm,
+        ))
     };
     let tol_mm = if to.shape == MoveShape::Travel {
         2.0

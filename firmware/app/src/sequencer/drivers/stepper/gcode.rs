@@ -1,5 +1,6 @@
 //! The stepper driver's G-code stage: blocks handed over whole to its task.
 
+use crate::domain::units::mm_from_cm;
 use crate::grbl::{Block, Laser, PointMm};
 use crate::sequencer::drivers::stage::Stage;
 use crate::sequencer::drivers::stepper::{StepperJob, config};
@@ -179,8 +180,8 @@ impl StepperJob {
         self.inflight = None;
         if let Some(p) = at {
             motion.position = PointMm {
-                x_mm: p.x_cm * 10.0,
-                y_mm: p.y_cm * 10.0,
+                x_mm: mm_from_cm(p.x_cm),
+                y_mm: mm_from_cm(p.y_cm),
             };
         }
     }
@@ -217,7 +218,8 @@ pub(in crate::sequencer) fn junction(
     gcode: bool,
     out: &mut dyn ActionSink,
 ) {
-    let want = gcode.then(|| (settings.gcode_junction_mm / (settings.oq_cm * 10.0)).to_degrees());
+    let want =
+        gcode.then(|| (settings.gcode_junction_mm / mm_from_cm(settings.oq_cm)).to_degrees());
     if want != *current {
         *current = want;
         let deviation_deg = want.unwrap_or(settings.stepper.junction_deviation_deg);
