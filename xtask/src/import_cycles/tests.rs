@@ -228,6 +228,53 @@ fn the_gcode_session_and_the_drivers_stay_below_the_core() {
     assert!(offenders.is_empty(), "{offenders:#?}");
 }
 
+/// Whether `line` converts between cm and mm by hand: a factor of 10 (or
+/// 0.1) on a line that names a length in cm or mm.
+fn converts_cm_mm_by_hand(line: &str) -> bool {
+    let names_length = ["_cm", "_mm", "cm(", "mm("]
+        .iter()
+        .any(|u| line.contains(u));
+    let factor = ["* 10.0", "10.0 *", "/ 10.0", "* 0.1", "0.1 *"]
+        .iter()
+        .any(|f| {
+            line.match_indices(f).any(|(i, _)| {
+                // `110.0 *` or `* 10.05` are other numbers.
+                let before = line[..i].chars().next_back();
+                let after = line[i + f.len()..].chars().next();
+                !before.is_some_and(|c| c.is_ascii_digit() || c == '.')
+                    && !after.is_some_and(|c| c.is_ascii_digit())
+            })
+        });
+    names_length && factor
+}
+
+#[test]
+fn only_domain_units_converts_cm_and_mm() {
+    assert!(converts_cm_mm_by_hand("let d_mm = 10.0 * d_cm;"));
+    assert!(converts_cm_mm_by_hand("PointCm::new(p.x_mm / 10.0, 0.0)"));
+    assert!(!converts_cm_mm_by_hand(
+        "let deg = f64::from(tenths) / 10.0;"
+    ));
+    assert!(!converts_cm_mm_by_hand("let x_mm = 110.0 * k;"));
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/app/src");
+    let mut texts = BTreeMap::new();
+    collect(&dir, &dir, &mut texts).unwrap();
+    let units: Module = vec!["domain".into(), "units".into()];
+    let offenders: Vec<String> = texts
+        .iter()
+        .filter(|(m, _)| **m != units && !m.last().is_some_and(|l| l.ends_with("_tests")))
+        .flat_map(|(m, text)| {
+            text.lines()
+                .filter(|l| converts_cm_mm_by_hand(l))
+                .map(move |l| format!("{}: {}", m.join("/"), l.trim()))
+        })
+        .collect();
+    assert!(
+        offenders.is_empty(),
+        "cm <-> mm by hand (use domain::units): {offenders:#?}"
+    );
+}
+
 /// The source trees of the workspace's crates (the separate workspaces
 /// `firmware/qemu-m4` and `firmware/bench-m4` included), as
 /// `(crate, directory below the repository root)`.
