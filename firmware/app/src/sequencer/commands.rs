@@ -75,7 +75,7 @@ impl Core {
                 self.pending = Some(Pending::Save);
                 out.act(Action::Save);
             }
-            Command::Grbl(line) => self.session().grbl_line(line.as_str(), out),
+            Command::Grbl(line) => self.session().line(line.as_str(), out),
             Command::Servo(setup) => self.servo_setup(setup, out),
             Command::Preset(preset) => self.preset(preset, out),
         }

@@ -174,7 +174,7 @@ impl Core {
             Event::Stepper(event) => self.stepper_event(event, out),
             Event::DwellEnded => {
                 self.dwell_finished(out);
-                self.session().gcode_dwell_check(out);
+                self.session().dwell_check(out);
             }
             Event::Tick => self.heartbeat = self.heartbeat.wrapping_add(1),
             Event::CheckStep => self.check_step(CHECKS_PER_STEP, out),
@@ -182,7 +182,7 @@ impl Core {
             Event::PresetLoaded { n, point } => self.preset_loaded(n, point, out),
             Event::SettingsLoaded(loaded) => self.settings_loaded(loaded, out),
             Event::GateLost => self.gate_lost = true,
-            Event::Realtime(request) => self.session().grbl_realtime(request, out),
+            Event::Realtime(request) => self.session().realtime(request, out),
         }
         // A command in check has not changed anything yet.
         if !matches!(self.pending, Some(Pending::Check { .. })) {

@@ -114,7 +114,7 @@ impl Session<'_> {
             self.stop(why, out);
         }
         if let Some(alarm) = alarm {
-            self.grbl_alarm(alarm, out);
+            self.alarm(alarm, out);
         }
         result
     }
@@ -129,7 +129,7 @@ impl Session<'_> {
         if let Some(run) = self.run.take() {
             log::info!("stop {} ({})", run.kind.name(), why);
         }
-        self.gcode_abort(out);
+        self.abort(out);
     }
 
     /// Closes the master laser gate (laser dark from now on, also samples

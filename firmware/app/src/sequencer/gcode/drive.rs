@@ -54,7 +54,7 @@ impl Session<'_> {
         if self.jobs.gimbal.is_following() {
             self.stream_tick(out);
         } else if self.drivers().hands_over_blocks() {
-            self.gcode_stepper_send(out);
+            self.stepper_send(out);
         } else {
             return false;
         }
@@ -83,14 +83,14 @@ impl Session<'_> {
         out: &mut dyn ActionSink,
     ) -> bool {
         match *event {
-            GalvoEvent::Done { seq } => self.gcode_galvo_done(seq, out),
-            GalvoEvent::Refused { seq, error } if self.gcode_awaits_galvo(seq) => {
+            GalvoEvent::Done { seq } => self.galvo_done(seq, out),
+            GalvoEvent::Refused { seq, error } if self.awaits_galvo(seq) => {
                 self.notify(out, format_args!("MSG:galvo: {error}"));
-                self.grbl_alarm(crate::grbl::Alarm::SoftLimit, out);
+                self.alarm(crate::grbl::Alarm::SoftLimit, out);
                 true
             }
             GalvoEvent::Stopped(at) => {
-                self.gcode_galvo_stopped(at, out);
+                self.galvo_stopped(at, out);
                 true
             }
             _ => false,
@@ -107,17 +107,17 @@ impl Session<'_> {
         if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
             *self.stepper_homing = false;
         }
-        self.gcode_stepper_event(event, out)
+        self.stepper_report(event, out)
     }
 
     /// Sends the pieces that continue the galvo stroke in flight.
-    pub(in crate::sequencer) fn gcode_galvo_send_ahead(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn galvo_send_ahead(&mut self, out: &mut dyn ActionSink) {
         self.with_stage(out, |st, jobs, out| jobs.galvo.send_ahead(st, out));
     }
 
     /// The galvo loop finished job `seq`; `true` when it was the G-code
     /// step's.
-    pub(in crate::sequencer) fn gcode_galvo_done(
+    pub(in crate::sequencer) fn galvo_done(
         &mut self,
         seq: u32,
         out: &mut dyn ActionSink,
@@ -132,13 +132,13 @@ impl Session<'_> {
         if self.with_stage(out, |st, jobs, _| jobs.galvo.done(st, seq)) {
             self.gcode.take_owed(out);
         }
-        self.gcode_step_done(out);
+        self.step_done(out);
         self.with_stage(out, |st, jobs, out| jobs.galvo.drop_unadopted(st, out));
         true
     }
 
     /// Whether the G-code step waits for galvo job `seq`.
-    pub(in crate::sequencer) fn gcode_awaits_galvo(&self, seq: u32) -> bool {
+    pub(in crate::sequencer) fn awaits_galvo(&self, seq: u32) -> bool {
         self.gcode
             .motion
             .current
@@ -150,7 +150,7 @@ impl Session<'_> {
     /// hold waits for it, what was marked is done and the hold is held
     /// (or, resumed meanwhile, goes on from the stop point).
     #[inline(never)]
-    pub(in crate::sequencer) fn gcode_galvo_stopped(
+    pub(in crate::sequencer) fn galvo_stopped(
         &mut self,
         at: Option<MarkStop>,
         out: &mut dyn ActionSink,
@@ -167,7 +167,7 @@ impl Session<'_> {
         let resumed = motion.hold == Hold::None;
         motion.hold = Hold::Held;
         if resumed {
-            self.grbl_resume(out);
+            self.resume(out);
         }
     }
 
@@ -210,7 +210,7 @@ impl Session<'_> {
                 self.gcode.motion.current = Some(self.gcode.new_current(block, 1));
                 if !self.stream_begin(&block, out) {
                     self.gcode.motion.current = None;
-                    self.grbl_advance(out);
+                    self.advance(out);
                 }
             }
             None => {
@@ -220,7 +220,7 @@ impl Session<'_> {
                     // the parser had gone on to the dropped jogs' ends.
                     self.gcode.sync_position();
                 }
-                self.grbl_advance(out);
+                self.advance(out);
             }
         }
     }
@@ -241,7 +241,7 @@ impl Session<'_> {
             motion.current = None;
             self.jobs.gimbal.clear();
             self.gcode.sync_position();
-            self.grbl_advance(out);
+            self.advance(out);
             return;
         }
         motion.hold = Hold::Held;
@@ -265,7 +265,7 @@ impl Session<'_> {
 
     /// The servo task reports move `seq` arrived; `true` when it was the
     /// G-code step's.
-    fn gcode_servo_arrived(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
+    fn servo_arrived(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
         if self.stream_arrived(seq) {
             out.act(Action::Note(LaserEvent::GimbalArrived));
             return true;
@@ -286,30 +286,30 @@ impl Session<'_> {
         }
         self.gcode.motion.arrived = true;
         out.act(Action::Note(LaserEvent::GimbalArrived));
-        self.gcode_step_done(out);
+        self.step_done(out);
         true
     }
 
     /// The G-code side of a servo report: an arrival of the step in flight
     /// moves on; `true` for a fault of it (the caller stops, after its own
     /// fault handling).
-    pub(in crate::sequencer) fn gcode_servo_outcome(
+    pub(in crate::sequencer) fn servo_outcome(
         &mut self,
         outcome: &ServoOutcome,
         out: &mut dyn ActionSink,
     ) -> bool {
         match *outcome {
             ServoOutcome::Arrived { seq, .. } => {
-                self.gcode_servo_arrived(seq, out);
+                self.servo_arrived(seq, out);
                 false
             }
-            ServoOutcome::Fault { seq, .. } => self.gcode_awaits_servo(seq),
+            ServoOutcome::Fault { seq, .. } => self.awaits_servo(seq),
             _ => false,
         }
     }
 
     /// Whether the G-code step waits for servo move `seq`.
-    fn gcode_awaits_servo(&self, seq: u32) -> bool {
+    fn awaits_servo(&self, seq: u32) -> bool {
         self.gcode
             .motion
             .current

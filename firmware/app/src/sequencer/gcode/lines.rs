@@ -18,62 +18,62 @@ use crate::text::reply_text;
 impl Session<'_> {
     /// A G-code or `$` line from the console: closed with `ok` (for a
     /// motion, once it is queued) or `error:N`.
-    pub(in crate::sequencer) fn grbl_line(&mut self, line: &str, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn line(&mut self, line: &str, out: &mut dyn ActionSink) {
         match classify(line) {
-            LineKind::System => self.grbl_system(line, out),
-            _ => self.grbl_gcode(line, out),
+            LineKind::System => self.system_line(line, out),
+            _ => self.gcode_line(line, out),
         }
     }
 
     /// Closes the current reply with `error:N`.
-    pub(in crate::sequencer) fn grbl_error(&self, out: &mut dyn ActionSink, error: GrblError) {
+    pub(in crate::sequencer) fn error(&self, out: &mut dyn ActionSink, error: GrblError) {
         report::error(out, error);
     }
 
     /// `ALARM:N`, the machine locked; motion stopped, laser dark.
-    pub(in crate::sequencer) fn grbl_alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
         self.stop("grbl alarm", out);
         self.gcode.mode = GrblMode::Alarm;
         report::alarm(out, alarm);
     }
 
-    fn grbl_gcode(&mut self, line: &str, out: &mut dyn ActionSink) {
+    fn gcode_line(&mut self, line: &str, out: &mut dyn ActionSink) {
         if self.gcode.mode == GrblMode::Alarm || self.gcode.motion.jogging() {
-            return self.grbl_error(out, GrblError::GcodeLock);
+            return self.error(out, GrblError::GcodeLock);
         }
         let before = self.gcode.parser;
         let blocks = match self.gcode.parser.execute(line) {
             Ok(blocks) => blocks,
-            Err(e) => return self.grbl_error(out, e),
+            Err(e) => return self.error(out, e),
         };
         if !blocks.iter().all(|b| self.block_reachable(b)) {
             self.gcode.parser = before;
-            self.grbl_alarm(Alarm::SoftLimit, out);
+            self.alarm(Alarm::SoftLimit, out);
             report::ok(out);
             return;
         }
-        self.grbl_queue(blocks, out);
+        self.queue_blocks(blocks, out);
     }
 
     /// Queues `blocks` and answers `ok`, or keeps them until the queue has
     /// room (the `ok` then waits: back-pressure to the sender).
-    fn grbl_queue(&mut self, blocks: Blocks, out: &mut dyn ActionSink) {
+    fn queue_blocks(&mut self, blocks: Blocks, out: &mut dyn ActionSink) {
         if self.gcode.mode == GrblMode::Check || blocks.is_empty() {
             return report::ok(out);
         }
         self.gcode.motion.owed = Some(blocks);
         self.gcode.take_owed(out);
-        self.grbl_advance(out);
-        self.gcode_galvo_send_ahead(out);
+        self.advance(out);
+        self.galvo_send_ahead(out);
         if self.drivers().gimbal_streams() {
             self.with_stage(out, |st, jobs, _| jobs.gimbal.remember(st));
         }
     }
 
-    fn grbl_system(&mut self, line: &str, out: &mut dyn ActionSink) {
+    fn system_line(&mut self, line: &str, out: &mut dyn ActionSink) {
         let command = match parse_system(line) {
             Ok(command) => command,
-            Err(e) => return self.grbl_error(out, e),
+            Err(e) => return self.error(out, e),
         };
         let idle = self.gcode.motion.is_idle();
         match command {
@@ -90,15 +90,15 @@ impl Session<'_> {
                     self.notify(out, format_args!("MSG:Caution: Unlocked"));
                 }
             }
-            SystemCommand::Home => return self.grbl_home(idle, out),
+            SystemCommand::Home => return self.home(idle, out),
             SystemCommand::Sleep => {
                 self.stop("grbl sleep", out);
                 self.gcode.sync_position();
             }
-            SystemCommand::Jog(text) => return self.grbl_jog(text, out),
+            SystemCommand::Jog(text) => return self.jog(text, out),
             SystemCommand::Restore(scope) => {
                 if !idle {
-                    return self.grbl_error(out, GrblError::NotIdle);
+                    return self.error(out, GrblError::NotIdle);
                 }
                 if matches!(scope, RestoreScope::Settings | RestoreScope::All) {
                     self.gcode.values = GrblValues::default();
@@ -112,12 +112,12 @@ impl Session<'_> {
             }
             SystemCommand::SetSetting { number, value } => {
                 if !idle {
-                    return self.grbl_error(out, GrblError::NotIdle);
+                    return self.error(out, GrblError::NotIdle);
                 }
                 match self.gcode.set_setting(number, value, self.settings) {
                     Ok(Written::Session) => {}
                     Ok(Written::Product) => self.configure_galvo(out),
-                    Err(e) => return self.grbl_error(out, e),
+                    Err(e) => return self.error(out, e),
                 }
             }
         }
@@ -126,16 +126,16 @@ impl Session<'_> {
 
     /// `$H`: no switches to home on; aims at the board origin (dark) and
     /// unlocks an alarm.
-    fn grbl_home(&mut self, idle: bool, out: &mut dyn ActionSink) {
+    fn home(&mut self, idle: bool, out: &mut dyn ActionSink) {
         if !idle || self.gcode.mode == GrblMode::Check {
-            return self.grbl_error(out, GrblError::NotIdle);
+            return self.error(out, GrblError::NotIdle);
         }
         if self.drivers().any(Driver::homes_with_switches) {
             // The reply waits for the end of homing (grbl's `$H`): a
             // sender's next lines wait with it.
             return match self.start_homing(out) {
                 Ok(()) => self.gcode.homing = true,
-                Err(_) => self.grbl_error(out, GrblError::HomingDisabled),
+                Err(_) => self.error(out, GrblError::HomingDisabled),
             };
         }
         self.gcode.mode = GrblMode::Normal;
@@ -148,36 +148,36 @@ impl Session<'_> {
                 to: crate::grbl::PointMm::ZERO,
             });
         }
-        self.grbl_queue(blocks, out);
+        self.queue_blocks(blocks, out);
     }
 
     /// `$J=`: a jog, dark; refused beyond the reachable workspace
     /// (error:15, no alarm, as grbl with soft limits). As grbl 1.1, only
     /// when idle or jogging: otherwise (a job running, a hold, an alarm,
     /// check mode) error:8.
-    fn grbl_jog(&mut self, text: &str, out: &mut dyn ActionSink) {
+    fn jog(&mut self, text: &str, out: &mut dyn ActionSink) {
         let busy = !self.gcode.motion.is_idle() && !self.gcode.motion.jogging();
         if self.gcode.mode != GrblMode::Normal || busy {
-            return self.grbl_error(out, GrblError::NotIdle);
+            return self.error(out, GrblError::NotIdle);
         }
         let before = self.gcode.parser;
         let jog = match self.gcode.parser.jog(text) {
             Ok(jog) => jog,
-            Err(e) => return self.grbl_error(out, e),
+            Err(e) => return self.error(out, e),
         };
         let mut blocks = Blocks::new();
         if let Some(block) = jog {
             if !self.block_reachable(&block) {
                 self.gcode.parser = before;
-                return self.grbl_error(out, GrblError::TravelExceeded);
+                return self.error(out, GrblError::TravelExceeded);
             }
             let _ = blocks.push(block);
         }
-        self.grbl_queue(blocks, out);
+        self.queue_blocks(blocks, out);
     }
 
     /// A realtime command from the console.
-    pub(in crate::sequencer) fn grbl_realtime(
+    pub(in crate::sequencer) fn realtime(
         &mut self,
         request: RealtimeRequest,
         out: &mut dyn ActionSink,
@@ -190,13 +190,13 @@ impl Session<'_> {
                 self.gcode.count_report();
                 report::push(out, text);
             }
-            Realtime::FeedHold => self.grbl_hold(out),
-            Realtime::CycleStart => self.grbl_resume(out),
-            Realtime::SoftReset => self.grbl_reset(out),
-            Realtime::JogCancel => self.grbl_jog_cancel(out),
+            Realtime::FeedHold => self.hold(out),
+            Realtime::CycleStart => self.resume(out),
+            Realtime::SoftReset => self.soft_reset(out),
+            Realtime::JogCancel => self.jog_cancel(out),
             Realtime::FeedOverride(step) => {
                 ov.feed = step.apply(ov.feed, 10, 200);
-                self.gcode_stepper_override(out);
+                self.stepper_override(out);
             }
             Realtime::RapidOverride(percent) => ov.rapid = percent,
             Realtime::SpindleOverride(step) => ov.spindle = step.apply(ov.spindle, 10, 200),
@@ -208,7 +208,7 @@ impl Session<'_> {
     /// 0x18: everything stops at once, laser dark; the parser's modes
     /// reset (position, offsets and settings kept); ALARM:3 if it
     /// interrupted motion.
-    fn grbl_reset(&mut self, out: &mut dyn ActionSink) {
+    fn soft_reset(&mut self, out: &mut dyn ActionSink) {
         let moving = self.gcode.motion.current.is_some() && self.gcode.motion.hold != Hold::Held;
         // grbl's reset kills the motion at once where a driver can (the
         // position is then uncertain: ALARM:3); `stop` would brake.

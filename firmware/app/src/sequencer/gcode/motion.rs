@@ -13,7 +13,7 @@ use embassy_time::Duration;
 impl Session<'_> {
     /// Starts the next block when nothing runs (and no hold), skipping
     /// blocks with nothing to move.
-    pub(in crate::sequencer) fn grbl_advance(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn advance(&mut self, out: &mut dyn ActionSink) {
         while self.gcode.motion.current.is_none() && self.gcode.motion.hold == Hold::None {
             let Some(block) = self.gcode.motion.queue.pop_front() else {
                 return;
@@ -56,7 +56,7 @@ impl Session<'_> {
                     let g = &mut self.gcode;
                     let count = g.step_count(&block, path_step_cm, drivers);
                     g.motion.current = Some(g.new_current(block, count));
-                    self.gcode_send_step(out);
+                    self.send_step(out);
                 }
             }
         }
@@ -65,7 +65,7 @@ impl Session<'_> {
     /// `!`: laser dark at once; the gimbal stops after the step in
     /// flight, the galvo brakes along its stroke (held where it reports
     /// marking stopped).
-    pub(in crate::sequencer) fn grbl_hold(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn hold(&mut self, out: &mut dyn ActionSink) {
         let motion = &self.gcode.motion;
         if motion.hold != Hold::None
             || motion.is_idle()
@@ -101,7 +101,7 @@ impl Session<'_> {
     }
 
     /// `~`: resumes after a hold (or an M0 pause).
-    pub(in crate::sequencer) fn grbl_resume(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn resume(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         match motion.hold {
             Hold::None => {}
@@ -109,16 +109,16 @@ impl Session<'_> {
             Hold::Held => {
                 motion.hold = Hold::None;
                 if motion.current.is_some() {
-                    self.gcode_send_step(out);
+                    self.send_step(out);
                 } else {
-                    self.grbl_advance(out);
+                    self.advance(out);
                 }
             }
         }
     }
 
     /// 0x85: the jog stops after the step in flight; queued jogs dropped.
-    pub(in crate::sequencer) fn grbl_jog_cancel(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn jog_cancel(&mut self, out: &mut dyn ActionSink) {
         if !self.gcode.motion.jogging() {
             return;
         }
@@ -130,13 +130,13 @@ impl Session<'_> {
         c.cancelled = true;
         if c.galvo_seq.take().is_some() {
             crate::sequencer::drivers::stage::stop_galvo(self.inputs, out);
-            self.gcode_step_done(out);
+            self.step_done(out);
         }
     }
 
     /// A stop from anywhere (`stop`, the button, a fault, a reset, an
     /// alarm): the queue is dropped; a line waiting for room is answered.
-    pub(in crate::sequencer) fn gcode_abort(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn abort(&mut self, out: &mut dyn ActionSink) {
         self.jobs.gimbal.clear();
         self.jobs.stepper.clear();
         if self.gcode.motion.clear() {

@@ -1,6 +1,6 @@
 //! The G-code motion queue: blocks queued by [`crate::sequencer::gcode`] run one
 //! after the other, each split into steps the actuators execute. Every
-//! actuator is dispatched in one place ([`Session::gcode_send_step`](crate::sequencer::gcode::context::Session::gcode_send_step)):
+//! actuator is dispatched in one place ([`Session::send_step`](crate::sequencer::gcode::context::Session::send_step)):
 //!
 //! * gimbal: a servo move per path step (`path.step_cm`, arcs also within
 //!   `$12`) at the programmed feed (servo speed permitting), laser lit

@@ -1,5 +1,5 @@
 //! The G-code step in flight: the drivers that draw get it through the
-//! driver interface ([`Session::gcode_send_step`]: a driver's own stage, or
+//! driver interface ([`Session::send_step`]: a driver's own stage, or
 //! [`Session::driver_step`] for each), and report it done (servo arrival,
 //! galvo job done, dwell end; each driver's side in `drivers/`); then the
 //! next step, block or hold follows.
@@ -15,7 +15,7 @@ use embassy_time::Instant;
 
 impl Session<'_> {
     /// Sends the current step to every actuator that draws.
-    pub(in crate::sequencer) fn gcode_send_step(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn send_step(&mut self, out: &mut dyn ActionSink) {
         if self.drivers_send_in_own_stage(out) {
             return;
         }
@@ -70,12 +70,12 @@ impl Session<'_> {
             c.galvo_seq = galvo_seq;
         }
         if galvo_seq.is_some() {
-            self.gcode_galvo_send_ahead(out);
+            self.galvo_send_ahead(out);
         }
     }
 
     /// When the dwell deadline passed: the dwell block is done.
-    pub(in crate::sequencer) fn gcode_dwell_check(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn dwell_check(&mut self, out: &mut dyn ActionSink) {
         let now = self.inputs.now;
         let Some(c) = self.gcode.motion.current.as_mut() else {
             return;
@@ -92,13 +92,13 @@ impl Session<'_> {
                 };
             }
             self.gcode.motion.gimbal_lit = false;
-            self.gcode_step_done(out);
+            self.step_done(out);
         }
     }
 
     /// Every actuator finished the step in flight: the next step, the next
     /// block, or the hold.
-    pub(in crate::sequencer) fn gcode_step_done(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn step_done(&mut self, out: &mut dyn ActionSink) {
         let motion = &mut self.gcode.motion;
         let Some(mut c) = motion.current else { return };
         let stepper = c.stepper_seq.is_some();
@@ -120,9 +120,9 @@ impl Session<'_> {
             if c.cancelled {
                 self.gcode.sync_position();
             }
-            self.grbl_advance(out);
+            self.advance(out);
         } else {
-            self.gcode_send_step(out);
+            self.send_step(out);
         }
     }
 }

@@ -13,12 +13,12 @@ use crate::stepper::{HomingFailure, StepperEvent};
 
 impl Session<'_> {
     /// Hands the current block to the stepper (or waits for rest first).
-    pub(in crate::sequencer) fn gcode_stepper_send(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn stepper_send(&mut self, out: &mut dyn ActionSink) {
         self.with_stage(out, |st, jobs, out| jobs.stepper.send(st, out));
     }
 
     /// Tells the stepper task the feed override when it changed.
-    pub(in crate::sequencer) fn gcode_stepper_override(&mut self, out: &mut dyn ActionSink) {
+    pub(in crate::sequencer) fn stepper_override(&mut self, out: &mut dyn ActionSink) {
         let percent = self.gcode.overrides.feed;
         let stepping = self.drivers().hands_over_blocks();
         self.jobs.stepper.send_override(percent, stepping, out);
@@ -26,7 +26,7 @@ impl Session<'_> {
 
     /// The G-code side of a stepper report: `true` when it was the job's.
     #[inline(never)]
-    pub(in crate::sequencer) fn gcode_stepper_event(
+    pub(in crate::sequencer) fn stepper_report(
         &mut self,
         event: &StepperEvent,
         out: &mut dyn ActionSink,
@@ -35,7 +35,7 @@ impl Session<'_> {
             StepperReport::Other => false,
             StepperReport::Handled => true,
             StepperReport::BlockDone => {
-                self.gcode_stepper_done(out);
+                self.stepper_block_done(out);
                 true
             }
             StepperReport::Refused => {
@@ -44,7 +44,7 @@ impl Session<'_> {
                     // (its axes beyond their soft limits): as on the galvo.
                     self.notify(out, format_args!("MSG:stepper: move refused: {why:?}"));
                 }
-                self.grbl_alarm(Alarm::SoftLimit, out);
+                self.alarm(Alarm::SoftLimit, out);
                 true
             }
             StepperReport::AtRest => {
@@ -60,7 +60,7 @@ impl Session<'_> {
     /// grbl, `ALARM:N` (locked) and then `ok`; parameters that allow no
     /// homing: `error:5`.
     #[inline(never)]
-    pub(in crate::sequencer) fn gcode_homing_done(
+    pub(in crate::sequencer) fn homing_done(
         &mut self,
         steps: [i32; 2],
         failed: Option<HomingFailure>,
@@ -75,11 +75,11 @@ impl Session<'_> {
 
     /// The current block is done on the stepper's side.
     #[inline(never)]
-    fn gcode_stepper_done(&mut self, out: &mut dyn ActionSink) {
+    fn stepper_block_done(&mut self, out: &mut dyn ActionSink) {
         if let Some(c) = self.gcode.motion.current.as_mut() {
             c.stepper_seq = None;
         }
-        self.gcode_step_done(out);
+        self.step_done(out);
     }
 }
 

@@ -21,7 +21,7 @@ impl Core {
             Start::Pattern { pattern, once } => (pattern.name(), once),
         };
         log::info!("start {} (once={})", name, once);
-        self.session().gcode_abort(out);
+        self.session().abort(out);
         out.act(Action::Note(LaserEvent::RunStarted));
         // Nothing of an earlier run may shine: a new gate generation, and
         // the galvo drops its points and an underrun latch; the stepper
@@ -167,7 +167,7 @@ impl Core {
             Said::Notice(text) => notice(out, text),
             Said::Homed(text, steps, failed) => {
                 notice(out, text);
-                self.session().gcode_homing_done(steps, failed, out);
+                self.session().homing_done(steps, failed, out);
             }
         }
     }
@@ -207,7 +207,7 @@ impl Core {
         outcome: ServoOutcome,
         out: &mut dyn ActionSink,
     ) {
-        let gcode_fault = self.session().gcode_servo_outcome(&outcome, out);
+        let gcode_fault = self.session().servo_outcome(&outcome, out);
         match outcome {
             ServoOutcome::Recovered { id } => self.servo_recovered(id, out),
             ServoOutcome::Arrived {

@@ -96,7 +96,7 @@ impl Stream {
         c.index = u32::from(at_end);
         if final_move {
             // The last move of the burst waits for arrival and settles
-            // (`gcode_servo_arrived`); what follows starts from rest.
+            // (`servo_arrived`); what follows starts from rest.
             self.cursor = None;
             return false;
         }
