@@ -117,11 +117,7 @@ impl Session<'_> {
 
     /// The galvo loop finished job `seq`; `true` when it was the G-code
     /// step's.
-    pub(in crate::sequencer) fn galvo_done(
-        &mut self,
-        seq: u32,
-        out: &mut dyn ActionSink,
-    ) -> bool {
+    pub(in crate::sequencer) fn galvo_done(&mut self, seq: u32, out: &mut dyn ActionSink) -> bool {
         let Some(c) = self.gcode.motion.current.as_mut() else {
             return false;
         };
