@@ -42,6 +42,12 @@ pub fn test() -> Result<()> {
     clippy_host.extend(["--", "-D", "warnings"]);
     run("cargo", &clippy_host)?;
 
+    // The API docs, with every intra-doc link resolved (a link to a
+    // renamed or private item fails).
+    let mut doc = vec!["doc", "--no-deps"];
+    doc.extend(package_args(HOST_PACKAGES));
+    run_with_env("cargo", &doc, &[("RUSTDOCFLAGS", "-D warnings".as_ref())])?;
+
     let mut clippy_target = vec!["-p", "firmware"];
     clippy_target.extend(package_args(TARGET_LIBRARIES));
     run("cargo", &target_clippy_args(&clippy_target))?;

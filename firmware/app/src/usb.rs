@@ -1,5 +1,5 @@
 //! The USB CDC-ACM command-line task body: bytes from the host → lines →
-//! [`Command`](crate::command::Command)s on the command channel; replies and
+//! [`Command`]s on the command channel; replies and
 //! notices from the [outbound queue](crate::outbound) back to the host.
 //!
 //! Generic over `embedded_io_async` so the same code runs on the USB CDC-ACM

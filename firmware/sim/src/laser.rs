@@ -1,5 +1,5 @@
 //! The simulated laser output: the master
-//! [`LaserGate`](laser_app::laser_gate::LaserGate) with every change
+//! [`LaserGate`] with every change
 //! recorded with its time, and the gimbal's laser pin ANDed with it.
 //!
 //! The gate's hook is a plain `fn`, so the per-simulation state it writes

@@ -23,7 +23,7 @@
 //!   replies but must be whole lines.
 //! * **(e) on the G-code path** ([`ViolationKind::OffPath`]) and **(f)
 //!   motions end in time** ([`ViolationKind::LateMotion`]): see
-//!   [`conformance`] for the rules and their stated tolerances.
+//!   `conformance` for the rules and their stated tolerances.
 //! * **(h) patterns on their figure** ([`ViolationKind::OffFigure`]):
 //!   every lit sample of a `pattern`, `goto` or `grid` run lies within the
 //!   spot's tolerance of the figure modelled from the transcript

@@ -191,7 +191,7 @@ pub fn sse_of(model: &Quadratic, points: &[MeasuredPoint], axis: usize) -> Resul
 ///
 /// Needs at least 6 points that determine a quadratic: not all on one line
 /// (or repeated), not all on one conic, and spread over at least
-/// [`MIN_SPREAD_MM`] (not one spot measured many times).
+/// `MIN_SPREAD_MM` (not one spot measured many times).
 ///
 /// Every position and error must be within ±[`MAX_MEASURED_MM`] (10 m).
 /// The reported SSE, R² and RMSE are those of the returned raw

@@ -24,7 +24,7 @@ use crate::Bytes;
 const DEVICE: u8 = 1;
 
 /// What a whole-input scan of the spec finds in `data`: the frames for
-/// [`DEVICE`], the counts, and how many bytes at the end wait for more.
+/// `DEVICE`, the counts, and how many bytes at the end wait for more.
 pub fn model(data: &[u8]) -> (Vec<Frame>, Counters, usize) {
     let mut c = Counters::default();
     let mut frames = Vec::new();

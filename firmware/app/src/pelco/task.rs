@@ -196,7 +196,7 @@ impl<R: Read, W: Write + PelcoLine> PelcoTask<R, W> {
 
 /// Sends `command` through the command channel when no other command is in
 /// flight, its reply kept from the console's host; waits for the reply
-/// (`None` when none came within [`REPLY_TIMEOUT`]).
+/// (`None` when none came within `REPLY_TIMEOUT`).
 pub async fn send_quietly(link: &CommandLink, command: Command) -> Option<QuietReply> {
     while !link.outbound.begin_quiet_command() {
         Timer::after(POLL).await;

@@ -31,7 +31,7 @@ pub(super) const STROKE_SEGMENTS: usize = 4;
 pub type Segments = heapless::Vec<Segment, STROKE_SEGMENTS>;
 
 /// A stroke: drawn without a break from `start` through its segments, in
-/// the [`Unit`] it was built in.
+/// the [`Unit`](crate::domain::units::Unit) it was built in.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stroke {
     /// Start point `[x, y]`.

@@ -6,7 +6,7 @@ use crate::galvo::dac::DacSample;
 
 /// The galvo loop's memory: the loop (its prepared steps and jump
 /// integrator, about 22 KB) and the half buffer of `HALF` samples it
-/// computes into (at least the DAC's [`DacStream::half_len`]). A board
+/// computes into (at least the DAC's [`DacStream::half_len`](crate::galvo::dac::DacStream::half_len)). A board
 /// keeps it in a `static` and hands it to
 /// [`GalvoTask::run_in`](crate::app::GalvoTask::run_in), so it is counted
 /// once and the task's future holds only a reference.

@@ -31,7 +31,7 @@ fn next_stroke(job: &Job, stroke: usize) -> Option<usize> {
 }
 
 impl GalvoLoop {
-    /// Prepares the next steps of the queued work (up to [`PREP_DEPTH`]
+    /// Prepares the next steps of the queued work (up to `PREP_DEPTH`
     /// ahead): plans their jumps and loads their strokes. Runs between
     /// half buffers, never inside the refill. Returns how many steps it
     /// prepared.

@@ -62,7 +62,7 @@ pub enum GalvoError {
     /// An underrun latched the laser off; a `Stop` clears it.
     Faulted,
     /// The board cannot plan jumps by bisection (`planner seed`) in time
-    /// ([`DacStream::F64_PLANNING`]).
+    /// ([`DacStream::F64_PLANNING`](crate::galvo::dac::DacStream::F64_PLANNING)).
     SeedTooSlow,
 }
 
