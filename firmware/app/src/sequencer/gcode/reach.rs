@@ -172,13 +172,7 @@ impl<'a> ReachCheck<'a> {
             return false;
         };
         let circle = match *block {
-            Block::Arc { arc, .. } => {
-                let (sx, sy) = (
-                    arc.from.x_mm - arc.centre.x_mm,
-                    arc.from.y_mm - arc.centre.y_mm,
-                );
-                Some((arc.centre, libm::sqrt(sx * sx + sy * sy)))
-            }
+            Block::Arc { arc, .. } => Some((arc.centre, arc.radius_mm)),
             _ => None,
         };
         drivers.iter().all(|d| {
