@@ -8,48 +8,33 @@ use crate::grbl::Block;
 
 /// The figures of the (at most `N`) blocks last planned, with their keys.
 #[derive(Debug, Clone)]
-pub(in crate::sequencer) struct DegPerMm<const N: usize> {
-    entries: [(u64, f64); N],
-    len: usize,
-}
+pub(in crate::sequencer) struct DegPerMm<const N: usize>(heapless::Vec<(u64, f64), N>);
 
 impl<const N: usize> DegPerMm<N> {
     /// Nothing kept.
     pub(in crate::sequencer) const fn new() -> Self {
-        Self {
-            entries: [(0, 0.0); N],
-            len: 0,
-        }
+        Self(heapless::Vec::new())
     }
 
     /// Forgets every figure (the geometry changed).
     pub(in crate::sequencer) fn clear(&mut self) {
-        self.len = 0;
+        self.0.clear();
     }
 
     /// The figure kept for `block`, °/mm.
     pub(in crate::sequencer) fn get(&self, block: &Block) -> Option<f64> {
         let key = key(block)?;
-        self.entries
-            .get(..self.len)?
-            .iter()
-            .find(|(k, _)| *k == key)
-            .map(|&(_, v)| v)
+        self.0.iter().find(|(k, _)| *k == key).map(|&(_, v)| v)
     }
 
     /// Keeps `v` for `block` (`false`: full, or not a motion block).
     pub(in crate::sequencer) fn push(&mut self, block: &Block, v: f64) -> bool {
-        let (Some(key), Some(slot)) = (key(block), self.entries.get_mut(self.len)) else {
-            return false;
-        };
-        *slot = (key, v);
-        self.len += 1;
-        true
+        key(block).is_some_and(|key| self.0.push((key, v)).is_ok())
     }
 
     /// Whether `N` figures are kept.
     pub(in crate::sequencer) fn is_full(&self) -> bool {
-        self.len >= N
+        self.0.is_full()
     }
 }
 
