@@ -22,7 +22,6 @@ use crate::sequencer::laser::{LaserEvent, LaserPower};
 use crate::sequencer::run::Run;
 use crate::settings::Settings;
 use crate::stepper::StepperRequest;
-use crate::text::reply_text;
 
 /// The G-code session with what it works on during one event.
 pub(in crate::sequencer) struct Session<'a> {
@@ -157,14 +156,5 @@ impl Session<'_> {
     /// Sends the galvo loop the parameters of the settings.
     pub(in crate::sequencer) fn configure_galvo(&mut self, out: &mut dyn ActionSink) {
         galvo::points::configure(self.settings, *self.run, self.inputs, out);
-    }
-
-    /// Queues a notice line.
-    pub(in crate::sequencer) fn notify(
-        &self,
-        out: &mut dyn ActionSink,
-        args: core::fmt::Arguments<'_>,
-    ) {
-        out.act(Action::Line(Line::Notice(reply_text(args))));
     }
 }

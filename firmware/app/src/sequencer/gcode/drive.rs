@@ -11,10 +11,11 @@ use crate::grbl::Block;
 use crate::sequencer::drivers::{Driver, DriverStep, dispatch};
 use crate::sequencer::gcode::context::Session;
 use crate::sequencer::gcode::queue::{CORNER_SETTLE_MS, Hold, planned_length, point_at};
+use crate::sequencer::gcode::report;
 use crate::sequencer::io::{Action, ActionSink};
 use crate::sequencer::laser::LaserEvent;
 use crate::servo::task::ServoOutcome;
-use crate::stepper::{StepperEvent, StepperRequest};
+use crate::stepper::StepperRequest;
 use embassy_time::Duration;
 
 impl Session<'_> {
@@ -85,7 +86,7 @@ impl Session<'_> {
         match *event {
             GalvoEvent::Done { seq } => self.galvo_done(seq, out),
             GalvoEvent::Refused { seq, error } if self.awaits_galvo(seq) => {
-                self.notify(out, format_args!("MSG:galvo: {error}"));
+                report::notice(out, format_args!("MSG:galvo: {error}"));
                 self.alarm(crate::grbl::Alarm::SoftLimit, out);
                 true
             }
@@ -95,19 +96,6 @@ impl Session<'_> {
             }
             _ => false,
         }
-    }
-
-    /// A report of the stepper task, when it is the G-code session's:
-    /// `true` when it was. The end of homing is noted either way.
-    pub(in crate::sequencer) fn stepper_event(
-        &mut self,
-        event: &StepperEvent,
-        out: &mut dyn ActionSink,
-    ) -> bool {
-        if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
-            *self.stepper_homing = false;
-        }
-        self.stepper_report(event, out)
     }
 
     /// Sends the pieces that continue the galvo stroke in flight.

@@ -25,11 +25,6 @@ impl Session<'_> {
         }
     }
 
-    /// Closes the current reply with `error:N`.
-    pub(in crate::sequencer) fn error(&self, out: &mut dyn ActionSink, error: GrblError) {
-        report::error(out, error);
-    }
-
     /// `ALARM:N`, the machine locked; motion stopped, laser dark.
     pub(in crate::sequencer) fn alarm(&mut self, alarm: Alarm, out: &mut dyn ActionSink) {
         self.stop("grbl alarm", out);
@@ -39,12 +34,12 @@ impl Session<'_> {
 
     fn gcode_line(&mut self, line: &str, out: &mut dyn ActionSink) {
         if self.gcode.mode == GrblMode::Alarm || self.gcode.motion.jogging() {
-            return self.error(out, GrblError::GcodeLock);
+            return report::error(out, GrblError::GcodeLock);
         }
         let before = self.gcode.parser;
         let blocks = match self.gcode.parser.execute(line) {
             Ok(blocks) => blocks,
-            Err(e) => return self.error(out, e),
+            Err(e) => return report::error(out, e),
         };
         if !blocks.iter().all(|b| self.block_reachable(b)) {
             self.gcode.parser = before;
@@ -73,7 +68,7 @@ impl Session<'_> {
     fn system_line(&mut self, line: &str, out: &mut dyn ActionSink) {
         let command = match parse_system(line) {
             Ok(command) => command,
-            Err(e) => return self.error(out, e),
+            Err(e) => return report::error(out, e),
         };
         let idle = self.gcode.motion.is_idle();
         match command {
@@ -87,7 +82,7 @@ impl Session<'_> {
             SystemCommand::Unlock => {
                 if self.gcode.mode == GrblMode::Alarm {
                     self.gcode.mode = GrblMode::Normal;
-                    self.notify(out, format_args!("MSG:Caution: Unlocked"));
+                    report::notice(out, format_args!("MSG:Caution: Unlocked"));
                 }
             }
             SystemCommand::Home => return self.home(idle, out),
@@ -98,7 +93,7 @@ impl Session<'_> {
             SystemCommand::Jog(text) => return self.jog(text, out),
             SystemCommand::Restore(scope) => {
                 if !idle {
-                    return self.error(out, GrblError::NotIdle);
+                    return report::error(out, GrblError::NotIdle);
                 }
                 if matches!(scope, RestoreScope::Settings | RestoreScope::All) {
                     self.gcode.values = GrblValues::default();
@@ -108,16 +103,16 @@ impl Session<'_> {
                     self.gcode.parser.g54 = crate::grbl::PointMm::ZERO;
                     self.gcode.parser.g92 = crate::grbl::PointMm::ZERO;
                 }
-                self.notify(out, format_args!("MSG:Restoring defaults"));
+                report::notice(out, format_args!("MSG:Restoring defaults"));
             }
             SystemCommand::SetSetting { number, value } => {
                 if !idle {
-                    return self.error(out, GrblError::NotIdle);
+                    return report::error(out, GrblError::NotIdle);
                 }
                 match self.gcode.set_setting(number, value, self.settings) {
                     Ok(Written::Session) => {}
                     Ok(Written::Product) => self.configure_galvo(out),
-                    Err(e) => return self.error(out, e),
+                    Err(e) => return report::error(out, e),
                 }
             }
         }
@@ -128,14 +123,14 @@ impl Session<'_> {
     /// unlocks an alarm.
     fn home(&mut self, idle: bool, out: &mut dyn ActionSink) {
         if !idle || self.gcode.mode == GrblMode::Check {
-            return self.error(out, GrblError::NotIdle);
+            return report::error(out, GrblError::NotIdle);
         }
         if self.drivers().any(Driver::homes_with_switches) {
             // The reply waits for the end of homing (grbl's `$H`): a
             // sender's next lines wait with it.
             return match self.start_homing(out) {
                 Ok(()) => self.gcode.homing = true,
-                Err(_) => self.error(out, GrblError::HomingDisabled),
+                Err(_) => report::error(out, GrblError::HomingDisabled),
             };
         }
         self.gcode.mode = GrblMode::Normal;
@@ -158,18 +153,18 @@ impl Session<'_> {
     fn jog(&mut self, text: &str, out: &mut dyn ActionSink) {
         let busy = !self.gcode.motion.is_idle() && !self.gcode.motion.jogging();
         if self.gcode.mode != GrblMode::Normal || busy {
-            return self.error(out, GrblError::NotIdle);
+            return report::error(out, GrblError::NotIdle);
         }
         let before = self.gcode.parser;
         let jog = match self.gcode.parser.jog(text) {
             Ok(jog) => jog,
-            Err(e) => return self.error(out, e),
+            Err(e) => return report::error(out, e),
         };
         let mut blocks = Blocks::new();
         if let Some(block) = jog {
             if !self.block_reachable(&block) {
                 self.gcode.parser = before;
-                return self.error(out, GrblError::TravelExceeded);
+                return report::error(out, GrblError::TravelExceeded);
             }
             let _ = blocks.push(block);
         }
@@ -229,7 +224,7 @@ impl Session<'_> {
             reply_text(format_args!("{}", crate::grbl::report::BANNER)),
         );
         if self.gcode.mode == GrblMode::Alarm {
-            self.notify(out, format_args!("MSG:'$H'|'$X' to unlock"));
+            report::notice(out, format_args!("MSG:'$H'|'$X' to unlock"));
         }
     }
 }

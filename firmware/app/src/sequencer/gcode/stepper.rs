@@ -24,13 +24,17 @@ impl Session<'_> {
         self.jobs.stepper.send_override(percent, stepping, out);
     }
 
-    /// The G-code side of a stepper report: `true` when it was the job's.
+    /// A report of the stepper task, when it is the G-code session's:
+    /// `true` when it was the job's. The end of homing is noted either way.
     #[inline(never)]
-    pub(in crate::sequencer) fn stepper_report(
+    pub(in crate::sequencer) fn stepper_event(
         &mut self,
         event: &StepperEvent,
         out: &mut dyn ActionSink,
     ) -> bool {
+        if let StepperEvent::Homed { .. } | StepperEvent::HomingFailed { .. } = event {
+            *self.stepper_homing = false;
+        }
         match self.with_stage(out, |st, jobs, out| jobs.stepper.event(st, event, out)) {
             StepperReport::Other => false,
             StepperReport::Handled => true,
@@ -42,7 +46,7 @@ impl Session<'_> {
                 if let StepperEvent::Refused { why, .. } = event {
                     // The checks before it passed, the stepper refused it
                     // (its axes beyond their soft limits): as on the galvo.
-                    self.notify(out, format_args!("MSG:stepper: move refused: {why:?}"));
+                    report::notice(out, format_args!("MSG:stepper: move refused: {why:?}"));
                 }
                 self.alarm(Alarm::SoftLimit, out);
                 true
