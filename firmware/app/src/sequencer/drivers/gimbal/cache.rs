@@ -3,7 +3,7 @@
 //! instructions) when it is queued or first planned, not every period.
 
 use crate::sequencer::drivers::gimbal::deg_per_mm::DegPerMm;
-use crate::sequencer::drivers::gimbal::plan::joint_deg_per_mm_aimed;
+use crate::sequencer::drivers::gimbal::plan::joint_deg_per_mm;
 use crate::sequencer::drivers::gimbal::{PLAN_BLOCKS, Stream};
 use crate::sequencer::drivers::stage::Stage;
 use crate::sequencer::gcode::queue::planned_length;
@@ -28,10 +28,7 @@ impl Stream {
                 break;
             }
             lit = Some(block_lit);
-            let v = match self.deg_per_mm.get(block) {
-                Some(v) => v,
-                None => joint_deg_per_mm_aimed(st, block, length),
-            };
+            let v = joint_deg_per_mm(st, &self.deg_per_mm, block, length);
             if !kept.push(block, v) {
                 break;
             }

@@ -51,7 +51,12 @@ pub(in crate::sequencer) fn stream_limits(
 
 /// The larger joint's travel per mm along `block` (two pieces), °/mm:
 /// kept since the block was queued (`kept`), or worked out.
-fn joint_deg_per_mm(st: &Stage, kept: &DegPerMm<PLAN_BLOCKS>, block: &Block, length: f64) -> f64 {
+pub(super) fn joint_deg_per_mm(
+    st: &Stage,
+    kept: &DegPerMm<PLAN_BLOCKS>,
+    block: &Block,
+    length: f64,
+) -> f64 {
     match kept.get(block) {
         Some(v) => v,
         None => joint_deg_per_mm_aimed(st, block, length),
@@ -60,7 +65,7 @@ fn joint_deg_per_mm(st: &Stage, kept: &DegPerMm<PLAN_BLOCKS>, block: &Block, len
 
 /// [`joint_deg_per_mm`] through the aims of the block's ends and middle.
 #[inline(never)]
-pub(super) fn joint_deg_per_mm_aimed(st: &Stage, block: &Block, length: f64) -> f64 {
+fn joint_deg_per_mm_aimed(st: &Stage, block: &Block, length: f64) -> f64 {
     let aim = |k: u32| st.aimer.aim(cm(point_at(block, k, 2))).ok();
     let (mut yaw, mut pitch) = (0.0, 0.0);
     let mut prev = aim(0);
