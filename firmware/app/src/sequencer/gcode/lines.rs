@@ -98,6 +98,8 @@ impl Session<'_> {
                 if matches!(scope, RestoreScope::Settings | RestoreScope::All) {
                     self.gcode.values = GrblValues::default();
                     self.settings.gcode_junction_mm = Settings::default().gcode_junction_mm;
+                    // `$11` is also the galvo loop's marking junction.
+                    self.configure_galvo(out);
                 }
                 if matches!(scope, RestoreScope::Offsets | RestoreScope::All) {
                     self.gcode.parser.g54 = crate::grbl::PointMm::ZERO;

@@ -443,3 +443,23 @@ fn the_minimum_feed_holds_after_the_feed_override_on_the_gimbal() {
     let end = trace.last().expect("moved").1;
     assert!((end[0] - 0.05).abs() < 1e-9 && end[1] == 0.0, "{end:?}");
 }
+
+#[test]
+fn restoring_the_settings_tells_the_galvo_loop_the_default_junction_deviation() {
+    let mut core = Core::new(Instant::from_millis(0));
+    let junctions = |out: &[Action]| -> Vec<f64> {
+        out.iter()
+            .filter_map(|a| match a {
+                Action::ConfigureGalvo(c) => Some(c.junction_deviation_mm),
+                _ => None,
+            })
+            .collect()
+    };
+    assert_eq!(junctions(&line(&mut core, 1, "$11=2")), [2.0]);
+    // `$RST=$` puts `$11` back to its default: the galvo loop marks with it
+    // from now on, not with the 2 mm it was last told.
+    let out = line(&mut core, 2, "$RST=$");
+    assert_eq!(out.last(), Some(&Action::Line(Line::Ok)));
+    assert_eq!(junctions(&out), [0.01]);
+    assert_eq!(core.settings.gcode_junction_mm, 0.01);
+}
